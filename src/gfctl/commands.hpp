@@ -1,0 +1,33 @@
+#pragma once
+// gfctl subcommands (contracts: DESIGN §8). Each returns the process exit code:
+// 0 success, 2 bad arguments or input (one-line message on stderr naming file, line, field).
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace gesture_formation::gfctl {
+
+/// Parsed `--key value` options and bare flags (`--flag` → "1").
+struct Args {
+  std::string command;
+  std::map<std::string, std::string> options;
+
+  bool has(const std::string& k) const { return options.count(k) != 0; }
+  std::string get(const std::string& k, const std::string& def = "") const {
+    const auto it = options.find(k);
+    return it == options.end() ? def : it->second;
+  }
+};
+
+constexpr int kExitOk = 0;
+constexpr int kExitBadInput = 2;
+
+/// Prints "gfctl <cmd>: message" to stderr and returns kExitBadInput.
+int badInput(const Args& args, const std::string& message);
+/// Checks that every required option is present and no unknown option was given.
+bool checkOptions(const Args& args, const std::vector<std::string>& required, const std::vector<std::string>& optional);
+
+int cmdEstimate(const Args& args);
+
+}  // namespace gesture_formation::gfctl

@@ -1,0 +1,231 @@
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include <boost/math/distributions/chi_squared.hpp>
+#include <Eigen/Dense>
+
+#include "gesture_formation/estimation/human_kalman.hpp"
+
+using namespace gesture_formation::estimation;
+
+namespace {
+
+PositionMeasurement meas(const Eigen::Vector3d& z, double s = 0.3) {
+  PositionMeasurement m;
+  m.z_world = z;
+  m.sigma_world = Eigen::Matrix3d::Identity() * s * s;
+  m.source = DistanceSource::kStereo;
+  return m;
+}
+
+}  // namespace
+
+TEST(HumanKalmanTest, FirstMeasurementInitialises) {
+  HumanKalman kf;
+  PositionMeasurement m = meas(Eigen::Vector3d(1, 2, 3));
+  m.sigma_world(0, 1) = m.sigma_world(1, 0) = 0.01;
+  EXPECT_EQ(kf.step(5.0, m), UpdateOutcome::kInitialized);
+  EXPECT_TRUE(kf.initialized());
+  EXPECT_DOUBLE_EQ(kf.time(), 5.0);
+  EXPECT_EQ(kf.state().head<3>(), Eigen::Vector3d(1, 2, 3));
+  EXPECT_EQ(kf.state().tail<3>(), Eigen::Vector3d::Zero());
+  Matrix6d P0 = Matrix6d::Zero();
+  P0.topLeftCorner<3, 3>() = m.sigma_world;
+  P0.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity();  // σ_v0 = 1 m/s
+  EXPECT_LT((kf.covariance() - P0).norm(), 1e-15);
+}
+
+TEST(HumanKalmanTest, PredictInflatesCovarianceByFPFtPlusQ) {
+  HumanKalman kf;
+  kf.step(0.0, meas(Eigen::Vector3d(0, 0, 0)));
+  const Matrix6d P0 = kf.covariance();
+  Vector6d x0 = kf.state();
+  x0.tail<3>() = Eigen::Vector3d(1, -1, 0.5);
+  // Set a velocity through a fused measurement would be indirect; test F on the covariance
+  // and check the position propagation with predicted().
+  ASSERT_TRUE(kf.predict(0.5));
+  Matrix6d F = Matrix6d::Identity();
+  F.topRightCorner<3, 3>() = 0.5 * Eigen::Matrix3d::Identity();
+  Matrix6d Q = Matrix6d::Zero();
+  Q.diagonal() << 0.01, 0.01, 0.01, 0.01, 0.01, 0.01;
+  const Matrix6d expected = F * P0 * F.transpose() + Q;
+  EXPECT_LT((kf.covariance() - expected).norm(), 1e-14);
+  EXPECT_DOUBLE_EQ(kf.time(), 0.5);
+  EXPECT_FALSE(kf.predict(0.4)) << "time going backwards must be refused";
+  EXPECT_LT((kf.covariance() - expected).norm(), 1e-14) << "a refused prediction changes nothing";
+}
+
+TEST(HumanKalmanTest, UpdateMatchesTextbookFormulaOnDynamicMatrices) {
+  HumanKalman kf;
+  kf.step(0.0, meas(Eigen::Vector3d(0, 0, 0), 0.5));
+  kf.step(0.2, meas(Eigen::Vector3d(0.1, 0.05, 0.0), 0.5));
+  kf.predict(0.4);
+  const Eigen::MatrixXd P = kf.covariance();
+  const Eigen::VectorXd x = kf.state();
+  PositionMeasurement m = meas(Eigen::Vector3d(0.3, 0.1, -0.05), 0.4);
+  m.sigma_world(0, 2) = m.sigma_world(2, 0) = 0.02;
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(3, 6);
+  H.leftCols(3).setIdentity();
+  const Eigen::MatrixXd S = H * P * H.transpose() + Eigen::MatrixXd(m.sigma_world);
+  const Eigen::MatrixXd K = P * H.transpose() * S.inverse();
+  const Eigen::VectorXd x_exp = x + K * (Eigen::VectorXd(m.z_world) - H * x);
+  const Eigen::MatrixXd P_exp = (Eigen::MatrixXd::Identity(6, 6) - K * H) * P;
+  EXPECT_EQ(kf.update(m), UpdateOutcome::kFused);
+  EXPECT_LT((Eigen::VectorXd(kf.state()) - x_exp).norm(), 1e-12);
+  EXPECT_LT((Eigen::MatrixXd(kf.covariance()) - P_exp).norm(), 1e-12);
+}
+
+TEST(HumanKalmanTest, GatingRejectsOutlierAndKeepsState) {
+  HumanKalman kf;
+  kf.step(0.0, meas(Eigen::Vector3d(0, 0, 0), 0.1));
+  kf.step(0.1, meas(Eigen::Vector3d(0.01, 0, 0), 0.1));
+  const Vector6d x = kf.state();
+  EXPECT_EQ(kf.step(0.2, meas(Eigen::Vector3d(20, 0, 0), 0.1)), UpdateOutcome::kGated);
+  EXPECT_GT(kf.lastMahalanobis2(), 16.27);
+  EXPECT_EQ(kf.state().head<3>(), (x.head<3>() + 0.1 * x.tail<3>()).eval()) << "only the prediction applied";
+  EXPECT_EQ(kf.counters().gated, 1u);
+}
+
+TEST(HumanKalmanTest, ReinitialisesAfterMaxConsecutiveRejections) {
+  HumanKalmanConfig cfg;
+  cfg.max_consecutive_rejections = 3;
+  HumanKalman kf(cfg);
+  kf.step(0.0, meas(Eigen::Vector3d(0, 0, 0), 0.05));
+  double t = 0.0;
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(kf.step(t += 0.1, meas(Eigen::Vector3d(30, 0, 0), 0.05)), UpdateOutcome::kGated);
+  EXPECT_EQ(kf.step(t += 0.1, meas(Eigen::Vector3d(30, 0, 0), 0.05)), UpdateOutcome::kReinitialized);
+  EXPECT_EQ(kf.state().head<3>(), Eigen::Vector3d(30, 0, 0));
+  EXPECT_EQ(kf.state().tail<3>(), Eigen::Vector3d::Zero());
+  EXPECT_EQ(kf.consecutiveRejections(), 0);
+  EXPECT_EQ(kf.counters().reinitializations, 1u);
+  // A fused measurement in between resets the count.
+  for (int i = 0; i < 2; ++i) kf.step(t += 0.1, meas(Eigen::Vector3d(-30, 0, 0), 0.05));
+  EXPECT_EQ(kf.step(t += 0.1, meas(Eigen::Vector3d(30, 0, 0), 0.05)), UpdateOutcome::kFused);
+  EXPECT_EQ(kf.step(t += 0.1, meas(Eigen::Vector3d(-30, 0, 0), 0.05)), UpdateOutcome::kGated);
+  EXPECT_EQ(kf.consecutiveRejections(), 1);
+}
+
+TEST(HumanKalmanTest, OutOfOrderAndInvalidMeasurementsChangeNothing) {
+  HumanKalman kf;
+  kf.step(1.0, meas(Eigen::Vector3d(1, 1, 1)));
+  kf.step(2.0, meas(Eigen::Vector3d(1.1, 1, 1)));
+  const Vector6d x = kf.state();
+  const Matrix6d P = kf.covariance();
+  EXPECT_EQ(kf.step(1.5, meas(Eigen::Vector3d(1, 1, 1))), UpdateOutcome::kOutOfOrder);
+  EXPECT_EQ(kf.step(std::nan(""), meas(Eigen::Vector3d(1, 1, 1))), UpdateOutcome::kInvalid);
+  EXPECT_EQ(kf.step(2.5, meas(Eigen::Vector3d(std::nan(""), 1, 1))), UpdateOutcome::kInvalid);
+  PositionMeasurement inf_cov = meas(Eigen::Vector3d(1, 1, 1));
+  inf_cov.sigma_world(1, 1) = INFINITY;
+  EXPECT_EQ(kf.step(2.5, inf_cov), UpdateOutcome::kInvalid);
+  PositionMeasurement neg_cov = meas(Eigen::Vector3d(1, 1, 1));
+  neg_cov.sigma_world = -100.0 * Eigen::Matrix3d::Identity();
+  EXPECT_EQ(kf.update(neg_cov), UpdateOutcome::kInvalid) << "S not positive definite";
+  EXPECT_EQ(kf.state(), x);
+  EXPECT_EQ(kf.covariance(), P);
+  EXPECT_DOUBLE_EQ(kf.time(), 2.0);
+  EXPECT_EQ(kf.counters().out_of_order, 1u);
+  EXPECT_EQ(kf.counters().invalid, 4u);
+}
+
+TEST(HumanKalmanTest, LostAfterTimeout) {
+  HumanKalmanConfig cfg;
+  cfg.lost_timeout_s = 2.0;
+  HumanKalman kf(cfg);
+  EXPECT_FALSE(kf.lost(100.0)) << "never initialised is not 'lost'";
+  kf.step(10.0, meas(Eigen::Vector3d(0, 0, 0)));
+  kf.predict(11.0);
+  EXPECT_FALSE(kf.lost(11.9));
+  EXPECT_TRUE(kf.lost(12.1));
+  kf.step(12.2, meas(Eigen::Vector3d(0, 0, 0)));
+  EXPECT_FALSE(kf.lost(12.3));
+}
+
+TEST(HumanKalmanTest, PredictedTrajectoryFollowsConstantVelocity) {
+  HumanKalman kf;
+  double t = 0.0;
+  for (int i = 0; i <= 50; ++i, t += 0.1) kf.step(t, meas(Eigen::Vector3d(1.0 * t, 0.5 * t, 0.0), 0.01));
+  const double t0 = kf.time();
+  const auto traj = kf.predictTrajectory(t0, 0.2, 40);
+  ASSERT_EQ(traj.size(), 40u);
+  for (std::size_t k = 0; k < traj.size(); ++k) {
+    EXPECT_NEAR(traj[k].t_s, t0 + 0.2 * static_cast<double>(k), 1e-12);
+    const Eigen::Vector3d expected = kf.state().head<3>() + (traj[k].t_s - t0) * kf.state().tail<3>();
+    EXPECT_NEAR((traj[k].p_world - expected).norm(), 0.0, 1e-12);
+    if (k > 0) {
+      EXPECT_GT(traj[k].cov_p.trace(), traj[k - 1].cov_p.trace());
+    }
+  }
+  EXPECT_NEAR(kf.state()(3), 1.0, 0.05);
+  EXPECT_NEAR(kf.state()(4), 0.5, 0.05);
+  const auto s = kf.predicted(t0 + 1.0);
+  EXPECT_NEAR((s.p_world - (kf.state().head<3>() + kf.state().tail<3>())).norm(), 0.0, 1e-12);
+  EXPECT_DOUBLE_EQ(kf.time(), t0) << "predicted() must not change the filter";
+  EXPECT_TRUE(HumanKalman().predictTrajectory(0, 0.2, 40).empty());
+}
+
+// Consistency on tracks that follow the filter's own model (paper: x⁺ = F x + ε, ε ~ N(0, Q)
+// per step; z = p + ζ with Σ rotated into the world by a camera that circles the worker).
+// NEES e = (x − x̂)ᵀ P⁻¹ (x − x̂) ~ χ²₆ for a consistent filter. Checks:
+//  1. (the criterion) per run, the final-step NEES inside the two-sided 95 % χ²₆ band
+//     in ≥ 90 of 100 runs;
+//  2. no bias: the grand mean of NEES over all runs and steps within ±5 % of 6. The per-step
+//     100-run averages are strongly correlated from step to step, so counting how many steps
+//     fall inside the χ²₆₀₀/100 band is not a binomial count (an earlier version of this test
+//     did that and mis-fired at 71/80 on a filter whose mean NEES was 6.03); the grand mean has
+//     a standard error of ≈ 0.12 here, while a filter missing Q, or with Σ rotated wrongly,
+//     is off by a factor of several.
+TEST(HumanKalmanTest, NeesConsistentOverSeededRuns) {
+  constexpr int kRuns = 100;
+  constexpr int kSteps = 80;
+  constexpr double kDt = 0.2;
+  const HumanKalmanConfig cfg;
+  const MeasurementNoise noise;
+  const boost::math::chi_squared chi6(6);
+  const double lo6 = boost::math::quantile(chi6, 0.025), hi6 = boost::math::quantile(chi6, 0.975);
+  std::vector<double> nees_sum(kSteps, 0.0);
+  int final_inside = 0;
+  for (int run = 0; run < kRuns; ++run) {
+    std::mt19937_64 rng(1000 + run);
+    std::normal_distribution<double> n01(0.0, 1.0);
+    auto randn3 = [&]() { return Eigen::Vector3d(n01(rng), n01(rng), n01(rng)); };
+    HumanKalman kf(cfg);
+    Vector6d x;
+    x.head<3>() = Eigen::Vector3d(5, 3, 0) + 2.0 * randn3();
+    x.tail<3>() = cfg.initial_velocity_std_mps * randn3();
+    double nees = 0.0;
+    for (int k = 0; k < kSteps; ++k) {
+      const double t = k * kDt;
+      if (k > 0) {
+        x.head<3>() += kDt * x.tail<3>();
+        x.head<3>() += cfg.sigma_p_m * randn3();
+        x.tail<3>() += cfg.sigma_v_mps * randn3();
+      }
+      // The camera circles the worker; the distance source changes along the run.
+      const double az = 0.05 * k + run;
+      const Eigen::Vector3d cam = x.head<3>() + Eigen::Vector3d(10 * std::cos(az), 10 * std::sin(az), 3.0);
+      const Eigen::Vector3d zc = (x.head<3>() - cam).normalized();
+      const Eigen::Vector3d xc = zc.cross(Eigen::Vector3d::UnitZ()).normalized();
+      Eigen::Matrix3d R;
+      R << xc, zc.cross(xc), zc;
+      const DistanceSource src = k % 30 < 10 ? DistanceSource::kUwb : k % 30 < 20 ? DistanceSource::kStereo
+                                                                                 : DistanceSource::kApparent;
+      const Eigen::Vector3d sd(noise.sigma_xy_m, noise.sigma_xy_m, noise.sigmaAlongRay(src));
+      PositionMeasurement m;
+      m.sigma_world = R * sd.cwiseAbs2().asDiagonal() * R.transpose();
+      m.z_world = x.head<3>() + R * sd.cwiseProduct(randn3());
+      m.source = src;
+      kf.step(t, m);
+      const Vector6d e = x - kf.state();
+      nees = e.dot(kf.covariance().ldlt().solve(e));
+      nees_sum[static_cast<std::size_t>(k)] += nees;
+    }
+    if (nees >= lo6 && nees <= hi6) ++final_inside;
+  }
+  double grand_mean = 0.0;
+  for (double s : nees_sum) grand_mean += s / (kRuns * kSteps);
+  EXPECT_GE(final_inside, 90) << "final-step NEES inside [" << lo6 << ", " << hi6 << "]";
+  EXPECT_NEAR(grand_mean, 6.0, 0.3);
+  std::cout << "NEES: final-step inside [" << lo6 << ", " << hi6 << "] in " << final_inside << "/" << kRuns
+            << " runs; grand mean " << grand_mean << " (expected 6)\n";
+}

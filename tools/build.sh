@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# Configures and builds gesture_formation into build/ (plain CMake + Ninja; catkin's CMake
+# macros work without a workspace). Extra arguments are passed to ninja (e.g. a target).
+#   tools/build.sh            # everything: core, gfctl, nodelets, tests, benchmarks
+#   tools/build.sh gfctl      # just the CLI
+set -eo pipefail
+cd "$(dirname "$0")/.."
+# Debian's python3 first: a pyenv shim breaks catkin (docs/toolchain.md, trap 1).
+export PATH=/usr/bin:/bin:$PATH
+BUILD_DIR=${GF_BUILD_DIR:-build}
+launcher=()
+command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+mkdir -p "$BUILD_DIR"
+if [ ! -f "$BUILD_DIR/build.ninja" ]; then
+  cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo "${launcher[@]}" \
+    -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 \
+    -DCATKIN_DEVEL_PREFIX="$PWD/$BUILD_DIR/devel" -DGF_WERROR=ON > "$BUILD_DIR/configure.log" 2>&1 \
+    || { cat "$BUILD_DIR/configure.log"; exit 1; }
+fi
+ninja -C "$BUILD_DIR" -j"${GF_JOBS:-$(nproc)}" "$@"
