@@ -22,6 +22,11 @@ constexpr int kMaxWarnings = 20;
 
 }  // namespace
 
+namespace {
+int cmdEstimate(const Args& args);
+const Registrar kRegistrar{"estimate", "--config FILE --in meas.csv --out states.csv   replay the worker estimator (DESIGN 8.1)",
+                           cmdEstimate};
+
 int cmdEstimate(const Args& args) {
   if (!checkOptions(args, {"config", "in", "out"}, {})) return kExitBadInput;
   std::vector<std::string> warnings;
@@ -121,5 +126,6 @@ int cmdEstimate(const Args& args) {
   }
   return kExitOk;
 }
+}  // namespace
 
 }  // namespace gesture_formation::gfctl

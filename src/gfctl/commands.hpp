@@ -28,6 +28,16 @@ int badInput(const Args& args, const std::string& message);
 /// Checks that every required option is present and no unknown option was given.
 bool checkOptions(const Args& args, const std::vector<std::string>& required, const std::vector<std::string>& optional);
 
-int cmdEstimate(const Args& args);
+/// Self-registration: in a cmd_*.cpp, `static const Registrar kReg{"name", "usage", runFn};`
+using CommandFn = int (*)(const Args&);
+struct CommandInfo {
+  const char* name;
+  const char* usage;
+  CommandFn run;
+};
+std::vector<CommandInfo>& commandRegistry();
+struct Registrar {
+  Registrar(const char* name, const char* usage, CommandFn run) { commandRegistry().push_back({name, usage, run}); }
+};
 
 }  // namespace gesture_formation::gfctl

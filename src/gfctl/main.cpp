@@ -1,13 +1,18 @@
 // gfctl: the offline command-line tool of gesture_formation (no ROS master needed).
 #include <cstdio>
 #include <cstring>
-#include <functional>
+#include <algorithm>
 #include <iostream>
 #include <string>
 
 #include "commands.hpp"
 
 namespace gesture_formation::gfctl {
+
+std::vector<CommandInfo>& commandRegistry() {
+  static std::vector<CommandInfo> registry;
+  return registry;
+}
 
 int badInput(const Args& args, const std::string& message) {
   std::cerr << "gfctl " << args.command << ": " << message << std::endl;
@@ -36,20 +41,12 @@ bool checkOptions(const Args& args, const std::vector<std::string>& required, co
 
 namespace {
 
-struct Command {
-  const char* name;
-  const char* usage;
-  std::function<int(const Args&)> run;
-};
-
-const Command kCommands[] = {
-    {"estimate", "--config FILE --in meas.csv --out states.csv   replay the worker estimator (DESIGN 8.1)",
-     cmdEstimate},
-};
-
 void usage(std::FILE* out) {
   std::fprintf(out, "usage: gfctl <command> [options]\n\ncommands:\n");
-  for (const auto& c : kCommands) std::fprintf(out, "  %-16s %s\n", c.name, c.usage);
+  auto commands = commandRegistry();
+  std::sort(commands.begin(), commands.end(),
+            [](const CommandInfo& a, const CommandInfo& b) { return std::strcmp(a.name, b.name) < 0; });
+  for (const auto& c : commands) std::fprintf(out, "  %-16s %s\n", c.name, c.usage);
   std::fprintf(out, "\nExit codes: 0 success, 2 bad arguments or input.\n");
 }
 
@@ -81,7 +78,7 @@ int main(int argc, char** argv) {
       args.options[a] = "1";
     }
   }
-  for (const auto& c : kCommands) {
+  for (const auto& c : commandRegistry()) {
     if (args.command == c.name) {
       try {
         return c.run(args);
