@@ -39,7 +39,7 @@ PACKAGES=(
   ros-std-msgs ros-geometry-msgs ros-sensor-msgs ros-nav-msgs ros-visualization-msgs ros-std-srvs ros-trajectory-msgs
   librostest-dev python3-rostest python3-roslaunch python3-rostopic python3-rosbag
   python3-rosnode python3-rosservice python3-rosmsg rosbash
-  python3-std-srvs python3-geometry-msgs python3-sensor-msgs python3-nav-msgs python3-visualization-msgs python3-tf2-msgs
+  python3-tf2-ros python3-std-srvs python3-geometry-msgs python3-sensor-msgs python3-nav-msgs python3-visualization-msgs python3-tf2-msgs
   libeigen3-dev libopencv-dev libopencv-contrib-dev libompl-dev liboctomap-dev libfcl-dev libceres-dev
   liblcm-dev liblcm-bin libyaml-cpp-dev libssl-dev
   libcereal-dev libsimde-dev

@@ -1,0 +1,51 @@
+#pragma once
+// Loads ROS parameters and collects every problem, so that a nodelet can refuse to start with
+// one message listing all of them (house style: never ros::shutdown() from a nodelet).
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <ros/node_handle.h>
+
+namespace gesture_formation::nodelets {
+
+class ParamLoader {
+ public:
+  explicit ParamLoader(const ros::NodeHandle& nh) : nh_(nh) {}
+
+  void load(const std::string& name, std::string& value) {
+    if (!nh_.getParam(name, value)) missing(name);
+    loaded_ << "  " << name << " = " << value << "\n";
+  }
+  void load(const std::string& name, double& value, double lo = -std::numeric_limits<double>::infinity(),
+            double hi = std::numeric_limits<double>::infinity()) {
+    if (!nh_.getParam(name, value)) {
+      missing(name);
+      return;
+    }
+    if (!(value >= lo && value <= hi)) {
+      std::ostringstream os;
+      os << nh_.resolveName(name) << ": value " << value << " out of range [" << lo << ", " << hi << "]";
+      errors_.push_back(os.str());
+    }
+    loaded_ << "  " << name << " = " << value << "\n";
+  }
+  void addErrors(const std::vector<std::string>& errors) { errors_.insert(errors_.end(), errors.begin(), errors.end()); }
+
+  bool ok() const { return errors_.empty(); }
+  std::string report() const {
+    std::string s;
+    for (const auto& e : errors_) s += "  - " + e + "\n";
+    return s;
+  }
+  std::string loaded() const { return loaded_.str(); }
+
+ private:
+  void missing(const std::string& name) { errors_.push_back(nh_.resolveName(name) + ": missing (required)"); }
+  ros::NodeHandle nh_;
+  std::vector<std::string> errors_;
+  std::ostringstream loaded_;
+};
+
+}  // namespace gesture_formation::nodelets

@@ -1,0 +1,135 @@
+// WorkerEstimator nodelet: WorkerDetection (+ UWB range, + tf of the camera optical frame)
+// → WorkerState. A thin adapter over estimation::HumanKalman (docs/estimation.md).
+//
+// Topics: detection_in (gesture_formation/WorkerDetection), uwb_in (sensor_msgs/Range),
+//         worker_state_out (gesture_formation/WorkerState).
+// Parameters (all required, listed at once when missing): ~config_file (estimator YAML, every
+// key required), ~world_frame, ~uwb_max_age_s, ~tf_timeout_s, ~publish_rate_hz.
+#include <mutex>
+
+#include <nodelet/nodelet.h>
+#include <pluginlib/class_list_macros.hpp>
+#include <ros/ros.h>
+#include <sensor_msgs/Range.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+
+#include "conversions.hpp"
+#include "gesture_formation/estimation/estimator_config.hpp"
+#include "param_loader.hpp"
+
+namespace gesture_formation::nodelets {
+
+class WorkerEstimatorNodelet : public nodelet::Nodelet {
+ private:
+  void onInit() override {
+    ros::NodeHandle& nh = getNodeHandle();
+    ros::NodeHandle& pnh = getPrivateNodeHandle();
+    ParamLoader params(pnh);
+    std::string config_file;
+    params.load("config_file", config_file);
+    params.load("world_frame", world_frame_);
+    params.load("uwb_max_age_s", uwb_max_age_s_, 0.0, 10.0);
+    params.load("tf_timeout_s", tf_timeout_s_, 0.0, 1.0);
+    double rate_hz = 0.0;
+    params.load("publish_rate_hz", rate_hz, 0.1, 200.0);
+    if (!config_file.empty()) {
+      const auto cfg = estimation::loadEstimatorConfig(config_file, common::ConfigReader::MissingKeys::kError);
+      if (cfg) {
+        config_ = *cfg;
+      } else {
+        params.addErrors({cfg.reason()});
+      }
+    }
+    if (!params.ok()) {
+      NODELET_ERROR_STREAM("WorkerEstimator refuses to start; fix these parameters:\n" << params.report());
+      return;  // stays uninitialised: no subscriptions, no output
+    }
+    NODELET_INFO_STREAM("WorkerEstimator loaded:\n" << params.loaded());
+    camera_ = estimation::CameraModel(config_.camera);
+    filter_ = estimation::HumanKalman(config_.filter);
+    tf_listener_ = std::make_unique<tf2_ros::TransformListener>(tf_buffer_);
+    state_pub_ = nh.advertise<gesture_formation::WorkerState>("worker_state_out", 10);
+    detection_sub_ = nh.subscribe("detection_in", 10, &WorkerEstimatorNodelet::onDetection, this);
+    uwb_sub_ = nh.subscribe("uwb_in", 10, &WorkerEstimatorNodelet::onUwb, this);
+    timer_ = nh.createTimer(ros::Duration(1.0 / rate_hz), &WorkerEstimatorNodelet::onTimer, this);
+  }
+
+  void onUwb(const sensor_msgs::Range::ConstPtr& msg) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const bool valid = std::isfinite(msg->range) && msg->range >= msg->min_range && msg->range <= msg->max_range;
+    last_uwb_m_ = valid ? msg->range : std::nan("");
+    last_uwb_stamp_ = msg->header.stamp;
+  }
+
+  void onDetection(const gesture_formation::WorkerDetection::ConstPtr& msg) {
+    if (!msg->detected) return;
+    geometry_msgs::TransformStamped T_world_camera;
+    try {
+      T_world_camera = tf_buffer_.lookupTransform(world_frame_, msg->header.frame_id, msg->header.stamp,
+                                                  ros::Duration(tf_timeout_s_));
+    } catch (const tf2::TransformException& e) {
+      NODELET_WARN_STREAM_THROTTLE(1.0, "WorkerEstimator: no camera pose for the detection: " << e.what());
+      return;
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    const double t = msg->header.stamp.toSec();
+    const double uwb_age_s = std::abs((msg->header.stamp - last_uwb_stamp_).toSec());
+    const double d_uwb = uwb_age_s <= uwb_max_age_s_ ? last_uwb_m_ : std::nan("");
+    const auto m = estimation::makeMeasurement(camera_, toCameraPose(T_world_camera), toBox(*msg), d_uwb,
+                                               msg->stereo_distance_m, config_.human_height_m, config_.noise);
+    if (!m) {
+      NODELET_WARN_STREAM_THROTTLE(1.0, "WorkerEstimator: detection rejected: " << m.reason());
+      return;
+    }
+    const auto outcome = filter_.step(t, *m);
+    if (!filter_.initialized()) return;
+    auto out = toWorkerState(filter_.state(), filter_.covariance());
+    out.header.stamp = ros::Time(filter_.time());
+    out.header.frame_id = world_frame_;
+    out.source = estimation::toString(m->source);
+    out.accepted = estimation::accepted(outcome);
+    out.lost = filter_.lost(t);
+    out.predicted = false;
+    state_pub_.publish(out);
+  }
+
+  void onTimer(const ros::TimerEvent& event) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!filter_.initialized()) return;
+    const double t = event.current_real.toSec();
+    const auto s = filter_.predicted(t);
+    estimation::Vector6d x;
+    x << s.p_world, s.v_world;
+    estimation::Matrix6d P = filter_.covariance();
+    P.topLeftCorner<3, 3>() = s.cov_p;
+    auto out = toWorkerState(x, P);
+    out.header.stamp = event.current_real;
+    out.header.frame_id = world_frame_;
+    out.source = "none";
+    out.accepted = false;
+    out.lost = filter_.lost(t);
+    out.predicted = true;
+    state_pub_.publish(out);
+  }
+
+  std::mutex mutex_;
+  estimation::EstimatorConfig config_;
+  estimation::CameraModel camera_;
+  estimation::HumanKalman filter_;
+  std::string world_frame_;
+  double uwb_max_age_s_ = 0.0;
+  double tf_timeout_s_ = 0.0;
+  double last_uwb_m_ = std::nan("");
+  ros::Time last_uwb_stamp_;
+  tf2_ros::Buffer tf_buffer_;
+  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+  ros::Publisher state_pub_;
+  ros::Subscriber detection_sub_;
+  ros::Subscriber uwb_sub_;
+  ros::Timer timer_;
+};
+
+}  // namespace gesture_formation::nodelets
+
+PLUGINLIB_EXPORT_CLASS(gesture_formation::nodelets::WorkerEstimatorNodelet, nodelet::Nodelet)
