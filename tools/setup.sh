@@ -15,9 +15,10 @@ PROXSUITE_VERSION="0.7.2"
 die() { echo "setup: $*" >&2; exit 1; }
 
 # --- the OS --------------------------------------------------------------------------
-[ -r /etc/os-release ] || die "cannot read /etc/os-release; this project supports Debian 12 (bookworm) only"
-# shellcheck disable=SC1091
-. /etc/os-release
+OS_RELEASE=${GF_OS_RELEASE:-/etc/os-release}   # override only for testing this check
+[ -r "$OS_RELEASE" ] || die "cannot read $OS_RELEASE; this project supports Debian 12 (bookworm) only"
+# shellcheck disable=SC1090
+. "$OS_RELEASE"
 if [ "${ID:-}" != "debian" ] || [ "${VERSION_ID:-}" != "12" ]; then
   die "unsupported OS '${PRETTY_NAME:-unknown}': this project supports Debian 12 (bookworm) only (ROS 1 comes from Debian's packages)"
 fi
