@@ -1,0 +1,177 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include <Eigen/Geometry>
+
+#include "gesture_formation/gesture/skeleton_synth.hpp"
+
+using namespace gesture_formation::gesture;
+using Eigen::Vector3d;
+
+namespace {
+
+double angleDeg(const Vector3d& a, const Vector3d& b) {
+  return std::atan2(a.cross(b).norm(), a.dot(b)) * 180.0 / 3.14159265358979323846;
+}
+
+/// Elbow angle: 180° = straight arm.
+double elbowDeg(const Body3D& b, bool left) {
+  const int s = left ? kLeftShoulder : kRightShoulder, e = left ? kLeftElbow : kRightElbow,
+            w = left ? kLeftWrist : kRightWrist;
+  return angleDeg(b.p[s] - b.p[e], b.p[w] - b.p[e]);
+}
+
+/// Angle between the arm (shoulder → wrist) and straight down.
+double armFromDownDeg(const Body3D& b, bool left) {
+  const int s = left ? kLeftShoulder : kRightShoulder, w = left ? kLeftWrist : kRightWrist;
+  return angleDeg(b.p[w] - b.p[s], Vector3d(0, 0, -1));
+}
+
+double height(const Body3D& b) { return b.head_top.z(); }
+
+}  // namespace
+
+// DESIGN §2 pose definitions, checked in the body frame over 200 random bodies each.
+TEST(SkeletonSynthTest, GesturePosesMatchTheirDefinitions) {
+  for (int seed = 0; seed < 200; ++seed) {
+    SkeletonSynthesizer synth(SynthConfig{}, static_cast<std::uint64_t>(seed));
+    const bool left = seed % 2 == 0;
+    {  // 1: forearms crossed over the midline, wrists at or above the shoulders, elbows lower
+      const Body3D b = synth.pose(Motion::kCrossArms, 1.0, 0.0, left);
+      EXPECT_LT(b.p[kLeftWrist].y(), 0.0) << seed;
+      EXPECT_GT(b.p[kRightWrist].y(), 0.0) << seed;
+      EXPECT_GE(b.p[kLeftWrist].z(), b.p[kLeftShoulder].z() - 0.01) << seed;
+      EXPECT_LT(b.p[kLeftElbow].z(), b.p[kLeftWrist].z()) << seed;
+      EXPECT_GT(b.p[kLeftWrist].x(), 0.1) << "in front of the body, seed " << seed;
+    }
+    {  // 2: one arm straight, abducted 70–110°, the other down
+      const Body3D b = synth.pose(Motion::kExtendArmSide, 1.0, 0.0, left);
+      EXPECT_GT(elbowDeg(b, left), 170.0) << seed;
+      EXPECT_GE(armFromDownDeg(b, left), 69.0) << seed;
+      EXPECT_LE(armFromDownDeg(b, left), 111.0) << seed;
+      EXPECT_LT(armFromDownDeg(b, !left), 20.0) << seed;
+    }
+    {  // 3: wrists within a hand's width in front of the mid-chest, forearms near horizontal
+      const Body3D b = synth.pose(Motion::kPalmsTogether, 1.0, 0.0, left);
+      const double H = height(b);
+      EXPECT_LT((b.p[kLeftWrist] - b.p[kRightWrist]).norm(), 0.1) << seed;
+      EXPECT_GT(b.p[kLeftWrist].z(), 0.66 * H) << seed;
+      EXPECT_LT(b.p[kLeftWrist].z(), 0.78 * H) << seed;
+      const Vector3d fore = b.p[kLeftWrist] - b.p[kLeftElbow];
+      EXPECT_LT(std::abs(std::asin(fore.z() / fore.norm())) * 180 / 3.14159265, 35.0) << seed;
+    }
+    {  // 4: one arm straight up (> 150° from down), the other down
+      const Body3D b = synth.pose(Motion::kRaiseArmUp, 1.0, 0.0, left);
+      EXPECT_GT(elbowDeg(b, left), 170.0) << seed;
+      EXPECT_GT(armFromDownDeg(b, left), 150.0) << seed;
+      EXPECT_LT(armFromDownDeg(b, !left), 20.0) << seed;
+    }
+  }
+}
+
+// The near-misses differ from the gestures exactly where DESIGN §2 draws the line.
+TEST(SkeletonSynthTest, NearMissesStayOutsideTheGestureDefinitions) {
+  for (int seed = 0; seed < 200; ++seed) {
+    SkeletonSynthesizer synth(SynthConfig{}, static_cast<std::uint64_t>(seed));
+    const bool left = seed % 2 == 0;
+    {  // reaching up to a bolt: bent arm in front, not straight up
+      const Body3D b = synth.pose(Motion::kReachUpBolt, 1.0, 0.0, left);
+      EXPECT_LT(elbowDeg(b, left), 165.0) << seed;
+      EXPECT_GT((left ? b.p[kLeftWrist] : b.p[kRightWrist]).x(), 0.15) << seed;
+    }
+    {  // arms folded low: wrists below the chest
+      const Body3D b = synth.pose(Motion::kArmsFoldedLow, 1.0, 0.0, left);
+      EXPECT_LT(b.p[kLeftWrist].z(), 0.66 * height(b)) << seed;
+      EXPECT_LT(b.p[kRightWrist].z(), 0.66 * height(b)) << seed;
+    }
+    {  // tool at the waist: wrists below the elbows
+      const Body3D b = synth.pose(Motion::kToolAtWaist, 1.0, 0.0, left);
+      EXPECT_LT(b.p[kLeftWrist].z(), b.p[kLeftElbow].z()) << seed;
+      EXPECT_LT(b.p[kRightWrist].z(), b.p[kRightElbow].z()) << seed;
+    }
+    {  // part-way or pointing: abducted < 60° to the side, or pointing forward
+      const Body3D b = synth.pose(Motion::kArmPartwayOrPointing, 1.0, 0.0, left);
+      const Vector3d arm = (left ? b.p[kLeftWrist] - b.p[kLeftShoulder] : b.p[kRightWrist] - b.p[kRightShoulder]);
+      const bool partway = armFromDownDeg(b, left) < 60.0;
+      const bool forward = arm.x() > std::abs(arm.y());
+      EXPECT_TRUE(partway || forward) << seed;
+    }
+  }
+}
+
+TEST(SkeletonSynthTest, DeterministicForASeed) {
+  SkeletonSynthesizer a(SynthConfig{}, 42), b(SynthConfig{}, 42), c(SynthConfig{}, 43);
+  for (int i = 0; i < 5; ++i) {
+    const auto sa = a.next(), sb = b.next(), sc = c.next();
+    ASSERT_EQ(sa.frames.size(), sb.frames.size());
+    for (std::size_t f = 0; f < sa.frames.size(); ++f) {
+      EXPECT_EQ(sa.frames[f].skeleton.x, sb.frames[f].skeleton.x);
+      EXPECT_EQ(sa.frames[f].label, sb.frames[f].label);
+    }
+    if (i == 0) {
+      EXPECT_NE(sa.frames[0].skeleton.u, sc.frames[0].skeleton.u);
+    }
+  }
+}
+
+TEST(SkeletonSynthTest, LabelsBoxesAndKeypointsAreConsistent) {
+  SkeletonSynthesizer synth(SynthConfig{}, 7);
+  int gesture_frames = 0, none_seq_label_frames = 0;
+  for (int i = 0; i < 300; ++i) {
+    const auto seq = synth.next();
+    const int id = gestureIdOf(seq.motion);
+    int labelled = 0;
+    for (const auto& f : seq.frames) {
+      const auto& s = f.skeleton;
+      EXPECT_TRUE(f.label == 0 || f.label == id);
+      labelled += f.label != 0;
+      ASSERT_GT(s.w, 0.0);
+      ASSERT_GT(s.h, 0.0);
+      int inside = 0, present = 0;
+      for (int k = 0; k < kNumKeypoints; ++k) {
+        const auto j = static_cast<std::size_t>(k);
+        if (s.c[j] <= 0.0) continue;
+        ++present;
+        // Keypoint noise is up to 2.5 % of the box height, ×2.5 for hidden face keypoints:
+        // 4σ ≈ 0.25 h around the box.
+        const double m = 0.25 * s.h;
+        inside += s.x[j] >= s.u - m && s.x[j] <= s.u + s.w + m && s.y[j] >= s.v - m && s.y[j] <= s.v + s.h + m;
+        EXPECT_LE(s.c[j], 1.0);
+      }
+      EXPECT_EQ(inside, present) << "keypoints near their box";
+    }
+    if (id != 0) {
+      EXPECT_GT(labelled, 5) << "a gesture is held for frames";
+      gesture_frames += labelled;
+    } else {
+      none_seq_label_frames += labelled;
+    }
+    EXPECT_GE(seq.distance_m, 5.0);
+    EXPECT_LE(seq.distance_m, 20.0);
+  }
+  EXPECT_GT(gesture_frames, 1000);
+  EXPECT_EQ(none_seq_label_frames, 0);
+}
+
+TEST(SkeletonSynthTest, ProjectedHeightShrinksWithDistance) {
+  SkeletonSynthesizer synth(SynthConfig{}, 3);
+  const auto near = synth.generateFrom(Motion::kIdle, 5.0, 10.0, 0.0);
+  const auto far = synth.generateFrom(Motion::kIdle, 15.0, 10.0, 0.0);
+  const double h_near = near.frames[0].skeleton.h, h_far = far.frames[0].skeleton.h;
+  // A 1.55–1.95 m worker 5 m away through a 615 px lens: roughly 190–250 px; 15 m: a third.
+  EXPECT_GT(h_near, 150.0);
+  EXPECT_LT(h_near, 300.0);
+  EXPECT_NEAR(h_far / h_near, near.height_m / far.height_m / 3.0, 0.12);
+}
+
+TEST(SkeletonSynthTest, ValidateNamesBadRanges) {
+  SynthConfig c;
+  c.distance_min_m = 30;
+  c.distance_max_m = 10;
+  c.fps = 0;
+  const auto e = c.validate();
+  ASSERT_EQ(e.size(), 2u);
+  EXPECT_NE(e[0].find("fps"), std::string::npos);
+  EXPECT_NE(e[1].find("distance_m"), std::string::npos);
+}
