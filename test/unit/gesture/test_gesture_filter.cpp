@@ -1,0 +1,250 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "gesture_formation/gesture/gesture_filter.hpp"
+
+using namespace gesture_formation::gesture;
+using gesture_formation::common::ConfigReader;
+
+namespace {
+
+GestureFilterConfig config(int k, int min_meas, double max_age, double ratio, double cooldown) {
+  GestureFilterConfig c;
+  c.window_size = k;
+  c.min_measurements = min_meas;
+  c.max_age_s = max_age;
+  c.ratio_threshold = ratio;
+  c.cooldown_s = cooldown;
+  return c;
+}
+
+/// Feeds (t, id) pairs; returns the times at which the filter fired.
+std::vector<double> feed(GestureFilter& f, const std::vector<std::pair<double, int>>& rows) {
+  std::vector<double> fired;
+  for (const auto& [t, id] : rows) {
+    if (f.update(t, id).fired) fired.push_back(t);
+  }
+  return fired;
+}
+
+}  // namespace
+
+TEST(GestureFilterTest, DefaultsAreThePapers) {
+  const GestureFilterConfig c;
+  EXPECT_EQ(c.window_size, 20);
+  EXPECT_EQ(c.min_measurements, 20);
+  EXPECT_EQ(c.max_age_s, 20.0);
+  EXPECT_EQ(c.ratio_threshold, 0.8);
+  EXPECT_EQ(c.cooldown_s, 5.0);
+  EXPECT_TRUE(c.validate().empty());
+}
+
+TEST(GestureFilterTest, FiresOnceTheWindowIsFullAndDominant) {
+  GestureFilter f(GestureFilterConfig{});
+  for (int i = 0; i < 19; ++i) {
+    const auto o = f.update(0.1 * i, 2);
+    EXPECT_TRUE(o.accepted);
+    EXPECT_FALSE(o.evaluated);
+  }
+  const auto o = f.update(1.9, 2);
+  EXPECT_TRUE(o.evaluated);
+  EXPECT_TRUE(o.fired);
+  EXPECT_EQ(o.verdict, FilterVerdict::kFired);
+  EXPECT_EQ(o.dominant_id, 2);
+  EXPECT_EQ(o.dominant_ratio, 1.0);
+  EXPECT_EQ(f.lastFiredTime(), 1.9);
+}
+
+TEST(GestureFilterTest, RatioMustStrictlyExceedThreshold) {
+  // 16 of 20 = 0.8 exactly: no; 17 of 20 = 0.85: yes.
+  GestureFilter h(GestureFilterConfig{});
+  std::vector<std::pair<double, int>> rows;
+  for (int i = 0; i < 4; ++i) rows.push_back({i, 3});
+  for (int i = 4; i < 20; ++i) rows.push_back({i, 1});
+  EXPECT_TRUE(feed(h, rows).empty());  // 16/20 = 0.8 is not > 0.8
+  EXPECT_EQ(h.update(19.5, 3).verdict, FilterVerdict::kBelowThreshold);  // a 3 replaces the oldest 3: still 16/20
+  const auto o = h.update(20.0, 1);    // oldest 3 leaves the window (K): 17/20
+  EXPECT_EQ(o.dominant_ratio, 0.85);
+  EXPECT_TRUE(o.fired);
+}
+
+TEST(GestureFilterTest, TieForMostFrequentFiresNothing) {
+  GestureFilter f(config(4, 4, 20.0, 0.4, 0.0));
+  f.update(0.0, 1);
+  f.update(0.1, 2);
+  f.update(0.2, 1);
+  const auto o = f.update(0.3, 2);  // 2 × 1, 2 × 2: ratio 0.5 > 0.4 but a tie
+  EXPECT_TRUE(o.evaluated);
+  EXPECT_FALSE(o.fired);
+  EXPECT_EQ(o.dominant_id, -1);
+  EXPECT_EQ(o.dominant_ratio, 0.5);
+  EXPECT_EQ(o.verdict, FilterVerdict::kTie);
+  EXPECT_TRUE(f.update(0.4, 2).fired);  // window 1,2,1,2 → 2,1,2,2: 3/4 of gesture 2
+}
+
+TEST(GestureFilterTest, NoneDominanceFiresNothing) {
+  GestureFilter f(config(5, 5, 20.0, 0.5, 0.0));
+  std::vector<std::pair<double, int>> rows;
+  for (int i = 0; i < 30; ++i) rows.push_back({0.1 * i, i % 5 == 0 ? 3 : 0});
+  EXPECT_TRUE(feed(f, rows).empty());
+  const auto o = f.update(3.0, 0);
+  EXPECT_EQ(o.dominant_id, 0);
+  EXPECT_EQ(o.verdict, FilterVerdict::kNoneDominant);
+}
+
+TEST(GestureFilterTest, EntryExactlyMaxAgeOldIsKept) {
+  // t_c = 2: at t = 3 the entry at t = 1 (exactly t_c old) stays, the one at 0.5 goes.
+  GestureFilter f(config(10, 3, 2.0, 0.5, 0.0));
+  f.update(0.5, 1);
+  f.update(1.0, 1);
+  const auto o = f.update(3.0, 1);
+  EXPECT_EQ(o.window_count, 2u);
+  EXPECT_FALSE(o.evaluated);
+  EXPECT_EQ(f.update(3.0, 1).window_count, 3u);
+  EXPECT_EQ(f.update(3.0000001, 1).window_count, 3u);  // the entry at 1.0 is now older than t − t_c
+}
+
+TEST(GestureFilterTest, CooldownBoundaryAndFirstCommandFree) {
+  GestureFilter f(config(2, 2, 100.0, 0.5, 5.0));
+  f.update(0.0, 4);
+  EXPECT_TRUE(f.update(1.0, 4).fired);   // first command: no cooldown
+  EXPECT_FALSE(f.update(5.5, 4).fired);  // 4.5 s < 5
+  const auto o = f.update(5.75, 4);
+  EXPECT_FALSE(o.fired);
+  EXPECT_EQ(o.verdict, FilterVerdict::kCooldown);
+  EXPECT_TRUE(o.reason.empty());
+  EXPECT_TRUE(f.update(6.0, 4).fired);   // exactly 5 s: fires
+  EXPECT_EQ(f.lastFiredTime(), 6.0);
+}
+
+TEST(GestureFilterTest, WindowLargerThanDataNeverEvaluates) {
+  GestureFilter f(GestureFilterConfig{});  // K = min = 20
+  std::vector<std::pair<double, int>> rows;
+  for (int i = 0; i < 19; ++i) rows.push_back({0.1 * i, 1});
+  EXPECT_TRUE(feed(f, rows).empty());
+  EXPECT_EQ(f.size(), 19u);
+}
+
+TEST(GestureFilterTest, MinMeasurementsBelowWindowSize) {
+  GestureFilter f(config(20, 5, 20.0, 0.8, 5.0));
+  std::vector<std::pair<double, int>> rows;
+  for (int i = 0; i < 5; ++i) rows.push_back({0.1 * i, 3});
+  const auto fired = feed(f, rows);
+  ASSERT_EQ(fired.size(), 1u);
+  EXPECT_DOUBLE_EQ(fired[0], 0.4);
+}
+
+TEST(GestureFilterTest, SparseInputIsLimitedByAge) {
+  // One measurement every 3 s with t_c = 5: the window never holds more than 2.
+  GestureFilter f(config(20, 3, 5.0, 0.5, 0.0));
+  for (int i = 0; i < 50; ++i) {
+    const auto o = f.update(3.0 * i, 1);
+    EXPECT_LE(o.window_count, 2u);
+    EXPECT_FALSE(o.fired);
+  }
+}
+
+TEST(GestureFilterTest, BurstsWithEqualTimesAreAccepted) {
+  GestureFilter f(config(6, 6, 1.0, 0.8, 5.0));
+  std::vector<std::pair<double, int>> rows;
+  for (int i = 0; i < 6; ++i) rows.push_back({10.0, 2});
+  const auto fired = feed(f, rows);
+  ASSERT_EQ(fired.size(), 1u);
+  EXPECT_EQ(f.size(), 6u);
+}
+
+TEST(GestureFilterTest, KeepsOnlyTheKNewest) {
+  GestureFilter f(config(10, 10, 1000.0, 0.8, 0.0));
+  for (int i = 0; i < 100; ++i) f.update(i, 1);
+  for (int i = 100; i < 108; ++i) {
+    const auto o = f.update(i, 2);
+    EXPECT_EQ(o.window_count, 10u);
+  }
+  const auto o = f.update(108, 2);  // 9 × 2 + 1 × 1
+  EXPECT_EQ(o.dominant_id, 2);
+  EXPECT_DOUBLE_EQ(o.dominant_ratio, 0.9);
+  EXPECT_TRUE(o.fired);
+}
+
+TEST(GestureFilterTest, RejectsBadMeasurementsWithoutChangingState) {
+  GestureFilter f(config(5, 5, 20.0, 0.5, 0.0));
+  f.update(1.0, 1);
+  f.update(2.0, 1);
+  const struct {
+    double t, id;
+    const char* why;
+  } bad[] = {{1.5, 1, "out of order"},
+             {std::nan(""), 1, "non-finite time"},
+             {INFINITY, 1, "non-finite time"},
+             {3.0, 5, "unknown gesture id"},
+             {3.0, -1, "unknown gesture id"},
+             {3.0, 1.5, "unknown gesture id"},
+             {3.0, std::nan(""), "unknown gesture id"}};
+  for (const auto& b : bad) {
+    const auto o = f.update(b.t, b.id);
+    EXPECT_FALSE(o.accepted);
+    EXPECT_NE(o.reason.find(b.why), std::string::npos) << o.reason;
+    EXPECT_EQ(f.size(), 2u);
+    EXPECT_EQ(f.lastTime(), 2.0);
+  }
+  EXPECT_TRUE(f.update(2.0, 1).accepted);
+}
+
+TEST(GestureFilterTest, NoisyStreamNeverFiresForNonGestureIdsAndRespectsCooldown) {
+  std::mt19937 rng(99);
+  std::uniform_int_distribution<int> id(0, 4);
+  GestureFilter f(GestureFilterConfig{});
+  double t = 0.0, last = -1e9;
+  int fired = 0;
+  for (int i = 0; i < 20000; ++i) {
+    t += (i % 7 == 0) ? 0.0 : 0.05;
+    const int g = (i / 200) % 2 == 0 ? 2 : id(rng);  // long runs of gesture 2 between uniform noise
+    const auto o = f.update(t, g);
+    if (o.fired) {
+      ++fired;
+      EXPECT_NE(o.dominant_id, 0);
+      EXPECT_GT(o.dominant_ratio, 0.8);
+      EXPECT_GE(t - last, 5.0);
+      last = t;
+    }
+  }
+  EXPECT_GT(fired, 10);
+}
+
+TEST(GestureFilterTest, ResetForgetsEverything) {
+  GestureFilter f(config(2, 2, 10.0, 0.5, 100.0));
+  f.update(0.0, 1);
+  EXPECT_TRUE(f.update(0.1, 1).fired);
+  f.reset();
+  EXPECT_EQ(f.size(), 0u);
+  f.update(0.0, 1);  // earlier time accepted after reset
+  EXPECT_TRUE(f.update(0.1, 1).fired);  // no cooldown after reset
+}
+
+TEST(GestureFilterTest, ConfigValidationNamesFields) {
+  auto c = config(10, 11, 0.0, 1.5, -1.0);
+  const auto e = c.validate();
+  ASSERT_EQ(e.size(), 4u);
+  EXPECT_NE(e[0].find("min_measurements"), std::string::npos);
+  EXPECT_NE(e[1].find("max_age_s"), std::string::npos);
+  EXPECT_NE(e[2].find("ratio_threshold"), std::string::npos);
+  EXPECT_NE(e[3].find("cooldown_s"), std::string::npos);
+  EXPECT_FALSE(GestureFilter::create(c));
+}
+
+TEST(GestureFilterTest, ReadConfigMinMeasurementsDefaultsToWindowSize) {
+  ConfigReader r = ConfigReader::fromString("window_size: 12\nratio_threshold: 0.6\n", "t.yaml",
+                                            ConfigReader::MissingKeys::kUseDefaults);
+  const auto c = readGestureFilterConfig(r);
+  EXPECT_TRUE(r.ok()) << r.errorReport();
+  EXPECT_EQ(c.window_size, 12);
+  EXPECT_EQ(c.min_measurements, 12);
+  EXPECT_EQ(c.ratio_threshold, 0.6);
+  ConfigReader bad = ConfigReader::fromString("window_size: 5\nmin_measurements: 6\nmax_age_s: -1\n", "b.yaml",
+                                              ConfigReader::MissingKeys::kUseDefaults);
+  readGestureFilterConfig(bad);
+  EXPECT_NE(bad.errorReport().find("min_measurements"), std::string::npos);
+  EXPECT_NE(bad.errorReport().find("max_age_s"), std::string::npos);
+}

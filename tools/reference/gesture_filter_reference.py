@@ -1,0 +1,163 @@
+#!/usr/bin/env python3
+"""Independent reference implementation of `gfctl gesture-filter` (DESIGN §2, §8.3 and the
+boundary semantics fixed in docs/formation.md §6-7), written from the text, not from the C++.
+
+    gesture_filter_reference.py --config gestures.yaml --in gestures.csv --out commands.csv
+
+Per row (t, gesture_id): skip the row (a warning in gfctl) when t is not finite, t is
+earlier than the last accepted row, or the id is not an integer in 0..max_gesture_id.
+Otherwise append; drop entries with t_i < t - max_age_s; keep the window_size newest;
+evaluate when len(G) >= min_measurements; f_d = max count / len(G); tie for the maximum ->
+nothing; fire when f_d > ratio_threshold, dominant != 0, and (no earlier command or
+t - t_last >= cooldown_s). Fired rows: `t,gesture_id,parameter,increment,value` with value
+the parameter after the increment, beta wrapped to (-180, 180], gamma / distance clamped
+(docs/formation.md §3-4: every UAV's elevation - leader gamma_L, follower gamma_L + gamma_i -
+within [gamma_min_deg, gamma_max_deg]; distance within [max(distance_min_m,
+safety_distance_m), distance_max_m]); UAVs of a group updated leader first, values joined
+with ';'. Events: parameter = event name, increment 0, value nan; unmapped: none,0,nan.
+"""
+import argparse
+import collections
+import csv
+import math
+import sys
+
+import yaml
+
+FILTER_DEFAULTS = {"window_size": 20, "max_age_s": 20.0, "ratio_threshold": 0.8, "cooldown_s": 5.0,
+                   "max_gesture_id": 4}
+PAPER_MAPPING = {1: {"parameter": "leader.beta_deg", "increment": -30},
+                 2: {"parameter": "leader.beta_deg", "increment": 30},
+                 3: {"parameter": "leader.gamma_deg", "increment": -5},
+                 4: {"parameter": "leader.gamma_deg", "increment": 5}}
+TABLE2 = [{"beta_deg": 90.0, "gamma_deg": 11.0, "distance_m": 10.0},
+          {"beta_deg": 60.0, "gamma_deg": 0.0, "distance_m": 8.0},
+          {"beta_deg": -60.0, "gamma_deg": 0.0, "distance_m": 8.0}]
+LIMITS = {"gamma_min_deg": -30.0, "gamma_max_deg": 60.0, "distance_min_m": 4.0, "distance_max_m": 25.0,
+          "safety_distance_m": 2.5}
+
+
+def fmt(v):
+    """Like gfctl's formatDouble: 10 significant digits, shortest form."""
+    if math.isnan(v):
+        return "nan"
+    return "%.10g" % v
+
+
+def wrap_deg(a):
+    w = math.fmod(a, 360.0)
+    if w > 180.0:
+        w -= 360.0
+    elif w <= -180.0:
+        w += 360.0
+    return w
+
+
+class Formation:
+    def __init__(self, cfg):
+        leader = dict(TABLE2[0])
+        leader.update(cfg.get("leader") or {})
+        if "followers" in cfg:
+            followers = []
+            for i, e in enumerate(cfg["followers"] or []):
+                base = dict(TABLE2[i + 1]) if i < 2 else {"gamma_deg": 0.0, "distance_m": 8.0}
+                base.update(e)
+                followers.append(base)
+        else:
+            followers = [dict(TABLE2[1]), dict(TABLE2[2])]
+        self.uavs = [leader] + followers  # index 0 leader
+        self.lim = dict(LIMITS)
+        self.lim.update(cfg.get("limits") or {})
+
+    def targets(self, who):
+        if who == "leader":
+            return [0]
+        if who == "all":
+            return list(range(len(self.uavs)))
+        if who == "followers":
+            return list(range(1, len(self.uavs)))
+        assert who.startswith("follower")
+        return [int(who[len("follower"):])]
+
+    def apply(self, path, inc):
+        who, name = path.split(".")
+        values = []
+        for u in sorted(set(self.targets(who))):
+            q = self.uavs[u][name] + inc
+            if name == "beta_deg":
+                q = wrap_deg(q)
+            elif name == "distance_m":
+                q = min(max(q, max(self.lim["distance_min_m"], self.lim["safety_distance_m"])), self.lim["distance_max_m"])
+            elif u == 0:  # the leader's gamma also lifts every follower
+                lo = max([self.lim["gamma_min_deg"]] + [self.lim["gamma_min_deg"] - f["gamma_deg"] for f in self.uavs[1:]])
+                hi = min([self.lim["gamma_max_deg"]] + [self.lim["gamma_max_deg"] - f["gamma_deg"] for f in self.uavs[1:]])
+                q = min(max(q, lo), hi)
+            else:
+                g0 = self.uavs[0]["gamma_deg"]
+                q = min(max(q, self.lim["gamma_min_deg"] - g0), self.lim["gamma_max_deg"] - g0)
+            self.uavs[u][name] = q
+            values.append(q)
+        return values
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--config", required=True)
+    ap.add_argument("--in", dest="inp", required=True)
+    ap.add_argument("--out", required=True)
+    args = ap.parse_args()
+    with open(args.config) as f:
+        cfg = yaml.safe_load(f) or {}
+    p = dict(FILTER_DEFAULTS)
+    p.update({k: cfg[k] for k in FILTER_DEFAULTS if k in cfg})
+    K = int(p["window_size"])
+    min_meas = int(cfg.get("min_measurements", K))
+    t_c, ratio, t_d, max_id = float(p["max_age_s"]), float(p["ratio_threshold"]), float(p["cooldown_s"]), int(p["max_gesture_id"])
+    mapping = {int(k): v for k, v in (cfg["mapping"] if "mapping" in cfg else PAPER_MAPPING).items()}
+    formation = Formation(cfg)
+
+    G = []  # (t, id), oldest first
+    last_t = None
+    last_fire = None
+    out = ["t,gesture_id,parameter,increment,value"]
+    with open(args.inp) as f:
+        for row in csv.DictReader(f):
+            t, g = float(row["t"]), float(row["gesture_id"])
+            if not math.isfinite(t) or (last_t is not None and t < last_t):
+                continue
+            if not math.isfinite(g) or g != int(g) or not 0 <= g <= max_id:
+                continue
+            g = int(g)
+            last_t = t
+            G.append((t, g))
+            G = [e for e in G if e[0] >= t - t_c]
+            G = G[-K:]
+            if len(G) < min_meas:
+                continue
+            counts = collections.Counter(e[1] for e in G)
+            top = max(counts.values())
+            leaders = [k for k, c in counts.items() if c == top]
+            if len(leaders) > 1:
+                continue
+            dominant = leaders[0]
+            if not top / len(G) > ratio or dominant == 0:
+                continue
+            if last_fire is not None and not (t - last_fire >= t_d):
+                continue
+            last_fire = t
+            action = mapping.get(dominant)
+            if action is None:
+                out.append(f"{fmt(t)},{dominant},none,0,nan")
+            elif "event" in action:
+                out.append(f"{fmt(t)},{dominant},{action['event']},0,nan")
+            else:
+                inc = float(action["increment"])
+                vals = formation.apply(action["parameter"], inc)
+                out.append(f"{fmt(t)},{dominant},{action['parameter']},{fmt(inc)},{';'.join(fmt(v) for v in vals)}")
+    with open(args.out, "w") as f:
+        f.write("\n".join(out) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
