@@ -1,0 +1,70 @@
+#include "gesture_formation/planning/lattice_tower.hpp"
+
+#include <array>
+#include <cmath>
+
+#include <Eigen/Geometry>
+
+namespace gesture_formation::planning {
+
+std::vector<std::string> LatticeTowerSpec::validate() const {
+  std::vector<std::string> e;
+  const std::string p = name.empty() ? std::string("tower") : "tower '" + name + "'";
+  if (!base_world.allFinite()) e.push_back(p + ": base must be finite");
+  if (!std::isfinite(yaw_rad)) e.push_back(p + ": yaw must be finite");
+  if (!(height_m > 0.0 && std::isfinite(height_m))) e.push_back(p + ": height_m must be > 0");
+  if (!(base_width_m > 0.0 && std::isfinite(base_width_m))) e.push_back(p + ": base_width_m must be > 0");
+  if (!(top_width_m > 0.0 && top_width_m <= base_width_m)) e.push_back(p + ": top_width_m must be in (0, base_width_m]");
+  if (panels < 1) e.push_back(p + ": panels must be >= 1");
+  if (!(leg_radius_m > 0.0)) e.push_back(p + ": leg_radius_m must be > 0");
+  if (!(brace_radius_m > 0.0)) e.push_back(p + ": brace_radius_m must be > 0");
+  for (std::size_t i = 0; i < cross_arms.size(); ++i) {
+    const auto& a = cross_arms[i];
+    const std::string q = p + ": cross_arms[" + std::to_string(i) + "]";
+    if (!(a.height_m > 0.0 && a.height_m <= height_m)) e.push_back(q + ".height_m must be in (0, height_m]");
+    if (!(a.half_length_m > 0.0)) e.push_back(q + ".half_length_m must be > 0");
+    if (!(a.section_m > 0.0)) e.push_back(q + ".section_m must be > 0");
+  }
+  return e;
+}
+
+Eigen::Vector3d LatticeTowerSpec::armTip(std::size_t arm, int side, double drop_m) const {
+  const CrossArmSpec& a = cross_arms.at(arm);
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  return base_world + R * Eigen::Vector3d(0.0, side >= 0 ? a.half_length_m : -a.half_length_m, a.height_m - drop_m);
+}
+
+PrimitiveSet towerPrimitives(const LatticeTowerSpec& spec) {
+  PrimitiveSet set;
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(spec.yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  auto world = [&](const Eigen::Vector3d& p_tower) -> Eigen::Vector3d { return spec.base_world + R * p_tower; };
+  // Leg k at height h: corners (±w/2, ±w/2) in counter-clockwise order.
+  const std::array<Eigen::Vector2d, 4> signs = {Eigen::Vector2d(1, 1), Eigen::Vector2d(-1, 1), Eigen::Vector2d(-1, -1),
+                                                Eigen::Vector2d(1, -1)};
+  auto corner = [&](int k, double h) -> Eigen::Vector3d {
+    const double w = spec.base_width_m + (spec.top_width_m - spec.base_width_m) * h / spec.height_m;
+    return world(Eigen::Vector3d(0.5 * w * signs[static_cast<std::size_t>(k)].x(),
+                                 0.5 * w * signs[static_cast<std::size_t>(k)].y(), h));
+  };
+  for (int k = 0; k < 4; ++k) set.cylinders.push_back(Cylinder{corner(k, 0.0), corner(k, spec.height_m), spec.leg_radius_m});
+  for (int level = 0; level < spec.panels; ++level) {
+    const double h0 = spec.height_m * level / spec.panels;
+    const double h1 = spec.height_m * (level + 1) / spec.panels;
+    for (int k = 0; k < 4; ++k) {
+      const int n = (k + 1) % 4;
+      set.cylinders.push_back(Cylinder{corner(k, h1), corner(n, h1), spec.brace_radius_m});  // ring
+      set.cylinders.push_back(Cylinder{corner(k, h0), corner(n, h1), spec.brace_radius_m});  // X bracing
+      set.cylinders.push_back(Cylinder{corner(n, h0), corner(k, h1), spec.brace_radius_m});
+    }
+  }
+  for (const auto& arm : spec.cross_arms) {
+    OrientedBox b;
+    b.center_world = world(Eigen::Vector3d(0.0, 0.0, arm.height_m));
+    b.size_m = Eigen::Vector3d(arm.section_m, 2.0 * arm.half_length_m, arm.section_m);
+    b.R_world_box = R;
+    set.boxes.push_back(b);
+  }
+  return set;
+}
+
+}  // namespace gesture_formation::planning
