@@ -1,0 +1,133 @@
+#pragma once
+/// \file
+/// \brief `WorkerTracker`: detector–tracker alternation that follows ONE person (the worker)
+/// and keeps its identity when several people are visible (DESIGN §2).
+///
+/// Per frame: if a track exists, the visual tracker (OpenCV contrib KCF or CSRT) predicts
+/// the box. The detector runs when (a) no track exists, (b) `detect_every_k` frames have
+/// passed since the last detection, or (c) the tracker reports failure. On a detection
+/// frame the worker is associated with a detection: the one with the highest IoU with the
+/// current box if ≥ `associate_min_iou`, else the nearest centre within
+/// `associate_gate` · max(w, h) of the current box. The associated detection re-initialises
+/// the tracker (it fixes the KCF scale and removes drift; a tracker box whose IoU with it is
+/// < `drift_iou` is counted as drift). Identity never jumps to another person while the
+/// current one is associated. If no detection is associated the tracker box is kept for up
+/// to `max_missed_detections` detection rounds, then the track is lost; after a loss the
+/// nearest detection within `reacquire_gate` · max(w, h) of the last box keeps the id during
+/// `reacquire_frames` frames, otherwise the best-scoring person starts a new id.
+///
+/// While a track exists, the detector runs on a square window around the worker
+/// (`roi_scale` · max(w, h), at least `roi_min_side_px`, shifted inside the frame) instead
+/// of the whole frame: a 60–120 px worker then reaches the network at ~full resolution
+/// rather than shrunk 2.5× by letterboxing a 640×480 frame into 256×256. If that window
+/// holds nobody, the whole frame is searched in the same step.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/tracking.hpp>
+
+#include "gesture_formation/common/result.hpp"
+#include "gesture_formation/perception/person_detector.hpp"
+
+namespace gesture_formation::perception {
+
+/// Visual tracker used between detections.
+enum class TrackerKind { kKcf, kCsrt };
+common::Result<TrackerKind> parseTrackerKind(const std::string& text);
+std::string toString(TrackerKind kind);
+
+/// \brief Configuration of `WorkerTracker` (defaults: docs/perception.md measurements).
+struct WorkerTrackerConfig {
+  TrackerKind tracker = TrackerKind::kKcf;  ///< KCF: ~1–3 ms on a worker-sized box; CSRT ~10×
+  int detect_every_k = 5;             ///< run the detector at least every k frames, ≥ 1
+  float min_detection_score = 0.25f;  ///< detections below are ignored, [0, 1)
+  float associate_min_iou = 0.2f;     ///< IoU to keep the identity, (0, 1]
+  float associate_gate = 1.0f;        ///< centre distance gate / max(w, h) of the current box, > 0
+  float drift_iou = 0.5f;             ///< tracker-vs-detection IoU below this counts as drift, (0, 1]
+  int max_missed_detections = 2;      ///< detection rounds without the worker before the track is lost, ≥ 0
+  int reacquire_frames = 30;          ///< frames after a loss during which the old id can be reacquired, ≥ 0
+  float reacquire_gate = 2.0f;        ///< centre gate / max(w, h) of the last box when reacquiring, > 0
+  float min_box_px = 8.0f;            ///< tracker boxes smaller than this (w or h) [px] are failures, ≥ 1
+  bool roi_detection = true;          ///< detect in a window around the worker while tracking
+  float roi_scale = 2.5f;             ///< window side / max(w, h) of the worker box, ≥ 1
+  float roi_min_side_px = 256.0f;     ///< smallest window side [px], ≥ 32 (256 = multipose input)
+
+  std::vector<std::string> validate() const;
+};
+
+/// \brief Where this frame's box came from.
+enum class BoxSource { kNone, kDetector, kTracker };
+std::string toString(BoxSource source);
+
+/// \brief Result of one frame.
+struct TrackStep {
+  bool found = false;            ///< the worker's box is valid this frame
+  int id = -1;                   ///< worker identity (increments when a new person is chosen), −1 none
+  cv::Rect2f box_px;             ///< worker box in the frame's pixels (clipped to the image)
+  BoxSource source = BoxSource::kNone;
+  bool detector_ran = false;     ///< the detector ran this frame
+  bool roi_used = false;         ///< the detector ran on `roi_px` (else or also on the whole frame)
+  cv::Rect roi_px;               ///< detection window of this frame when roi_used
+  bool tracker_failed = false;   ///< the visual tracker reported failure this frame
+  bool drift = false;            ///< re-initialised because the tracker drifted from the detection
+  bool identity_changed = false; ///< a new id was started this frame
+  std::vector<Detection> detections;  ///< all detections of this frame (empty if none ran)
+  int worker_detection = -1;     ///< index in `detections` of the worker, −1 none
+  double detect_ms = 0.0;        ///< detector wall time this frame [ms]
+  double track_ms = 0.0;         ///< tracker update + init wall time this frame [ms]
+};
+
+/// \brief Running counters (for logs and tests).
+struct TrackCounters {
+  int frames = 0, detections_run = 0, tracker_failures = 0, drifts = 0, identities = 0, lost = 0;
+};
+
+/// \brief Detector–tracker alternation. Thread safety: not reentrant.
+class WorkerTracker {
+ public:
+  /// Takes ownership of `detector`; fails with the first config problem or a null detector.
+  static common::Result<std::unique_ptr<WorkerTracker>> create(const WorkerTrackerConfig& config,
+                                                               std::unique_ptr<PersonDetector> detector);
+
+  /// \brief Processes the next frame (8-bit BGR, same size for the whole sequence). A bad
+  /// frame fails with the reason and leaves the track unchanged.
+  common::Result<TrackStep> step(const cv::Mat& frame_bgr);
+
+  /// Forgets the track (next frame detects and starts a new id).
+  void reset();
+
+  /// \brief Tells the tracker where the worker is (e.g. an operator's click, or a hand
+  /// label in tests): forgets the current track; the next detection nearest to `box_px`
+  /// (within `reacquire_gate` · max(w, h)) becomes the worker with a new id.
+  void setWorkerHint(const cv::Rect2f& box_px);
+
+  const TrackCounters& counters() const { return counters_; }
+  const WorkerTrackerConfig& config() const { return config_; }
+  PersonDetector& detector() { return *detector_; }
+
+ private:
+  WorkerTracker(WorkerTrackerConfig config, std::unique_ptr<PersonDetector> detector);
+  cv::Ptr<cv::Tracker> makeTracker() const;
+  bool initTracker(const cv::Mat& frame, const cv::Rect2f& box);
+  /// Detections in `window` of `frame`, boxes in frame pixels.
+  common::Result<std::vector<Detection>> detectIn(const cv::Mat& frame, const cv::Rect& window);
+
+  WorkerTrackerConfig config_;
+  std::unique_ptr<PersonDetector> detector_;
+  cv::Ptr<cv::Tracker> tracker_;
+  bool tracking_ = false;        ///< a live track exists
+  cv::Rect2f box_;               ///< current (or last) worker box
+  int id_ = -1;                  ///< current (or last) id
+  int next_id_ = 0;
+  int frames_since_detection_ = 0;
+  int missed_detections_ = 0;
+  int frames_since_lost_ = -1;   ///< −1: never lost / no previous box
+  bool hint_pending_ = false;    ///< setWorkerHint was called and not yet resolved
+  cv::Size frame_size_;
+  TrackCounters counters_;
+};
+
+}  // namespace gesture_formation::perception

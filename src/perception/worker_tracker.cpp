@@ -1,0 +1,304 @@
+#include "gesture_formation/perception/worker_tracker.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "gesture_formation/perception/dnn_model.hpp"
+
+namespace gesture_formation::perception {
+
+namespace {
+
+double msSince(int64_t t0) { return static_cast<double>(cv::getTickCount() - t0) * 1000.0 / cv::getTickFrequency(); }
+
+cv::Point2f centre(const cv::Rect2f& r) { return {r.x + r.width / 2, r.y + r.height / 2}; }
+
+/// Index of the detection nearest (centre distance) to `ref` within gate · max(w, h), or −1.
+int nearestWithin(const cv::Rect2f& ref, const std::vector<Detection>& dets, float gate) {
+  const float limit = gate * std::max(ref.width, ref.height);
+  int best = -1;
+  float best_d = limit;
+  for (std::size_t i = 0; i < dets.size(); ++i) {
+    const float d = static_cast<float>(cv::norm(centre(dets[i].box_px) - centre(ref)));
+    if (d <= best_d) {
+      best_d = d;
+      best = static_cast<int>(i);
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+common::Result<TrackerKind> parseTrackerKind(const std::string& text) {
+  if (text == "kcf") return common::Result<TrackerKind>::ok(TrackerKind::kKcf);
+  if (text == "csrt") return common::Result<TrackerKind>::ok(TrackerKind::kCsrt);
+  return common::Result<TrackerKind>::fail("tracker must be kcf or csrt, got '" + text + "'");
+}
+
+std::string toString(TrackerKind kind) { return kind == TrackerKind::kKcf ? "kcf" : "csrt"; }
+
+std::string toString(BoxSource source) {
+  switch (source) {
+    case BoxSource::kDetector: return "detector";
+    case BoxSource::kTracker: return "tracker";
+    case BoxSource::kNone: break;
+  }
+  return "none";
+}
+
+std::vector<std::string> WorkerTrackerConfig::validate() const {
+  std::vector<std::string> e;
+  const auto num = [](double v) { return std::to_string(v); };
+  if (detect_every_k < 1) e.push_back("tracker.detect_every_k must be >= 1, got " + std::to_string(detect_every_k));
+  if (!(min_detection_score >= 0.0f && min_detection_score < 1.0f)) {
+    e.push_back("tracker.min_detection_score must be in [0, 1), got " + num(min_detection_score));
+  }
+  if (!(associate_min_iou > 0.0f && associate_min_iou <= 1.0f)) {
+    e.push_back("tracker.associate_min_iou must be in (0, 1], got " + num(associate_min_iou));
+  }
+  if (!(associate_gate > 0.0f && std::isfinite(associate_gate))) {
+    e.push_back("tracker.associate_gate must be > 0, got " + num(associate_gate));
+  }
+  if (!(drift_iou > 0.0f && drift_iou <= 1.0f)) e.push_back("tracker.drift_iou must be in (0, 1], got " + num(drift_iou));
+  if (max_missed_detections < 0) {
+    e.push_back("tracker.max_missed_detections must be >= 0, got " + std::to_string(max_missed_detections));
+  }
+  if (reacquire_frames < 0) e.push_back("tracker.reacquire_frames must be >= 0, got " + std::to_string(reacquire_frames));
+  if (!(reacquire_gate > 0.0f && std::isfinite(reacquire_gate))) {
+    e.push_back("tracker.reacquire_gate must be > 0, got " + num(reacquire_gate));
+  }
+  if (!(min_box_px >= 1.0f && std::isfinite(min_box_px))) e.push_back("tracker.min_box_px must be >= 1, got " + num(min_box_px));
+  if (!(roi_scale >= 1.0f && std::isfinite(roi_scale))) e.push_back("tracker.roi_scale must be >= 1, got " + num(roi_scale));
+  if (!(roi_min_side_px >= 32.0f && std::isfinite(roi_min_side_px))) {
+    e.push_back("tracker.roi_min_side_px must be >= 32, got " + num(roi_min_side_px));
+  }
+  return e;
+}
+
+common::Result<std::unique_ptr<WorkerTracker>> WorkerTracker::create(const WorkerTrackerConfig& config,
+                                                                     std::unique_ptr<PersonDetector> detector) {
+  using R = common::Result<std::unique_ptr<WorkerTracker>>;
+  const auto problems = config.validate();
+  if (!problems.empty()) return R::fail(problems.front());
+  if (!detector) return R::fail("worker tracker: no person detector given");
+  return R::ok(std::unique_ptr<WorkerTracker>(new WorkerTracker(config, std::move(detector))));
+}
+
+WorkerTracker::WorkerTracker(WorkerTrackerConfig config, std::unique_ptr<PersonDetector> detector)
+    : config_(std::move(config)), detector_(std::move(detector)) {}
+
+void WorkerTracker::reset() {
+  tracker_.reset();
+  tracking_ = false;
+  id_ = -1;
+  frames_since_detection_ = 0;
+  missed_detections_ = 0;
+  frames_since_lost_ = -1;
+  hint_pending_ = false;
+}
+
+void WorkerTracker::setWorkerHint(const cv::Rect2f& box_px) {
+  reset();
+  if (!(box_px.width > 0 && box_px.height > 0)) return;
+  box_ = box_px;
+  hint_pending_ = true;
+  frames_since_lost_ = 0;
+}
+
+cv::Ptr<cv::Tracker> WorkerTracker::makeTracker() const {
+  if (config_.tracker == TrackerKind::kCsrt) return cv::TrackerCSRT::create();
+  return cv::TrackerKCF::create();
+}
+
+bool WorkerTracker::initTracker(const cv::Mat& frame, const cv::Rect2f& box) {
+  const cv::Rect r(static_cast<int>(std::lround(box.x)), static_cast<int>(std::lround(box.y)),
+                   std::max(1, static_cast<int>(std::lround(box.width))), std::max(1, static_cast<int>(std::lround(box.height))));
+  try {
+    tracker_ = makeTracker();
+    tracker_->init(frame, r);
+  } catch (const cv::Exception&) {
+    tracker_.reset();
+    return false;
+  }
+  return true;
+}
+
+common::Result<std::vector<Detection>> WorkerTracker::detectIn(const cv::Mat& frame, const cv::Rect& window) {
+  auto dets = detector_->detect(frame(window));
+  if (!dets) return dets;
+  for (auto& d : *dets) {
+    d.box_px.x += static_cast<float>(window.x);
+    d.box_px.y += static_cast<float>(window.y);
+    for (auto& k : d.keypoints) {
+      if (k.c > 0.0f) {
+        k.x += static_cast<float>(window.x);
+        k.y += static_cast<float>(window.y);
+      }
+    }
+    d.roi.center_px += cv::Point2f(static_cast<float>(window.x), static_cast<float>(window.y));
+  }
+  return dets;
+}
+
+common::Result<TrackStep> WorkerTracker::step(const cv::Mat& frame) {
+  using R = common::Result<TrackStep>;
+  const std::string bad = checkBgrImage(frame, "frame");
+  if (!bad.empty()) return R::fail("worker tracker: " + bad);
+  if (frame_size_ != frame.size()) {
+    if (frame_size_.area() > 0) reset();  // a new stream: boxes of the old one are meaningless
+    frame_size_ = frame.size();
+  }
+  ++counters_.frames;
+  const cv::Rect2f image_rect(0.0f, 0.0f, static_cast<float>(frame.cols), static_cast<float>(frame.rows));
+  TrackStep out;
+
+  // 1. visual tracker prediction
+  cv::Rect2f predicted;
+  bool have_pred = false;
+  if (tracking_ && tracker_) {
+    const int64_t t0 = cv::getTickCount();
+    cv::Rect r;
+    bool ok = false;
+    try {
+      ok = tracker_->update(frame, r);
+    } catch (const cv::Exception&) {
+      ok = false;
+    }
+    out.track_ms += msSince(t0);
+    predicted = cv::Rect2f(r) & image_rect;
+    have_pred = ok && predicted.width >= config_.min_box_px && predicted.height >= config_.min_box_px;
+    if (!have_pred) {
+      out.tracker_failed = true;
+      ++counters_.tracker_failures;
+    }
+  }
+
+  // 2. detection when due, when there is no track, or when the tracker failed
+  const bool need_detect = !tracking_ || !have_pred || frames_since_detection_ + 1 >= config_.detect_every_k;
+  if (!need_detect) {
+    ++frames_since_detection_;
+    box_ = predicted;
+    out.found = true;
+    out.source = BoxSource::kTracker;
+    out.id = id_;
+    out.box_px = box_;
+    return R::ok(out);
+  }
+
+  const int64_t t0 = cv::getTickCount();
+  const auto keep = [&](const std::vector<Detection>& dets) {
+    out.detections.clear();
+    for (const auto& d : dets) {
+      if (d.score >= config_.min_detection_score && d.box_px.width > 0 && d.box_px.height > 0) out.detections.push_back(d);
+    }
+  };
+  if (tracking_ && config_.roi_detection) {
+    const cv::Rect2f ref = have_pred ? predicted : box_;
+    const int side = std::min({std::max(static_cast<int>(std::lround(config_.roi_scale * std::max(ref.width, ref.height))),
+                                        static_cast<int>(std::lround(config_.roi_min_side_px))),
+                               frame.cols, frame.rows});
+    const cv::Point2f c = centre(ref);
+    const int x = std::clamp(static_cast<int>(std::lround(c.x - side / 2.0f)), 0, frame.cols - side);
+    const int y = std::clamp(static_cast<int>(std::lround(c.y - side / 2.0f)), 0, frame.rows - side);
+    out.roi_px = cv::Rect(x, y, side, side);
+    out.roi_used = true;
+    auto dets = detectIn(frame, out.roi_px);
+    if (!dets) return R::fail("worker tracker: " + dets.reason());
+    keep(*dets);
+  }
+  if (out.detections.empty()) {
+    auto dets = detector_->detect(frame);
+    if (!dets) return R::fail("worker tracker: " + dets.reason());
+    keep(*dets);
+  }
+  out.detect_ms = msSince(t0);
+  out.detector_ran = true;
+  ++counters_.detections_run;
+  frames_since_detection_ = 0;
+
+  bool lost_now = false;
+  if (tracking_) {
+    const cv::Rect2f ref = have_pred ? predicted : box_;
+    int idx = -1;
+    float best_iou = 0.0f;
+    for (std::size_t i = 0; i < out.detections.size(); ++i) {
+      const float o = iou(ref, out.detections[i].box_px);
+      if (o > best_iou) {
+        best_iou = o;
+        idx = static_cast<int>(i);
+      }
+    }
+    if (best_iou < config_.associate_min_iou) idx = nearestWithin(ref, out.detections, config_.associate_gate);
+    if (idx >= 0) {
+      const cv::Rect2f det = out.detections[static_cast<std::size_t>(idx)].box_px;
+      out.drift = have_pred && iou(predicted, det) < config_.drift_iou;
+      if (out.drift) ++counters_.drifts;
+      const int64_t t1 = cv::getTickCount();
+      const bool ok = initTracker(frame, det);
+      out.track_ms += msSince(t1);
+      missed_detections_ = 0;
+      box_ = det;
+      out.found = true;
+      out.source = BoxSource::kDetector;
+      out.worker_detection = idx;
+      if (!ok) tracking_ = false;  // re-detect next frame; the box of this frame stands
+    } else {
+      ++missed_detections_;
+      if (have_pred && missed_detections_ <= config_.max_missed_detections) {
+        box_ = predicted;
+        out.found = true;
+        out.source = BoxSource::kTracker;
+      } else {
+        tracking_ = false;
+        tracker_.reset();
+        frames_since_lost_ = 0;
+        ++counters_.lost;
+        lost_now = true;
+      }
+    }
+  }
+
+  // 3. (re)acquisition — never in the frame where the track was just lost, so the identity
+  // cannot hop to a neighbour that the association above rejected. While a hint or a
+  // recently lost worker is remembered, only a detection near it is taken.
+  const bool remembering = (id_ >= 0 || hint_pending_) && frames_since_lost_ >= 0 &&
+                           frames_since_lost_ <= config_.reacquire_frames;
+  int idx = -1;
+  if (!tracking_ && !out.found && !lost_now && !out.detections.empty()) {
+    if (remembering) idx = nearestWithin(box_, out.detections, config_.reacquire_gate);
+    if (idx < 0 && !hint_pending_) {
+      idx = 0;  // best score first: a new worker
+      id_ = next_id_++;
+      out.identity_changed = true;
+      ++counters_.identities;
+    } else if (idx >= 0 && hint_pending_) {
+      id_ = next_id_++;
+      out.identity_changed = true;
+      ++counters_.identities;
+    }
+  }
+  if (idx >= 0) {
+    const cv::Rect2f det = out.detections[static_cast<std::size_t>(idx)].box_px;
+    const int64_t t1 = cv::getTickCount();
+    tracking_ = initTracker(frame, det);
+    out.track_ms += msSince(t1);
+    missed_detections_ = 0;
+    frames_since_lost_ = -1;
+    hint_pending_ = false;
+    box_ = det;
+    out.found = true;
+    out.source = BoxSource::kDetector;
+    out.worker_detection = idx;
+  } else if (!tracking_ && !out.found && frames_since_lost_ >= 0) {
+    ++frames_since_lost_;
+    if (frames_since_lost_ > config_.reacquire_frames) hint_pending_ = false;
+  }
+  if (out.found) {
+    out.id = id_;
+    out.box_px = box_;
+  }
+  return R::ok(out);
+}
+
+}  // namespace gesture_formation::perception
