@@ -22,7 +22,9 @@ class Result {
   const T& value() const { return *value_; }
   T& value() { return *value_; }
   const T& operator*() const { return *value_; }
+  T& operator*() { return *value_; }
   const T* operator->() const { return &*value_; }
+  T* operator->() { return &*value_; }
   /// Empty when the result holds a value.
   const std::string& reason() const { return reason_; }
 
