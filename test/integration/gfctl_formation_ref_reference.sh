@@ -1,7 +1,7 @@
 #!/bin/bash
 # gfctl formation-ref against the independent Python implementation
-# (tools/reference/formation_ref_reference.py) to 1e-9 (relative to max(1, |value|): gfctl
-# prints 10 significant digits; headings modulo 2π and checked wrapped to (−π, π]) on a
+# (tools/reference/formation_ref_reference.py) to 1e-9 absolute (gfctl
+# prints 15 significant digits; headings modulo 2π and checked wrapped to (−π, π]) on a
 # random worker trajectory (fixed seed) with headings far outside (−π, π], under the
 # shipped config/formation.yaml, 3 and 5 followers, other parameter values and a config
 # with only some keys; plus: a config outside the limits is an error (exit 2), not clamped.

@@ -88,7 +88,7 @@ def fmt(v):
         return v
     if math.isnan(v):
         return "nan"
-    return "%.10g" % v
+    return "%.15g" % v
 
 
 def main():

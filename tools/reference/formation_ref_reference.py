@@ -15,8 +15,8 @@ Followers use the leader's desired phiL, xiL of the same row; h_heading is phiH.
 Config: leader/followers as in DESIGN §8.2 (degrees), defaults Table II; limits as in
 docs/formation.md §3 (this script checks them and exits 2 on a violation, like gfctl).
 
---compare: same header and labels; numeric fields equal to tol * max(1, |value|) (gfctl
-prints 10 significant digits), heading/pitch compared modulo 2*pi; both files' headings
+--compare: same header and labels; numeric fields equal to an absolute tol (gfctl
+prints 15 significant digits), heading/pitch compared modulo 2*pi; both files' headings
 must lie in (-pi, pi].
 """
 import argparse
@@ -132,13 +132,13 @@ def compare(a, b, tol):
                 if name == "heading" and not all(-math.pi < w <= math.pi + 1e-9 for w in (fu, fv)):
                     bad += 1
                     print(f"line {line}: heading not wrapped: {u} / {v}")
-            rel = diff / max(1.0, abs(fu), abs(fv))
+            rel = diff
             worst = max(worst, rel)
             if rel > tol:
                 bad += 1
                 if bad <= 10:
-                    print(f"line {line} field {name}: {u} vs {v} (rel diff {rel:.3g})")
-    print(f"compared {len(ra) - 1} rows: {bad} differences beyond {tol} (relative to max(1,|v|)); worst {worst:.3g}")
+                    print(f"line {line} field {name}: {u} vs {v} (abs diff {rel:.3g})")
+    print(f"compared {len(ra) - 1} rows: {bad} differences beyond {tol} (absolute); worst {worst:.3g}")
     return 1 if bad else 0
 
 

@@ -38,10 +38,10 @@ LIMITS = {"gamma_min_deg": -30.0, "gamma_max_deg": 60.0, "distance_min_m": 4.0, 
 
 
 def fmt(v):
-    """Like gfctl's formatDouble: 10 significant digits, shortest form."""
+    """Like gfctl's formatDouble: 15 significant digits, shortest form."""
     if math.isnan(v):
         return "nan"
-    return "%.10g" % v
+    return "%.15g" % v
 
 
 def wrap_deg(a):

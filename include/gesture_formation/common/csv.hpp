@@ -17,7 +17,7 @@ namespace gesture_formation::common {
 /// \brief Parses a whole field as a double. "nan", "inf" accepted; empty or trailing junk is not.
 std::optional<double> parseDouble(std::string_view field);
 
-/// \brief Formats a double with 10 significant digits; NaN as "nan", ±inf as "inf"/"-inf".
+/// \brief Formats a double with 15 significant digits (enough for 1e-9 m comparisons of coordinates up to 1e5 m); NaN as "nan", ±inf as "inf"/"-inf".
 std::string formatDouble(double v);
 
 /// \brief Reads a CSV file with a header row, one record per line (no quoted commas).
