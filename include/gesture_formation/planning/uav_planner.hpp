@@ -27,6 +27,7 @@
 #include <Eigen/Core>
 
 #include "gesture_formation/formation/formation_geometry.hpp"
+#include "gesture_formation/planning/planner_config.hpp"
 
 namespace gesture_formation::planning {
 
@@ -109,6 +110,81 @@ struct PlanResult {
   int qp_constraints = 0;
   int qp_iterations = 0;
   double min_obstacle_clearance_m = 0.0;  ///< verified clearance of the returned plan
+  // --- added by the planner implementation (fields may be added, never renamed) ---------
+  /// False only for a braking plan that itself failed verification (the last resort is
+  /// returned anyway, `reason` says why), or an empty trajectory when the state is not finite.
+  bool verified = false;
+  double min_uav_margin_m = 0.0;       ///< min over plans/time of distance − required (m)
+  double min_worker_distance_m = 0.0;  ///< min distance to the worker's prediction (m)
+  std::vector<Eigen::Vector3d> path_world;  ///< stage-2 path (after merging), for display
+  int corridor_count = 0;
+  int projected_references = 0;  ///< reference steps moved out of obstacles / the worker zone
+  int path_searches = 0;         ///< A* searches run for blocked segments
 };
+
+class TrajectoryVerifier;
+class CorridorBuilder;
+class GridPathSearch;
+class TrajectoryQp;
+struct TrajectoryQpProblem;
+
+/// \brief One UAV's planner: the three stages of DESIGN §4 with verification and fallback
+/// (docs/planning.md §5–§8). Construct once per UAV from the scenario's map and distance
+/// field (built once per scenario and shared by every UAV's planner; they must outlive it).
+/// Stateful (last verified plan, QP warm start, plan sequence); deterministic for the same
+/// sequence of requests when `time_budget_ms` is 0 (otherwise only the budget fallback
+/// depends on the machine's speed). Not thread-safe; one instance per UAV.
+class UavPlanner {
+ public:
+  /// \brief `config` must be valid; otherwise `configError()` names every bad field and
+  /// every `plan()` returns a braking plan with that reason.
+  UavPlanner(const PlannerConfig& config, std::shared_ptr<const OccupancyMap> map,
+             std::shared_ptr<const DistanceField> field);
+  ~UavPlanner();
+  UavPlanner(const UavPlanner&) = delete;
+  UavPlanner& operator=(const UavPlanner&) = delete;
+  UavPlanner(UavPlanner&&) noexcept;
+  UavPlanner& operator=(UavPlanner&&) noexcept;
+
+  const PlannerConfig& config() const { return config_; }
+  const std::string& configError() const { return config_error_; }
+
+  /// \brief One replanning (see the file comment for the safety contract).
+  PlanResult plan(const PlanRequest& request);
+
+  /// \brief The last plan that passed verification (empty before the first).
+  const PlannedTrajectory& lastVerifiedPlan() const { return last_verified_; }
+  /// \brief Forgets the last plan and the warm start (e.g. after a reset of the mission).
+  void reset();
+  /// \brief Keep a copy of each replanning's QP (for `gfctl plan --dump-qp` and tests;
+  /// off by default: it costs a copy per replanning).
+  void keepLastQp(bool keep) { keep_last_qp_ = keep; }
+  /// \brief The last QP assembled by plan() when keepLastQp(true); nullptr otherwise.
+  const TrajectoryQpProblem* lastQp() const { return last_qp_.get(); }
+
+ private:
+  struct Stage2;
+  PlanResult fallback(const PlanRequest& request, PlanResult result, const std::string& reason);
+  PlannedTrajectory brakePlan(const PlanRequest& request) const;
+
+  PlannerConfig config_;
+  std::string config_error_;
+  std::shared_ptr<const OccupancyMap> map_;
+  std::shared_ptr<const DistanceField> field_;
+  std::unique_ptr<TrajectoryVerifier> verifier_;
+  std::unique_ptr<CorridorBuilder> corridors_;
+  std::unique_ptr<GridPathSearch> search_;
+  std::unique_ptr<TrajectoryQp> qp_;
+  PlannedTrajectory last_verified_;
+  std::uint32_t sequence_ = 0;
+  bool keep_last_qp_ = false;
+  std::unique_ptr<TrajectoryQpProblem> last_qp_;
+};
+
+/// \brief Plans a formation in priority order (DESIGN §4): planners[0] (the leader) first,
+/// then followers in index order; request i gets the plans returned for 0..i−1 appended to
+/// its higher_priority_plans (so each UAV avoids every higher-priority UAV's fresh plan).
+/// Precondition: planners.size() == requests.size(). Deterministic.
+std::vector<PlanResult> planInPriorityOrder(const std::vector<UavPlanner*>& planners, std::vector<PlanRequest> requests);
 
 }  // namespace gesture_formation::planning

@@ -1,0 +1,70 @@
+#pragma once
+/// \file
+/// \brief Stage 2 of the planner (docs/planning.md §5): projection of reference points out of
+/// obstacles onto the distance field, straight-segment validity, and A* on the voxel grid
+/// (26-connected, free = distance-field value at the voxel centre ≥ the clearance) for the
+/// segments that are blocked. The OMPL alternative (RRT-Connect in R³ with the same validity)
+/// lives in bench/bench_planner.cpp only; the decision and figures are in docs/planning.md.
+///
+/// Clearances are distances to occupied voxel centres (the DistanceField's lower bound; true
+/// distance ≥ the value read). Thread safety: const methods of GridPathSearch are not
+/// thread-safe (reused scratch buffers); the free functions are.
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "gesture_formation/common/result.hpp"
+#include "gesture_formation/planning/distance_field.hpp"
+#include "gesture_formation/planning/occupancy_map.hpp"
+
+namespace gesture_formation::planning {
+
+/// \brief The nearest point to p (world) whose distance-field clearance is ≥ clearance_m,
+/// within max_move_m: gradient ascent on the field (central differences, one voxel steps),
+/// then, if that stalls in a pocket, an exhaustive search of voxel centres in growing cubic
+/// shells. nullopt when nothing within max_move_m qualifies. Returns p itself when it is
+/// already clear.
+std::optional<Eigen::Vector3d> projectToClearance(const DistanceField& field, const OccupancyMap& map,
+                                                  const Eigen::Vector3d& p_world, double clearance_m, double max_move_m);
+
+/// \brief True when every point of the segment a → b sampled every resolution/2 has field
+/// clearance ≥ clearance_m (so the true distance to every voxel centre is ≥ clearance_m at
+/// those points).
+bool segmentClear(const DistanceField& field, double resolution_m, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                  double clearance_m);
+
+/// \brief Smallest field clearance (m) along a → b sampled every resolution/2.
+double segmentClearance(const DistanceField& field, double resolution_m, const Eigen::Vector3d& a, const Eigen::Vector3d& b);
+
+/// \brief Weighted A* (ε = 1.5) between two points on the voxel grid inside a box around them.
+class GridPathSearch {
+ public:
+  GridPathSearch(const OccupancyMap& map, const DistanceField& field) : map_(map), field_(field) {}
+
+  struct Stats {
+    int expansions = 0;
+    int raw_waypoints = 0;
+  };
+
+  /// \brief Path a → b (both included, world frame) through voxel centres whose clearance is
+  /// ≥ clearance_m, inside the box around a, b grown by margin_m (clipped to the map grid),
+  /// shortcut wherever a straight piece stays ≥ shortcut_clearance_m. The start and goal
+  /// voxels count as free. Fails when the goal is unreachable within the box or the budget.
+  common::Result<std::vector<Eigen::Vector3d>> search(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double clearance_m,
+                                                      double shortcut_clearance_m, double margin_m, int max_expansions,
+                                                      Stats* stats = nullptr) const;
+
+ private:
+  const OccupancyMap& map_;
+  const DistanceField& field_;
+  mutable std::vector<std::uint32_t> stamp_;
+  mutable std::uint32_t generation_ = 0;
+  mutable std::vector<float> g_;
+  mutable std::vector<std::int32_t> parent_;
+  mutable std::vector<std::uint8_t> closed_;
+};
+
+}  // namespace gesture_formation::planning

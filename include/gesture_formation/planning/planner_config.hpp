@@ -1,0 +1,127 @@
+#pragma once
+/// \file
+/// \brief Parameters of one UAV's three-stage planner (UavPlanner, docs/planning.md §5–§8),
+/// with documented defaults, `validate()` naming every bad field, and a YAML loader
+/// (`config/planner.yaml`) on common::ConfigReader that lists every missing or out-of-range
+/// key at once.
+///
+/// Units: SI, names carry them. Distances to obstacles are measured to occupied voxel
+/// *centres* (corridors, path search, distance field) unless the name says `cube`.
+/// Thread safety: value types and pure functions.
+
+#include <string>
+#include <vector>
+
+#include "gesture_formation/common/config_reader.hpp"
+#include "gesture_formation/common/result.hpp"
+
+namespace gesture_formation::planning {
+
+/// \brief Hard dynamic limits. The QP enforces inner polyhedral approximations so that the
+/// true Euclidean norms hold (docs/planning.md §6.3): |v_z| ≤ max_vertical, and the
+/// horizontal part inside the octagon inscribed in the disc of radius
+/// sqrt(max² − max_vertical²), so ‖v‖ ≤ max everywhere (also between samples).
+struct DynamicLimits {
+  double max_speed_mps = 5.0;                  ///< ‖v‖ bound, > 0
+  double max_vertical_speed_mps = 2.0;         ///< |v_z| bound, in (0, max_speed_mps)
+  double max_acceleration_mps2 = 3.0;          ///< ‖a‖ bound, > 0
+  double max_vertical_acceleration_mps2 = 2.0; ///< |a_z| bound, in (0, max_acceleration_mps2)
+  double max_heading_rate_radps = 1.0;         ///< camera heading rate bound, > 0
+  double max_pitch_rate_radps = 0.5;           ///< camera pitch rate bound, > 0
+  double min_pitch_rad = -1.4;                 ///< camera pitch range (gimbal), < max
+  double max_pitch_rad = 0.5;
+};
+
+/// \brief Cost weights of the trajectory QP (dimension-free after scaling by dt, see
+/// docs/planning.md §6.2). All ≥ 0; reference > 0 (the QP must be strictly convex).
+struct QpWeights {
+  double reference = 1.0;          ///< Σ ‖p_k − r_k‖² (r_k: projected reference)
+  double acceleration = 0.05;      ///< Σ ‖a_k‖²
+  double jerk = 0.01;              ///< Σ ‖(a_{k+1} − a_k)/dt‖²
+  double terminal_velocity = 1.0;  ///< ‖v_N‖² (end near hover)
+};
+
+struct PlannerConfig {
+  DynamicLimits limits;
+  QpWeights weights;
+
+  // --- stage 2: references and path ---------------------------------------------------
+  /// Distance kept from occupied voxel centres by the corridors (CorridorBuilder
+  /// clearance): UAV radius + √3/2·resolution + margin. > 0.
+  double obstacle_clearance_m = 0.8;
+  /// Clearance a reference point / path segment needs (≥ obstacle_clearance_m): references
+  /// closer to a voxel centre are projected to the nearest point with this clearance.
+  double path_clearance_m = 1.0;
+  /// Largest distance (m) a reference may be moved by the projection; > 0.
+  double max_projection_m = 6.0;
+  /// Consecutive reference points are merged into one path segment while every merged point
+  /// lies within this distance (m) of the segment (fewer, larger corridors). ≥ 0.
+  double path_merge_tolerance_m = 0.6;
+  /// Graph search (A*, 26-connected, on the distance field): the search box is the blocked
+  /// segment's bounding box grown by this margin (m), > 0.
+  double search_margin_m = 8.0;
+  /// Node budget of one graph search (expanded voxels), ≥ 100.
+  int search_max_expansions = 200000;
+
+  // --- stage 3: corridors and QP ----------------------------------------------------------
+  /// Corridor local box margin (m) per axis around each path segment, > obstacle distance 0.
+  double corridor_box_margin_m = 4.0;
+  /// Samples are kept this far (m) inside their polytopes' planes, ≥ 0.
+  double corridor_margin_m = 0.05;
+  /// Γ_dis: distance (m) kept from every higher-priority UAV's planned position at the same
+  /// time (paper Table II: 2.5 m), > 0.
+  double mutual_distance_m = 2.5;
+  /// An older plan of another UAV gets margin Γ_dis + age_margin_speed_mps·age (its UAV may
+  /// have replanned since and moved at up to this speed), ≥ 0.
+  double age_margin_speed_mps = 5.0;
+  /// Distance (m) kept from the worker's predicted (mid-body) position, > 0.
+  double worker_safety_distance_m = 3.0;
+  /// Extra distance (m) added to the inter-UAV and worker half-spaces in the QP only, so that
+  /// the trajectory between samples still verifies, ≥ 0.
+  double qp_distance_buffer_m = 0.15;
+  /// ProxQP absolute accuracy and iteration limit.
+  double qp_eps_abs = 1e-6;
+  int qp_max_iterations = 4000;
+
+  // --- camera heading / pitch -------------------------------------------------------------
+  /// Solver of the camera angles (camera_tracking.hpp): the closed-form rate-limited filter
+  /// (default: same line-of-sight error as Ceres in bench_planner at 1/2000 of the time,
+  /// docs/planning.md §6.5) or the Ceres least-squares problem.
+  enum class CameraSolver { kFilter, kCeres } camera_solver = CameraSolver::kFilter;
+  double heading_weight = 1.0;            ///< Ceres: line-of-sight residual weight, > 0
+  double heading_smoothness_weight = 2.0; ///< Ceres: angular-acceleration residual weight, ≥ 0
+
+  // --- verification and fallback ------------------------------------------------------------
+  /// Radius (m) of the ball around the UAV that must not touch any occupied voxel *cube*
+  /// (FCL) at every densely sampled point, > 0, ≤ obstacle_clearance_m − √3/2·res.
+  double verify_clearance_m = 0.5;
+  /// Verification points per sample interval (≥ 1; positions, velocities, accelerations are
+  /// evaluated on the cubic Hermite spline between samples).
+  int verify_substeps = 4;
+  /// Relative tolerance of the speed/acceleration checks and absolute (m) of the distance
+  /// checks, ≥ 0.
+  double verify_tolerance = 1e-3;
+  /// The last verified plan may be reused only when it still covers at least this much time
+  /// (s) after t_now, > 0 ...
+  double fallback_min_horizon_s = 2.0;
+  /// ... and its position at t_now lies within this distance (m) of the current state, > 0.
+  double fallback_max_deviation_m = 1.0;
+  /// Wall-clock budget (ms) of one replanning; exceeded → fallback. 0 disables (tests that
+  /// must be deterministic under load).
+  double time_budget_ms = 100.0;
+
+  /// Every problem, each naming the field and its value; empty when valid.
+  std::vector<std::string> validate() const;
+};
+
+/// \brief Reads every key of PlannerConfig (the layout of config/planner.yaml) under
+/// `prefix` ("" or e.g. "planner."). In kError mode every missing key is an error; in
+/// kUseDefaults mode absent keys keep the defaults. Cross-field rules (validate()) are
+/// added to the reader's errors.
+PlannerConfig readPlannerConfig(common::ConfigReader& reader, const std::string& prefix = "");
+
+/// \brief Loads and validates a planner YAML file. Failure lists every problem, one per line.
+common::Result<PlannerConfig> loadPlannerConfig(const std::string& path, common::ConfigReader::MissingKeys mode,
+                                                std::vector<std::string>* warnings = nullptr);
+
+}  // namespace gesture_formation::planning

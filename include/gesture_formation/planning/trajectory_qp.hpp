@@ -1,0 +1,102 @@
+#pragma once
+/// \file
+/// \brief Stage 3 trajectory optimisation as one sparse QP solved by ProxQP
+/// (proxsuite::proxqp::sparse), docs/planning.md §6.
+///
+/// Model: per axis a triple integrator with constant jerk on each interval [t_k, t_{k+1}],
+/// dt fixed. Variables: p_k, v_k, a_k ∈ R³ for k = 1..N (sample 0 is the fixed initial
+/// state), ordered [p_1 v_1 a_1 p_2 …] (9N). Equalities (6N), with j_k = (a_{k+1} − a_k)/dt:
+///   p_{k+1} = p_k + v_k dt + a_k dt²/3 + a_{k+1} dt²/6,   v_{k+1} = v_k + (a_k + a_{k+1}) dt/2.
+/// Cost (×dt, so weights do not depend on the sampling):
+///   Σ_k w_ref‖p_k − r_k‖² + w_acc‖a_k‖² + w_jerk‖(a_k − a_{k−1})/dt‖²  + w_term‖v_N‖².
+/// Inequalities (all hard):
+///   - position rows a·p_k ≤ b (corridor polytopes, inter-UAV and worker half-spaces);
+///   - velocity in the inner polyhedron V (VelocityPolygon) at every sample *and* at the
+///     middle Bézier control point v_k + a_k dt/2 of every interval — v(t) is a quadratic
+///     Bézier on each interval, so it stays in V between samples too;
+///   - acceleration in the inner polyhedron A at every sample (a(t) is linear in between).
+/// Thread safety: not thread-safe (keeps the warm start).
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+namespace gesture_formation::planning {
+
+/// \brief Inner polyhedral approximation of {‖x‖ ≤ max_norm, |x_z| ≤ max_vertical}: |x_z| ≤
+/// max_vertical and (x, y) in the regular octagon inscribed in the disc of radius
+/// r = sqrt(max_norm² − max_vertical²) (apothem r cos(π/8)). Every point of it satisfies
+/// ‖x‖ ≤ max_norm; it contains the ball of radius min(r cos(π/8), max_vertical).
+struct NormPolygon {
+  double max_norm = 1.0;
+  double max_vertical = 0.5;
+  /// Rows d·x ∈ [−h, h]: directions (unit) and half-widths h.
+  static constexpr int kRows = 5;
+  Eigen::Matrix<double, kRows, 3> directions() const;
+  Eigen::Matrix<double, kRows, 1> halfWidths() const;
+  bool contains(const Eigen::Vector3d& x, double tolerance = 0.0) const;
+};
+
+/// \brief One linear constraint on the position of sample k (1 ≤ k ≤ N): a·p_k ≤ b.
+struct PositionConstraint {
+  int sample = 1;
+  Eigen::Vector3d a = Eigen::Vector3d::UnitX();
+  double b = 0.0;
+  enum class Kind { kCorridor, kUav, kWorker } kind = Kind::kCorridor;
+};
+
+struct TrajectoryQpProblem {
+  double dt_s = 0.2;
+  int intervals = 0;  ///< N ≥ 1
+  Eigen::Vector3d p0 = Eigen::Vector3d::Zero(), v0 = Eigen::Vector3d::Zero(), a0 = Eigen::Vector3d::Zero();
+  /// r_k for k = 0..N (index 0 unused), world frame [m].
+  std::vector<Eigen::Vector3d> reference;
+  std::vector<PositionConstraint> constraints;
+  NormPolygon velocity;
+  NormPolygon acceleration;
+  double w_reference = 1.0, w_acceleration = 0.05, w_jerk = 0.01, w_terminal_velocity = 1.0;
+  double eps_abs = 1e-6;
+  int max_iterations = 4000;
+};
+
+struct TrajectoryQpSolution {
+  enum class Status { kSolved, kInfeasible, kMaxIterations, kNumerical, kBadInput } status = Status::kBadInput;
+  std::string reason;  ///< empty when solved
+  /// p, v, a for k = 0..N (index 0 = the initial state).
+  std::vector<Eigen::Vector3d> p, v, a;
+  int variables = 0, equalities = 0, inequalities = 0, iterations = 0;
+  double primal_residual = 0.0;  ///< max constraint violation of the returned x (ProxQP's scale)
+  double objective = 0.0;
+  bool warm_started = false;
+  bool solved() const { return status == Status::kSolved; }
+};
+
+/// \brief The assembled QP in ProxQP's form: min ½xᵀHx + gᵀx s.t. Ax = b, l ≤ Cx ≤ u
+/// (±1e20 = no bound), x = [p_1 v_1 a_1 … p_N v_N a_N]. The constant of the cost is
+/// `cost_constant` (so TrajectoryQp::cost = ½xᵀHx + gᵀx + cost_constant).
+struct QpMatrices {
+  Eigen::SparseMatrix<double> H, A, C;
+  Eigen::VectorXd g, b, l, u;
+  double cost_constant = 0.0;
+};
+
+/// \brief Assembles and solves the QP. `warm` (optional): a guess of p, v, a for k = 0..N
+/// (e.g. the previous plan re-timed), used as ProxQP's primal warm start.
+class TrajectoryQp {
+ public:
+  TrajectoryQpSolution solve(const TrajectoryQpProblem& problem, const TrajectoryQpSolution* warm = nullptr) const;
+  /// \brief The matrices solve() hands to ProxQP (problem must be valid: see solve()).
+  static QpMatrices assemble(const TrajectoryQpProblem& problem);
+
+  /// \brief Worst violation of every constraint of `problem` (dynamics equalities, rows,
+  /// velocity/acceleration polyhedra incl. the Bézier points) by p, v, a: ≤ 0 when all hold.
+  static double maxViolation(const TrajectoryQpProblem& problem, const std::vector<Eigen::Vector3d>& p,
+                             const std::vector<Eigen::Vector3d>& v, const std::vector<Eigen::Vector3d>& a);
+  /// \brief The objective ½xᵀHx + gᵀx + const (the cost above) of p, v, a.
+  static double cost(const TrajectoryQpProblem& problem, const std::vector<Eigen::Vector3d>& p,
+                     const std::vector<Eigen::Vector3d>& v, const std::vector<Eigen::Vector3d>& a);
+};
+
+}  // namespace gesture_formation::planning

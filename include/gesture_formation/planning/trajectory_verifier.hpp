@@ -1,0 +1,74 @@
+#pragma once
+/// \file
+/// \brief Verification of a planned trajectory before it may be executed (docs/planning.md
+/// §7). The continuous trajectory is the cubic Hermite spline through the samples' p and v
+/// (for the QP's constant-jerk output it is exactly the planned curve); it is evaluated at
+/// `substeps` points per interval, sample times included, and every point must have:
+///   - finite p, v, a, heading, pitch;
+///   - no occupied voxel cube within clearance_m (distance field first — its value minus the
+///     voxel half-diagonal is a lower bound of the distance to the cubes — and FCL's exact
+///     ball/cube test where the field cannot decide);
+///   - ‖v‖ ≤ max_speed, |v_z| ≤ max_vertical_speed, ‖a‖ ≤ max_acceleration, |a_z| ≤ max
+///     vertical acceleration (relative tolerance), heading/pitch steps within their rate limits;
+///   - distance ≥ Γ_dis + age_margin_speed·age to every other plan at the same time;
+///   - distance ≥ worker_safety_distance_m to the worker's predicted position.
+/// On the first interval [t0, t0+dt], which starts from the measured state, a limit the state
+/// itself already violates only has to not get worse (min(limit, value at t0)).
+/// Thread safety: not thread-safe (FCL).
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "gesture_formation/formation/formation_geometry.hpp"
+#include "gesture_formation/planning/distance_field.hpp"
+#include "gesture_formation/planning/occupancy_map.hpp"
+#include "gesture_formation/planning/planner_config.hpp"
+#include "gesture_formation/planning/uav_planner.hpp"
+
+namespace gesture_formation::planning {
+
+/// \brief Position, velocity, acceleration of the Hermite spline at time t (clamped to the
+/// trajectory; after the end: the last position, hovering).
+struct TrajectoryPoint {
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();
+  Eigen::Vector3d a = Eigen::Vector3d::Zero();
+};
+TrajectoryPoint evaluateTrajectory(const PlannedTrajectory& trajectory, double t_s);
+
+/// \brief The worker's predicted position at time t: linear interpolation of the horizon whose
+/// step k is at t0_s + k·dt_s (clamped at both ends).
+Eigen::Vector3d workerPositionAt(const formation::WorkerHorizon& worker, double t0_s, double dt_s, double t_s);
+
+struct VerificationReport {
+  bool ok = false;
+  std::string reason;  ///< first failure, with time and values; empty when ok
+  double min_obstacle_clearance_m = 0.0;  ///< lower bound of the distance to the voxel cubes
+  double min_uav_margin_m = 0.0;          ///< min over other plans of (distance − required)
+  double min_worker_distance_m = 0.0;
+  double max_speed_mps = 0.0;
+  double max_acceleration_mps2 = 0.0;
+};
+
+class TrajectoryVerifier {
+ public:
+  TrajectoryVerifier(const OccupancyMap& map, const DistanceField& field, const PlannerConfig& config);
+  ~TrajectoryVerifier();
+  TrajectoryVerifier(const TrajectoryVerifier&) = delete;
+  TrajectoryVerifier& operator=(const TrajectoryVerifier&) = delete;
+
+  /// \brief Checks `trajectory` from its t0 to its end. `t_now_s` dates the other plans (age
+  /// = t_now − their t0). `worker` may have 0 steps (no worker).
+  VerificationReport verify(const PlannedTrajectory& trajectory, double t_now_s, const std::vector<PlannedTrajectory>& others,
+                            const formation::WorkerHorizon& worker, double worker_t0_s, double worker_dt_s) const;
+
+ private:
+  const OccupancyMap& map_;
+  const DistanceField& field_;
+  PlannerConfig config_;
+  FclClearance fcl_;
+};
+
+}  // namespace gesture_formation::planning

@@ -1,0 +1,292 @@
+// gfctl plan --problem problem.json --out traj.csv [--json timings.json] [--dump-qp qp.json]
+// One replanning of one UAV (docs/planning.md §9). The problem file is JSON (read with
+// yaml-cpp, a YAML 1.2 superset of JSON, through common::ConfigReader, so that every bad or
+// missing field is reported at once as "problem.json: key: message").
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include "commands.hpp"
+#include "gesture_formation/common/config_reader.hpp"
+#include "gesture_formation/common/csv.hpp"
+#include "gesture_formation/formation/formation_config.hpp"
+#include "gesture_formation/formation/formation_geometry.hpp"
+#include "gesture_formation/planning/distance_field.hpp"
+#include "gesture_formation/planning/occupancy_map.hpp"
+#include "gesture_formation/planning/scenario.hpp"
+#include "gesture_formation/planning/trajectory_qp.hpp"
+#include "gesture_formation/planning/uav_planner.hpp"
+
+namespace gesture_formation::gfctl {
+
+namespace {
+int cmdPlan(const Args& args);
+const Registrar kRegistrar{
+    "plan",
+    "--problem problem.json --out traj.csv [--json result.json] [--dump-qp qp.json]   one replanning of one UAV (docs/planning.md 9)",
+    cmdPlan};
+
+using common::ConfigReader;
+using common::Range;
+
+std::string resolve(const std::string& base_file, const std::string& path) {
+  if (path.empty() || path[0] == '/') return path;
+  const auto slash = base_file.find_last_of('/');
+  return slash == std::string::npos ? path : base_file.substr(0, slash + 1) + path;
+}
+
+Eigen::Vector3d readVec3(ConfigReader& r, const std::string& key, bool required) {
+  std::vector<double> v{0.0, 0.0, 0.0};
+  if (required || r.has(key)) r.readDoubleList(key, v, 3, 3, Range::any());
+  return v.size() == 3 ? Eigen::Vector3d(v[0], v[1], v[2]) : Eigen::Vector3d::Zero();
+}
+
+std::string num(double v) {
+  if (!std::isfinite(v)) return "null";
+  std::ostringstream os;
+  os << std::setprecision(17) << v;
+  return os.str();
+}
+
+void writeSparse(std::ostream& os, const Eigen::SparseMatrix<double>& m) {
+  // [[row, col, value], ...] with the shape separately.
+  os << "{\"rows\": " << m.rows() << ", \"cols\": " << m.cols() << ", \"entries\": [";
+  bool first = true;
+  for (int k = 0; k < m.outerSize(); ++k) {
+    for (Eigen::SparseMatrix<double>::InnerIterator it(m, k); it; ++it) {
+      os << (first ? "" : ", ") << "[" << it.row() << ", " << it.col() << ", " << num(it.value()) << "]";
+      first = false;
+    }
+  }
+  os << "]}";
+}
+
+void writeVector(std::ostream& os, const Eigen::VectorXd& v) {
+  os << "[";
+  for (int i = 0; i < v.size(); ++i) os << (i ? ", " : "") << (std::abs(v(i)) >= 1e20 ? (v(i) > 0 ? "1e20" : "-1e20") : num(v(i)));
+  os << "]";
+}
+
+int cmdPlan(const Args& args) {
+  if (!checkOptions(args, {"problem", "out"}, {"json", "dump-qp"})) return kExitBadInput;
+  const std::string problem_path = args.get("problem");
+  {
+    std::ifstream probe(problem_path);
+    if (!probe) return badInput(args, problem_path + ": cannot open");
+  }
+  ConfigReader r = ConfigReader::fromFile(problem_path, ConfigReader::MissingKeys::kError);
+  std::string scenario_file;
+  r.readString("scenario", scenario_file);
+  planning::PlanRequest req;
+  r.readInt("uav_index", req.uav_index, Range::atLeast(0));
+  r.readDouble("t_now_s", req.t_now_s, Range::any());
+  r.readDouble("dt_s", req.dt_s, Range::positive());
+  int steps = 41;
+  r.readInt("steps", steps, Range::closed(2, formation::kMaxHorizonSteps));
+  req.state.t_s = req.t_now_s;
+  req.state.p_world = readVec3(r, "state.p", true);
+  req.state.v_world = readVec3(r, "state.v", false);
+  req.state.a_world = readVec3(r, "state.a", false);
+  if (r.has("state.heading_rad")) r.readDouble("state.heading_rad", req.state.heading_rad, Range::any());
+  if (r.has("state.pitch_rad")) r.readDouble("state.pitch_rad", req.state.pitch_rad, Range::any());
+  // The worker: constant-velocity prediction over the horizon (DESIGN §3).
+  const Eigen::Vector3d worker_p = readVec3(r, "worker.p", true);
+  const Eigen::Vector3d worker_v = readVec3(r, "worker.v", false);
+  double worker_heading = 0.0;
+  if (r.has("worker.heading_rad")) r.readDouble("worker.heading_rad", worker_heading, Range::any());
+  if (!r.ok()) {
+    std::cerr << "gfctl plan: invalid problem:\n" << r.errorReport();
+    return kExitBadInput;
+  }
+  req.worker.p_world.resize(3, steps);
+  req.worker.heading_rad.resize(1, steps);
+  for (int k = 0; k < steps; ++k) {
+    req.worker.p_world.col(k) = worker_p + worker_v * (k * req.dt_s);
+    req.worker.heading_rad(k) = worker_heading;
+  }
+  // Reference: explicit rows [x, y, z, heading, pitch], or the formation's (stage 1).
+  if (r.has("reference")) {
+    int rows = 0;
+    while (r.has("reference[" + std::to_string(rows) + "]")) ++rows;
+    if (rows != steps) {
+      r.addError("reference", "has " + std::to_string(rows) + " rows, steps is " + std::to_string(steps));
+    } else {
+      req.reference.resize(steps);
+      for (int k = 0; k < steps; ++k) {
+        std::vector<double> row{0, 0, 0, 0, 0};
+        r.readDoubleList("reference[" + std::to_string(k) + "]", row, 5, 5, Range::any());
+        if (row.size() == 5) {
+          req.reference.p_world.col(k) = Eigen::Vector3d(row[0], row[1], row[2]);
+          req.reference.heading_rad(k) = row[3];
+          req.reference.pitch_rad(k) = row[4];
+        }
+      }
+    }
+  } else {
+    std::string formation_file;
+    r.readString("formation", formation_file);  // missing → error naming both options
+    if (r.ok()) {
+      const std::string fpath = resolve(problem_path, formation_file);
+      const auto fc = formation::loadFormationConfig(fpath, ConfigReader::MissingKeys::kUseDefaults);
+      if (!fc) {
+        std::cerr << "gfctl plan: invalid formation config " << fpath << ":\n" << fc.reason();
+        return kExitBadInput;
+      }
+      if (!fc->params.hasUav(req.uav_index)) {
+        r.addError("uav_index", "is " + std::to_string(req.uav_index) + " but the formation has " +
+                                    std::to_string(fc->params.uavCount()) + " UAVs");
+      } else {
+        std::vector<formation::ReferenceTrajectory> refs;
+        formation::formationHorizon(req.worker, fc->params, nullptr, refs);
+        req.reference = refs[static_cast<std::size_t>(req.uav_index)];
+      }
+    }
+  }
+  // Other (higher-priority) plans: samples [x, y, z, vx, vy, vz] (velocities optional → 0).
+  for (int j = 0; r.has("other_plans[" + std::to_string(j) + "]"); ++j) {
+    const std::string key = "other_plans[" + std::to_string(j) + "]";
+    planning::PlannedTrajectory p;
+    r.readInt(key + ".uav_index", p.uav_index, Range::atLeast(0));
+    r.readDouble(key + ".t0_s", p.t0_s, Range::any());
+    r.readDouble(key + ".dt_s", p.dt_s, Range::positive());
+    for (int k = 0; r.has(key + ".samples[" + std::to_string(k) + "]"); ++k) {
+      std::vector<double> row;
+      r.readDoubleList(key + ".samples[" + std::to_string(k) + "]", row, 3, 6, Range::any());
+      if (row.size() != 3 && row.size() != 6) {
+        if (!row.empty()) r.addError(key + ".samples[" + std::to_string(k) + "]", "needs 3 or 6 numbers");
+        continue;
+      }
+      planning::TrajectorySample s;
+      s.p_world = Eigen::Vector3d(row[0], row[1], row[2]);
+      if (row.size() == 6) s.v_world = Eigen::Vector3d(row[3], row[4], row[5]);
+      p.samples.push_back(s);
+    }
+    if (p.samples.empty()) r.addError(key + ".samples", "missing or empty");
+    req.higher_priority_plans.push_back(p);
+  }
+  planning::PlannerConfig config;
+  if (r.has("planner_config")) {
+    std::string cfg_file;
+    r.readString("planner_config", cfg_file);
+    const std::string cpath = resolve(problem_path, cfg_file);
+    std::vector<std::string> warnings;
+    const auto c = planning::loadPlannerConfig(cpath, ConfigReader::MissingKeys::kUseDefaults, &warnings);
+    for (const auto& w : warnings) std::cerr << "gfctl plan: warning: " << w << "\n";
+    if (!c) {
+      std::cerr << "gfctl plan: invalid planner config " << cpath << ":\n" << c.reason();
+      return kExitBadInput;
+    }
+    config = *c;
+  }
+  for (const auto& k : r.unusedKeys()) std::cerr << "gfctl plan: warning: " << problem_path << ": unknown key '" << k << "' ignored\n";
+  if (!r.ok()) {
+    std::cerr << "gfctl plan: invalid problem:\n" << r.errorReport();
+    return kExitBadInput;
+  }
+  // Non-finite numbers are accepted by the reader's "any" range only if finite; NaN given as
+  // .nan in YAML is rejected there. The planner still checks everything (fallback on bad).
+
+  const std::string scenario_path = resolve(problem_path, scenario_file);
+  const auto scenario = planning::loadScenario(scenario_path);
+  if (!scenario) {
+    std::cerr << "gfctl plan: invalid scenario " << scenario_path << ":\n" << scenario.reason();
+    return kExitBadInput;
+  }
+  const auto t_map = std::chrono::steady_clock::now();
+  auto map = planning::OccupancyMap::fromScenario(*scenario);
+  if (!map) return badInput(args, scenario_path + ": " + map.reason());
+  auto map_ptr = std::make_shared<const planning::OccupancyMap>(std::move(map.value()));
+  auto field = std::make_shared<const planning::DistanceField>(*map_ptr);
+  const double map_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_map).count();
+
+  planning::UavPlanner planner(config, map_ptr, field);
+  if (!planner.configError().empty()) return badInput(args, "planner config: " + planner.configError());
+  planner.keepLastQp(args.has("dump-qp"));
+  const planning::PlanResult res = planner.plan(req);
+
+  std::ofstream out(args.get("out"));
+  if (!out) return badInput(args, args.get("out") + ": cannot open for writing");
+  out << "t,x,y,z,vx,vy,vz,ax,ay,az,heading,pitch\n";
+  const auto& tr = res.trajectory;
+  for (std::size_t k = 0; k < tr.samples.size(); ++k) {
+    const auto& s = tr.samples[k];
+    out << common::formatDouble(tr.t0_s + static_cast<double>(k) * tr.dt_s);
+    for (const Eigen::Vector3d* v : {&s.p_world, &s.v_world, &s.a_world}) {
+      for (int i = 0; i < 3; ++i) out << ',' << common::formatDouble((*v)(i));
+    }
+    out << ',' << common::formatDouble(s.heading_rad) << ',' << common::formatDouble(s.pitch_rad) << '\n';
+  }
+  out.flush();
+  if (!out) return badInput(args, args.get("out") + ": write failed");
+
+  const auto& T = res.timings;
+  std::ostringstream js;
+  js << "{\"status\": \"" << planning::toString(res.status) << "\", \"reason\": \"";
+  for (char c : res.reason) js << (c == '"' || c == '\\' ? std::string("\\") + c : std::string(1, c));
+  js << "\", \"verified\": " << (res.verified ? "true" : "false") << ", \"timings_ms\": {\"path\": " << num(T.path_ms)
+     << ", \"corridor\": " << num(T.corridor_ms) << ", \"qp\": " << num(T.qp_ms) << ", \"heading\": " << num(T.heading_ms)
+     << ", \"verify\": " << num(T.verify_ms) << ", \"total\": " << num(T.total_ms) << ", \"map_build\": " << num(map_ms)
+     << "}, \"qp\": {\"variables\": " << res.qp_variables << ", \"constraints\": " << res.qp_constraints
+     << ", \"iterations\": " << res.qp_iterations << "}, \"corridors\": " << res.corridor_count
+     << ", \"projected_references\": " << res.projected_references << ", \"path_searches\": " << res.path_searches
+     << ", \"min_obstacle_clearance_m\": " << num(res.min_obstacle_clearance_m)
+     << ", \"min_uav_margin_m\": " << num(res.min_uav_margin_m) << ", \"min_worker_distance_m\": " << num(res.min_worker_distance_m)
+     << "}\n";
+  const std::string json_path = args.has("json") ? args.get("json") : args.get("out") + ".json";
+  std::ofstream jout(json_path);
+  if (!jout) return badInput(args, json_path + ": cannot open for writing");
+  jout << js.str();
+  jout.flush();
+  if (!jout) return badInput(args, json_path + ": write failed");
+
+  if (args.has("dump-qp")) {
+    const planning::TrajectoryQpProblem* qp = planner.lastQp();
+    std::ofstream q(args.get("dump-qp"));
+    if (!q) return badInput(args, args.get("dump-qp") + ": cannot open for writing");
+    if (qp == nullptr) {
+      q << "null\n";
+    } else {
+      const planning::QpMatrices m = planning::TrajectoryQp::assemble(*qp);
+      const planning::TrajectoryQpSolution sol = planning::TrajectoryQp().solve(*qp);
+      Eigen::VectorXd x(9 * qp->intervals);
+      for (int k = 1; k <= qp->intervals; ++k) {
+        x.segment<3>(9 * (k - 1)) = sol.p[static_cast<std::size_t>(k)];
+        x.segment<3>(9 * (k - 1) + 3) = sol.v[static_cast<std::size_t>(k)];
+        x.segment<3>(9 * (k - 1) + 6) = sol.a[static_cast<std::size_t>(k)];
+      }
+      q << "{\"H\": ";
+      writeSparse(q, m.H);
+      q << ", \"g\": ";
+      writeVector(q, m.g);
+      q << ", \"A\": ";
+      writeSparse(q, m.A);
+      q << ", \"b\": ";
+      writeVector(q, m.b);
+      q << ", \"C\": ";
+      writeSparse(q, m.C);
+      q << ", \"l\": ";
+      writeVector(q, m.l);
+      q << ", \"u\": ";
+      writeVector(q, m.u);
+      q << ", \"cost_constant\": " << num(m.cost_constant) << ", \"status\": \"" << (sol.solved() ? "solved" : sol.reason)
+        << "\", \"x\": ";
+      writeVector(q, x);
+      q << ", \"objective\": " << num(sol.objective) << "}\n";
+    }
+    q.flush();
+    if (!q) return badInput(args, args.get("dump-qp") + ": write failed");
+  }
+
+  std::cout << "gfctl plan: " << planning::toString(res.status) << (res.reason.empty() ? "" : " (" + res.reason + ")") << "; "
+            << tr.samples.size() << " samples; path " << T.path_ms << " ms, corridors " << T.corridor_ms << " ms ("
+            << res.corridor_count << "), QP " << T.qp_ms << " ms (" << res.qp_variables << " variables, " << res.qp_constraints
+            << " constraints, " << res.qp_iterations << " iterations), camera " << T.heading_ms << " ms, verify "
+            << T.verify_ms << " ms, total " << T.total_ms << " ms (map build " << map_ms << " ms)\n";
+  return kExitOk;
+}
+}  // namespace
+
+}  // namespace gesture_formation::gfctl

@@ -1,0 +1,339 @@
+#include "gesture_formation/planning/trajectory_qp.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include <Eigen/Sparse>
+#include <proxsuite/proxqp/sparse/sparse.hpp>
+
+namespace gesture_formation::planning {
+
+// ---- NormPolygon ------------------------------------------------------------------------
+
+Eigen::Matrix<double, NormPolygon::kRows, 3> NormPolygon::directions() const {
+  const double s = std::sqrt(0.5);
+  Eigen::Matrix<double, kRows, 3> d;
+  d << 1, 0, 0,  //
+      0, 1, 0,   //
+      s, s, 0,   //
+      s, -s, 0,  //
+      0, 0, 1;
+  return d;
+}
+
+Eigen::Matrix<double, NormPolygon::kRows, 1> NormPolygon::halfWidths() const {
+  const double r = std::sqrt(std::max(0.0, max_norm * max_norm - max_vertical * max_vertical));
+  const double apothem = r * std::cos(M_PI / 8.0);
+  Eigen::Matrix<double, kRows, 1> h;
+  h << apothem, apothem, apothem, apothem, max_vertical;
+  return h;
+}
+
+bool NormPolygon::contains(const Eigen::Vector3d& x, double tolerance) const {
+  const Eigen::Matrix<double, kRows, 1> r = directions() * x;
+  return (r.cwiseAbs() - halfWidths()).maxCoeff() <= tolerance;
+}
+
+// ---- QP assembly ---------------------------------------------------------------------------
+
+namespace {
+
+constexpr double kInf = 1e20;  // ProxQP's "no bound"
+
+/// Index of component `axis` of quantity q (0 p, 1 v, 2 a) of sample k ≥ 1.
+inline int var(int k, int q, int axis) { return 9 * (k - 1) + 3 * q + axis; }
+
+using Triplets = std::vector<Eigen::Triplet<double>>;
+
+std::string checkProblem(const TrajectoryQpProblem& pr) {
+  std::ostringstream e;
+  if (!(pr.dt_s > 0.0) || !std::isfinite(pr.dt_s)) e << "dt_s must be > 0, got " << pr.dt_s << "; ";
+  if (pr.intervals < 1) e << "intervals must be >= 1, got " << pr.intervals << "; ";
+  if (static_cast<int>(pr.reference.size()) != pr.intervals + 1) {
+    e << "reference has " << pr.reference.size() << " points, need intervals + 1 = " << pr.intervals + 1 << "; ";
+  }
+  if (!pr.p0.allFinite() || !pr.v0.allFinite() || !pr.a0.allFinite()) e << "initial state is not finite; ";
+  for (std::size_t k = 1; k < pr.reference.size(); ++k) {
+    if (!pr.reference[k].allFinite()) {
+      e << "reference[" << k << "] is not finite; ";
+      break;
+    }
+  }
+  for (std::size_t i = 0; i < pr.constraints.size(); ++i) {
+    const auto& c = pr.constraints[i];
+    if (c.sample < 1 || c.sample > pr.intervals || !c.a.allFinite() || !std::isfinite(c.b)) {
+      e << "constraint " << i << " (sample " << c.sample << ") is invalid; ";
+      break;
+    }
+  }
+  if (!(pr.w_reference > 0.0) || pr.w_acceleration < 0.0 || pr.w_jerk < 0.0 || pr.w_terminal_velocity < 0.0) {
+    e << "weights must be >= 0 (reference > 0); ";
+  }
+  return e.str();
+}
+
+}  // namespace
+
+double TrajectoryQp::maxViolation(const TrajectoryQpProblem& pr, const std::vector<Eigen::Vector3d>& p,
+                                  const std::vector<Eigen::Vector3d>& v, const std::vector<Eigen::Vector3d>& a) {
+  const int N = pr.intervals;
+  const double dt = pr.dt_s;
+  double worst = -std::numeric_limits<double>::infinity();
+  const auto upd = [&worst](double x) { worst = std::max(worst, std::isfinite(x) ? x : std::numeric_limits<double>::infinity()); };
+  upd((p[0] - pr.p0).cwiseAbs().maxCoeff());
+  upd((v[0] - pr.v0).cwiseAbs().maxCoeff());
+  upd((a[0] - pr.a0).cwiseAbs().maxCoeff());
+  for (int k = 0; k < N; ++k) {
+    const Eigen::Vector3d ep = p[k + 1] - (p[k] + v[k] * dt + a[k] * (dt * dt / 3.0) + a[k + 1] * (dt * dt / 6.0));
+    const Eigen::Vector3d ev = v[k + 1] - (v[k] + (a[k] + a[k + 1]) * (dt / 2.0));
+    upd(ep.cwiseAbs().maxCoeff());
+    upd(ev.cwiseAbs().maxCoeff());
+  }
+  for (const auto& c : pr.constraints) upd(c.a.dot(p[c.sample]) - c.b);
+  const auto dv = pr.velocity.directions();
+  const auto hv = pr.velocity.halfWidths();
+  const auto da = pr.acceleration.directions();
+  const auto ha = pr.acceleration.halfWidths();
+  for (int k = 1; k <= N; ++k) {
+    upd(((dv * v[k]).cwiseAbs() - hv).maxCoeff());
+    if (k < N) upd(((dv * (v[k] + a[k] * (dt / 2.0))).cwiseAbs() - hv).maxCoeff());
+    upd(((da * a[k]).cwiseAbs() - ha).maxCoeff());
+  }
+  return worst;
+}
+
+double TrajectoryQp::cost(const TrajectoryQpProblem& pr, const std::vector<Eigen::Vector3d>& p,
+                          const std::vector<Eigen::Vector3d>& v, const std::vector<Eigen::Vector3d>& a) {
+  const double dt = pr.dt_s;
+  double c = 0.0;
+  for (int k = 1; k <= pr.intervals; ++k) {
+    c += dt * (pr.w_reference * (p[k] - pr.reference[k]).squaredNorm() + pr.w_acceleration * a[k].squaredNorm() +
+               pr.w_jerk * ((a[k] - a[k - 1]) / dt).squaredNorm());
+  }
+  c += pr.w_terminal_velocity * v[pr.intervals].squaredNorm();
+  return c;
+}
+
+QpMatrices TrajectoryQp::assemble(const TrajectoryQpProblem& pr) {
+  const int N = pr.intervals;
+  const double dt = pr.dt_s;
+  const int n = 9 * N;
+  const int n_eq = 6 * N;
+  const int n_poly = NormPolygon::kRows;
+  const int n_in = static_cast<int>(pr.constraints.size()) + n_poly * (N + (N - 1) + N);
+  QpMatrices m;
+
+  // Cost: ½xᵀHx + gᵀx; a term c‖Mx − m‖² adds 2c MᵀM to H and −2c Mᵀm to g.
+  Triplets ht;
+  ht.reserve(static_cast<std::size_t>(n) * 3);
+  Eigen::VectorXd& g = m.g;
+  g = Eigen::VectorXd::Zero(n);
+  const double wr = 2.0 * dt * pr.w_reference;
+  const double wa = 2.0 * dt * pr.w_acceleration;
+  const double wj = 2.0 * pr.w_jerk / dt;  // dt·w/dt² per ‖Δa‖²
+  const double wt = 2.0 * pr.w_terminal_velocity;
+  for (int k = 1; k <= N; ++k) {
+    for (int i = 0; i < 3; ++i) {
+      ht.emplace_back(var(k, 0, i), var(k, 0, i), wr);
+      g(var(k, 0, i)) -= wr * pr.reference[k](i);
+      // acceleration + jerk (a_k − a_{k−1}); a_0 is fixed.
+      const bool last = k == N;
+      ht.emplace_back(var(k, 2, i), var(k, 2, i), wa + wj * (last ? 1.0 : 2.0));
+      if (k > 1) {
+        ht.emplace_back(var(k, 2, i), var(k - 1, 2, i), -wj);
+        ht.emplace_back(var(k - 1, 2, i), var(k, 2, i), -wj);
+      } else {
+        g(var(k, 2, i)) -= wj * pr.a0(i);
+      }
+      if (last) ht.emplace_back(var(k, 1, i), var(k, 1, i), wt);
+    }
+  }
+  m.H.resize(n, n);
+  m.H.setFromTriplets(ht.begin(), ht.end());
+
+  // Dynamics equalities.
+  Triplets at;
+  at.reserve(static_cast<std::size_t>(n_eq) * 5);
+  Eigen::VectorXd& b = m.b;
+  b = Eigen::VectorXd::Zero(n_eq);
+  int row = 0;
+  for (int k = 0; k < N; ++k) {
+    for (int i = 0; i < 3; ++i) {
+      // p_{k+1} − p_k − v_k dt − a_k dt²/3 − a_{k+1} dt²/6 = 0
+      at.emplace_back(row, var(k + 1, 0, i), 1.0);
+      at.emplace_back(row, var(k + 1, 2, i), -dt * dt / 6.0);
+      if (k == 0) {
+        b(row) = pr.p0(i) + pr.v0(i) * dt + pr.a0(i) * dt * dt / 3.0;
+      } else {
+        at.emplace_back(row, var(k, 0, i), -1.0);
+        at.emplace_back(row, var(k, 1, i), -dt);
+        at.emplace_back(row, var(k, 2, i), -dt * dt / 3.0);
+      }
+      ++row;
+      // v_{k+1} − v_k − (a_k + a_{k+1}) dt/2 = 0
+      at.emplace_back(row, var(k + 1, 1, i), 1.0);
+      at.emplace_back(row, var(k + 1, 2, i), -dt / 2.0);
+      if (k == 0) {
+        b(row) = pr.v0(i) + pr.a0(i) * dt / 2.0;
+      } else {
+        at.emplace_back(row, var(k, 1, i), -1.0);
+        at.emplace_back(row, var(k, 2, i), -dt / 2.0);
+      }
+      ++row;
+    }
+  }
+  m.A.resize(n_eq, n);
+  m.A.setFromTriplets(at.begin(), at.end());
+
+  // Inequalities l ≤ Cx ≤ u.
+  Triplets ct;
+  ct.reserve(static_cast<std::size_t>(n_in) * 6);
+  Eigen::VectorXd& l = m.l;
+  Eigen::VectorXd& u = m.u;
+  l = Eigen::VectorXd::Constant(n_in, -kInf);
+  u = Eigen::VectorXd::Constant(n_in, kInf);
+  row = 0;
+  for (const auto& c : pr.constraints) {
+    for (int i = 0; i < 3; ++i) {
+      if (c.a(i) != 0.0) ct.emplace_back(row, var(c.sample, 0, i), c.a(i));
+    }
+    u(row) = c.b;
+    ++row;
+  }
+  const auto dv = pr.velocity.directions();
+  const auto hv = pr.velocity.halfWidths();
+  const auto da = pr.acceleration.directions();
+  const auto ha = pr.acceleration.halfWidths();
+  for (int k = 1; k <= N; ++k) {
+    for (int r = 0; r < n_poly; ++r) {
+      for (int i = 0; i < 3; ++i) {
+        if (dv(r, i) != 0.0) ct.emplace_back(row, var(k, 1, i), dv(r, i));
+      }
+      l(row) = -hv(r);
+      u(row) = hv(r);
+      ++row;
+      if (k < N) {  // middle Bézier control point of v on [t_k, t_{k+1}]
+        for (int i = 0; i < 3; ++i) {
+          if (dv(r, i) != 0.0) {
+            ct.emplace_back(row, var(k, 1, i), dv(r, i));
+            ct.emplace_back(row, var(k, 2, i), dv(r, i) * dt / 2.0);
+          }
+        }
+        l(row) = -hv(r);
+        u(row) = hv(r);
+        ++row;
+      }
+      for (int i = 0; i < 3; ++i) {
+        if (da(r, i) != 0.0) ct.emplace_back(row, var(k, 2, i), da(r, i));
+      }
+      l(row) = -ha(r);
+      u(row) = ha(r);
+      ++row;
+    }
+  }
+  m.C.resize(n_in, n);
+  m.C.setFromTriplets(ct.begin(), ct.end());
+
+  // Constant of the cost: Σ dt·w_ref‖r_k‖² + dt·w_jerk‖a_0/dt‖² (the a_1 − a_0 term).
+  for (int k = 1; k <= N; ++k) m.cost_constant += dt * pr.w_reference * pr.reference[static_cast<std::size_t>(k)].squaredNorm();
+  m.cost_constant += pr.w_jerk / dt * pr.a0.squaredNorm();
+  return m;
+}
+
+TrajectoryQpSolution TrajectoryQp::solve(const TrajectoryQpProblem& pr, const TrajectoryQpSolution* warm) const {
+  TrajectoryQpSolution out;
+  const std::string bad = checkProblem(pr);
+  if (!bad.empty()) {
+    out.status = TrajectoryQpSolution::Status::kBadInput;
+    out.reason = "QP input: " + bad.substr(0, bad.size() - 2);
+    return out;
+  }
+  const int N = pr.intervals;
+  const int n = 9 * N;
+  const QpMatrices m = assemble(pr);
+  const int n_eq = static_cast<int>(m.b.size());
+  const int n_in = static_cast<int>(m.l.size());
+  out.variables = n;
+  out.equalities = n_eq;
+  out.inequalities = n_in;
+  const auto& H = m.H;
+  const auto& g = m.g;
+  const auto& A = m.A;
+  const auto& b = m.b;
+  const auto& C = m.C;
+  const auto& l = m.l;
+  const auto& u = m.u;
+
+  namespace pq = proxsuite::proxqp;
+  pq::sparse::QP<double, int> qp(n, n_eq, n_in);
+  qp.settings.eps_abs = pr.eps_abs;
+  qp.settings.eps_rel = 0.0;
+  qp.settings.max_iter = pr.max_iterations;
+  qp.settings.verbose = false;
+  qp.settings.compute_timings = false;
+  qp.init(H, g, A, b, C, l, u);
+  if (warm != nullptr && static_cast<int>(warm->p.size()) == N + 1 && static_cast<int>(warm->v.size()) == N + 1 &&
+      static_cast<int>(warm->a.size()) == N + 1) {
+    Eigen::VectorXd x0(n);
+    bool finite = true;
+    for (int k = 1; k <= N; ++k) {
+      x0.segment<3>(var(k, 0, 0)) = warm->p[k];
+      x0.segment<3>(var(k, 1, 0)) = warm->v[k];
+      x0.segment<3>(var(k, 2, 0)) = warm->a[k];
+    }
+    finite = x0.allFinite();
+    if (finite) {
+      qp.solve(x0, proxsuite::nullopt, proxsuite::nullopt);
+      out.warm_started = true;
+    } else {
+      qp.solve();
+    }
+  } else {
+    qp.solve();
+  }
+  out.iterations = static_cast<int>(qp.results.info.iter);
+  const Eigen::VectorXd& x = qp.results.x;
+  out.p.assign(N + 1, pr.p0);
+  out.v.assign(N + 1, pr.v0);
+  out.a.assign(N + 1, pr.a0);
+  for (int k = 1; k <= N; ++k) {
+    out.p[k] = x.segment<3>(var(k, 0, 0));
+    out.v[k] = x.segment<3>(var(k, 1, 0));
+    out.a[k] = x.segment<3>(var(k, 2, 0));
+  }
+  out.primal_residual = maxViolation(pr, out.p, out.v, out.a);
+  out.objective = cost(pr, out.p, out.v, out.a);
+  switch (qp.results.info.status) {
+    case pq::QPSolverOutput::PROXQP_SOLVED:
+      out.status = TrajectoryQpSolution::Status::kSolved;
+      break;
+    case pq::QPSolverOutput::PROXQP_PRIMAL_INFEASIBLE:
+    case pq::QPSolverOutput::PROXQP_SOLVED_CLOSEST_PRIMAL_FEASIBLE:
+      out.status = TrajectoryQpSolution::Status::kInfeasible;
+      out.reason = "QP primal infeasible";
+      break;
+    case pq::QPSolverOutput::PROXQP_MAX_ITER_REACHED:
+      out.status = TrajectoryQpSolution::Status::kMaxIterations;
+      out.reason = "QP reached " + std::to_string(pr.max_iterations) + " iterations";
+      break;
+    default:
+      out.status = TrajectoryQpSolution::Status::kNumerical;
+      out.reason = "QP solver failed";
+      break;
+  }
+  if (out.solved() && !x.allFinite()) {
+    out.status = TrajectoryQpSolution::Status::kNumerical;
+    out.reason = "QP solution is not finite";
+  }
+  // ProxQP's criterion is on the equilibrated problem; insist on the original scale too.
+  if (out.solved() && !(out.primal_residual <= 100.0 * pr.eps_abs + 1e-9)) {
+    std::ostringstream os;
+    os << "QP solution violates a constraint by " << out.primal_residual;
+    out.status = TrajectoryQpSolution::Status::kNumerical;
+    out.reason = os.str();
+  }
+  return out;
+}
+
+}  // namespace gesture_formation::planning

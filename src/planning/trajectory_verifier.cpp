@@ -1,0 +1,177 @@
+#include "gesture_formation/planning/trajectory_verifier.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "gesture_formation/common/angles.hpp"
+
+namespace gesture_formation::planning {
+
+TrajectoryPoint evaluateTrajectory(const PlannedTrajectory& tr, double t) {
+  TrajectoryPoint out;
+  if (tr.samples.empty()) return out;
+  const std::size_t n = tr.samples.size();
+  const auto& first = tr.samples.front();
+  out.p = first.p_world;
+  if (n == 1 || !(tr.dt_s > 0.0)) return out;  // a single point: hover there
+  if (!(t > tr.t0_s)) {
+    out.v = first.v_world;
+    out.a = first.a_world;
+    return out;
+  }
+  const double u = (t - tr.t0_s) / tr.dt_s;
+  if (u >= static_cast<double>(n - 1)) {
+    out.p = tr.samples.back().p_world;
+    if (u <= static_cast<double>(n - 1) + 1e-9) {
+      out.v = tr.samples.back().v_world;
+      out.a = tr.samples.back().a_world;
+    }
+    return out;  // after the end: hover
+  }
+  const auto k = static_cast<std::size_t>(std::floor(u));
+  const double s = u - static_cast<double>(k);
+  const double dt = tr.dt_s;
+  const auto& A = tr.samples[k];
+  const auto& B = tr.samples[k + 1];
+  const double s2 = s * s, s3 = s2 * s;
+  out.p = (2 * s3 - 3 * s2 + 1) * A.p_world + (s3 - 2 * s2 + s) * dt * A.v_world + (-2 * s3 + 3 * s2) * B.p_world +
+          (s3 - s2) * dt * B.v_world;
+  out.v = ((6 * s2 - 6 * s) * A.p_world + (-6 * s2 + 6 * s) * B.p_world) / dt + (3 * s2 - 4 * s + 1) * A.v_world +
+          (3 * s2 - 2 * s) * B.v_world;
+  out.a = ((12 * s - 6) * A.p_world + (-12 * s + 6) * B.p_world) / (dt * dt) +
+          ((6 * s - 4) * A.v_world + (6 * s - 2) * B.v_world) / dt;
+  return out;
+}
+
+Eigen::Vector3d workerPositionAt(const formation::WorkerHorizon& w, double t0, double dt, double t) {
+  const int n = w.steps();
+  if (n == 0) return Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  if (n == 1 || !(dt > 0.0) || !(t > t0)) return w.p_world.col(0);
+  const double u = (t - t0) / dt;
+  if (u >= n - 1) return w.p_world.col(n - 1);
+  const int k = static_cast<int>(std::floor(u));
+  const double s = u - k;
+  return (1.0 - s) * w.p_world.col(k) + s * w.p_world.col(k + 1);
+}
+
+TrajectoryVerifier::TrajectoryVerifier(const OccupancyMap& map, const DistanceField& field, const PlannerConfig& config)
+    : map_(map), field_(field), config_(config), fcl_(map) {}
+
+TrajectoryVerifier::~TrajectoryVerifier() = default;
+
+VerificationReport TrajectoryVerifier::verify(const PlannedTrajectory& tr, double t_now, const std::vector<PlannedTrajectory>& others,
+                                              const formation::WorkerHorizon& worker, double worker_t0, double worker_dt) const {
+  VerificationReport rep;
+  const auto fail = [&rep](const std::string& why) {
+    rep.ok = false;
+    if (rep.reason.empty()) rep.reason = why;
+    return rep;
+  };
+  if (tr.samples.size() < 2 || !(tr.dt_s > 0.0) || !std::isfinite(tr.t0_s)) return fail("verify: trajectory has < 2 samples or bad dt/t0");
+  for (std::size_t k = 0; k < tr.samples.size(); ++k) {
+    const auto& s = tr.samples[k];
+    if (!s.p_world.allFinite() || !s.v_world.allFinite() || !s.a_world.allFinite() || !std::isfinite(s.heading_rad) ||
+        !std::isfinite(s.pitch_rad)) {
+      std::ostringstream os;
+      os << "verify: sample " << k << " is not finite";
+      return fail(os.str());
+    }
+  }
+  const DynamicLimits& L = config_.limits;
+  const double rel = 1.0 + config_.verify_tolerance;
+  const double tol = config_.verify_tolerance;
+  const double rho = OccupancyMap::rasterInflation(map_.resolution());
+  // Heading / pitch rate limits between samples.
+  for (std::size_t k = 0; k + 1 < tr.samples.size(); ++k) {
+    const double dh = std::abs(common::wrapAngle(tr.samples[k + 1].heading_rad - tr.samples[k].heading_rad));
+    const double dp = std::abs(tr.samples[k + 1].pitch_rad - tr.samples[k].pitch_rad);
+    if (dh > L.max_heading_rate_radps * tr.dt_s * rel + 1e-9 || dp > L.max_pitch_rate_radps * tr.dt_s * rel + 1e-9) {
+      std::ostringstream os;
+      os << "verify: camera rate limit exceeded between samples " << k << " and " << k + 1 << " (heading step " << dh
+         << " rad, pitch step " << dp << " rad)";
+      return fail(os.str());
+    }
+  }
+  // Required distances to the other plans (age margin) and to the worker.
+  std::vector<double> required(others.size());
+  for (std::size_t j = 0; j < others.size(); ++j) {
+    const double age = std::max(0.0, t_now - others[j].t0_s);
+    required[j] = config_.mutual_distance_m + config_.age_margin_speed_mps * age;
+  }
+  const TrajectoryPoint start = evaluateTrajectory(tr, tr.t0_s);
+  std::vector<double> start_dist(others.size());
+  for (std::size_t j = 0; j < others.size(); ++j) start_dist[j] = (start.p - evaluateTrajectory(others[j], tr.t0_s).p).norm();
+  const bool has_worker = worker.steps() > 0;
+  const double start_worker = has_worker ? (start.p - workerPositionAt(worker, worker_t0, worker_dt, tr.t0_s)).norm() : 0.0;
+  const double start_clear = field_.clearance(start.p) - rho;
+
+  rep.min_obstacle_clearance_m = std::numeric_limits<double>::infinity();
+  rep.min_uav_margin_m = std::numeric_limits<double>::infinity();
+  rep.min_worker_distance_m = std::numeric_limits<double>::infinity();
+  const int sub = config_.verify_substeps;
+  const int intervals = static_cast<int>(tr.samples.size()) - 1;
+  for (int k = 0; k < intervals; ++k) {
+    const bool first = k == 0;
+    const TrajectoryPoint s0 = evaluateTrajectory(tr, tr.t0_s + k * tr.dt_s);
+    for (int q = (k == 0 ? 0 : 1); q <= sub; ++q) {
+      const double t = tr.t0_s + (k + static_cast<double>(q) / sub) * tr.dt_s;
+      TrajectoryPoint x = evaluateTrajectory(tr, t);
+      if (q == sub) {  // the sample itself (exact, avoids the after-end hover rule)
+        const auto& smp = tr.samples[static_cast<std::size_t>(k + 1)];
+        x.p = smp.p_world;
+        x.v = smp.v_world;
+        x.a = (evaluateTrajectory(tr, t - 1e-9 * tr.dt_s)).a;
+      }
+      std::ostringstream os;
+      os.precision(4);
+      // Dynamic limits (the first interval: not worse than the measured state).
+      const double vmax = first ? std::max(L.max_speed_mps, s0.v.norm()) : L.max_speed_mps;
+      const double vzmax = first ? std::max(L.max_vertical_speed_mps, std::abs(s0.v.z())) : L.max_vertical_speed_mps;
+      const double amax = first ? std::max(L.max_acceleration_mps2, s0.a.norm()) : L.max_acceleration_mps2;
+      const double azmax = first ? std::max(L.max_vertical_acceleration_mps2, std::abs(s0.a.z())) : L.max_vertical_acceleration_mps2;
+      rep.max_speed_mps = std::max(rep.max_speed_mps, x.v.norm());
+      rep.max_acceleration_mps2 = std::max(rep.max_acceleration_mps2, x.a.norm());
+      if (x.v.norm() > vmax * rel || std::abs(x.v.z()) > vzmax * rel) {
+        os << "verify: speed " << x.v.norm() << " m/s (vertical " << x.v.z() << ") exceeds the limit at t=" << t;
+        return fail(os.str());
+      }
+      if (x.a.norm() > amax * rel || std::abs(x.a.z()) > azmax * rel) {
+        os << "verify: acceleration " << x.a.norm() << " m/s^2 (vertical " << x.a.z() << ") exceeds the limit at t=" << t;
+        return fail(os.str());
+      }
+      // Obstacles.
+      const double lower = field_.clearance(x.p) - rho;
+      rep.min_obstacle_clearance_m = std::min(rep.min_obstacle_clearance_m, std::max(0.0, lower));
+      const double need = first ? std::min(config_.verify_clearance_m, std::max(0.0, start_clear)) : config_.verify_clearance_m;
+      if (lower < need && fcl_.collides(x.p, need)) {
+        os << "verify: obstacle within " << need << " m of (" << x.p.transpose() << ") at t=" << t;
+        return fail(os.str());
+      }
+      // Other UAVs' plans.
+      for (std::size_t j = 0; j < others.size(); ++j) {
+        const double d = (x.p - evaluateTrajectory(others[j], t).p).norm();
+        const double req = first ? std::min(required[j], start_dist[j]) : required[j];
+        rep.min_uav_margin_m = std::min(rep.min_uav_margin_m, d - required[j]);
+        if (d < req - tol) {
+          os << "verify: " << d << " m from UAV " << others[j].uav_index << "'s plan at t=" << t << " (need " << req << " m)";
+          return fail(os.str());
+        }
+      }
+      // Worker.
+      if (has_worker) {
+        const double d = (x.p - workerPositionAt(worker, worker_t0, worker_dt, t)).norm();
+        rep.min_worker_distance_m = std::min(rep.min_worker_distance_m, d);
+        const double req = first ? std::min(config_.worker_safety_distance_m, start_worker) : config_.worker_safety_distance_m;
+        if (d < req - tol) {
+          os << "verify: " << d << " m from the worker at t=" << t << " (need " << req << " m)";
+          return fail(os.str());
+        }
+      }
+    }
+  }
+  rep.ok = true;
+  return rep;
+}
+
+}  // namespace gesture_formation::planning

@@ -1,0 +1,602 @@
+// UavPlanner: stage 2 (projection, path), stage 3 (corridors, QP, camera), verification and
+// fallback. docs/planning.md §5–§8.
+#include "gesture_formation/planning/uav_planner.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "gesture_formation/common/angles.hpp"
+#include "gesture_formation/planning/camera_tracking.hpp"
+#include "gesture_formation/planning/corridor_builder.hpp"
+#include "gesture_formation/planning/distance_field.hpp"
+#include "gesture_formation/planning/occupancy_map.hpp"
+#include "gesture_formation/planning/path_search.hpp"
+#include "gesture_formation/planning/trajectory_qp.hpp"
+#include "gesture_formation/planning/trajectory_verifier.hpp"
+
+namespace gesture_formation::planning {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+std::string joinErrors(const std::vector<std::string>& e) {
+  std::string s;
+  for (const auto& x : e) s += (s.empty() ? "" : "; ") + x;
+  return s;
+}
+
+/// Largest speed along unit direction d inside the polygon (support of the inner set).
+double supportAlong(const NormPolygon& poly, const Eigen::Vector3d& d) {
+  const auto D = poly.directions();
+  const auto h = poly.halfWidths();
+  double s = std::numeric_limits<double>::infinity();
+  for (int r = 0; r < NormPolygon::kRows; ++r) {
+    const double c = std::abs(D.row(r).dot(d));
+    if (c > 1e-12) s = std::min(s, h(r) / c);
+  }
+  return s;
+}
+
+std::string checkRequest(const PlanRequest& r) {
+  std::ostringstream e;
+  const auto& s = r.state;
+  if (!std::isfinite(r.t_now_s)) e << "t_now_s is not finite; ";
+  if (!(r.dt_s > 0.0) || !std::isfinite(r.dt_s)) e << "dt_s must be > 0, got " << r.dt_s << "; ";
+  if (!s.v_world.allFinite()) e << "state.v_world is not finite; ";
+  if (!s.a_world.allFinite()) e << "state.a_world is not finite; ";
+  if (!std::isfinite(s.heading_rad) || !std::isfinite(s.pitch_rad)) e << "state heading/pitch not finite; ";
+  const int n = r.reference.steps();
+  if (n < 2) e << "reference has " << n << " steps, need >= 2; ";
+  if (r.reference.heading_rad.cols() != n || r.reference.pitch_rad.cols() != n) e << "reference angle rows mismatch; ";
+  if (r.worker.steps() != 0 && r.worker.steps() != n) {
+    e << "worker horizon has " << r.worker.steps() << " steps, reference " << n << "; ";
+  }
+  for (int k = 0; k < n; ++k) {
+    if (!r.reference.p_world.col(k).allFinite()) {
+      e << "reference step " << k << " is not finite; ";
+      break;
+    }
+  }
+  for (int k = 0; k < r.worker.steps(); ++k) {
+    if (!r.worker.p_world.col(k).allFinite()) {
+      e << "worker step " << k << " is not finite; ";
+      break;
+    }
+  }
+  for (std::size_t j = 0; j < r.higher_priority_plans.size(); ++j) {
+    const auto& p = r.higher_priority_plans[j];
+    bool ok = !p.samples.empty() && p.dt_s > 0.0 && std::isfinite(p.t0_s);
+    for (const auto& smp : p.samples) ok = ok && smp.p_world.allFinite() && smp.v_world.allFinite();
+    if (!ok) e << "higher_priority_plans[" << j << "] (uav " << p.uav_index << ") is empty or not finite; ";
+  }
+  const std::string out = e.str();
+  return out.empty() ? out : "bad request: " + out.substr(0, out.size() - 2);
+}
+
+}  // namespace
+
+// ---- construction -------------------------------------------------------------------------
+
+UavPlanner::UavPlanner(const PlannerConfig& config, std::shared_ptr<const OccupancyMap> map,
+                       std::shared_ptr<const DistanceField> field)
+    : config_(config), map_(std::move(map)), field_(std::move(field)) {
+  auto errors = config_.validate();
+  if (!map_ || !field_) errors.push_back("map and distance field must be given");
+  config_error_ = joinErrors(errors);
+  if (!config_error_.empty()) config_ = PlannerConfig{};  // keep the object usable (brake only)
+  CorridorConfig cc;
+  cc.clearance_m = config_.obstacle_clearance_m;
+  cc.local_box_margin_m = Eigen::Vector3d::Constant(config_.corridor_box_margin_m);
+  corridors_ = std::make_unique<CorridorBuilder>(cc);
+  qp_ = std::make_unique<TrajectoryQp>();
+  if (map_ && field_) {
+    verifier_ = std::make_unique<TrajectoryVerifier>(*map_, *field_, config_);
+    search_ = std::make_unique<GridPathSearch>(*map_, *field_);
+  }
+}
+
+UavPlanner::~UavPlanner() = default;
+UavPlanner::UavPlanner(UavPlanner&&) noexcept = default;
+UavPlanner& UavPlanner::operator=(UavPlanner&&) noexcept = default;
+
+void UavPlanner::reset() {
+  last_verified_ = PlannedTrajectory{};
+  sequence_ = 0;
+}
+
+// ---- fallbacks -------------------------------------------------------------------------------
+
+PlannedTrajectory UavPlanner::brakePlan(const PlanRequest& req) const {
+  PlannedTrajectory tr;
+  tr.uav_index = req.uav_index;
+  tr.t0_s = req.t_now_s;
+  tr.dt_s = req.dt_s > 0.0 && std::isfinite(req.dt_s) ? req.dt_s : 0.2;
+  const int n = std::max(2, req.reference.steps());
+  const Eigen::Vector3d p0 = req.state.p_world;
+  const Eigen::Vector3d v0 = req.state.v_world.allFinite() ? req.state.v_world : Eigen::Vector3d::Zero();
+  const double speed = v0.norm();
+  Eigen::Vector3d dir = Eigen::Vector3d::Zero();
+  double decel = 0.0, t_stop = 0.0;
+  if (speed > 1e-9) {
+    dir = v0 / speed;
+    // Largest deceleration along −dir with ‖a‖ ≤ a_max and |a_z| ≤ a_z,max, then lowered so
+    // that the stop falls on a sample (the braking curve is then one quadratic per interval,
+    // which the Hermite spline reproduces exactly).
+    double amax = config_.limits.max_acceleration_mps2;
+    if (std::abs(dir.z()) * amax > config_.limits.max_vertical_acceleration_mps2) {
+      amax = config_.limits.max_vertical_acceleration_mps2 / std::abs(dir.z());
+    }
+    const double steps = std::ceil(speed / amax / tr.dt_s - 1e-9);
+    t_stop = steps * tr.dt_s;
+    decel = speed / t_stop;
+  }
+  const Eigen::Vector3d p_stop = p0 + v0 * t_stop - 0.5 * decel * dir * t_stop * t_stop;
+  std::vector<Eigen::Vector3d> positions;
+  for (int k = 0; k < n; ++k) {
+    const double t = k * tr.dt_s;
+    TrajectorySample s;
+    if (t < t_stop - 1e-9) {
+      s.p_world = p0 + v0 * t - 0.5 * decel * dir * t * t;
+      s.v_world = v0 - decel * dir * t;
+      s.a_world = -decel * dir;
+    } else {
+      s.p_world = p_stop;
+    }
+    positions.push_back(s.p_world);
+    tr.samples.push_back(s);
+  }
+  // Camera: keep looking at the worker within the rate limits (closed-form filter: no
+  // failure modes), else hold the current angles.
+  CameraTrackingProblem cam;
+  cam.dt_s = tr.dt_s;
+  cam.heading0_rad = std::isfinite(req.state.heading_rad) ? req.state.heading_rad : 0.0;
+  cam.pitch0_rad = std::isfinite(req.state.pitch_rad) ? req.state.pitch_rad : 0.0;
+  const bool worker_ok = req.worker.steps() == n && req.worker.p_world.allFinite();
+  if (worker_ok) {
+    cam.p_world = positions;
+    for (int k = 0; k < n; ++k) cam.target_world.push_back(req.worker.p_world.col(k));
+    cam.max_heading_rate_radps = config_.limits.max_heading_rate_radps;
+    cam.max_pitch_rate_radps = config_.limits.max_pitch_rate_radps;
+    cam.min_pitch_rad = config_.limits.min_pitch_rad;
+    cam.max_pitch_rad = config_.limits.max_pitch_rad;
+  }
+  const CameraTrack track = worker_ok ? cameraFilter(cam) : CameraTrack{};
+  for (int k = 0; k < n; ++k) {
+    tr.samples[static_cast<std::size_t>(k)].heading_rad = track.ok ? track.heading_rad[static_cast<std::size_t>(k)] : cam.heading0_rad;
+    tr.samples[static_cast<std::size_t>(k)].pitch_rad = track.ok ? track.pitch_rad[static_cast<std::size_t>(k)] : cam.pitch0_rad;
+  }
+  return tr;
+}
+
+PlanResult UavPlanner::fallback(const PlanRequest& req, PlanResult result, const std::string& reason) {
+  const auto t_fb = Clock::now();
+  result.reason = reason;
+  const bool state_finite = req.state.p_world.allFinite();
+  const int n = std::max(2, req.reference.steps());
+  const double dt = req.dt_s > 0.0 && std::isfinite(req.dt_s) ? req.dt_s : 0.2;
+  // 1. The last verified plan, re-timed to t_now, if it still covers enough and verifies now.
+  std::string why_not;
+  if (last_verified_.empty()) {
+    why_not = "no previous plan";
+  } else if (!std::isfinite(req.t_now_s) || last_verified_.tEnd() < req.t_now_s + config_.fallback_min_horizon_s) {
+    std::ostringstream os;
+    os << "previous plan ends at " << last_verified_.tEnd() << " s, before t_now + " << config_.fallback_min_horizon_s << " s";
+    why_not = os.str();
+  } else {
+    const TrajectoryPoint at_now = evaluateTrajectory(last_verified_, req.t_now_s);
+    const double deviation = (at_now.p - req.state.p_world).norm();
+    if (state_finite && !(deviation <= config_.fallback_max_deviation_m)) {
+      std::ostringstream os;
+      os << "previous plan is " << deviation << " m from the state";
+      why_not = os.str();
+    } else {
+      PlannedTrajectory prev;
+      prev.uav_index = req.uav_index;
+      prev.t0_s = req.t_now_s;
+      prev.dt_s = dt;
+      for (int k = 0; k < n; ++k) {
+        const double t = req.t_now_s + k * dt;
+        const TrajectoryPoint x = evaluateTrajectory(last_verified_, t);
+        const TrajectorySample angles = last_verified_.sampleAt(t);
+        TrajectorySample s;
+        s.p_world = x.p;
+        s.v_world = x.v;
+        s.a_world = x.a;
+        s.heading_rad = angles.heading_rad;
+        s.pitch_rad = angles.pitch_rad;
+        prev.samples.push_back(s);
+      }
+      const VerificationReport rep =
+          verifier_ ? verifier_->verify(prev, req.t_now_s, req.higher_priority_plans, req.worker, req.t_now_s, dt)
+                    : VerificationReport{};
+      if (rep.ok) {
+        result.trajectory = prev;
+        result.status = PlanStatus::kFallbackPrevious;
+        result.verified = true;
+        result.min_obstacle_clearance_m = rep.min_obstacle_clearance_m;
+        result.min_uav_margin_m = rep.min_uav_margin_m;
+        result.min_worker_distance_m = rep.min_worker_distance_m;
+        result.reason += "; reusing verified plan #" + std::to_string(last_verified_.sequence);
+        result.trajectory.sequence = ++sequence_;
+        result.timings.verify_ms += msSince(t_fb);
+        return result;
+      }
+      why_not = "previous plan fails now: " + rep.reason;
+    }
+  }
+  // 2. Last resort: brake to hover along the current velocity.
+  result.status = PlanStatus::kFallbackBrake;
+  result.reason += "; " + why_not + "; braking to hover";
+  if (!state_finite) {
+    result.trajectory = PlannedTrajectory{};
+    result.trajectory.uav_index = req.uav_index;
+    result.verified = false;
+    result.reason += " impossible (state position not finite): empty trajectory";
+    result.timings.verify_ms += msSince(t_fb);
+    return result;
+  }
+  result.trajectory = brakePlan(req);
+  result.trajectory.sequence = ++sequence_;
+  if (verifier_) {
+    const VerificationReport rep =
+        verifier_->verify(result.trajectory, req.t_now_s, req.higher_priority_plans, req.worker, req.t_now_s, dt);
+    result.verified = rep.ok;
+    result.min_obstacle_clearance_m = rep.min_obstacle_clearance_m;
+    result.min_uav_margin_m = rep.min_uav_margin_m;
+    result.min_worker_distance_m = rep.min_worker_distance_m;
+    if (rep.ok) {
+      last_verified_ = result.trajectory;  // the UAV now executes it; reusable next time
+    } else {
+      result.reason += " (brake plan NOT verified: " + rep.reason + ")";
+    }
+  }
+  result.timings.verify_ms += msSince(t_fb);
+  return result;
+}
+
+// ---- the three stages ------------------------------------------------------------------------
+
+PlanResult UavPlanner::plan(const PlanRequest& req) {
+  const auto t_start = Clock::now();
+  PlanResult result;
+  result.trajectory.uav_index = req.uav_index;
+  const auto finish = [&](PlanResult r) {
+    r.timings.total_ms = msSince(t_start);
+    return r;
+  };
+  if (!config_error_.empty()) return finish(fallback(req, result, "invalid planner config: " + config_error_));
+  if (!req.state.p_world.allFinite()) return finish(fallback(req, result, "bad request: state.p_world is not finite"));
+  const std::string bad = checkRequest(req);
+  if (!bad.empty()) return finish(fallback(req, result, bad));
+
+  const OccupancyMap& map = *map_;
+  const DistanceField& field = *field_;
+  const double res = map.resolution();
+  const double dt = req.dt_s;
+  const int N = req.reference.steps() - 1;
+  const Eigen::Vector3d p0 = req.state.p_world;
+  const bool has_worker = req.worker.steps() > 0;
+
+  // ---- stage 2: project the references, connect them, merge -----------------------------
+  auto t_stage = Clock::now();
+  std::vector<Eigen::Vector3d> ref(static_cast<std::size_t>(N) + 1, p0);
+  const double worker_keep = config_.worker_safety_distance_m + config_.qp_distance_buffer_m;
+  for (int k = 1; k <= N; ++k) {
+    Eigen::Vector3d r = req.reference.p_world.col(k);
+    bool moved = false;
+    if (has_worker) {  // out of the worker's safety sphere, horizontally away from it
+      const Eigen::Vector3d w = req.worker.p_world.col(k);
+      Eigen::Vector3d d = r - w;
+      if (d.norm() < worker_keep) {
+        Eigen::Vector3d h(d.x(), d.y(), 0.0);
+        if (h.norm() < 1e-6) h = Eigen::Vector3d(p0.x() - w.x(), p0.y() - w.y(), 0.0);
+        if (h.norm() < 1e-6) h = Eigen::Vector3d::UnitX();
+        d = d + h.normalized() * (worker_keep - d.norm() + 1e-3);
+        if (d.norm() < worker_keep) d = d.normalized() * (worker_keep + 1e-3);
+        r = w + d;
+        moved = true;
+      }
+    }
+    const auto proj = projectToClearance(field, map, r, config_.path_clearance_m, config_.max_projection_m);
+    if (proj) {
+      moved = moved || (*proj - r).norm() > 1e-9;
+      r = *proj;
+    } else {
+      r = ref[static_cast<std::size_t>(k) - 1];  // nothing clear nearby: hold the previous target
+      moved = true;
+    }
+    if (moved) ++result.projected_references;
+    ref[static_cast<std::size_t>(k)] = r;
+  }
+  // Waypoints: the current position, then the projected references (duplicates dropped),
+  // with A* detours where the straight segment is not clear.
+  const double seg_clear = config_.obstacle_clearance_m;
+  const double start_clear = field.clearance(p0);
+  std::vector<Eigen::Vector3d> raw{p0};
+  bool truncated = false;
+  for (int k = 1; k <= N && !truncated; ++k) {
+    const Eigen::Vector3d& target = ref[static_cast<std::size_t>(k)];
+    if ((target - raw.back()).norm() < 1e-3) continue;
+    const bool from_start = raw.size() == 1;
+    const double need = from_start ? std::min(seg_clear, start_clear - res) : seg_clear;
+    if (segmentClear(field, res, raw.back(), target, need)) {
+      raw.push_back(target);
+      continue;
+    }
+    ++result.path_searches;
+    const auto detour = search_->search(raw.back(), target, config_.path_clearance_m, seg_clear, config_.search_margin_m,
+                                        config_.search_max_expansions);
+    if (!detour) {
+      truncated = true;  // the rest of the reference is unreachable for now
+      break;
+    }
+    for (std::size_t i = 1; i < detour->size(); ++i) raw.push_back((*detour)[i]);
+  }
+  // Greedy merge: extend a segment over the following waypoints while it stays clear and
+  // every skipped waypoint lies within the merge tolerance of it.
+  std::vector<Eigen::Vector3d> path{raw.front()};
+  {
+    std::size_t i = 0;
+    while (i + 1 < raw.size()) {
+      std::size_t j = i + 1;
+      while (j + 1 < raw.size()) {
+        const std::size_t c = j + 1;
+        const Eigen::Vector3d a = raw[i], b = raw[c];
+        const Eigen::Vector3d ab = b - a;
+        const double L2 = ab.squaredNorm();
+        bool close = true;
+        for (std::size_t m = i + 1; m < c && close; ++m) {
+          const double s = L2 > 0 ? std::clamp((raw[m] - a).dot(ab) / L2, 0.0, 1.0) : 0.0;
+          close = (raw[m] - (a + s * ab)).norm() <= config_.path_merge_tolerance_m;
+        }
+        const double need = i == 0 ? std::min(seg_clear, start_clear - res) : seg_clear;
+        if (!close || !segmentClear(field, res, a, b, need)) break;
+        j = c;
+      }
+      path.push_back(raw[j]);
+      i = j;
+    }
+  }
+  if (path.size() == 1) {  // already at the (static) reference: a short segment to hold a corridor
+    Eigen::Vector3d d = req.state.v_world.norm() > 1e-3 ? Eigen::Vector3d(req.state.v_world.normalized()) : Eigen::Vector3d::UnitZ();
+    path.push_back(p0 + 0.05 * d);
+  }
+  result.path_world = path;
+  result.timings.path_ms = msSince(t_stage);
+  (void)truncated;
+
+  // ---- stage 3a: corridors ----------------------------------------------------------------
+  t_stage = Clock::now();
+  std::vector<SegmentCorridor> corridors;
+  corridors.reserve(path.size() - 1);
+  for (std::size_t i = 0; i + 1 < path.size(); ++i) {
+    auto c = corridors_->buildSegment(path[i], path[i + 1], map);
+    if (!c) {
+      result.timings.corridor_ms = msSince(t_stage);
+      return finish(fallback(req, result, "corridor " + std::to_string(i) + ": " + c.reason()));
+    }
+    corridors.push_back(std::move(c.value()));
+  }
+  result.corridor_count = static_cast<int>(corridors.size());
+  result.timings.corridor_ms = msSince(t_stage);
+
+  // ---- stage 3b: QP ---------------------------------------------------------------------------
+  t_stage = Clock::now();
+  TrajectoryQpProblem qp;
+  qp.dt_s = dt;
+  qp.intervals = N;
+  qp.p0 = p0;
+  qp.v0 = req.state.v_world;
+  qp.a0 = req.state.a_world;
+  qp.reference = ref;
+  qp.velocity = NormPolygon{config_.limits.max_speed_mps, config_.limits.max_vertical_speed_mps};
+  qp.acceleration = NormPolygon{config_.limits.max_acceleration_mps2, config_.limits.max_vertical_acceleration_mps2};
+  qp.w_reference = config_.weights.reference;
+  qp.w_acceleration = config_.weights.acceleration;
+  qp.w_jerk = config_.weights.jerk;
+  qp.w_terminal_velocity = config_.weights.terminal_velocity;
+  qp.eps_abs = config_.qp_eps_abs;
+  qp.max_iterations = config_.qp_max_iterations;
+
+  // Assignment of samples to corridors: a guide point moves along the path no faster than the
+  // inner speed/acceleration sets allow (70 %), towards the projection of r_k, stopping on
+  // every waypoint it passes; sample k must lie in the corridors of the guide's segments at
+  // k−1 and k (so every chord x_{k−1}x_k lies in one convex corridor).
+  const int M = static_cast<int>(path.size()) - 1;
+  std::vector<double> S(static_cast<std::size_t>(M) + 1, 0.0);
+  for (int i = 0; i < M; ++i) S[static_cast<std::size_t>(i) + 1] = S[static_cast<std::size_t>(i)] + (path[static_cast<std::size_t>(i) + 1] - path[static_cast<std::size_t>(i)]).norm();
+  const auto segOf = [&](double sigma) {
+    int s = static_cast<int>(std::upper_bound(S.begin(), S.end(), sigma + 1e-12) - S.begin()) - 1;
+    return std::clamp(s, 0, M - 1);
+  };
+  const auto tangent = [&](int s) {
+    const Eigen::Vector3d d = path[static_cast<std::size_t>(s) + 1] - path[static_cast<std::size_t>(s)];
+    return Eigen::Vector3d(d / std::max(d.norm(), 1e-12));
+  };
+  std::vector<int> seg(static_cast<std::size_t>(N) + 1, 0);
+  std::vector<Eigen::Vector3d> guide(static_cast<std::size_t>(N) + 1, p0);
+  {
+    double sigma = 0.0, target_sigma = 0.0;
+    double u = std::max(0.0, req.state.v_world.dot(tangent(0)));
+    int search_from = 0;
+    for (int k = 1; k <= N; ++k) {
+      // Projection of r_k onto the path (monotone, a window of segments ahead).
+      double best = std::numeric_limits<double>::infinity(), best_sigma = target_sigma;
+      for (int s = search_from; s < std::min(M, search_from + 12); ++s) {
+        const Eigen::Vector3d a = path[static_cast<std::size_t>(s)], b = path[static_cast<std::size_t>(s) + 1];
+        const Eigen::Vector3d ab = b - a;
+        const double t = std::clamp((ref[static_cast<std::size_t>(k)] - a).dot(ab) / std::max(ab.squaredNorm(), 1e-12), 0.0, 1.0);
+        const double d = (ref[static_cast<std::size_t>(k)] - (a + t * ab)).norm();
+        if (d < best - 1e-9) best = d, best_sigma = S[static_cast<std::size_t>(s)] + t * ab.norm();
+      }
+      target_sigma = std::max(target_sigma, best_sigma);
+      const int s_prev = segOf(sigma);
+      search_from = s_prev;
+      const Eigen::Vector3d t_dir = tangent(s_prev);
+      const double v_cap = 0.7 * supportAlong(qp.velocity, t_dir);
+      const double a_cap = 0.5 * supportAlong(qp.acceleration, t_dir);
+      u = std::min(u + a_cap * dt, v_cap);
+      double next = std::min(target_sigma, sigma + u * dt);
+      const double boundary = S[static_cast<std::size_t>(s_prev) + 1];
+      if (s_prev < M - 1 && next > boundary) next = boundary;  // stop on the waypoint
+      if (next < sigma + u * dt) u = (next - sigma) / dt;       // waiting slows the guide down
+      sigma = std::min(next, S.back());
+      const int s = segOf(sigma);
+      seg[static_cast<std::size_t>(k)] = s;
+      const double local = std::clamp(sigma - S[static_cast<std::size_t>(s)], 0.0, S[static_cast<std::size_t>(s) + 1] - S[static_cast<std::size_t>(s)]);
+      guide[static_cast<std::size_t>(k)] = path[static_cast<std::size_t>(s)] + local * tangent(s);
+    }
+  }
+  // Corridor rows, pruned when the sample cannot reach them (‖x_k − p0‖ ≤ v_max t_k).
+  const double vmax = config_.limits.max_speed_mps;
+  for (int k = 1; k <= N; ++k) {
+    const double reach = vmax * k * dt;
+    const int s_prev = seg[static_cast<std::size_t>(k) - 1], s_cur = seg[static_cast<std::size_t>(k)];
+    for (int s : {s_prev, s_cur}) {
+      const Polytope& P = corridors[static_cast<std::size_t>(s)].polytope;
+      for (int r = 0; r < P.rows(); ++r) {
+        const Eigen::Vector3d a = P.A.row(r).transpose();
+        const double b = P.b(r) - config_.corridor_margin_m;
+        if (a.dot(p0) + reach < b) continue;  // unreachable plane
+        qp.constraints.push_back(PositionConstraint{k, a, b, PositionConstraint::Kind::kCorridor});
+      }
+      if (s_prev == s_cur) break;
+    }
+  }
+  // Linearisation points for the distance half-spaces: the last verified plan at t_k, else
+  // the current position.
+  const bool have_prev = !last_verified_.empty() && last_verified_.tEnd() > req.t_now_s;
+  const auto linPoint = [&](int k) {
+    return have_prev ? evaluateTrajectory(last_verified_, req.t_now_s + k * dt).p : p0;
+  };
+  const auto addSeparation = [&](int k, const Eigen::Vector3d& o, double margin, PositionConstraint::Kind kind) {
+    if ((o - p0).norm() - margin > vmax * k * dt) return;  // cannot get that close by t_k
+    Eigen::Vector3d n = linPoint(k) - o;
+    if (n.norm() < 1e-6) n = guide[static_cast<std::size_t>(k)] - o;
+    if (n.norm() < 1e-6) n = Eigen::Vector3d::UnitZ();
+    n.normalize();
+    // n·(x − o) ≥ margin  ⇔  (−n)·x ≤ −n·o − margin
+    qp.constraints.push_back(PositionConstraint{k, -n, -n.dot(o) - margin, kind});
+  };
+  for (const auto& other : req.higher_priority_plans) {
+    const double age = std::max(0.0, req.t_now_s - other.t0_s);
+    const double margin = config_.mutual_distance_m + config_.age_margin_speed_mps * age + config_.qp_distance_buffer_m;
+    for (int k = 1; k <= N; ++k) {
+      addSeparation(k, evaluateTrajectory(other, req.t_now_s + k * dt).p, margin, PositionConstraint::Kind::kUav);
+    }
+  }
+  if (has_worker) {
+    for (int k = 1; k <= N; ++k) {
+      addSeparation(k, req.worker.p_world.col(k), config_.worker_safety_distance_m + config_.qp_distance_buffer_m,
+                    PositionConstraint::Kind::kWorker);
+    }
+  }
+  // Warm start: the last verified plan re-timed (primal only; the constraint set changes).
+  TrajectoryQpSolution warm;
+  if (have_prev) {
+    for (int k = 0; k <= N; ++k) {
+      const TrajectoryPoint x = evaluateTrajectory(last_verified_, req.t_now_s + k * dt);
+      warm.p.push_back(x.p);
+      warm.v.push_back(x.v);
+      warm.a.push_back(x.a);
+    }
+  }
+  if (keep_last_qp_) last_qp_ = std::make_unique<TrajectoryQpProblem>(qp);
+  const TrajectoryQpSolution sol = qp_->solve(qp, have_prev ? &warm : nullptr);
+  result.qp_variables = sol.variables;
+  result.qp_constraints = sol.equalities + sol.inequalities;
+  result.qp_iterations = sol.iterations;
+  result.timings.qp_ms = msSince(t_stage);
+  if (!sol.solved()) return finish(fallback(req, result, sol.reason));
+
+  // ---- camera heading / pitch (filter or Ceres) ----------------------------------------------------------
+  t_stage = Clock::now();
+  std::vector<double> heading(static_cast<std::size_t>(N) + 1, req.state.heading_rad);
+  std::vector<double> pitch(static_cast<std::size_t>(N) + 1, req.state.pitch_rad);
+  if (has_worker) {
+    CameraTrackingProblem cam;
+    cam.dt_s = dt;
+    cam.heading0_rad = req.state.heading_rad;
+    cam.pitch0_rad = req.state.pitch_rad;
+    cam.p_world = sol.p;
+    for (int k = 0; k <= N; ++k) cam.target_world.push_back(req.worker.p_world.col(k));
+    cam.max_heading_rate_radps = config_.limits.max_heading_rate_radps;
+    cam.max_pitch_rate_radps = config_.limits.max_pitch_rate_radps;
+    cam.min_pitch_rad = config_.limits.min_pitch_rad;
+    cam.max_pitch_rad = config_.limits.max_pitch_rad;
+    cam.weight = config_.heading_weight;
+    cam.smoothness_weight = config_.heading_smoothness_weight;
+    const CameraTrack track =
+        config_.camera_solver == PlannerConfig::CameraSolver::kCeres ? solveCameraCeres(cam) : cameraFilter(cam);
+    if (!track.ok) {
+      result.timings.heading_ms = msSince(t_stage);
+      return finish(fallback(req, result, track.reason));
+    }
+    heading = track.heading_rad;
+    pitch = track.pitch_rad;
+  } else {  // no worker: follow the reference's angles within the rate limits
+    for (int k = 1; k <= N; ++k) {
+      const double sh = config_.limits.max_heading_rate_radps * dt, sp = config_.limits.max_pitch_rate_radps * dt;
+      const auto i = static_cast<std::size_t>(k);
+      heading[i] = common::wrapAngle(heading[i - 1] +
+                                     std::clamp(common::wrapAngle(req.reference.heading_rad(k) - heading[i - 1]), -sh, sh));
+      pitch[i] = pitch[i - 1] + std::clamp(std::clamp(req.reference.pitch_rad(k), config_.limits.min_pitch_rad,
+                                                      config_.limits.max_pitch_rad) - pitch[i - 1], -sp, sp);
+    }
+  }
+  result.timings.heading_ms = msSince(t_stage);
+
+  // ---- verification ---------------------------------------------------------------------------
+  t_stage = Clock::now();
+  PlannedTrajectory tr;
+  tr.uav_index = req.uav_index;
+  tr.t0_s = req.t_now_s;
+  tr.dt_s = dt;
+  for (int k = 0; k <= N; ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    TrajectorySample s;
+    s.p_world = sol.p[i];
+    s.v_world = sol.v[i];
+    s.a_world = sol.a[i];
+    s.heading_rad = heading[i];
+    s.pitch_rad = pitch[i];
+    tr.samples.push_back(s);
+  }
+  const VerificationReport rep =
+      verifier_->verify(tr, req.t_now_s, req.higher_priority_plans, req.worker, req.t_now_s, dt);
+  result.timings.verify_ms = msSince(t_stage);
+  if (!rep.ok) return finish(fallback(req, result, rep.reason));
+  if (config_.time_budget_ms > 0.0 && msSince(t_start) > config_.time_budget_ms) {
+    std::ostringstream os;
+    os << "time budget exceeded (" << msSince(t_start) << " ms > " << config_.time_budget_ms << " ms)";
+    return finish(fallback(req, result, os.str()));
+  }
+  tr.sequence = ++sequence_;
+  result.trajectory = tr;
+  result.status = PlanStatus::kOptimized;
+  result.reason.clear();
+  result.verified = true;
+  result.min_obstacle_clearance_m = rep.min_obstacle_clearance_m;
+  result.min_uav_margin_m = rep.min_uav_margin_m;
+  result.min_worker_distance_m = rep.min_worker_distance_m;
+  last_verified_ = tr;
+  return finish(result);
+}
+
+std::vector<PlanResult> planInPriorityOrder(const std::vector<UavPlanner*>& planners, std::vector<PlanRequest> requests) {
+  std::vector<PlanResult> results;
+  results.reserve(planners.size());
+  for (std::size_t i = 0; i < planners.size() && i < requests.size(); ++i) {
+    for (std::size_t j = 0; j < i; ++j) {
+      if (!results[j].trajectory.empty()) requests[i].higher_priority_plans.push_back(results[j].trajectory);
+    }
+    results.push_back(planners[i]->plan(requests[i]));
+  }
+  return results;
+}
+
+}  // namespace gesture_formation::planning

@@ -1,0 +1,399 @@
+// UavPlanner on the real power_towers map: verified plans, fallbacks, priorities and
+// crossing UAVs in closed loop (plan, fly one period along the plan, replan), narrow gaps
+// between conductor lines, worker safety distance. Every property is checked independently of
+// the planner's own verifier (brute-force distances to occupied voxel centres).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+
+#include "gesture_formation/common/angles.hpp"
+#include "gesture_formation/planning/distance_field.hpp"
+#include "gesture_formation/planning/occupancy_map.hpp"
+#include "gesture_formation/planning/scenario.hpp"
+#include "gesture_formation/planning/trajectory_verifier.hpp"
+#include "gesture_formation/planning/uav_planner.hpp"
+
+using namespace gesture_formation;
+using namespace gesture_formation::planning;
+
+namespace {
+
+struct World {
+  std::shared_ptr<const OccupancyMap> map;
+  std::shared_ptr<const DistanceField> field;
+};
+
+const World& towers() {
+  static const World w = [] {
+    auto s = loadScenario(std::string(GF_SOURCE_DIR) + "/config/scenarios/power_towers.yaml");
+    if (!s) throw std::runtime_error(s.reason());
+    auto m = OccupancyMap::fromScenario(*s);
+    if (!m) throw std::runtime_error(m.reason());
+    World out;
+    out.map = std::make_shared<const OccupancyMap>(std::move(m.value()));
+    out.field = std::make_shared<const DistanceField>(*out.map);
+    return out;
+  }();
+  return w;
+}
+
+PlannerConfig testConfig() {
+  PlannerConfig c;
+  c.time_budget_ms = 0.0;  // deterministic under load
+  return c;
+}
+
+/// A request whose reference left `from` at t = 0 towards `to` at constant speed (then holds),
+/// the worker standing at `worker`.
+PlanRequest straightRequest(int uav, double t, const UavKinematicState& state, const Eigen::Vector3d& from,
+                            const Eigen::Vector3d& to, double speed, const Eigen::Vector3d& worker, int steps = 41) {
+  PlanRequest r;
+  r.uav_index = uav;
+  r.t_now_s = t;
+  r.state = state;
+  r.dt_s = 0.2;
+  r.reference.resize(steps);
+  r.worker.p_world.resize(3, steps);
+  r.worker.heading_rad.resize(1, steps);
+  const double len = (to - from).norm();
+  for (int k = 0; k < steps; ++k) {
+    // The reference left `from` at t = 0 (so it keeps progressing across replannings).
+    const double s = len > 0 ? std::min(1.0, speed * (t + k * r.dt_s) / len) : 1.0;
+    r.reference.p_world.col(k) = from + s * (to - from);
+    r.reference.heading_rad(k) = 0.0;
+    r.reference.pitch_rad(k) = 0.0;
+    r.worker.p_world.col(k) = worker;
+    r.worker.heading_rad(k) = 0.0;
+  }
+  return r;
+}
+
+UavKinematicState stateAt(const Eigen::Vector3d& p, double t = 0.0) {
+  UavKinematicState s;
+  s.t_s = t;
+  s.p_world = p;
+  return s;
+}
+
+/// Independent check of obstacle clearance: brute force over the occupied voxel centres near
+/// the point (true distance to the centres, not the field's lower bound).
+double centreDistance(const OccupancyMap& map, const Eigen::Vector3d& p, double radius) {
+  std::vector<Eigen::Vector3d> pts;
+  Aabb box{p - Eigen::Vector3d::Constant(radius), p + Eigen::Vector3d::Constant(radius)};
+  map.pointsInBox(box, pts);
+  double d = radius;
+  for (const auto& q : pts) d = std::min(d, (q - p).norm());
+  return d;
+}
+
+/// Every dense point of the plan keeps `clearance` + voxel half-diagonal from voxel centres
+/// (so a ball of `clearance` misses every voxel cube), the limits hold, finite numbers.
+void expectSafe(const PlannedTrajectory& tr, const OccupancyMap& map, const PlannerConfig& cfg) {
+  ASSERT_GE(tr.samples.size(), 2u);
+  const double rho = OccupancyMap::rasterInflation(map.resolution());
+  for (double t = tr.t0_s; t <= tr.tEnd() + 1e-9; t += tr.dt_s / 8) {
+    const TrajectoryPoint x = evaluateTrajectory(tr, t);
+    ASSERT_TRUE(x.p.allFinite() && x.v.allFinite() && x.a.allFinite()) << "t=" << t;
+    EXPECT_GE(centreDistance(map, x.p, 3.0), cfg.verify_clearance_m + rho - 1e-6) << "t=" << t << " p=" << x.p.transpose();
+    EXPECT_LE(x.v.norm(), cfg.limits.max_speed_mps * (1 + 1e-3)) << "t=" << t;
+    EXPECT_LE(x.a.norm(), cfg.limits.max_acceleration_mps2 * (1 + 1e-3)) << "t=" << t;
+  }
+}
+
+/// Moves the state along the plan for `period` seconds (perfect tracking).
+UavKinematicState advance(const PlannedTrajectory& tr, double t_next) {
+  const TrajectoryPoint x = evaluateTrajectory(tr, t_next);
+  UavKinematicState s;
+  s.t_s = t_next;
+  s.p_world = x.p;
+  s.v_world = x.v;
+  s.a_world = x.a;
+  const TrajectorySample a = tr.sampleAt(t_next);
+  s.heading_rad = a.heading_rad;
+  s.pitch_rad = a.pitch_rad;
+  return s;
+}
+
+}  // namespace
+
+TEST(UavPlannerTest, ConfigValidateNamesEveryBadField) {
+  PlannerConfig c;
+  c.limits.max_speed_mps = -1.0;
+  c.limits.max_vertical_acceleration_mps2 = 5.0;  // > max_acceleration 3
+  c.path_clearance_m = 0.1;                       // < obstacle clearance
+  c.verify_substeps = 0;
+  const auto e = c.validate();
+  ASSERT_EQ(e.size(), 5u);  // max_speed, vertical speed (not < max_speed), vertical accel, path clearance, substeps
+  std::string all;
+  for (const auto& s : e) all += s + "\n";
+  for (const char* f : {"limits.max_speed_mps", "limits.max_vertical_speed_mps", "limits.max_vertical_acceleration_mps2",
+                        "path.path_clearance_m", "verify.substeps"}) {
+    EXPECT_NE(all.find(f), std::string::npos) << f << " not named in:\n" << all;
+  }
+  EXPECT_NE(all.find("got -1"), std::string::npos) << all;
+  EXPECT_TRUE(PlannerConfig{}.validate().empty());
+}
+
+TEST(UavPlannerTest, ShippedYamlLoadsInStrictMode) {
+  std::vector<std::string> warnings;
+  const auto c = loadPlannerConfig(std::string(GF_SOURCE_DIR) + "/config/planner.yaml",
+                                   common::ConfigReader::MissingKeys::kError, &warnings);
+  ASSERT_TRUE(c) << c.reason();
+  EXPECT_TRUE(warnings.empty()) << warnings.front();
+  EXPECT_DOUBLE_EQ(c->mutual_distance_m, 2.5);
+}
+
+TEST(UavPlannerTest, YamlListsEveryBadKeyAtOnce) {
+  auto r = common::ConfigReader::fromString("limits: {max_speed_mps: -3}\nqp: {mutual_distance_m: abc}\n", "p.yaml",
+                                            common::ConfigReader::MissingKeys::kError);
+  readPlannerConfig(r);
+  const std::string report = r.errorReport();
+  EXPECT_NE(report.find("limits.max_speed_mps"), std::string::npos) << report;
+  EXPECT_NE(report.find("qp.mutual_distance_m"), std::string::npos) << report;
+  EXPECT_NE(report.find("weights.reference"), std::string::npos) << report;  // missing
+  EXPECT_NE(report.find("verify.substeps"), std::string::npos) << report;    // missing
+}
+
+TEST(UavPlannerTest, FreeSpacePlanFollowsReferenceAndVerifies) {
+  const World& w = towers();
+  UavPlanner planner(testConfig(), w.map, w.field);
+  ASSERT_TRUE(planner.configError().empty());
+  const Eigen::Vector3d from(-8, -12, 10), to(-2, -12, 10);
+  const PlanResult r = planner.plan(straightRequest(0, 0.0, stateAt(from), from, to, 1.5, Eigen::Vector3d(-5, -3, 1)));
+  ASSERT_EQ(r.status, PlanStatus::kOptimized) << r.reason;
+  EXPECT_TRUE(r.verified);
+  ASSERT_EQ(r.trajectory.samples.size(), 41u);
+  EXPECT_EQ(r.trajectory.samples[0].p_world, from);
+  // Reaches the reference's end (6 m in 4 s at 1.5 m/s, then 4 s to settle).
+  EXPECT_LT((r.trajectory.samples.back().p_world - to).norm(), 0.3);
+  EXPECT_GT(r.qp_variables, 0);
+  EXPECT_GT(r.qp_iterations, 0);
+  expectSafe(r.trajectory, *w.map, planner.config());
+  // The camera looks at the worker at the end (line of sight within a few degrees).
+  const auto& last = r.trajectory.samples.back();
+  const Eigen::Vector3d d = Eigen::Vector3d(-5, -3, 1) - last.p_world;
+  EXPECT_NEAR(common::wrapAngle(last.heading_rad - std::atan2(d.y(), d.x())), 0.0, 0.05);
+}
+
+TEST(UavPlannerTest, ReferenceInsideTowerIsProjectedAndPlanAvoidsIt) {
+  const World& w = towers();
+  UavPlanner planner(testConfig(), w.map, w.field);
+  // The reference ends on the west tower's leg at (2.6, 2.6, 5) region / inside the lattice.
+  const Eigen::Vector3d from(-6, 6, 6), to(2.7, 2.7, 6);
+  const PlanResult r = planner.plan(straightRequest(0, 0.0, stateAt(from), from, to, 2.0, Eigen::Vector3d(-8, 8, 1)));
+  ASSERT_EQ(r.status, PlanStatus::kOptimized) << r.reason;
+  EXPECT_GT(r.projected_references, 0);
+  expectSafe(r.trajectory, *w.map, planner.config());
+}
+
+TEST(UavPlannerTest, PassesThroughGapBetweenConductors) {
+  // From below the lower conductors (z 16 at the towers, ~13 mid-span) to above them, between
+  // the middle phase (y = 0) and the side phase (y = 6.5) at mid-span: a 6.5 m wide gap.
+  const World& w = towers();
+  PlannerConfig cfg = testConfig();
+  UavPlanner planner(cfg, w.map, w.field);
+  const Eigen::Vector3d from(25, 3.25, 9), to(25, 3.25, 18);
+  UavKinematicState s = stateAt(from);
+  double t = 0.0;
+  bool crossed = false;
+  for (int cycle = 0; cycle < 30; ++cycle) {
+    const PlanResult r = planner.plan(straightRequest(0, t, s, from, to, 1.5, Eigen::Vector3d(25, 10, 1)));
+    ASSERT_TRUE(r.verified) << r.reason;
+    expectSafe(r.trajectory, *w.map, cfg);
+    t += 0.4;
+    s = advance(r.trajectory, t);
+    crossed = crossed || s.p_world.z() > 15.5;
+  }
+  EXPECT_TRUE(crossed) << "ended at " << s.p_world.transpose();
+  EXPECT_LT((s.p_world - to).norm(), 1.0);
+}
+
+TEST(UavPlannerTest, WorkerSafetyDistanceHoldsWhenReferenceIsOnTheWorker) {
+  const World& w = towers();
+  PlannerConfig cfg = testConfig();
+  UavPlanner planner(cfg, w.map, w.field);
+  const Eigen::Vector3d worker(-6, -8, 1.0);
+  const Eigen::Vector3d from(-6, -14, 3);
+  UavKinematicState s = stateAt(from);
+  double t = 0.0;
+  for (int cycle = 0; cycle < 20; ++cycle) {
+    const PlanResult r = planner.plan(straightRequest(0, t, s, from, worker, 2.0, worker));
+    ASSERT_TRUE(r.verified) << r.reason;
+    for (double tt = r.trajectory.t0_s; tt <= r.trajectory.tEnd(); tt += 0.05) {
+      ASSERT_GE((evaluateTrajectory(r.trajectory, tt).p - worker).norm(), cfg.worker_safety_distance_m - 1e-3) << tt;
+    }
+    t += 0.4;
+    s = advance(r.trajectory, t);
+  }
+}
+
+TEST(UavPlannerTest, StartInsideObstacleFallsBackToBrake) {
+  const World& w = towers();
+  UavPlanner planner(testConfig(), w.map, w.field);
+  const Eigen::Vector3d ground(10, -10, 0.1);  // inside the ground voxels
+  const PlanResult r = planner.plan(straightRequest(0, 0.0, stateAt(ground), ground, Eigen::Vector3d(10, -10, 5), 1.0,
+                                                    Eigen::Vector3d(0, -5, 1)));
+  EXPECT_EQ(r.status, PlanStatus::kFallbackBrake);
+  EXPECT_FALSE(r.reason.empty());
+  EXPECT_NE(r.reason.find("no previous plan"), std::string::npos) << r.reason;
+  ASSERT_FALSE(r.trajectory.empty());
+  for (const auto& smp : r.trajectory.samples) EXPECT_EQ(smp.p_world, ground);  // at rest: hover in place
+}
+
+TEST(UavPlannerTest, NanReferenceFallsBackToPreviousPlanThenBrake) {
+  const World& w = towers();
+  UavPlanner planner(testConfig(), w.map, w.field);
+  const Eigen::Vector3d from(-8, -12, 10), to(-2, -12, 10), worker(-5, -3, 1);
+  const PlanResult first = planner.plan(straightRequest(0, 0.0, stateAt(from), from, to, 1.5, worker));
+  ASSERT_EQ(first.status, PlanStatus::kOptimized) << first.reason;
+  PlanRequest bad = straightRequest(0, 0.4, advance(first.trajectory, 0.4), from, to, 1.5, worker);
+  bad.reference.p_world(1, 7) = std::numeric_limits<double>::quiet_NaN();
+  const PlanResult r = planner.plan(bad);
+  EXPECT_EQ(r.status, PlanStatus::kFallbackPrevious) << r.reason;
+  EXPECT_NE(r.reason.find("reference step 7"), std::string::npos) << r.reason;
+  EXPECT_TRUE(r.verified);
+  // The fallback is the previous plan re-timed: same positions at the same times.
+  for (double t = 0.4; t <= 6.0; t += 0.3) {
+    EXPECT_LT((evaluateTrajectory(r.trajectory, t).p - evaluateTrajectory(first.trajectory, t).p).norm(), 1e-9) << t;
+  }
+  // Much later the previous plan no longer covers the horizon: brake.
+  PlanRequest late = bad;
+  late.t_now_s = 7.5;
+  late.state = advance(first.trajectory, 7.5);
+  const PlanResult b = planner.plan(late);
+  EXPECT_EQ(b.status, PlanStatus::kFallbackBrake) << b.reason;
+  // NaN state: no trajectory can be trusted to start there.
+  PlanRequest nan_state = late;
+  nan_state.state.p_world.x() = std::numeric_limits<double>::quiet_NaN();
+  const PlanResult n = planner.plan(nan_state);
+  EXPECT_NE(n.status, PlanStatus::kOptimized);
+  EXPECT_NE(n.reason.find("state.p_world"), std::string::npos) << n.reason;
+}
+
+TEST(UavPlannerTest, FailedVerificationFallsBack) {
+  // A verification clearance larger than the corridors keep (0.8 m from centres − 0.17 m
+  // half-diagonal ≈ 0.63 m from cubes) makes plans that pass close to the tower fail
+  // verification: the previous plan (far from it) is reused, and without one the UAV brakes.
+  const World& w = towers();
+  PlannerConfig cfg = testConfig();
+  cfg.verify_clearance_m = 0.75;
+  UavPlanner planner(cfg, w.map, w.field);
+  const Eigen::Vector3d from(-6, -6, 6), worker(-8, -10, 1);
+  const PlanResult first = planner.plan(straightRequest(0, 0.0, stateAt(from), from, from, 1.0, worker));
+  ASSERT_EQ(first.status, PlanStatus::kOptimized) << first.reason;
+  // Now ask for a reference hugging the tower leg: the QP hugs the corridor boundary.
+  const PlanResult r = planner.plan(straightRequest(0, 0.2, advance(first.trajectory, 0.2), from,
+                                                    Eigen::Vector3d(2.6, 2.6, 6), 3.0, worker));
+  EXPECT_EQ(r.status, PlanStatus::kFallbackPrevious) << r.reason;
+  EXPECT_NE(r.reason.find("verify: obstacle"), std::string::npos) << r.reason;
+  UavPlanner fresh(cfg, w.map, w.field);
+  const PlanResult b = fresh.plan(straightRequest(0, 0.0, stateAt(from), from, Eigen::Vector3d(2.6, 2.6, 6), 3.0, worker));
+  EXPECT_EQ(b.status, PlanStatus::kFallbackBrake) << b.reason;
+  EXPECT_NE(b.reason.find("verify: obstacle"), std::string::npos) << b.reason;
+}
+
+TEST(UavPlannerTest, DeterministicForTheSameRequests) {
+  const World& w = towers();
+  UavPlanner a(testConfig(), w.map, w.field), b(testConfig(), w.map, w.field);
+  const Eigen::Vector3d from(-6, 6, 6), to(2.7, 2.7, 6);
+  const auto req = straightRequest(0, 0.0, stateAt(from), from, to, 2.0, Eigen::Vector3d(-8, 8, 1));
+  const PlanResult ra = a.plan(req), rb = b.plan(req);
+  ASSERT_EQ(ra.trajectory.samples.size(), rb.trajectory.samples.size());
+  for (std::size_t k = 0; k < ra.trajectory.samples.size(); ++k) {
+    EXPECT_EQ(ra.trajectory.samples[k].p_world, rb.trajectory.samples[k].p_world);
+    EXPECT_EQ(ra.trajectory.samples[k].heading_rad, rb.trajectory.samples[k].heading_rad);
+  }
+}
+
+/// Closed loop: n UAVs fly crossing references; each period they replan in priority order
+/// and fly the period along their plans. Mutual distance (dense in time) ≥ Γ_dis always.
+void crossingLoop(int n) {
+  const World& w = towers();
+  PlannerConfig cfg = testConfig();
+  std::vector<std::unique_ptr<UavPlanner>> owned;
+  std::vector<UavPlanner*> planners;
+  for (int i = 0; i < n; ++i) {
+    owned.push_back(std::make_unique<UavPlanner>(cfg, w.map, w.field));
+    planners.push_back(owned.back().get());
+  }
+  // Starts on a circle of radius 8 around (25, -9, 8) (south of the line, free space), goals
+  // diametrically opposite: every pair's straight paths cross at the centre.
+  const Eigen::Vector3d c(25, -9, 8);
+  std::vector<Eigen::Vector3d> start, goal;
+  std::vector<UavKinematicState> state;
+  for (int i = 0; i < n; ++i) {
+    // Two UAVs: paths crossing at right angles; three: at 60° (no goal is another's start).
+    const double ang = (n == 2 ? M_PI / 2 : 2 * M_PI / n) * i + 0.3;
+    start.push_back(c + 8 * Eigen::Vector3d(std::cos(ang), std::sin(ang) * 0.6, 0.0));
+    goal.push_back(c - 8 * Eigen::Vector3d(std::cos(ang), std::sin(ang) * 0.6, 0.0));
+    state.push_back(stateAt(start.back()));
+  }
+  const Eigen::Vector3d worker(25, -20, 1);
+  double t = 0.0, min_d = std::numeric_limits<double>::infinity();
+  int optimized = 0, total = 0;
+  const double period = 0.4;
+  for (int cycle = 0; cycle < 40; ++cycle) {
+    std::vector<PlanRequest> req;
+    for (int i = 0; i < n; ++i) req.push_back(straightRequest(i, t, state[static_cast<std::size_t>(i)], start[static_cast<std::size_t>(i)], goal[static_cast<std::size_t>(i)], 2.0, worker));
+    const auto res = planInPriorityOrder(planners, req);
+    for (int i = 0; i < n; ++i) {
+      const auto& r = res[static_cast<std::size_t>(i)];
+      ASSERT_TRUE(r.verified) << "cycle " << cycle << " uav " << i << ": " << r.reason;
+      optimized += r.status == PlanStatus::kOptimized;
+      ++total;
+    }
+    // Fly one period (dense check of every pair along the executed pieces).
+    for (double tt = t; tt <= t + period + 1e-9; tt += 0.02) {
+      for (int i = 0; i < n; ++i) {
+        for (int j = i + 1; j < n; ++j) {
+          const double d = (evaluateTrajectory(res[static_cast<std::size_t>(i)].trajectory, tt).p -
+                            evaluateTrajectory(res[static_cast<std::size_t>(j)].trajectory, tt).p).norm();
+          min_d = std::min(min_d, d);
+          ASSERT_GE(d, cfg.mutual_distance_m - 1e-3) << "UAVs " << i << "," << j << " at t=" << tt;
+        }
+      }
+    }
+    t += period;
+    for (int i = 0; i < n; ++i) state[static_cast<std::size_t>(i)] = advance(res[static_cast<std::size_t>(i)].trajectory, t);
+  }
+  // They actually crossed: each ended near its goal (not stuck).
+  for (int i = 0; i < n; ++i) {
+    EXPECT_LT((state[static_cast<std::size_t>(i)].p_world - goal[static_cast<std::size_t>(i)]).norm(), 2.0) << "uav " << i;
+  }
+  EXPECT_GT(optimized, total * 9 / 10);
+  ::testing::Test::RecordProperty("min_mutual_distance_m", std::to_string(min_d));
+}
+
+TEST(UavPlannerTest, TwoUavsCrossingKeepMutualDistance) { crossingLoop(2); }
+TEST(UavPlannerTest, ThreeUavsCrossingKeepMutualDistance) { crossingLoop(3); }
+
+TEST(UavPlannerTest, OlderPlanGetsLargerMargin) {
+  const World& w = towers();
+  PlannerConfig cfg = testConfig();
+  UavPlanner planner(cfg, w.map, w.field);
+  // Another UAV hovering 4 m ahead of the reference's end. Fresh: the margin 2.5 m lets the
+  // UAV reach its reference; 0.6 s old: 2.5 + 5·0.6 = 5.5 m keeps it farther away.
+  const Eigen::Vector3d from(-8, -12, 10), to(-2, -12, 10), other_p(2, -12, 10);
+  PlannedTrajectory other;
+  other.uav_index = 0;
+  other.dt_s = 0.2;
+  for (int k = 0; k < 41; ++k) {
+    TrajectorySample s;
+    s.p_world = other_p;
+    other.samples.push_back(s);
+  }
+  for (double age : {0.0, 0.6}) {
+    UavPlanner p(cfg, w.map, w.field);
+    auto req = straightRequest(1, 10.0, stateAt(from, 10.0), from, to, 1.5, Eigen::Vector3d(-5, -3, 1));
+    other.t0_s = 10.0 - age;
+    req.higher_priority_plans = {other};
+    const PlanResult r = p.plan(req);
+    ASSERT_EQ(r.status, PlanStatus::kOptimized) << r.reason;
+    const double end_gap = (r.trajectory.samples.back().p_world - other_p).norm();
+    EXPECT_GE(end_gap, cfg.mutual_distance_m + cfg.age_margin_speed_mps * age - 1e-3) << "age " << age;
+    if (age == 0.0) {
+      EXPECT_LT((r.trajectory.samples.back().p_world - to).norm(), 0.3);
+    }
+  }
+}
