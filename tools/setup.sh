@@ -47,6 +47,7 @@ PACKAGES=(
   python3-venv python3-pip python3-yaml python3-numpy
   opencv-doc
   rviz xvfb xauth imagemagick graphviz
+  clang libclang-rt-14-dev                      # libFuzzer + ASan/UBSan runtimes for fuzz/ (tools/fuzz/run_fuzzers.sh)
 )
 
 missing=()

@@ -48,7 +48,9 @@ bool parseStrictDouble(const std::string& s, double& out) {
 void collectLeaves(const YAML::Node& node, const std::string& prefix, std::vector<std::string>& out) {
   if (node.IsMap()) {
     for (const auto& kv : node) {
-      const std::string k = kv.first.as<std::string>();
+      // A key that is not a scalar (YAML allows `{a: 1}: x` or `[1, 2]: x`) has no dotted
+      // name: it is reported as unknown under a placeholder instead of throwing.
+      const std::string k = kv.first.IsScalar() ? kv.first.Scalar() : std::string("<non-scalar key>");
       collectLeaves(kv.second, prefix.empty() ? k : prefix + "." + k, out);
     }
   } else if (node.IsSequence()) {

@@ -109,3 +109,16 @@ TEST(ConfigReaderTest, SyntaxErrorAndMissingFileAreReported) {
   auto f = ConfigReader::fromFile("/nonexistent/x.yaml", ConfigReader::MissingKeys::kError);
   EXPECT_TRUE(contains(f.errors(), "/nonexistent/x.yaml: cannot open file"));
 }
+
+// Found by fuzz_config: a mapping used as a key made unusedKeys() throw (YAML bad conversion).
+TEST(ConfigReaderTest, NonScalarKeysAreReportedNotThrown) {
+  auto r = ConfigReader::fromString("a:\n  b: 2.5\n  ? {x: 1}\n  : 3\n  [1, 2]: 4\n", "cfg.yaml", ConfigReader::MissingKeys::kError);
+  double b = 0.0;
+  r.readDouble("a.b", b, Range::positive());
+  EXPECT_TRUE(r.ok()) << r.errorReport();
+  EXPECT_DOUBLE_EQ(b, 2.5);
+  std::vector<std::string> unused;
+  ASSERT_NO_THROW(unused = r.unusedKeys());
+  EXPECT_EQ(unused.size(), 2u);
+  EXPECT_TRUE(contains(unused, "a.<non-scalar key>"));
+}

@@ -1,0 +1,71 @@
+// Writes valid encodings as seed inputs: gf_fuzz_make_seeds <corpus_dir>
+// (fuzz/corpus/<target>/seed_*). Run by tools/fuzz/run_fuzzers.sh --seeds.
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "fuzz_common.hpp"
+#include "gesture_formation/comm/payloads.hpp"
+#include "gesture_formation/comm/signer.hpp"
+#include "gesture_formation/lcm_bridge/lcm_transport.hpp"
+
+using namespace gesture_formation;
+using namespace gesture_formation::comm;
+
+namespace {
+
+void write(const std::string& path, const std::vector<std::uint8_t>& bytes) {
+  std::ofstream f(path, std::ios::binary);
+  f.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+}
+
+std::vector<std::uint8_t> withPrefix(std::uint8_t prefix, const std::vector<std::uint8_t>& b) {
+  std::vector<std::uint8_t> out{prefix};
+  out.insert(out.end(), b.begin(), b.end());
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 2) {
+    std::fprintf(stderr, "usage: %s <corpus_dir>\n", argv[0]);
+    return 2;
+  }
+  const std::string dir = argv[1];
+  Heartbeat hb;
+  hb.uav_index = 1;
+  hb.worker_visible = true;
+  WorkerStateMessage ws;
+  ws.p_world = {1, 2, 3};
+  ws.covariance_diag = {0.1, 0.1, 0.1, 1, 1, 1};
+  planning::PlannedTrajectory plan;
+  plan.uav_index = 1;
+  plan.samples.resize(3);
+  formation::FormationParams params;
+  formation::FormationCommand cmd;
+  cmd.id = {"operator", 7};
+  cmd.target = formation::CommandTarget::list({1, 2});
+  cmd.parameter = formation::Parameter::kGamma;
+  cmd.amount = 5;
+  const std::vector<std::vector<std::uint8_t>> payloads = {
+      encodePayload(hb).value(), encodePayload(ws).value(), encodePayload(plan).value(),
+      encodePayload(params).value(), encodePayload(cmd).value()};
+  for (std::size_t i = 0; i < payloads.size(); ++i) {
+    write(dir + "/payloads/seed_" + std::to_string(i), withPrefix(static_cast<std::uint8_t>(i), payloads[i]));
+  }
+  KeyEntry k;
+  k.id = 2;
+  k.key = gf_fuzz::fuzzKey(2);
+  Signer signer(1, KeyRing::create({k}, 2).value(), 1);
+  for (std::size_t i = 0; i < payloads.size(); ++i) {
+    const auto sealed = signer.seal(static_cast<MessageType>(i + 1), payloads[i], 100.0).value();
+    write(dir + "/lcm_envelope/seed_" + std::to_string(i), lcm_bridge::encodeLcmEnvelope(sealed));
+    // fuzz_envelope script: mode 0 (raw bytes), now step 0, length, the bytes.
+    std::vector<std::uint8_t> script{0x00, 0x00, 0x00};
+    script.insert(script.end(), sealed.begin(), sealed.end());
+    write(dir + "/envelope/seed_" + std::to_string(i), script);
+  }
+  return 0;
+}

@@ -1,0 +1,103 @@
+#pragma once
+/// \file
+/// \brief The authenticated envelope every inter-UAV message travels in (docs/security.md §3).
+///
+/// Wire layout, all integers big-endian (network order), doubles IEEE-754 binary64 big-endian:
+/// ```
+/// offset size field
+///      0    2 magic 'G' 'F' (0x47 0x46)
+///      2    1 version (kEnvelopeVersion = 1)
+///      3    1 message type (MessageType, 1..5)
+///      4    2 sender id
+///      6    1 key id (which pre-shared key made the tag)
+///      7    1 flags (reserved, must be 0)
+///      8    8 sequence number (per sender, strictly increasing over all types)
+///     16    8 stamp [s] (sender clock; finite)
+///     24    4 payload length N ≤ kMaxPayloadBytes
+///     28    N payload (MessageType-specific, payloads.hpp)
+///   28+N   32 tag = HMAC-SHA256(key[key id], bytes 0 .. 28+N−1)
+/// ```
+/// Total size = 60 + N bytes; the length field must match the datagram size exactly.
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "gesture_formation/comm/hmac.hpp"
+#include "gesture_formation/common/result.hpp"
+
+namespace gesture_formation::comm {
+
+constexpr std::uint8_t kMagic0 = 0x47;  // 'G'
+constexpr std::uint8_t kMagic1 = 0x46;  // 'F'
+constexpr std::uint8_t kEnvelopeVersion = 1;
+constexpr std::size_t kHeaderBytes = 28;
+/// Largest payload [bytes]: fits a planned trajectory of kMaxTrajectorySamples samples and
+/// stays below LCM's 64 KiB single-datagram limit with the header and tag.
+constexpr std::size_t kMaxPayloadBytes = 60000;
+constexpr std::size_t kMinEnvelopeBytes = kHeaderBytes + kTagBytes;
+constexpr std::size_t kMaxEnvelopeBytes = kHeaderBytes + kMaxPayloadBytes + kTagBytes;
+
+/// \brief What a payload holds (payloads.hpp). Values are wire constants: never renumber.
+enum class MessageType : std::uint8_t {
+  kHeartbeat = 1,
+  kWorkerState = 2,
+  kPlannedTrajectory = 3,
+  kFormationParams = 4,
+  kFormationCommand = 5,
+};
+constexpr std::uint8_t kMinMessageType = 1;
+constexpr std::uint8_t kMaxMessageType = 5;
+/// \brief "heartbeat", "worker_state", "planned_trajectory", "formation_params", "formation_command".
+const char* toString(MessageType type);
+bool isKnownMessageType(std::uint8_t value);
+
+/// \brief A decoded (and, from Verifier, authenticated) envelope.
+struct Envelope {
+  MessageType type = MessageType::kHeartbeat;
+  std::uint16_t sender_id = 0;
+  std::uint8_t key_id = 0;
+  std::uint64_t sequence = 0;
+  double stamp_s = 0.0;
+  std::vector<std::uint8_t> payload;
+};
+
+/// \brief Why bytes are not a well-formed envelope (checked before authentication).
+enum class EnvelopeError {
+  kNone,
+  kTruncated,       ///< shorter than header + tag, or than the length field says
+  kOversize,        ///< larger than kMaxEnvelopeBytes or payload length > kMaxPayloadBytes
+  kBadMagic,
+  kBadVersion,
+  kBadType,
+  kBadFlags,
+  kLengthMismatch,  ///< longer than the length field says (trailing bytes)
+  kBadStamp,        ///< stamp not finite
+};
+const char* toString(EnvelopeError e);
+
+/// \brief A structurally valid envelope, borrowing the input buffer (not yet authenticated).
+struct EnvelopeView {
+  MessageType type = MessageType::kHeartbeat;
+  std::uint16_t sender_id = 0;
+  std::uint8_t key_id = 0;
+  std::uint64_t sequence = 0;
+  double stamp_s = 0.0;
+  const std::uint8_t* payload = nullptr;
+  std::size_t payload_bytes = 0;
+  const std::uint8_t* signed_bytes = nullptr;  ///< header + payload (what the tag covers)
+  std::size_t signed_size = 0;
+  const std::uint8_t* tag = nullptr;           ///< kTagBytes
+};
+
+/// \brief Checks the structure (sizes, magic, version, type, flags, length, stamp) and fills
+/// `view`; `view` is untouched on error. Never reads outside [data, data + size).
+EnvelopeError parseEnvelope(const std::uint8_t* data, std::size_t size, EnvelopeView& view);
+
+/// \brief Serialises and tags an envelope with `key` (whose id must be envelope.key_id).
+/// Fails on a payload above kMaxPayloadBytes, a non-finite stamp, an unknown type, or an
+/// OpenSSL failure. Signer is the normal way in; this is the primitive.
+common::Result<std::vector<std::uint8_t>> sealEnvelope(const Envelope& envelope, const std::uint8_t* key,
+                                                       std::size_t key_bytes);
+
+}  // namespace gesture_formation::comm

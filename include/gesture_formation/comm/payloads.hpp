@@ -1,0 +1,135 @@
+#pragma once
+/// \file
+/// \brief Payload codecs for the messages UAVs exchange (docs/security.md §3.2 has the byte
+/// tables). Integers big-endian, doubles IEEE-754 binary64 big-endian, no padding.
+///
+/// Encoders refuse what decoders would refuse (non-finite numbers, oversize arrays, values
+/// out of range), so a node never sends what its peers must drop. Decoders are strict: the
+/// payload must be consumed exactly, every double finite, every array within its maximum,
+/// every enum value known; the output is written only on success.
+/// Thread safety: free functions are reentrant; PayloadDecoder has no locking.
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "gesture_formation/comm/envelope.hpp"
+#include "gesture_formation/common/result.hpp"
+#include "gesture_formation/formation/formation_commands.hpp"
+#include "gesture_formation/formation/formation_params.hpp"
+#include "gesture_formation/planning/uav_planner.hpp"
+
+namespace gesture_formation::comm {
+
+/// Largest number of samples in a planned trajectory (88 bytes each: 52.8 kB < kMaxPayloadBytes).
+constexpr std::size_t kMaxTrajectorySamples = 600;
+/// Largest UAV index on the wire (leader 0, followers 1..kMaxUavIndex).
+constexpr int kMaxUavIndex = 31;
+constexpr std::size_t kMaxFollowers = kMaxUavIndex;
+/// Largest number of UAVs listed in one command target.
+constexpr std::size_t kMaxCommandTargets = kMaxUavIndex + 1;
+/// Largest command sender name [bytes]; printable ASCII without spaces (0x21..0x7e).
+constexpr std::size_t kMaxSenderNameBytes = 64;
+
+/// \brief Liveness of one UAV, sent periodically (e.g. 5 Hz).
+struct Heartbeat {
+  enum class Status : std::uint8_t { kOk = 0, kDegraded = 1, kFailsafe = 2, kLanding = 3 };
+  std::uint16_t uav_index = 0;           ///< 0 = leader, ≤ kMaxUavIndex
+  Status status = Status::kOk;
+  bool worker_visible = false;           ///< the worker is in this UAV's camera / estimate
+  std::uint32_t last_plan_sequence = 0;  ///< PlannedTrajectory::sequence of the last plan sent
+};
+
+/// \brief The leader's worker estimate (DESIGN §3): state at t_s with the covariance diagonal.
+struct WorkerStateMessage {
+  double t_s = 0.0;
+  Eigen::Vector3d p_world = Eigen::Vector3d::Zero();  ///< [m] ENU
+  Eigen::Vector3d v_world = Eigen::Vector3d::Zero();  ///< [m/s] ENU
+  /// pxx, pyy, pzz [m²], pvxx, pvyy, pvzz [(m/s)²]; each ≥ 0.
+  std::array<double, 6> covariance_diag{{0, 0, 0, 0, 0, 0}};
+  bool lost = false;  ///< estimator reports the worker lost (prediction only, timed out)
+};
+
+/// \brief Why a payload was refused. Values index PayloadCounters.
+enum class PayloadError : std::uint8_t {
+  kNone = 0,
+  kWrongType,      ///< envelope type is not the one asked for
+  kTruncated,      ///< fewer bytes than the fields need
+  kTrailingBytes,  ///< bytes left after the last field
+  kNonFinite,      ///< a NaN or ±inf double
+  kOversizeArray,  ///< an element count above its maximum
+  kOutOfRange,     ///< an enum, index, count, string or physical value outside its domain
+};
+constexpr std::size_t kPayloadErrorCount = 7;
+const char* toString(PayloadError e);
+
+// ---- encoders: fail naming the field on what a decoder would refuse ----------------------
+common::Result<std::vector<std::uint8_t>> encodePayload(const Heartbeat& m);
+common::Result<std::vector<std::uint8_t>> encodePayload(const WorkerStateMessage& m);
+common::Result<std::vector<std::uint8_t>> encodePayload(const planning::PlannedTrajectory& m);
+common::Result<std::vector<std::uint8_t>> encodePayload(const formation::FormationParams& m);
+common::Result<std::vector<std::uint8_t>> encodePayload(const formation::FormationCommand& m);
+
+/// \brief The envelope type of each payload.
+inline MessageType messageTypeOf(const Heartbeat&) { return MessageType::kHeartbeat; }
+inline MessageType messageTypeOf(const WorkerStateMessage&) { return MessageType::kWorkerState; }
+inline MessageType messageTypeOf(const planning::PlannedTrajectory&) { return MessageType::kPlannedTrajectory; }
+inline MessageType messageTypeOf(const formation::FormationParams&) { return MessageType::kFormationParams; }
+inline MessageType messageTypeOf(const formation::FormationCommand&) { return MessageType::kFormationCommand; }
+
+// ---- decoders: `out` written only on kNone; `reason` (optional) names the field ---------
+PayloadError decodePayload(const std::uint8_t* data, std::size_t size, Heartbeat& out, std::string* reason = nullptr);
+PayloadError decodePayload(const std::uint8_t* data, std::size_t size, WorkerStateMessage& out,
+                           std::string* reason = nullptr);
+PayloadError decodePayload(const std::uint8_t* data, std::size_t size, planning::PlannedTrajectory& out,
+                           std::string* reason = nullptr);
+PayloadError decodePayload(const std::uint8_t* data, std::size_t size, formation::FormationParams& out,
+                           std::string* reason = nullptr);
+PayloadError decodePayload(const std::uint8_t* data, std::size_t size, formation::FormationCommand& out,
+                           std::string* reason = nullptr);
+
+/// \brief One counter per PayloadError (kNone counts successful decodes).
+struct PayloadCounters {
+  std::array<std::uint64_t, kPayloadErrorCount> by_error{};
+  std::uint64_t count(PayloadError e) const { return by_error[static_cast<std::size_t>(e)]; }
+  std::uint64_t decoded() const { return count(PayloadError::kNone); }
+  std::uint64_t rejected() const;
+};
+
+/// \brief Decodes the payloads of authenticated envelopes and counts every refusal.
+class PayloadDecoder {
+ public:
+  /// \brief Checks the envelope type, then decodes; false (and a counter) on any error.
+  template <class T>
+  bool decode(const Envelope& envelope, T& out) {
+    T tmp{};
+    if (envelope.type != messageTypeOf(tmp)) {
+      last_reason_ = std::string("envelope type ") + toString(envelope.type) + ", expected " +
+                     toString(messageTypeOf(tmp));
+      return record(PayloadError::kWrongType);
+    }
+    const PayloadError e = decodePayload(envelope.payload.data(), envelope.payload.size(), tmp, &last_reason_);
+    if (e == PayloadError::kNone) out = std::move(tmp);
+    return record(e);
+  }
+
+  const PayloadCounters& counters() const { return counters_; }
+  /// \brief Why the last decode failed (names the field).
+  const std::string& lastReason() const { return last_reason_; }
+
+ private:
+  bool record(PayloadError e) {
+    ++counters_.by_error[static_cast<std::size_t>(e)];
+    if (e == PayloadError::kNone) last_reason_.clear();
+    return e == PayloadError::kNone;
+  }
+  PayloadCounters counters_;
+  std::string last_reason_;
+};
+
+}  // namespace gesture_formation::comm

@@ -1,0 +1,117 @@
+#pragma once
+/// \file
+/// \brief The receiving half of authenticated messaging: accepts an envelope only if it is
+/// well formed, from a known sender, tagged with an accepted key, fresh and not a replay;
+/// counts every rejection by kind (docs/security.md §4, §6).
+///
+/// Checks, in this order (the first failing one decides the verdict and its counter):
+///   1. structure (parseEnvelope): kTruncated / kOversize / kBadVersion / kBadType / kMalformed
+///   2. own sender id (our own multicast echo): kOwnMessage
+///   3. sender id in the configured set: kUnknownSender
+///   4. key id in the ring: kUnknownKey; still accepted at now (accept_until_s): kExpiredKey
+///   5. HMAC-SHA256 tag, constant-time compare: kForged
+///   6. stamp age: now − stamp > max age of the type → kTooOld; stamp − now > max_future_s
+///      (clock skew allowance) → kTooNew
+///   7. replay window of the sender: duplicate → kReplayed; below the window → kStale
+/// Only an accepted envelope changes state (the sender's replay window); a rejection
+/// changes nothing but its counter. Checks 1–4 run before any cryptography, so garbage costs
+/// no HMAC; senders' windows exist from construction, so unauthenticated traffic cannot
+/// allocate memory.
+/// Thread safety: none; one Verifier per receiving thread.
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "gesture_formation/comm/envelope.hpp"
+#include "gesture_formation/comm/key_ring.hpp"
+#include "gesture_formation/comm/replay_window.hpp"
+#include "gesture_formation/common/result.hpp"
+
+namespace gesture_formation::comm {
+
+/// \brief The outcome of Verifier::verify. Values index Counters.
+enum class Verdict : std::uint8_t {
+  kAccepted = 0,
+  kTruncated,       ///< shorter than its header/length says
+  kOversize,        ///< larger than the maximal envelope / payload
+  kBadVersion,
+  kBadType,         ///< unknown message type
+  kMalformed,       ///< bad magic, reserved flags, trailing bytes, non-finite stamp
+  kOwnMessage,      ///< our own sender id (multicast loopback); ignored
+  kUnknownSender,
+  kUnknownKey,
+  kExpiredKey,      ///< key id known but past its accept_until_s
+  kForged,          ///< tag does not verify
+  kTooOld,
+  kTooNew,
+  kReplayed,        ///< sequence already accepted (within the window)
+  kStale,           ///< sequence below the replay window
+};
+constexpr std::size_t kVerdictCount = 15;
+const char* toString(Verdict v);
+
+/// \brief One counter per verdict.
+struct VerifierCounters {
+  std::array<std::uint64_t, kVerdictCount> by_verdict{};
+  std::uint64_t count(Verdict v) const { return by_verdict[static_cast<std::size_t>(v)]; }
+  std::uint64_t accepted() const { return count(Verdict::kAccepted); }
+  /// Everything but kAccepted and kOwnMessage.
+  std::uint64_t rejected() const;
+  std::uint64_t total() const;
+};
+
+/// \brief Receiver policy. Defaults documented per field; validate() names the field.
+struct VerifierConfig {
+  std::vector<std::uint16_t> known_senders;  ///< sender ids accepted; non-empty, no default
+  std::optional<std::uint16_t> own_sender_id;  ///< this node's id (its echoes are ignored)
+  double max_age_s = 1.0;       ///< oldest acceptable stamp age [s], > 0
+  double max_future_s = 0.25;   ///< clock skew allowance: stamp may lead now by this [s], ≥ 0
+  /// Per-type overrides of max_age_s [s], each > 0 (e.g. heartbeat 2 s, command 5 s).
+  std::map<MessageType, double> max_age_s_by_type;
+  std::size_t replay_window = 1024;  ///< per sender [sequence numbers], 64..kMaxReplayWindow
+
+  /// \brief Every problem, each naming the field; empty when valid.
+  std::vector<std::string> validate() const;
+  double maxAgeS(MessageType type) const;
+};
+
+struct VerifyResult {
+  Verdict verdict = Verdict::kMalformed;
+  const char* detail = "";   ///< static text with the specific reason (never key material)
+  Envelope envelope;         ///< filled only when accepted
+  bool accepted() const { return verdict == Verdict::kAccepted; }
+};
+
+class Verifier {
+ public:
+  /// \brief Fails listing every config problem.
+  static common::Result<Verifier> create(const VerifierConfig& config, KeyRing keys);
+
+  /// \brief Runs the checks of the file comment on one datagram received at `now_s`
+  /// (same clock as the senders' stamps). Never throws, never reads outside the buffer.
+  VerifyResult verify(const std::uint8_t* data, std::size_t size, double now_s);
+
+  /// \brief Replaces the accepted keys (rotation). Replay windows are kept.
+  void setKeys(KeyRing keys) { keys_ = std::move(keys); }
+  const KeyRing& keys() const { return keys_; }
+  const VerifierCounters& counters() const { return counters_; }
+  const VerifierConfig& config() const { return config_; }
+  /// \brief The replay window of a configured sender (nullptr for others).
+  const ReplayWindow* window(std::uint16_t sender_id) const;
+
+ private:
+  Verifier(const VerifierConfig& config, KeyRing keys);
+  VerifyResult reject(Verdict v, const char* detail);
+
+  VerifierConfig config_;
+  KeyRing keys_;
+  std::map<std::uint16_t, ReplayWindow> windows_;
+  VerifierCounters counters_;
+};
+
+}  // namespace gesture_formation::comm

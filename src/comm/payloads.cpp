@@ -1,0 +1,396 @@
+#include "gesture_formation/comm/payloads.hpp"
+
+#include <cmath>
+#include <initializer_list>
+#include <set>
+
+#include "gesture_formation/comm/byte_io.hpp"
+
+namespace gesture_formation::comm {
+
+using Bytes = std::vector<std::uint8_t>;
+using EncodeResult = common::Result<Bytes>;
+
+const char* toString(PayloadError e) {
+  switch (e) {
+    case PayloadError::kNone: return "none";
+    case PayloadError::kWrongType: return "wrong_type";
+    case PayloadError::kTruncated: return "truncated";
+    case PayloadError::kTrailingBytes: return "trailing_bytes";
+    case PayloadError::kNonFinite: return "non_finite";
+    case PayloadError::kOversizeArray: return "oversize_array";
+    case PayloadError::kOutOfRange: return "out_of_range";
+  }
+  return "unknown";
+}
+
+std::uint64_t PayloadCounters::rejected() const {
+  std::uint64_t t = 0;
+  for (std::size_t i = 1; i < by_error.size(); ++i) t += by_error[i];
+  return t;
+}
+
+namespace {
+
+// ---- wire values of enums (explicit: independent of the C++ enums' order) -------------------
+std::uint8_t wireSource(formation::CommandSource s) { return s == formation::CommandSource::kGesture ? 1 : 0; }
+std::uint8_t wireGroup(formation::TargetGroup g) {
+  switch (g) {
+    case formation::TargetGroup::kLeader: return 0;
+    case formation::TargetGroup::kFollowers: return 1;
+    case formation::TargetGroup::kAll: return 2;
+    case formation::TargetGroup::kList: return 3;
+  }
+  return 255;
+}
+std::uint8_t wireParameter(formation::Parameter p) {
+  switch (p) {
+    case formation::Parameter::kBeta: return 0;
+    case formation::Parameter::kGamma: return 1;
+    case formation::Parameter::kDistance: return 2;
+  }
+  return 255;
+}
+std::uint8_t wireKind(formation::CommandKind k) { return k == formation::CommandKind::kSet ? 1 : 0; }
+
+bool validSenderName(const std::string& s) {
+  if (s.empty() || s.size() > kMaxSenderNameBytes) return false;
+  for (char c : s) {
+    if (c < 0x21 || c > 0x7e) return false;
+  }
+  return true;
+}
+
+bool allFinite(std::initializer_list<double> values) {
+  for (double v : values) {
+    if (!std::isfinite(v)) return false;
+  }
+  return true;
+}
+
+void putVector(ByteWriter& w, const Eigen::Vector3d& v) {
+  w.f64(v.x());
+  w.f64(v.y());
+  w.f64(v.z());
+}
+
+/// Decoding context: reads fields, remembers the first error and its field name.
+class Decoder {
+ public:
+  Decoder(const std::uint8_t* data, std::size_t size) : r_(data, size) {}
+
+  bool ok() const { return error_ == PayloadError::kNone; }
+  PayloadError error() const { return error_; }
+
+  bool fail(PayloadError e, const std::string& field) {
+    if (error_ == PayloadError::kNone) {
+      error_ = e;
+      field_ = field;
+    }
+    return false;
+  }
+  bool u8(std::uint8_t& v, const char* field) { return ok() && (r_.u8(v) || fail(PayloadError::kTruncated, field)); }
+  bool u16(std::uint16_t& v, const char* field) { return ok() && (r_.u16(v) || fail(PayloadError::kTruncated, field)); }
+  bool u32(std::uint32_t& v, const char* field) { return ok() && (r_.u32(v) || fail(PayloadError::kTruncated, field)); }
+  bool u64(std::uint64_t& v, const char* field) { return ok() && (r_.u64(v) || fail(PayloadError::kTruncated, field)); }
+  /// A finite double.
+  bool f64(double& v, const std::string& field) {
+    if (!ok()) return false;
+    double x = 0;
+    if (!r_.f64(x)) return fail(PayloadError::kTruncated, field);
+    if (!std::isfinite(x)) return fail(PayloadError::kNonFinite, field);
+    v = x;
+    return true;
+  }
+  bool vec3(Eigen::Vector3d& v, const std::string& field) {
+    return f64(v.x(), field + ".x") && f64(v.y(), field + ".y") && f64(v.z(), field + ".z");
+  }
+  bool bytes(std::size_t n, const std::uint8_t*& out, const char* field) {
+    return ok() && (r_.bytes(n, out) || fail(PayloadError::kTruncated, field));
+  }
+  /// Succeeds when every byte was consumed.
+  bool finish() {
+    if (ok() && r_.remaining() != 0) fail(PayloadError::kTrailingBytes, std::to_string(r_.remaining()) + " bytes after the last field");
+    return ok();
+  }
+  std::size_t remaining() const { return r_.remaining(); }
+
+  PayloadError report(std::string* reason) const {
+    if (reason != nullptr) *reason = ok() ? std::string() : std::string(toString(error_)) + ": " + field_;
+    return error_;
+  }
+
+ private:
+  ByteReader r_;
+  PayloadError error_ = PayloadError::kNone;
+  std::string field_;
+};
+
+bool validUavIndex(long v) { return v >= 0 && v <= kMaxUavIndex; }
+
+}  // namespace
+
+// ---- heartbeat: u16 uav_index, u8 status, u8 flags(bit0 worker_visible), u32 last_plan_sequence
+
+EncodeResult encodePayload(const Heartbeat& m) {
+  if (m.uav_index > kMaxUavIndex) return EncodeResult::fail("heartbeat.uav_index " + std::to_string(m.uav_index) + " > " + std::to_string(kMaxUavIndex));
+  if (static_cast<std::uint8_t>(m.status) > 3) return EncodeResult::fail("heartbeat.status out of range");
+  ByteWriter w;
+  w.u16(m.uav_index);
+  w.u8(static_cast<std::uint8_t>(m.status));
+  w.u8(m.worker_visible ? 1 : 0);
+  w.u32(m.last_plan_sequence);
+  return EncodeResult::ok(w.release());
+}
+
+PayloadError decodePayload(const std::uint8_t* data, std::size_t size, Heartbeat& out, std::string* reason) {
+  Decoder d(data, size);
+  Heartbeat m;
+  std::uint8_t status = 0, flags = 0;
+  if (d.u16(m.uav_index, "heartbeat.uav_index") && !validUavIndex(m.uav_index)) d.fail(PayloadError::kOutOfRange, "heartbeat.uav_index");
+  if (d.u8(status, "heartbeat.status") && status > 3) d.fail(PayloadError::kOutOfRange, "heartbeat.status");
+  if (d.u8(flags, "heartbeat.flags") && (flags & ~1u) != 0) d.fail(PayloadError::kOutOfRange, "heartbeat.flags");
+  d.u32(m.last_plan_sequence, "heartbeat.last_plan_sequence");
+  if (d.finish()) {
+    m.status = static_cast<Heartbeat::Status>(status);
+    m.worker_visible = (flags & 1u) != 0;
+    out = m;
+  }
+  return d.report(reason);
+}
+
+// ---- worker state: f64 t_s, p[3], v[3], cov_diag[6] (≥ 0), u8 flags(bit0 lost) -----------------
+
+EncodeResult encodePayload(const WorkerStateMessage& m) {
+  if (!std::isfinite(m.t_s)) return EncodeResult::fail("worker_state.t_s not finite");
+  if (!m.p_world.allFinite()) return EncodeResult::fail("worker_state.p_world not finite");
+  if (!m.v_world.allFinite()) return EncodeResult::fail("worker_state.v_world not finite");
+  for (double c : m.covariance_diag) {
+    if (!(std::isfinite(c) && c >= 0)) return EncodeResult::fail("worker_state.covariance_diag must be finite and >= 0");
+  }
+  ByteWriter w;
+  w.f64(m.t_s);
+  putVector(w, m.p_world);
+  putVector(w, m.v_world);
+  for (double c : m.covariance_diag) w.f64(c);
+  w.u8(m.lost ? 1 : 0);
+  return EncodeResult::ok(w.release());
+}
+
+PayloadError decodePayload(const std::uint8_t* data, std::size_t size, WorkerStateMessage& out, std::string* reason) {
+  Decoder d(data, size);
+  WorkerStateMessage m;
+  std::uint8_t flags = 0;
+  d.f64(m.t_s, "worker_state.t_s");
+  d.vec3(m.p_world, "worker_state.p_world");
+  d.vec3(m.v_world, "worker_state.v_world");
+  for (std::size_t i = 0; i < m.covariance_diag.size(); ++i) {
+    const std::string field = "worker_state.covariance_diag[" + std::to_string(i) + "]";
+    if (d.f64(m.covariance_diag[i], field) && m.covariance_diag[i] < 0) d.fail(PayloadError::kOutOfRange, field);
+  }
+  if (d.u8(flags, "worker_state.flags") && (flags & ~1u) != 0) d.fail(PayloadError::kOutOfRange, "worker_state.flags");
+  if (d.finish()) {
+    m.lost = (flags & 1u) != 0;
+    out = m;
+  }
+  return d.report(reason);
+}
+
+// ---- planned trajectory: u16 uav_index, u32 sequence, f64 t0_s, f64 dt_s (> 0), u16 count,
+//      count × (p[3] v[3] a[3] heading pitch) ------------------------------------------------
+
+EncodeResult encodePayload(const planning::PlannedTrajectory& m) {
+  if (!validUavIndex(m.uav_index)) return EncodeResult::fail("planned_trajectory.uav_index " + std::to_string(m.uav_index) + " outside [0, " + std::to_string(kMaxUavIndex) + "]");
+  if (!std::isfinite(m.t0_s)) return EncodeResult::fail("planned_trajectory.t0_s not finite");
+  if (!(std::isfinite(m.dt_s) && m.dt_s > 0)) return EncodeResult::fail("planned_trajectory.dt_s must be finite and > 0");
+  if (m.samples.size() > kMaxTrajectorySamples) {
+    return EncodeResult::fail("planned_trajectory.samples has " + std::to_string(m.samples.size()) + " entries, at most " + std::to_string(kMaxTrajectorySamples));
+  }
+  for (std::size_t k = 0; k < m.samples.size(); ++k) {
+    const planning::TrajectorySample& s = m.samples[k];
+    if (!(s.p_world.allFinite() && s.v_world.allFinite() && s.a_world.allFinite() && allFinite({s.heading_rad, s.pitch_rad}))) {
+      return EncodeResult::fail("planned_trajectory.samples[" + std::to_string(k) + "] not finite");
+    }
+  }
+  ByteWriter w;
+  w.u16(static_cast<std::uint16_t>(m.uav_index));
+  w.u32(m.sequence);
+  w.f64(m.t0_s);
+  w.f64(m.dt_s);
+  w.u16(static_cast<std::uint16_t>(m.samples.size()));
+  for (const planning::TrajectorySample& s : m.samples) {
+    putVector(w, s.p_world);
+    putVector(w, s.v_world);
+    putVector(w, s.a_world);
+    w.f64(s.heading_rad);
+    w.f64(s.pitch_rad);
+  }
+  return EncodeResult::ok(w.release());
+}
+
+PayloadError decodePayload(const std::uint8_t* data, std::size_t size, planning::PlannedTrajectory& out,
+                           std::string* reason) {
+  constexpr std::size_t kSampleBytes = 11 * 8;
+  Decoder d(data, size);
+  planning::PlannedTrajectory m;
+  std::uint16_t uav = 0, count = 0;
+  if (d.u16(uav, "planned_trajectory.uav_index") && !validUavIndex(uav)) d.fail(PayloadError::kOutOfRange, "planned_trajectory.uav_index");
+  d.u32(m.sequence, "planned_trajectory.sequence");
+  d.f64(m.t0_s, "planned_trajectory.t0_s");
+  if (d.f64(m.dt_s, "planned_trajectory.dt_s") && !(m.dt_s > 0)) d.fail(PayloadError::kOutOfRange, "planned_trajectory.dt_s");
+  if (d.u16(count, "planned_trajectory.count")) {
+    if (count > kMaxTrajectorySamples) {
+      d.fail(PayloadError::kOversizeArray, "planned_trajectory.count " + std::to_string(count));
+    } else if (d.remaining() < count * kSampleBytes) {
+      // Checked before allocating: the count cannot make us reserve more than the bytes hold.
+      d.fail(PayloadError::kTruncated, "planned_trajectory.samples");
+    }
+  }
+  if (d.ok()) {
+    m.uav_index = uav;
+    m.samples.resize(count);
+    for (std::size_t k = 0; k < count && d.ok(); ++k) {
+      planning::TrajectorySample& s = m.samples[k];
+      const std::string field = "planned_trajectory.samples[" + std::to_string(k) + "]";
+      d.vec3(s.p_world, field + ".p_world");
+      d.vec3(s.v_world, field + ".v_world");
+      d.vec3(s.a_world, field + ".a_world");
+      d.f64(s.heading_rad, field + ".heading_rad");
+      d.f64(s.pitch_rad, field + ".pitch_rad");
+    }
+  }
+  if (d.finish()) out = std::move(m);
+  return d.report(reason);
+}
+
+// ---- formation params: leader (β, γ, d), u8 follower count, count × (β, γ, d) ---------------
+
+EncodeResult encodePayload(const formation::FormationParams& m) {
+  if (m.followers.size() > kMaxFollowers) {
+    return EncodeResult::fail("formation_params.followers has " + std::to_string(m.followers.size()) + " entries, at most " + std::to_string(kMaxFollowers));
+  }
+  for (int u = 0; u < m.uavCount(); ++u) {
+    const formation::UavObservation& o = m.uav(u);
+    if (!allFinite({o.beta_deg, o.gamma_deg, o.distance_m}) || !(o.distance_m > 0)) {
+      return EncodeResult::fail("formation_params UAV " + formation::uavLabel(u) + ": values must be finite and distance_m > 0");
+    }
+  }
+  ByteWriter w;
+  auto put = [&w](const formation::UavObservation& o) {
+    w.f64(o.beta_deg);
+    w.f64(o.gamma_deg);
+    w.f64(o.distance_m);
+  };
+  put(m.leader);
+  w.u8(static_cast<std::uint8_t>(m.followers.size()));
+  for (const formation::UavObservation& o : m.followers) put(o);
+  return EncodeResult::ok(w.release());
+}
+
+PayloadError decodePayload(const std::uint8_t* data, std::size_t size, formation::FormationParams& out,
+                           std::string* reason) {
+  Decoder d(data, size);
+  formation::FormationParams m;
+  auto get = [&d](formation::UavObservation& o, const std::string& name) {
+    d.f64(o.beta_deg, name + ".beta_deg");
+    d.f64(o.gamma_deg, name + ".gamma_deg");
+    if (d.f64(o.distance_m, name + ".distance_m") && !(o.distance_m > 0)) d.fail(PayloadError::kOutOfRange, name + ".distance_m");
+  };
+  get(m.leader, "formation_params.leader");
+  std::uint8_t count = 0;
+  if (d.u8(count, "formation_params.follower_count") && count > kMaxFollowers) {
+    d.fail(PayloadError::kOversizeArray, "formation_params.follower_count " + std::to_string(count));
+  }
+  if (d.ok()) {
+    m.followers.assign(count, formation::UavObservation{});
+    for (std::size_t i = 0; i < count && d.ok(); ++i) get(m.followers[i], "formation_params.followers[" + std::to_string(i) + "]");
+  }
+  if (d.finish()) out = std::move(m);
+  return d.report(reason);
+}
+
+// ---- formation command: u8 name length, name, u64 sequence, u8 source, u8 group, u8 uav count,
+//      count × u16 uav, u8 parameter, u8 kind, f64 amount -------------------------------------
+
+EncodeResult encodePayload(const formation::FormationCommand& m) {
+  if (!validSenderName(m.id.sender)) {
+    return EncodeResult::fail("formation_command.id.sender must be 1.." + std::to_string(kMaxSenderNameBytes) + " printable ASCII characters without spaces");
+  }
+  const std::uint8_t group = wireGroup(m.target.group);
+  const std::uint8_t parameter = wireParameter(m.parameter);
+  if (group == 255) return EncodeResult::fail("formation_command.target.group out of range");
+  if (parameter == 255) return EncodeResult::fail("formation_command.parameter out of range");
+  const bool is_list = m.target.group == formation::TargetGroup::kList;
+  if (is_list && m.target.uavs.empty()) return EncodeResult::fail("formation_command.target.uavs is empty for a list target");
+  if (!is_list && !m.target.uavs.empty()) return EncodeResult::fail("formation_command.target.uavs must be empty unless the group is a list");
+  if (m.target.uavs.size() > kMaxCommandTargets) return EncodeResult::fail("formation_command.target.uavs has more than " + std::to_string(kMaxCommandTargets) + " entries");
+  for (formation::UavIndex u : m.target.uavs) {
+    if (!validUavIndex(u)) return EncodeResult::fail("formation_command.target.uavs holds UAV index " + std::to_string(u));
+  }
+  if (!std::isfinite(m.amount)) return EncodeResult::fail("formation_command.amount not finite");
+  ByteWriter w;
+  w.u8(static_cast<std::uint8_t>(m.id.sender.size()));
+  w.bytes(reinterpret_cast<const std::uint8_t*>(m.id.sender.data()), m.id.sender.size());
+  w.u64(m.id.sequence);
+  w.u8(wireSource(m.source));
+  w.u8(group);
+  w.u8(static_cast<std::uint8_t>(m.target.uavs.size()));
+  for (formation::UavIndex u : m.target.uavs) w.u16(static_cast<std::uint16_t>(u));
+  w.u8(parameter);
+  w.u8(wireKind(m.kind));
+  w.f64(m.amount);
+  return EncodeResult::ok(w.release());
+}
+
+PayloadError decodePayload(const std::uint8_t* data, std::size_t size, formation::FormationCommand& out,
+                           std::string* reason) {
+  Decoder d(data, size);
+  formation::FormationCommand m;
+  std::uint8_t name_len = 0, source = 0, group = 0, count = 0, parameter = 0, kind = 0;
+  if (d.u8(name_len, "formation_command.id.sender_length") && (name_len == 0 || name_len > kMaxSenderNameBytes)) {
+    d.fail(name_len == 0 ? PayloadError::kOutOfRange : PayloadError::kOversizeArray, "formation_command.id.sender_length");
+  }
+  const std::uint8_t* name = nullptr;
+  if (d.bytes(name_len, name, "formation_command.id.sender")) {
+    m.id.sender.assign(reinterpret_cast<const char*>(name), name_len);
+    if (!validSenderName(m.id.sender)) d.fail(PayloadError::kOutOfRange, "formation_command.id.sender");
+  }
+  d.u64(m.id.sequence, "formation_command.id.sequence");
+  if (d.u8(source, "formation_command.source") && source > 1) d.fail(PayloadError::kOutOfRange, "formation_command.source");
+  if (d.u8(group, "formation_command.target.group") && group > 3) d.fail(PayloadError::kOutOfRange, "formation_command.target.group");
+  if (d.u8(count, "formation_command.target.count")) {
+    if (count > kMaxCommandTargets) {
+      d.fail(PayloadError::kOversizeArray, "formation_command.target.count " + std::to_string(count));
+    } else if ((group == 3) != (count > 0)) {
+      d.fail(PayloadError::kOutOfRange, "formation_command.target.count (a list target needs UAVs, other groups none)");
+    }
+  }
+  for (std::size_t i = 0; i < count && d.ok(); ++i) {
+    std::uint16_t u = 0;
+    const std::string field = "formation_command.target.uavs[" + std::to_string(i) + "]";
+    if (d.u16(u, field.c_str())) {
+      if (!validUavIndex(u)) {
+        d.fail(PayloadError::kOutOfRange, field);
+      } else {
+        m.target.uavs.push_back(u);
+      }
+    }
+  }
+  if (d.u8(parameter, "formation_command.parameter") && parameter > 2) d.fail(PayloadError::kOutOfRange, "formation_command.parameter");
+  if (d.u8(kind, "formation_command.kind") && kind > 1) d.fail(PayloadError::kOutOfRange, "formation_command.kind");
+  d.f64(m.amount, "formation_command.amount");
+  if (d.finish()) {
+    static const formation::TargetGroup kGroups[] = {formation::TargetGroup::kLeader, formation::TargetGroup::kFollowers,
+                                                     formation::TargetGroup::kAll, formation::TargetGroup::kList};
+    static const formation::Parameter kParameters[] = {formation::Parameter::kBeta, formation::Parameter::kGamma,
+                                                       formation::Parameter::kDistance};
+    m.source = source == 1 ? formation::CommandSource::kGesture : formation::CommandSource::kOperator;
+    m.target.group = kGroups[group];
+    m.parameter = kParameters[parameter];
+    m.kind = kind == 1 ? formation::CommandKind::kSet : formation::CommandKind::kIncrement;
+    out = std::move(m);
+  }
+  return d.report(reason);
+}
+
+}  // namespace gesture_formation::comm

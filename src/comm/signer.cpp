@@ -1,0 +1,31 @@
+#include "gesture_formation/comm/signer.hpp"
+
+#include <limits>
+
+namespace gesture_formation::comm {
+
+common::Result<std::vector<std::uint8_t>> Signer::seal(MessageType type, const std::vector<std::uint8_t>& payload,
+                                                       double stamp_s) {
+  if (exhausted_) {
+    return common::Result<std::vector<std::uint8_t>>::fail("sequence numbers exhausted; restart with new keys");
+  }
+  Envelope e;
+  e.type = type;
+  e.sender_id = sender_id_;
+  e.key_id = keys_.activeId();
+  e.sequence = next_sequence_;
+  e.stamp_s = stamp_s;
+  e.payload = payload;
+  const KeyEntry& key = keys_.active();
+  auto sealed = sealEnvelope(e, key.key.data(), key.key.size());
+  if (sealed) {
+    if (next_sequence_ == std::numeric_limits<std::uint64_t>::max()) {
+      exhausted_ = true;
+    } else {
+      ++next_sequence_;
+    }
+  }
+  return sealed;
+}
+
+}  // namespace gesture_formation::comm

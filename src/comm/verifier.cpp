@@ -1,0 +1,154 @@
+#include "gesture_formation/comm/verifier.hpp"
+
+#include <cmath>
+#include <set>
+
+namespace gesture_formation::comm {
+
+const char* toString(Verdict v) {
+  switch (v) {
+    case Verdict::kAccepted: return "accepted";
+    case Verdict::kTruncated: return "truncated";
+    case Verdict::kOversize: return "oversize";
+    case Verdict::kBadVersion: return "bad_version";
+    case Verdict::kBadType: return "bad_type";
+    case Verdict::kMalformed: return "malformed";
+    case Verdict::kOwnMessage: return "own_message";
+    case Verdict::kUnknownSender: return "unknown_sender";
+    case Verdict::kUnknownKey: return "unknown_key";
+    case Verdict::kExpiredKey: return "expired_key";
+    case Verdict::kForged: return "forged";
+    case Verdict::kTooOld: return "too_old";
+    case Verdict::kTooNew: return "too_new";
+    case Verdict::kReplayed: return "replayed";
+    case Verdict::kStale: return "stale";
+  }
+  return "unknown";
+}
+
+std::uint64_t VerifierCounters::total() const {
+  std::uint64_t t = 0;
+  for (std::uint64_t c : by_verdict) t += c;
+  return t;
+}
+
+std::uint64_t VerifierCounters::rejected() const {
+  return total() - count(Verdict::kAccepted) - count(Verdict::kOwnMessage);
+}
+
+std::vector<std::string> VerifierConfig::validate() const {
+  std::vector<std::string> e;
+  if (known_senders.empty()) e.push_back("known_senders must list at least one sender id");
+  std::set<std::uint16_t> seen;
+  for (std::uint16_t s : known_senders) {
+    if (!seen.insert(s).second) e.push_back("known_senders lists sender id " + std::to_string(s) + " twice");
+    if (own_sender_id && *own_sender_id == s) {
+      e.push_back("known_senders must not contain own_sender_id " + std::to_string(s));
+    }
+  }
+  if (!(std::isfinite(max_age_s) && max_age_s > 0)) e.push_back("max_age_s must be > 0, got " + std::to_string(max_age_s));
+  if (!(std::isfinite(max_future_s) && max_future_s >= 0)) {
+    e.push_back("max_future_s must be >= 0, got " + std::to_string(max_future_s));
+  }
+  for (const auto& [type, age] : max_age_s_by_type) {
+    if (!isKnownMessageType(static_cast<std::uint8_t>(type))) {
+      e.push_back("max_age_s_by_type has an unknown message type");
+    } else if (!(std::isfinite(age) && age > 0)) {
+      e.push_back(std::string("max_age_s_by_type.") + toString(type) + " must be > 0, got " + std::to_string(age));
+    }
+  }
+  if (replay_window < 64 || replay_window > kMaxReplayWindow) {
+    e.push_back("replay_window must be in [64, " + std::to_string(kMaxReplayWindow) + "], got " +
+                std::to_string(replay_window));
+  }
+  return e;
+}
+
+double VerifierConfig::maxAgeS(MessageType type) const {
+  const auto it = max_age_s_by_type.find(type);
+  return it == max_age_s_by_type.end() ? max_age_s : it->second;
+}
+
+common::Result<Verifier> Verifier::create(const VerifierConfig& config, KeyRing keys) {
+  const std::vector<std::string> problems = config.validate();
+  if (!problems.empty()) {
+    std::string reason;
+    for (const std::string& p : problems) reason += (reason.empty() ? "" : "\n") + p;
+    return common::Result<Verifier>::fail(reason);
+  }
+  return common::Result<Verifier>::ok(Verifier(config, std::move(keys)));
+}
+
+Verifier::Verifier(const VerifierConfig& config, KeyRing keys) : config_(config), keys_(std::move(keys)) {
+  for (std::uint16_t s : config_.known_senders) windows_.emplace(s, ReplayWindow(config_.replay_window));
+}
+
+const ReplayWindow* Verifier::window(std::uint16_t sender_id) const {
+  const auto it = windows_.find(sender_id);
+  return it == windows_.end() ? nullptr : &it->second;
+}
+
+VerifyResult Verifier::reject(Verdict v, const char* detail) {
+  ++counters_.by_verdict[static_cast<std::size_t>(v)];
+  VerifyResult r;
+  r.verdict = v;
+  r.detail = detail;
+  return r;
+}
+
+VerifyResult Verifier::verify(const std::uint8_t* data, std::size_t size, double now_s) {
+  EnvelopeView view;
+  const EnvelopeError error = parseEnvelope(data, size, view);
+  switch (error) {
+    case EnvelopeError::kNone: break;
+    case EnvelopeError::kTruncated: return reject(Verdict::kTruncated, toString(error));
+    case EnvelopeError::kOversize: return reject(Verdict::kOversize, toString(error));
+    case EnvelopeError::kBadVersion: return reject(Verdict::kBadVersion, toString(error));
+    case EnvelopeError::kBadType: return reject(Verdict::kBadType, toString(error));
+    case EnvelopeError::kBadMagic:
+    case EnvelopeError::kBadFlags:
+    case EnvelopeError::kLengthMismatch:
+    case EnvelopeError::kBadStamp: return reject(Verdict::kMalformed, toString(error));
+  }
+  if (config_.own_sender_id && view.sender_id == *config_.own_sender_id) {
+    return reject(Verdict::kOwnMessage, "own sender id");
+  }
+  const auto window_it = windows_.find(view.sender_id);
+  if (window_it == windows_.end()) return reject(Verdict::kUnknownSender, "sender id not configured");
+  const KeyEntry* key = keys_.find(view.key_id);
+  if (key == nullptr) return reject(Verdict::kUnknownKey, "key id not in the key ring");
+  // (A NaN now_s passes here and fails the age check below.)
+  if (now_s > key->accept_until_s) return reject(Verdict::kExpiredKey, "key past its accept_until_s");
+
+  Tag tag{};
+  if (!hmacSha256(key->key.data(), key->key.size(), view.signed_bytes, view.signed_size, tag) ||
+      !constantTimeEqual(tag.data(), view.tag, kTagBytes)) {
+    return reject(Verdict::kForged, "tag does not verify");
+  }
+
+  // Written so that a NaN now_s fails the checks (counted too old).
+  const double age_s = now_s - view.stamp_s;
+  if (!(age_s <= config_.maxAgeS(view.type))) return reject(Verdict::kTooOld, "stamp older than the maximal age");
+  if (!(-age_s <= config_.max_future_s)) return reject(Verdict::kTooNew, "stamp ahead of now by more than max_future_s");
+
+  ReplayWindow& window = window_it->second;
+  switch (window.check(view.sequence)) {
+    case ReplayWindow::Check::kNew: break;
+    case ReplayWindow::Check::kDuplicate: return reject(Verdict::kReplayed, "sequence already accepted");
+    case ReplayWindow::Check::kTooOld: return reject(Verdict::kStale, "sequence below the replay window");
+  }
+
+  VerifyResult r;
+  r.verdict = Verdict::kAccepted;
+  r.envelope.type = view.type;
+  r.envelope.sender_id = view.sender_id;
+  r.envelope.key_id = view.key_id;
+  r.envelope.sequence = view.sequence;
+  r.envelope.stamp_s = view.stamp_s;
+  r.envelope.payload.assign(view.payload, view.payload + view.payload_bytes);
+  window.accept(view.sequence);
+  ++counters_.by_verdict[static_cast<std::size_t>(Verdict::kAccepted)];
+  return r;
+}
+
+}  // namespace gesture_formation::comm

@@ -1,0 +1,132 @@
+// LCM glue (gesture_formation_lcm) on memq:// only: in-process, no network traffic.
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "../comm_test_util.hpp"
+#include "gesture_formation/comm/payloads.hpp"
+#include "gesture_formation/lcm_bridge/lcm_transport.hpp"
+
+using namespace gesture_formation;
+using namespace gesture_formation::lcm_bridge;
+namespace t = gesture_formation::comm::testing;
+
+namespace {
+
+comm::Verifier verifier(std::vector<std::uint16_t> senders) {
+  comm::VerifierConfig c;
+  c.known_senders = std::move(senders);
+  auto v = comm::Verifier::create(c, t::ring({t::keyEntry(1, 10)}, 1));
+  EXPECT_TRUE(v) << v.reason();
+  return std::move(v.value());
+}
+
+std::unique_ptr<LcmTransport> memq() {
+  auto tr = LcmTransport::create("memq://");
+  EXPECT_TRUE(tr) << tr.reason();
+  return std::move(tr.value());
+}
+
+}  // namespace
+
+TEST(CommLcmTransportTest, ChannelNamesRoundTrip) {
+  for (std::uint8_t k = comm::kMinMessageType; k <= comm::kMaxMessageType; ++k) {
+    const auto type = static_cast<comm::MessageType>(k);
+    const std::string name = channelName(type, "GF_");
+    EXPECT_EQ(channelType(name, "GF_"), type) << name;
+  }
+  EXPECT_EQ(channelName(comm::MessageType::kPlannedTrajectory, "UAV_"), "UAV_PLANNED_TRAJECTORY");
+  EXPECT_FALSE(channelType("GF_POSE", "GF_"));
+  EXPECT_FALSE(channelType("XX_HEARTBEAT", "GF_"));
+}
+
+TEST(CommLcmTransportTest, LcmEnvelopeCodecChecksLengthBeforeDecoding) {
+  const std::vector<std::uint8_t> sealed(100, 0xAB);
+  const auto enc = encodeLcmEnvelope(sealed);
+  ASSERT_EQ(enc.size(), 12 + sealed.size());
+  std::vector<std::uint8_t> out;
+  ASSERT_TRUE(decodeLcmEnvelope(enc.data(), enc.size(), out));
+  EXPECT_EQ(out, sealed);
+  auto bad = enc;
+  bad[8] = 0xFF;  // negative length: lcm-gen's decoder would resize to it
+  out.clear();
+  EXPECT_FALSE(decodeLcmEnvelope(bad.data(), bad.size(), out));
+  EXPECT_TRUE(out.empty());
+  bad = enc;
+  bad[11] = 101;  // longer than the buffer
+  EXPECT_FALSE(decodeLcmEnvelope(bad.data(), bad.size(), out));
+  bad = enc;
+  bad[0] ^= 1;  // fingerprint
+  EXPECT_FALSE(decodeLcmEnvelope(bad.data(), bad.size(), out));
+  EXPECT_FALSE(decodeLcmEnvelope(enc.data(), 11, out));
+  EXPECT_FALSE(decodeLcmEnvelope(nullptr, 0, out));
+  EXPECT_TRUE(encodeLcmEnvelope(std::vector<std::uint8_t>(comm::kMaxEnvelopeBytes + 1)).empty());
+}
+
+TEST(CommLcmTransportTest, RefusesABadUrl) {
+  auto tr = LcmTransport::create("nosuchprovider://");
+  ASSERT_FALSE(tr);
+  EXPECT_NE(tr.reason().find("nosuchprovider://"), std::string::npos);
+}
+
+TEST(CommLcmTransportTest, SecureLinkCarriesAPlannedTrajectoryOverMemq) {
+  auto tr = memq();
+  double now = 10.0;
+  SecureLink link(*tr, comm::Signer(1, t::ring({t::keyEntry(1, 10)}, 1), 1), verifier({1}), [&now] { return now; });
+  std::vector<comm::Envelope> received;
+  link.setHandler([&](const comm::Envelope& e) { received.push_back(e); });
+
+  planning::PlannedTrajectory plan;
+  plan.uav_index = 1;
+  plan.sequence = 5;
+  plan.t0_s = 10.0;
+  plan.samples.resize(40);
+  plan.samples[7].p_world = {1, 2, 3};
+  auto seq = link.publish(plan);
+  ASSERT_TRUE(seq) << seq.reason();
+  EXPECT_EQ(seq.value(), 1u);
+  EXPECT_EQ(tr->drain(), 1);
+  ASSERT_EQ(received.size(), 1u);
+  EXPECT_EQ(received[0].type, comm::MessageType::kPlannedTrajectory);
+  comm::PayloadDecoder decoder;
+  planning::PlannedTrajectory got;
+  ASSERT_TRUE(decoder.decode(received[0], got)) << decoder.lastReason();
+  EXPECT_EQ(got.samples.size(), 40u);
+  EXPECT_EQ(got.samples[7].p_world, plan.samples[7].p_world);
+
+  comm::Heartbeat hb;
+  ASSERT_TRUE(link.publish(hb));
+  EXPECT_EQ(tr->drain(), 1);
+  EXPECT_EQ(received.size(), 2u);
+  EXPECT_EQ(link.verifierCounters().accepted(), 2u);
+  EXPECT_EQ(tr->counters().published, 2u);
+}
+
+TEST(CommLcmTransportTest, ForgedReplayedAndMisroutedEnvelopesAreDroppedAndCounted) {
+  auto tr = memq();
+  double now = 10.0;
+  SecureLink link(*tr, comm::Signer(1, t::ring({t::keyEntry(1, 10)}, 1), 1), verifier({1, 2}), [&now] { return now; });
+  int delivered = 0;
+  link.setHandler([&](const comm::Envelope&) { ++delivered; });
+
+  comm::Signer honest(2, t::ring({t::keyEntry(1, 10)}, 1), 1);
+  comm::Signer mallory(2, t::ring({t::keyEntry(1, 66)}, 1), 100);
+  const auto good = honest.seal(comm::MessageType::kFormationCommand, {1}, now).value();
+  ASSERT_TRUE(tr->publish(comm::MessageType::kFormationCommand, good));
+  ASSERT_TRUE(tr->publish(comm::MessageType::kFormationCommand, good));  // replay
+  ASSERT_TRUE(tr->publish(comm::MessageType::kFormationCommand, mallory.seal(comm::MessageType::kFormationCommand, {1}, now).value()));
+  ASSERT_TRUE(tr->publish(comm::MessageType::kHeartbeat, honest.seal(comm::MessageType::kFormationCommand, {2}, now).value()));
+  ASSERT_TRUE(tr->publish(comm::MessageType::kHeartbeat, std::vector<std::uint8_t>(10, 0)));  // garbage envelope
+  EXPECT_EQ(tr->drain(), 5);
+  EXPECT_EQ(delivered, 1);
+  EXPECT_EQ(link.verifierCounters().accepted(), 1u);
+  EXPECT_EQ(link.verifierCounters().count(comm::Verdict::kReplayed), 1u);
+  EXPECT_EQ(link.verifierCounters().count(comm::Verdict::kForged), 1u);
+  EXPECT_EQ(link.verifierCounters().count(comm::Verdict::kTruncated), 1u);
+  EXPECT_EQ(link.channelMismatches(), 1u);
+  // The misrouted envelope did not consume its sequence: sent on its own channel it is accepted.
+  const auto later = honest.seal(comm::MessageType::kHeartbeat, {}, now).value();
+  ASSERT_TRUE(tr->publish(comm::MessageType::kHeartbeat, later));
+  EXPECT_EQ(tr->drain(), 1);
+  EXPECT_EQ(delivered, 2);
+}

@@ -1,0 +1,336 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
+
+#include "gesture_formation/comm/byte_io.hpp"
+#include "gesture_formation/comm/payloads.hpp"
+
+using namespace gesture_formation::comm;
+namespace formation = gesture_formation::formation;
+namespace planning = gesture_formation::planning;
+
+namespace {
+
+const double kNaN = std::numeric_limits<double>::quiet_NaN();
+const double kInf = std::numeric_limits<double>::infinity();
+
+planning::PlannedTrajectory trajectory(std::size_t n, std::uint64_t seed = 3) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-50.0, 50.0);
+  planning::PlannedTrajectory t;
+  t.uav_index = 2;
+  t.sequence = 77;
+  t.t0_s = 12.25;
+  t.dt_s = 0.2;
+  for (std::size_t k = 0; k < n; ++k) {
+    planning::TrajectorySample s;
+    s.p_world = {u(rng), u(rng), u(rng)};
+    s.v_world = {u(rng), u(rng), u(rng)};
+    s.a_world = {u(rng), u(rng), u(rng)};
+    s.heading_rad = u(rng);
+    s.pitch_rad = u(rng);
+    t.samples.push_back(s);
+  }
+  return t;
+}
+
+formation::FormationCommand command() {
+  formation::FormationCommand c;
+  c.id = {"operator-gcs1", 123456789012ull};
+  c.source = formation::CommandSource::kGesture;
+  c.target = formation::CommandTarget::list({2, 0});
+  c.parameter = formation::Parameter::kDistance;
+  c.kind = formation::CommandKind::kSet;
+  c.amount = 12.5;
+  return c;
+}
+
+template <class T>
+std::vector<std::uint8_t> encoded(const T& m) {
+  auto r = encodePayload(m);
+  EXPECT_TRUE(r) << r.reason();
+  return r ? r.value() : std::vector<std::uint8_t>{};
+}
+
+template <class T>
+PayloadError decode(const std::vector<std::uint8_t>& b, T& out, std::string* reason = nullptr) {
+  return decodePayload(b.data(), b.size(), out, reason);
+}
+
+/// Overwrites the big-endian double at `offset`.
+void putDouble(std::vector<std::uint8_t>& b, std::size_t offset, double v) {
+  ByteWriter w;
+  w.f64(v);
+  std::memcpy(&b[offset], w.buffer().data(), 8);
+}
+
+}  // namespace
+
+TEST(CommPayloadsTest, HeartbeatRoundTrip) {
+  Heartbeat h;
+  h.uav_index = 3;
+  h.status = Heartbeat::Status::kFailsafe;
+  h.worker_visible = true;
+  h.last_plan_sequence = 0xDEADBEEF;
+  const auto b = encoded(h);
+  ASSERT_EQ(b.size(), 8u);
+  Heartbeat d;
+  ASSERT_EQ(decode(b, d), PayloadError::kNone);
+  EXPECT_EQ(d.uav_index, 3);
+  EXPECT_EQ(d.status, Heartbeat::Status::kFailsafe);
+  EXPECT_TRUE(d.worker_visible);
+  EXPECT_EQ(d.last_plan_sequence, 0xDEADBEEFu);
+  auto bad = b;
+  bad[2] = 4;
+  EXPECT_EQ(decode(bad, d), PayloadError::kOutOfRange);
+  bad = b;
+  bad[3] = 2;
+  EXPECT_EQ(decode(bad, d), PayloadError::kOutOfRange);
+  bad = b;
+  bad[1] = 32;
+  EXPECT_EQ(decode(bad, d), PayloadError::kOutOfRange);
+  h.uav_index = 32;
+  EXPECT_FALSE(encodePayload(h));
+}
+
+TEST(CommPayloadsTest, WorkerStateRoundTripAndNonFinite) {
+  WorkerStateMessage m;
+  m.t_s = 3.5;
+  m.p_world = {1, -2, 3.25};
+  m.v_world = {0.1, 0.2, -0.3};
+  m.covariance_diag = {0.01, 0.02, 0.03, 0.4, 0.5, 0.6};
+  m.lost = true;
+  const auto b = encoded(m);
+  ASSERT_EQ(b.size(), 13 * 8 + 1u);
+  WorkerStateMessage d;
+  ASSERT_EQ(decode(b, d), PayloadError::kNone);
+  EXPECT_EQ(d.p_world, m.p_world);
+  EXPECT_EQ(d.v_world, m.v_world);
+  EXPECT_EQ(d.covariance_diag, m.covariance_diag);
+  EXPECT_TRUE(d.lost);
+  // Every double replaced by NaN / inf in turn is refused naming the field; d is untouched.
+  for (std::size_t f = 0; f < 13; ++f) {
+    for (double bad_value : {kNaN, kInf, -kInf}) {
+      auto bad = b;
+      putDouble(bad, 8 * f, bad_value);
+      WorkerStateMessage untouched = d;
+      std::string reason;
+      ASSERT_EQ(decode(bad, untouched, &reason), PayloadError::kNonFinite) << f;
+      EXPECT_NE(reason.find("worker_state."), std::string::npos);
+      EXPECT_EQ(untouched.t_s, d.t_s);
+    }
+  }
+  auto neg = b;
+  putDouble(neg, 8 * 7, -0.1);
+  std::string reason;
+  EXPECT_EQ(decode(neg, d, &reason), PayloadError::kOutOfRange);
+  EXPECT_EQ(reason, "out_of_range: worker_state.covariance_diag[0]");
+  m.p_world.x() = kNaN;
+  EXPECT_FALSE(encodePayload(m));
+}
+
+TEST(CommPayloadsTest, PlannedTrajectoryRoundTripIsBitExact) {
+  for (std::size_t n : {0u, 1u, 40u, static_cast<unsigned>(kMaxTrajectorySamples)}) {
+    const auto t = trajectory(n);
+    const auto b = encoded(t);
+    ASSERT_EQ(b.size(), 24 + 88 * n);
+    ASSERT_LE(b.size(), kMaxPayloadBytes);
+    planning::PlannedTrajectory d;
+    ASSERT_EQ(decode(b, d), PayloadError::kNone);
+    EXPECT_EQ(d.uav_index, t.uav_index);
+    EXPECT_EQ(d.sequence, t.sequence);
+    EXPECT_EQ(d.t0_s, t.t0_s);
+    EXPECT_EQ(d.dt_s, t.dt_s);
+    ASSERT_EQ(d.samples.size(), n);
+    for (std::size_t k = 0; k < n; ++k) {
+      EXPECT_EQ(d.samples[k].p_world, t.samples[k].p_world);
+      EXPECT_EQ(d.samples[k].v_world, t.samples[k].v_world);
+      EXPECT_EQ(d.samples[k].a_world, t.samples[k].a_world);
+      EXPECT_EQ(d.samples[k].heading_rad, t.samples[k].heading_rad);
+      EXPECT_EQ(d.samples[k].pitch_rad, t.samples[k].pitch_rad);
+    }
+    EXPECT_EQ(encoded(d), b);
+  }
+}
+
+TEST(CommPayloadsTest, PlannedTrajectoryRefusals) {
+  const auto b = encoded(trajectory(3));
+  planning::PlannedTrajectory d;
+  std::string reason;
+  // Count above the maximum, whatever the bytes: refused before any allocation.
+  auto bad = b;
+  bad[22] = 0xFF;
+  bad[23] = 0xFF;
+  EXPECT_EQ(decode(bad, d, &reason), PayloadError::kOversizeArray);
+  EXPECT_EQ(reason, "oversize_array: planned_trajectory.count 65535");
+  bad = b;
+  bad[23] = 4;  // claims 4 samples, holds 3
+  EXPECT_EQ(decode(bad, d), PayloadError::kTruncated);
+  bad = b;
+  bad[23] = 2;  // claims 2, holds 3
+  EXPECT_EQ(decode(bad, d), PayloadError::kTrailingBytes);
+  bad = b;
+  putDouble(bad, 14, 0.0);  // dt
+  EXPECT_EQ(decode(bad, d), PayloadError::kOutOfRange);
+  bad = b;
+  putDouble(bad, 24 + 88 + 9 * 8, kNaN);  // samples[1].heading
+  EXPECT_EQ(decode(bad, d, &reason), PayloadError::kNonFinite);
+  EXPECT_EQ(reason, "non_finite: planned_trajectory.samples[1].heading_rad");
+  for (std::size_t cut = 0; cut < b.size(); ++cut) {
+    std::vector<std::uint8_t> part(b.begin(), b.begin() + static_cast<long>(cut));
+    ASSERT_EQ(decode(part, d), PayloadError::kTruncated) << cut;
+  }
+  auto t = trajectory(kMaxTrajectorySamples + 1);
+  EXPECT_FALSE(encodePayload(t));
+  t = trajectory(2);
+  t.uav_index = -1;
+  EXPECT_FALSE(encodePayload(t));
+  t = trajectory(2);
+  t.samples[1].a_world.z() = kInf;
+  EXPECT_FALSE(encodePayload(t));
+}
+
+TEST(CommPayloadsTest, FormationParamsRoundTripAndLimits) {
+  formation::FormationParams p;  // Table II
+  p.followers.push_back({15.0, -5.0, 9.5});
+  const auto b = encoded(p);
+  ASSERT_EQ(b.size(), 24 + 1 + 3 * 24u);
+  formation::FormationParams d;
+  d.followers.clear();
+  ASSERT_EQ(decode(b, d), PayloadError::kNone);
+  ASSERT_EQ(d.uavCount(), 4);
+  for (int u = 0; u < 4; ++u) {
+    EXPECT_EQ(d.uav(u).beta_deg, p.uav(u).beta_deg);
+    EXPECT_EQ(d.uav(u).gamma_deg, p.uav(u).gamma_deg);
+    EXPECT_EQ(d.uav(u).distance_m, p.uav(u).distance_m);
+  }
+  auto bad = b;
+  bad[24] = static_cast<std::uint8_t>(kMaxFollowers + 1);
+  EXPECT_EQ(decode(bad, d), PayloadError::kOversizeArray);
+  EXPECT_EQ(d.uavCount(), 4);  // untouched
+  bad = b;
+  putDouble(bad, 16, -1.0);  // leader distance
+  EXPECT_EQ(decode(bad, d), PayloadError::kOutOfRange);
+  p.followers.assign(kMaxFollowers + 1, formation::UavObservation{});
+  EXPECT_FALSE(encodePayload(p));
+}
+
+TEST(CommPayloadsTest, FormationCommandRoundTrip) {
+  const auto c = command();
+  const auto b = encoded(c);
+  formation::FormationCommand d;
+  ASSERT_EQ(decode(b, d), PayloadError::kNone);
+  EXPECT_EQ(d.id.sender, c.id.sender);
+  EXPECT_EQ(d.id.sequence, c.id.sequence);
+  EXPECT_EQ(d.source, c.source);
+  EXPECT_EQ(d.target.group, formation::TargetGroup::kList);
+  EXPECT_EQ(d.target.uavs, c.target.uavs);
+  EXPECT_EQ(d.parameter, c.parameter);
+  EXPECT_EQ(d.kind, c.kind);
+  EXPECT_EQ(d.amount, c.amount);
+  for (auto group : {formation::CommandTarget::leader(), formation::CommandTarget::followers(), formation::CommandTarget::all()}) {
+    formation::FormationCommand g = c;
+    g.target = group;
+    g.parameter = formation::Parameter::kGamma;
+    g.kind = formation::CommandKind::kIncrement;
+    g.source = formation::CommandSource::kOperator;
+    ASSERT_EQ(decode(encoded(g), d), PayloadError::kNone);
+    EXPECT_EQ(d.target.group, group.group);
+    EXPECT_TRUE(d.target.uavs.empty());
+    EXPECT_EQ(d.parameter, formation::Parameter::kGamma);
+    EXPECT_EQ(d.source, formation::CommandSource::kOperator);
+  }
+}
+
+TEST(CommPayloadsTest, FormationCommandRefusals) {
+  auto c = command();
+  c.amount = kNaN;
+  EXPECT_FALSE(encodePayload(c));
+  c = command();
+  c.id.sender = "has space";
+  EXPECT_FALSE(encodePayload(c));
+  c.id.sender = std::string(kMaxSenderNameBytes + 1, 'a');
+  EXPECT_FALSE(encodePayload(c));
+  c = command();
+  c.target.uavs.clear();
+  EXPECT_FALSE(encodePayload(c));
+  c = command();
+  c.target.uavs.push_back(kMaxUavIndex + 1);
+  EXPECT_FALSE(encodePayload(c));
+
+  const auto b = encoded(command());
+  const std::size_t name = 1 + command().id.sender.size();  // offset after the name
+  formation::FormationCommand d;
+  auto bad = b;
+  bad[0] = 0;
+  EXPECT_EQ(decode(bad, d), PayloadError::kOutOfRange);
+  bad[0] = 200;
+  EXPECT_EQ(decode(bad, d), PayloadError::kOversizeArray);
+  bad = b;
+  bad[1] = 0x07;  // control character in the name
+  EXPECT_EQ(decode(bad, d), PayloadError::kOutOfRange);
+  bad = b;
+  bad[name + 8] = 2;  // source
+  EXPECT_EQ(decode(bad, d), PayloadError::kOutOfRange);
+  bad = b;
+  bad[name + 9] = 0;  // group leader but a UAV list follows
+  EXPECT_EQ(decode(bad, d), PayloadError::kOutOfRange);
+  bad = b;
+  bad[name + 10] = 200;  // UAV count
+  EXPECT_EQ(decode(bad, d), PayloadError::kOversizeArray);
+  bad = b;
+  bad[name + 12] = 40;  // UAV index 40
+  EXPECT_EQ(decode(bad, d), PayloadError::kOutOfRange);
+  bad = b;
+  putDouble(bad, b.size() - 8, -kInf);
+  EXPECT_EQ(decode(bad, d), PayloadError::kNonFinite);
+  bad = b;
+  bad.push_back(1);
+  EXPECT_EQ(decode(bad, d), PayloadError::kTrailingBytes);
+}
+
+TEST(CommPayloadsTest, DecoderChecksTypeAndCountsEveryOutcome) {
+  PayloadDecoder decoder;
+  Envelope e;
+  e.type = MessageType::kHeartbeat;
+  e.payload = encoded(Heartbeat{});
+  Heartbeat h;
+  EXPECT_TRUE(decoder.decode(e, h));
+  WorkerStateMessage w;
+  EXPECT_FALSE(decoder.decode(e, w));
+  EXPECT_EQ(decoder.lastReason(), "envelope type heartbeat, expected worker_state");
+  e.payload.pop_back();
+  EXPECT_FALSE(decoder.decode(e, h));
+  e.type = MessageType::kWorkerState;
+  e.payload = encoded(WorkerStateMessage{});
+  putDouble(e.payload, 0, kNaN);
+  EXPECT_FALSE(decoder.decode(e, w));
+  EXPECT_EQ(decoder.counters().decoded(), 1u);
+  EXPECT_EQ(decoder.counters().count(PayloadError::kWrongType), 1u);
+  EXPECT_EQ(decoder.counters().count(PayloadError::kTruncated), 1u);
+  EXPECT_EQ(decoder.counters().count(PayloadError::kNonFinite), 1u);
+  EXPECT_EQ(decoder.counters().rejected(), 3u);
+}
+
+// Random byte strings: never crash, and whatever decodes re-encodes to the same bytes.
+TEST(CommPayloadsTest, RandomBytesDecodeOrRoundTripExactly) {
+  std::mt19937_64 rng(99);
+  int decoded = 0;
+  for (int i = 0; i < 20000; ++i) {
+    std::vector<std::uint8_t> b(rng() % 40);
+    for (auto& x : b) x = static_cast<std::uint8_t>(rng() % 4 == 0 ? 0 : rng());
+    Heartbeat h;
+    if (decode(b, h) == PayloadError::kNone) {
+      ++decoded;
+      EXPECT_EQ(encoded(h), b);
+    }
+    formation::FormationCommand c;
+    if (decode(b, c) == PayloadError::kNone) {
+      EXPECT_EQ(encoded(c), b);
+    }
+  }
+  EXPECT_GT(decoded, 0);
+}
