@@ -57,6 +57,32 @@ PrimitiveSet towerPrimitives(const LatticeTowerSpec& spec) {
       set.cylinders.push_back(Cylinder{corner(n, h0), corner(k, h1), spec.brace_radius_m});
     }
   }
+  if (spec.keep_out) {
+    const double th = spec.keep_out_thickness_m;
+    for (int level = 0; level < spec.panels; ++level) {
+      const double h0 = spec.height_m * level / spec.panels;
+      const double h1 = spec.height_m * (level + 1) / spec.panels;
+      for (int k = 0; k < 4; ++k) {
+        const int n = (k + 1) % 4;
+        const Eigen::Vector3d b0 = corner(k, h0), b1 = corner(n, h0), t0 = corner(k, h1), t1 = corner(n, h1);
+        const Eigen::Vector3d along = (b1 - b0).normalized();
+        const Eigen::Vector3d up = (0.5 * (t0 + t1) - 0.5 * (b0 + b1));
+        const Eigen::Vector3d up_dir = (up - up.dot(along) * along).normalized();
+        OrientedBox plate;
+        plate.center_world = 0.25 * (b0 + b1 + t0 + t1);
+        plate.size_m = Eigen::Vector3d((b1 - b0).norm(), up.norm(), th);
+        plate.R_world_box.col(0) = along;
+        plate.R_world_box.col(1) = up_dir;
+        plate.R_world_box.col(2) = along.cross(up_dir);
+        set.boxes.push_back(plate);
+      }
+    }
+    OrientedBox cap;
+    cap.center_world = world(Eigen::Vector3d(0.0, 0.0, spec.height_m));
+    cap.size_m = Eigen::Vector3d(spec.top_width_m, spec.top_width_m, th);
+    cap.R_world_box = R;
+    set.boxes.push_back(cap);
+  }
   for (const auto& arm : spec.cross_arms) {
     OrientedBox b;
     b.center_world = world(Eigen::Vector3d(0.0, 0.0, arm.height_m));

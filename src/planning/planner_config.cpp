@@ -71,6 +71,9 @@ std::vector<std::string> PlannerConfig::validate() const {
   require(e, pos(verify_clearance_m), "verify.clearance_m", verify_clearance_m, "must be > 0");
   require(e, verify_substeps >= 1 && verify_substeps <= 100, "verify.substeps", verify_substeps, "must be in [1, 100]");
   require(e, nonneg(verify_tolerance) && verify_tolerance < 0.1, "verify.tolerance", verify_tolerance, "must be in [0, 0.1)");
+  require(e, pos(recovery_speed_mps), "verify.recovery_speed_mps", recovery_speed_mps, "must be > 0");
+  require(e, pos(recovery_acceleration_mps2), "verify.recovery_acceleration_mps2", recovery_acceleration_mps2, "must be > 0");
+  require(e, pos(recovery_slack_m), "verify.recovery_slack_m", recovery_slack_m, "must be > 0");
   require(e, pos(fallback_min_horizon_s), "fallback.min_horizon_s", fallback_min_horizon_s, "must be > 0");
   require(e, pos(fallback_max_deviation_m), "fallback.max_deviation_m", fallback_max_deviation_m, "must be > 0");
   require(e, nonneg(time_budget_ms), "fallback.time_budget_ms", time_budget_ms, "must be >= 0 (0 disables)");
@@ -120,6 +123,9 @@ PlannerConfig readPlannerConfig(ConfigReader& r, const std::string& prefix) {
   r.readDouble(key("verify.clearance_m"), c.verify_clearance_m, Range::positive());
   r.readInt(key("verify.substeps"), c.verify_substeps, Range::closed(1, 100));
   r.readDouble(key("verify.tolerance"), c.verify_tolerance, Range{0.0, 0.1, true, false});
+  r.readDouble(key("verify.recovery_speed_mps"), c.recovery_speed_mps, Range::positive());
+  r.readDouble(key("verify.recovery_acceleration_mps2"), c.recovery_acceleration_mps2, Range::positive());
+  r.readDouble(key("verify.recovery_slack_m"), c.recovery_slack_m, Range::positive());
   r.readDouble(key("fallback.min_horizon_s"), c.fallback_min_horizon_s, Range::positive());
   r.readDouble(key("fallback.max_deviation_m"), c.fallback_max_deviation_m, Range::positive());
   r.readDouble(key("fallback.time_budget_ms"), c.time_budget_ms, Range::nonNegative());

@@ -201,6 +201,8 @@ class ScenarioReader {
     if (r_.has(k + ".panels")) r_.readInt(k + ".panels", t.panels, Range::closed(1, 1000));
     readOptional(k + ".leg_radius_m", t.leg_radius_m, Range::positive());
     readOptional(k + ".brace_radius_m", t.brace_radius_m, Range::positive());
+    if (r_.has(k + ".keep_out")) r_.readBool(k + ".keep_out", t.keep_out);
+    readOptional(k + ".keep_out_thickness_m", t.keep_out_thickness_m, Range::positive());
     for (std::size_t i = 0, n = listSize(k + ".cross_arms"); i < n; ++i) {
       const std::string a = item(k + ".cross_arms", i);
       CrossArmSpec arm;

@@ -151,7 +151,10 @@ VerificationReport TrajectoryVerifier::verify(const PlannedTrajectory& tr, doubl
       // Other UAVs' plans.
       for (std::size_t j = 0; j < others.size(); ++j) {
         const double d = (x.p - evaluateTrajectory(others[j], t).p).norm();
-        const double req = first ? std::min(required[j], start_dist[j]) : required[j];
+        const double req = start_dist[j] < required[j]
+                               ? std::min(required[j], start_dist[j] - config_.recovery_slack_m +
+                                                           recoveryAllowance(config_, t - tr.t0_s))
+                               : required[j];
         rep.min_uav_margin_m = std::min(rep.min_uav_margin_m, d - required[j]);
         if (d < req - tol) {
           os << "verify: " << d << " m from UAV " << others[j].uav_index << "'s plan at t=" << t << " (need " << req << " m)";
@@ -162,7 +165,10 @@ VerificationReport TrajectoryVerifier::verify(const PlannedTrajectory& tr, doubl
       if (has_worker) {
         const double d = (x.p - workerPositionAt(worker, worker_t0, worker_dt, t)).norm();
         rep.min_worker_distance_m = std::min(rep.min_worker_distance_m, d);
-        const double req = first ? std::min(config_.worker_safety_distance_m, start_worker) : config_.worker_safety_distance_m;
+        const double limit = config_.worker_safety_distance_m;
+        const double req = start_worker < limit ? std::min(limit, start_worker - config_.recovery_slack_m +
+                                                                      recoveryAllowance(config_, t - tr.t0_s))
+                                                : limit;
         if (d < req - tol) {
           os << "verify: " << d << " m from the worker at t=" << t << " (need " << req << " m)";
           return fail(os.str());

@@ -91,6 +91,10 @@ UavPlanner::UavPlanner(const PlannerConfig& config, std::shared_ptr<const Occupa
   CorridorConfig cc;
   cc.clearance_m = config_.obstacle_clearance_m;
   cc.local_box_margin_m = Eigen::Vector3d::Constant(config_.corridor_box_margin_m);
+  // The QP shrinks every corridor by corridor_margin_m: the seed segment (which starts at the
+  // current position) must stay inside the shrunk corridor, or a UAV closer to an obstacle
+  // than the clearance has no feasible first sample (found in the power-tower mission).
+  cc.seed_margin_m = config_.corridor_margin_m + 0.02;
   corridors_ = std::make_unique<CorridorBuilder>(cc);
   qp_ = std::make_unique<TrajectoryQp>();
   if (map_ && field_) {
@@ -467,14 +471,41 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
       if (s_prev == s_cur) break;
     }
   }
+  // Closer to obstacles than the corridor clearance (gusts, a corridor that had to shrink
+  // around the start): move away along the distance field's gradient at the recovery pace
+  // until the clearance is back, instead of hovering where the last plan left the UAV.
+  {
+    const double d_start = field.clearance(p0);
+    if (d_start < config_.obstacle_clearance_m) {
+      Eigen::Vector3d g;
+      for (int i = 0; i < 3; ++i) {
+        const Eigen::Vector3d e = Eigen::Vector3d::Unit(i) * res;
+        g(i) = (field.clearance(p0 + e) - field.clearance(p0 - e)) / (2.0 * res);
+      }
+      if (g.allFinite() && g.norm() > 1e-6) {
+        const Eigen::Vector3d away = g.normalized();
+        for (int k = 1; k <= N; ++k) {
+          const double gain = std::min(config_.obstacle_clearance_m - d_start,
+                                       -0.5 * config_.recovery_slack_m + 1.2 * recoveryAllowance(config_, k * dt));
+          // away·(x_k − p0) ≥ gain  ⇔  (−away)·x_k ≤ −away·p0 − gain
+          qp.constraints.push_back(PositionConstraint{k, -away, -away.dot(p0) - gain, PositionConstraint::Kind::kCorridor});
+        }
+      }
+    }
+  }
   // Linearisation points for the distance half-spaces: the last verified plan at t_k, else
   // the current position.
   const bool have_prev = !last_verified_.empty() && last_verified_.tEnd() > req.t_now_s;
   const auto linPoint = [&](int k) {
     return have_prev ? evaluateTrajectory(last_verified_, req.t_now_s + k * dt).p : p0;
   };
-  const auto addSeparation = [&](int k, const Eigen::Vector3d& o, double margin, PositionConstraint::Kind kind) {
+  const auto addSeparation = [&](int k, const Eigen::Vector3d& o, double margin, double d0, PositionConstraint::Kind kind) {
     if ((o - p0).norm() - margin > vmax * k * dt) return;  // cannot get that close by t_k
+    // Already inside at t0 (d0: the distance at t0): recover at the pace of
+    // PlannerConfig::recovery_speed_mps, 1.2× and half the slack of what the verifier asks.
+    if (d0 < margin) {
+      margin = std::min(margin, d0 - 0.5 * config_.recovery_slack_m + 1.2 * recoveryAllowance(config_, k * dt));
+    }
     Eigen::Vector3d n = linPoint(k) - o;
     if (n.norm() < 1e-6) n = guide[static_cast<std::size_t>(k)] - o;
     if (n.norm() < 1e-6) n = Eigen::Vector3d::UnitZ();
@@ -485,13 +516,15 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
   for (const auto& other : req.higher_priority_plans) {
     const double age = std::max(0.0, req.t_now_s - other.t0_s);
     const double margin = config_.mutual_distance_m + config_.age_margin_speed_mps * age + config_.qp_distance_buffer_m;
+    const double d0 = (p0 - evaluateTrajectory(other, req.t_now_s).p).norm();
     for (int k = 1; k <= N; ++k) {
-      addSeparation(k, evaluateTrajectory(other, req.t_now_s + k * dt).p, margin, PositionConstraint::Kind::kUav);
+      addSeparation(k, evaluateTrajectory(other, req.t_now_s + k * dt).p, margin, d0, PositionConstraint::Kind::kUav);
     }
   }
   if (has_worker) {
+    const double d0 = (p0 - req.worker.p_world.col(0)).norm();
     for (int k = 1; k <= N; ++k) {
-      addSeparation(k, req.worker.p_world.col(k), config_.worker_safety_distance_m + config_.qp_distance_buffer_m,
+      addSeparation(k, req.worker.p_world.col(k), config_.worker_safety_distance_m + config_.qp_distance_buffer_m, d0,
                     PositionConstraint::Kind::kWorker);
     }
   }
@@ -511,7 +544,28 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
   result.qp_constraints = sol.equalities + sol.inequalities;
   result.qp_iterations = sol.iterations;
   result.timings.qp_ms = msSince(t_stage);
-  if (!sol.solved()) return finish(fallback(req, result, sol.reason));
+  if (!sol.solved()) {
+    // Name the constraint family that makes it infeasible (users and the simulator's failure
+    // statistics need the cause; costs up to three more solves, only on failure).
+    std::string cause;
+    using Kind = PositionConstraint::Kind;
+    for (const auto& [kind, name] : {std::pair{Kind::kWorker, "worker separation"}, std::pair{Kind::kUav, "UAV separation"},
+                                     std::pair{Kind::kCorridor, "corridors"}}) {
+      TrajectoryQpProblem relaxed = qp;
+      const auto before = relaxed.constraints.size();
+      relaxed.constraints.erase(std::remove_if(relaxed.constraints.begin(), relaxed.constraints.end(),
+                                               [kind = kind](const PositionConstraint& c) { return c.kind == kind; }),
+                                relaxed.constraints.end());
+      if (relaxed.constraints.size() == before) continue;
+      if (qp_->solve(relaxed, nullptr).solved()) {
+        cause = std::string(" (feasible without the ") + name + " constraints)";
+        break;
+      }
+    }
+    if (cause.empty()) cause = " (infeasible even without any single family: dynamics vs the initial state)";
+    result.timings.qp_ms = msSince(t_stage);
+    return finish(fallback(req, result, sol.reason + cause));
+  }
 
   // ---- camera heading / pitch (filter or Ceres) ----------------------------------------------------------
   t_stage = Clock::now();

@@ -34,6 +34,12 @@ struct LatticeTowerSpec {
   double leg_radius_m = 0.12;    ///< > 0
   double brace_radius_m = 0.04;  ///< ring and diagonal members, > 0
   std::vector<CrossArmSpec> cross_arms;
+  /// Planning keep-out: close the four faces (one thin plate per panel and face, as wide as
+  /// the panel's bottom edge) and the top, so that no path leads between the members into
+  /// the tower body. Real towers are not flown through: the openings between braces are
+  /// about a metre wide, less than a UAV's safe clearance under gusts.
+  bool keep_out = false;
+  double keep_out_thickness_m = 0.1;  ///< plate thickness, > 0
 
   /// Every problem, each naming the field; empty when valid.
   std::vector<std::string> validate() const;

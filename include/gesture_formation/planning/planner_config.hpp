@@ -101,6 +101,15 @@ struct PlannerConfig {
   /// Relative tolerance of the speed/acceleration checks and absolute (m) of the distance
   /// checks, ≥ 0.
   double verify_tolerance = 1e-3;
+  /// Recovery from a separation the measured state already violates (the worker walked up to
+  /// a hovering UAV, a UAV starts too close to another): the required distance to the worker /
+  /// another UAV is then min(limit, d0 − recovery_slack_m + s(τ)), τ = t − t0, where s(τ) is
+  /// the distance covered from rest accelerating at recovery_acceleration_mps2 up to
+  /// recovery_speed_mps. The QP asks for 1.2·s(τ) with half the slack, so a solved plan
+  /// passes verification. All > 0 (docs/planning.md §7).
+  double recovery_speed_mps = 0.5;
+  double recovery_acceleration_mps2 = 1.0;
+  double recovery_slack_m = 0.1;
   /// The last verified plan may be reused only when it still covers at least this much time
   /// (s) after t_now, > 0 ...
   double fallback_min_horizon_s = 2.0;
@@ -113,6 +122,15 @@ struct PlannerConfig {
   /// Every problem, each naming the field and its value; empty when valid.
   std::vector<std::string> validate() const;
 };
+
+/// \brief s(τ): the distance covered in τ seconds from rest at recovery_acceleration_mps2,
+/// capped at recovery_speed_mps (0 for τ ≤ 0). See PlannerConfig::recovery_speed_mps.
+inline double recoveryAllowance(const PlannerConfig& c, double tau_s) {
+  if (!(tau_s > 0.0)) return 0.0;
+  const double t1 = c.recovery_speed_mps / c.recovery_acceleration_mps2;
+  if (tau_s <= t1) return 0.5 * c.recovery_acceleration_mps2 * tau_s * tau_s;
+  return 0.5 * c.recovery_speed_mps * t1 + c.recovery_speed_mps * (tau_s - t1);
+}
 
 /// \brief Reads every key of PlannerConfig (the layout of config/planner.yaml) under
 /// `prefix` ("" or e.g. "planner."). In kError mode every missing key is an error; in

@@ -397,3 +397,63 @@ TEST(UavPlannerTest, OlderPlanGetsLargerMargin) {
     }
   }
 }
+
+// Recovery (PlannerConfig::recovery_*): the worker walked up to a hovering UAV. The planner
+// must not give up (it did: "QP primal infeasible" every cycle, braking next to the worker in
+// the dense-pillar mission); it plans away at the recovery pace until the distance is back.
+TEST(UavPlannerTest, StartInsideWorkerZoneRecoversInsteadOfBraking) {
+  const World& w = towers();
+  PlannerConfig cfg = testConfig();
+  UavPlanner planner(cfg, w.map, w.field);
+  const Eigen::Vector3d worker(-6, -8, 1.0);
+  const Eigen::Vector3d start = worker + Eigen::Vector3d(1.5, 0.5, 1.0);  // 1.87 m < 3 m
+  UavKinematicState s = stateAt(start);
+  double t = 0.0;
+  double previous = (start - worker).norm();
+  for (int cycle = 0; cycle < 15; ++cycle) {
+    // The reference stays on the far side of the worker: only the recovery moves the UAV out.
+    const PlanResult r = planner.plan(straightRequest(0, t, s, start, start, 0.0, worker));
+    ASSERT_EQ(r.status, PlanStatus::kOptimized) << "cycle " << cycle << ": " << r.reason;
+    ASSERT_TRUE(r.verified);
+    expectSafe(r.trajectory, *w.map, cfg);
+    const double d0 = (s.p_world - worker).norm();
+    for (double tt = r.trajectory.t0_s; tt <= r.trajectory.tEnd(); tt += 0.05) {
+      const double required = std::min(cfg.worker_safety_distance_m,
+                                        d0 - cfg.recovery_slack_m + recoveryAllowance(cfg, tt - r.trajectory.t0_s));
+      ASSERT_GE((evaluateTrajectory(r.trajectory, tt).p - worker).norm(), required - 1e-3) << "cycle " << cycle << " t " << tt;
+    }
+    t += 0.4;
+    s = advance(r.trajectory, t);
+    const double now = (s.p_world - worker).norm();
+    if (previous < cfg.worker_safety_distance_m - 0.05) {
+      EXPECT_GT(now, previous) << "cycle " << cycle;
+    }
+    previous = now;
+  }
+  EXPECT_GE(previous, cfg.worker_safety_distance_m - 1e-3) << "still inside after 6 s";
+}
+
+// A UAV blown closer to the tower than the corridor clearance gets optimized plans that move it
+// back out (it used to hover at the reduced clearance and ratchet closer under gusts).
+TEST(UavPlannerTest, StartCloserThanCorridorClearanceMovesAway) {
+  const World& w = towers();
+  PlannerConfig cfg = testConfig();
+  UavPlanner planner(cfg, w.map, w.field);
+  // North of the west tower's north face at 2 m height: walking south from y = 4.2, the first
+  // point between the verify and the corridor clearance (field values are discrete).
+  Eigen::Vector3d start(0.0, 4.2, 2.0);
+  for (int i = 0; i < 200 && !(w.field->clearance(start) > 0.55 && w.field->clearance(start) < 0.75); ++i) start.y() -= 0.01;
+  const double c0 = w.field->clearance(start);
+  ASSERT_GT(c0, cfg.verify_clearance_m);
+  ASSERT_LT(c0, cfg.obstacle_clearance_m);
+  UavKinematicState s = stateAt(start);
+  double t = 0.0;
+  for (int cycle = 0; cycle < 10; ++cycle) {
+    const PlanResult r = planner.plan(straightRequest(0, t, s, start, start, 0.0, Eigen::Vector3d(-6, 8, 1)));
+    ASSERT_EQ(r.status, PlanStatus::kOptimized) << "cycle " << cycle << ": " << r.reason;
+    expectSafe(r.trajectory, *w.map, cfg);
+    t += 0.4;
+    s = advance(r.trajectory, t);
+  }
+  EXPECT_GE(w.field->clearance(s.p_world), cfg.obstacle_clearance_m - 0.05) << "from " << c0 << " m at " << start.transpose();
+}
