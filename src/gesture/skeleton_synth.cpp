@@ -323,6 +323,8 @@ SynthSequence SkeletonSynthesizer::render(Motion motion, double distance_m, doub
   const double fall = uniform(0.4, 0.9) / tempo;
   const double tail = uniform(config_.lead_min_s, config_.lead_max_s);
   const double duration = lead + rise + hold + fall + tail;
+  seq.motion_start_s = lead;
+  seq.motion_end_s = lead + rise + hold + fall;
   const double cycle_hz = (motion == Motion::kWalking ? 0.9 : 0.45) * tempo;
   const double phase0 = uniform(0.0, 2.0 * common::kPi);
   const double noise_frac = uniform(config_.keypoint_noise_min, config_.keypoint_noise_max);

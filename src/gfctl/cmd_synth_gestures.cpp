@@ -5,7 +5,9 @@
 
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
+#include <system_error>
 #include <iostream>
 
 #include "commands.hpp"
@@ -70,8 +72,10 @@ int cmdSynthGestures(const Args& args) {
     }
   }
   const std::string dir = args.get("out");
-  if (::mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST) {
-    return badInput(args, dir + ": cannot create directory: " + std::strerror(errno));
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec || !std::filesystem::is_directory(dir)) {
+    return badInput(args, dir + ": cannot create directory: " + (ec ? ec.message() : std::string("not a directory")));
   }
   gesture::SkeletonSynthesizer synth(config, static_cast<std::uint64_t>(*seed));
   std::vector<gesture::SynthSequence> sequences;
@@ -84,12 +88,12 @@ int cmdSynthGestures(const Args& args) {
   std::string error;
   if (!gesture::writeSkeletonCsv(dir + "/skeletons.csv", sequences, &error)) return badInput(args, error);
   std::ofstream meta(dir + "/sequences.csv");
-  meta << "sequence,motion,gesture_id,left_arm,height_m,distance_m,elevation_deg,azimuth_deg,frames\n";
+  meta << "sequence,motion,gesture_id,left_arm,height_m,distance_m,elevation_deg,azimuth_deg,frames,motion_start_s,motion_end_s\n";
   for (const auto& s : sequences) {
     meta << s.id << ',' << gesture::toString(s.motion) << ',' << gesture::gestureIdOf(s.motion) << ',' << (s.left_arm ? 1 : 0)
          << ',' << common::formatDouble(s.height_m) << ',' << common::formatDouble(s.distance_m) << ','
          << common::formatDouble(s.elevation_deg) << ',' << common::formatDouble(s.azimuth_deg) << ',' << s.frames.size()
-         << '\n';
+         << ',' << common::formatDouble(s.motion_start_s) << ',' << common::formatDouble(s.motion_end_s) << '\n';
   }
   if (!meta) return badInput(args, dir + "/sequences.csv: write failed");
   std::cout << "gfctl synth-gestures: " << sequences.size() << " sequences, " << frames << " frames → " << dir

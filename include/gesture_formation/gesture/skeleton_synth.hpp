@@ -70,6 +70,9 @@ struct SynthSequence {
   bool left_arm = true;   ///< for one-arm motions
   double height_m = 0.0;
   double distance_m = 0.0, elevation_deg = 0.0, azimuth_deg = 0.0;
+  /// The motion leaves the rest pose at motion_start_s and is back at rest at motion_end_s
+  /// (sequence time [s]); a gesture is "being performed" in between (issue 6/7 latency).
+  double motion_start_s = 0.0, motion_end_s = 0.0;
   std::vector<SynthFrame> frames;
 };
 

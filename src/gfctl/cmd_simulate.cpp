@@ -1,0 +1,293 @@
+// gfctl simulate --scenario FILE --out DIR [--seed N] [--seeds A..B] [--duration S] [--model ONNX] [--no-plot]
+// (DESIGN §8.4; docs/simulation.md)
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <sstream>
+
+#include "commands.hpp"
+#include "gesture_formation/common/csv.hpp"
+#include "gesture_formation/planning/catenary.hpp"
+#include "gesture_formation/planning/distance_field.hpp"
+#include "gesture_formation/planning/occupancy_map.hpp"
+#include "gesture_formation/planning/scenario.hpp"
+#include "gesture_formation/sim/mission_runner.hpp"
+
+namespace gesture_formation::gfctl {
+
+namespace {
+
+using common::formatDouble;
+
+int cmdSimulate(const Args& args);
+const Registrar kRegistrar{
+    "simulate",
+    "--scenario FILE --out DIR [--seed N | --seeds A..B] [--duration S] [--model ONNX] [--no-plot]   closed-loop "
+    "mission: metrics.json, timeline.csv, events.csv, timeline.png (DESIGN 8.4)",
+    cmdSimulate};
+
+bool makeDir(const std::string& path) {
+  std::string cur;
+  std::stringstream ss(path);
+  std::string part;
+  if (!path.empty() && path[0] == '/') cur = "/";
+  while (std::getline(ss, part, '/')) {
+    if (part.empty()) continue;
+    cur += part + "/";
+    if (mkdir(cur.c_str(), 0755) != 0 && errno != EEXIST) return false;
+  }
+  return true;
+}
+
+bool fileExists(const std::string& p) {
+  struct stat st {};
+  return stat(p.c_str(), &st) == 0;
+}
+
+bool parseUint(const std::string& s, std::uint64_t& v) {
+  if (s.empty() || s.find_first_not_of("0123456789") != std::string::npos || s.size() > 18) return false;
+  v = std::stoull(s);
+  return true;
+}
+
+/// Towers, conductor polylines, boxes and cylinders for the plot (scene.json).
+std::string sceneJson(const planning::Scenario& sc) {
+  std::ostringstream os;
+  auto v3 = [](const Eigen::Vector3d& v) {
+    return "[" + formatDouble(v.x()) + ", " + formatDouble(v.y()) + ", " + formatDouble(v.z()) + "]";
+  };
+  os << "{\n  \"bounds\": {\"min\": " << v3(sc.map.bounds.min_world) << ", \"max\": " << v3(sc.map.bounds.max_world)
+     << "},\n  \"towers\": [";
+  for (std::size_t i = 0; i < sc.towers.size(); ++i) {
+    const auto& t = sc.towers[i];
+    os << (i ? ", " : "") << "{\"name\": \"" << t.name << "\", \"base\": " << v3(t.base_world)
+       << ", \"yaw_rad\": " << formatDouble(t.yaw_rad) << ", \"height_m\": " << formatDouble(t.height_m)
+       << ", \"base_width_m\": " << formatDouble(t.base_width_m) << ", \"top_width_m\": " << formatDouble(t.top_width_m)
+       << ", \"arms\": [";
+    for (std::size_t a = 0; a < t.cross_arms.size(); ++a) {
+      os << (a ? ", " : "") << "{\"height_m\": " << formatDouble(t.cross_arms[a].height_m)
+         << ", \"half_length_m\": " << formatDouble(t.cross_arms[a].half_length_m) << "}";
+    }
+    os << "]}";
+  }
+  os << "],\n  \"conductors\": [";
+  for (std::size_t i = 0; i < sc.conductors.size(); ++i) {
+    const auto& c = sc.conductors[i];
+    const auto cat = planning::Catenary::fit(c.from_world, c.to_world, c.sag_m);
+    os << (i ? ", " : "") << "[";
+    for (int k = 0; k <= 40 && cat; ++k) os << (k ? ", " : "") << v3(cat->point(k / 40.0));
+    os << "]";
+  }
+  os << "],\n  \"boxes\": [";
+  for (std::size_t i = 0; i < sc.boxes.size(); ++i) {
+    const auto& b = sc.boxes[i];
+    os << (i ? ", " : "") << "{\"center\": " << v3(b.center_world) << ", \"size\": " << v3(b.size_m)
+       << ", \"yaw_rad\": " << formatDouble(std::atan2(b.R_world_box(1, 0), b.R_world_box(0, 0))) << "}";
+  }
+  os << "],\n  \"cylinders\": [";
+  for (std::size_t i = 0; i < sc.cylinders.size(); ++i) {
+    const auto& c = sc.cylinders[i];
+    os << (i ? ", " : "") << "{\"p0\": " << v3(c.p0_world) << ", \"p1\": " << v3(c.p1_world)
+       << ", \"radius_m\": " << formatDouble(c.radius_m) << "}";
+  }
+  os << "]\n}\n";
+  return os.str();
+}
+
+bool writeText(const std::string& path, const std::string& text) {
+  std::ofstream f(path);
+  f << text;
+  f.flush();
+  return static_cast<bool>(f);
+}
+
+/// The plotting script and the tools venv's python (tools/plot_timeline.py next to the models dir).
+std::string plotCommand(const std::string& dir) {
+  std::string root = GF_DEFAULT_MODELS_DIR;
+  const auto slash = root.find_last_of('/');
+  root = slash == std::string::npos ? "." : root.substr(0, slash);
+  const char* env = std::getenv("GF_SOURCE_DIR");
+  if (env != nullptr) root = env;
+  const std::string script = root + "/tools/plot_timeline.py";
+  const std::string python = "/opt/gesture_formation/venv/bin/python";
+  if (!fileExists(script) || !fileExists(python)) return "";
+  return python + " " + script + " " + dir;
+}
+
+struct Loaded {
+  planning::Scenario scenario;
+  sim::MissionConfig mission;
+  std::shared_ptr<const planning::OccupancyMap> map;
+  std::shared_ptr<const planning::DistanceField> field;
+  std::unique_ptr<sim::MissionClassifier> classifier;
+};
+
+int runOne(const Args& args, Loaded& L, std::uint64_t seed, double duration, const std::string& dir, bool plot,
+           sim::MissionMetrics* metrics_out) {
+  if (!makeDir(dir)) return badInput(args, dir + ": cannot create directory");
+  sim::MissionWorld world;
+  world.map = L.map.get();
+  world.field = L.field.get();
+  world.ground_height_m = L.scenario.ground.enabled ? L.scenario.ground.height_m : -1e9;
+  const auto planners = sim::uavPlannerFactory(L.mission.planner, L.map, L.field);
+  const auto out = sim::runMission(L.mission, world, planners, L.classifier.get(), seed, duration);
+  if (!out) return badInput(args, out.reason());
+  const auto& m = out->metrics;
+  std::string err;
+  if (!writeText(dir + "/metrics.json", sim::metricsJson(m))) return badInput(args, dir + "/metrics.json: write failed");
+  if (!sim::writeTimelineCsv(dir + "/timeline.csv", *out, L.mission.formation.params.uavCount(), &err) ||
+      !sim::writeEventsCsv(dir + "/events.csv", *out, &err)) {
+    return badInput(args, err);
+  }
+  if (!writeText(dir + "/scene.json", sceneJson(L.scenario))) return badInput(args, dir + "/scene.json: write failed");
+  std::cout << std::fixed << std::setprecision(2) << "seed " << seed << ": " << m.sim_time_s << " s simulated in "
+            << m.wall_time_s << " s wall: real-time factor " << m.real_time_factor << "x\n"
+            << "  min mutual " << m.min_mutual_distance_m << " m, min obstacle " << m.min_obstacle_distance_m
+            << " m, min human " << m.min_human_distance_m << " m, collisions " << m.collisions << "\n"
+            << "  requests applied " << m.requests_applied << "/" << m.requests_total << " (operator "
+            << m.operator_requests_applied << "/" << L.mission.requests.size() << ", gestures "
+            << m.gesture_requests_applied << "/" << m.gestures_performed << "), gesture success "
+            << m.gesture_success_rate << ", latency " << m.gesture_mean_latency_s << " s, false adaptations "
+            << m.false_adaptations << "\n"
+            << "  distance error rms " << m.distance_error_rms_m << " m, angle error rms " << m.angle_error_rms_deg
+            << " deg, estimate error rms " << m.human_estimate_error_rms_m << " m, planning median "
+            << m.planning_ms_median << " ms p99 " << m.planning_ms_p99 << " ms (fallback previous "
+            << m.plans_fallback_previous << ", brake " << m.plans_fallback_brake << " of " << m.plans << ")\n";
+  {
+    std::vector<std::pair<int, std::string>> reasons;
+    for (const auto& [why, count] : m.plan_failure_reasons) reasons.emplace_back(count, why);
+    std::sort(reasons.rbegin(), reasons.rend());
+    for (std::size_t i = 0; i < reasons.size() && i < 5; ++i) {
+      std::cout << "  failed replannings: " << reasons[i].first << " x " << reasons[i].second << "\n";
+    }
+  }
+  if (plot) {
+    const std::string cmd = plotCommand(dir);
+    if (cmd.empty()) {
+      std::cout << "  timeline.png not drawn: run  /opt/gesture_formation/venv/bin/python tools/plot_timeline.py "
+                << dir << "  (needs matplotlib; tools/setup.sh installs the venv)\n";
+    } else if (std::system((cmd + " > /dev/null").c_str()) != 0) {
+      std::cout << "  timeline.png: the plot script failed: " << cmd << "\n";
+    } else {
+      std::cout << "  wrote " << dir << "/timeline.png\n";
+    }
+  }
+  if (metrics_out) *metrics_out = m;
+  return kExitOk;
+}
+
+int cmdSimulate(const Args& args) {
+  if (!checkOptions(args, {"scenario", "out"}, {"seed", "seeds", "duration", "model", "no-plot"})) return kExitBadInput;
+  std::uint64_t seed = 1, seed_lo = 0, seed_hi = 0;
+  bool batch = false;
+  if (args.has("seed") && !parseUint(args.get("seed"), seed)) return badInput(args, "--seed: expected a non-negative integer, got '" + args.get("seed") + "'");
+  if (args.has("seeds")) {
+    const std::string s = args.get("seeds");
+    const auto dots = s.find("..");
+    if (dots == std::string::npos || !parseUint(s.substr(0, dots), seed_lo) || !parseUint(s.substr(dots + 2), seed_hi) ||
+        seed_hi < seed_lo) {
+      return badInput(args, "--seeds: expected A..B with A <= B, got '" + s + "'");
+    }
+    if (args.has("seed")) return badInput(args, "--seed and --seeds are exclusive");
+    batch = true;
+  }
+  double duration = 0.0;
+  if (args.has("duration")) {
+    const auto d = common::parseDouble(args.get("duration"));
+    if (!d || !(*d > 0.0) || !std::isfinite(*d)) return badInput(args, "--duration: expected seconds > 0, got '" + args.get("duration") + "'");
+    duration = *d;
+  }
+  const std::string path = args.get("scenario");
+  Loaded L;
+  auto sc = planning::loadScenario(path);
+  auto mission = sim::loadMissionConfig(path);
+  if (!sc || !mission) {
+    std::cerr << "gfctl simulate: invalid scenario:\n" << (sc ? "" : sc.reason()) << (mission ? "" : mission.reason());
+    return kExitBadInput;
+  }
+  L.scenario = std::move(*sc);
+  L.mission = std::move(*mission);
+  const std::string model = args.has("model") ? args.get("model") : L.mission.gesture_model;
+  if (!model.empty()) {
+    auto c = sim::loadOnnxClassifier(model);
+    if (!c) return badInput(args, model + ": cannot load the gesture model: " + c.reason());
+    L.classifier = std::move(*c);
+  } else {
+    std::cerr << "gfctl simulate: warning: no mission.gesture_model: gestures are not recognised\n";
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  auto map = planning::OccupancyMap::fromScenario(L.scenario);
+  if (!map) return badInput(args, path + ": map: " + map.reason());
+  L.map = std::make_shared<const planning::OccupancyMap>(std::move(*map));
+  L.field = std::make_shared<const planning::DistanceField>(*L.map);
+  std::cout << "map and distance field: " << std::fixed << std::setprecision(2)
+            << std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() << " s\n";
+  const std::string out = args.get("out");
+  const bool plot = !args.has("no-plot");
+  if (!batch) return runOne(args, L, seed, duration, out, plot, nullptr);
+
+  std::vector<sim::MissionMetrics> all;
+  for (std::uint64_t s = seed_lo; s <= seed_hi; ++s) {
+    sim::MissionMetrics m;
+    const int rc = runOne(args, L, s, duration, out + "/seed_" + std::to_string(s), false, &m);
+    if (rc != kExitOk) return rc;
+    all.push_back(m);
+  }
+  const std::vector<std::pair<const char*, double sim::MissionMetrics::*>> dkeys = {
+      {"min_mutual_distance_m", &sim::MissionMetrics::min_mutual_distance_m},
+      {"min_obstacle_distance_m", &sim::MissionMetrics::min_obstacle_distance_m},
+      {"min_human_distance_m", &sim::MissionMetrics::min_human_distance_m},
+      {"distance_error_rms_m", &sim::MissionMetrics::distance_error_rms_m},
+      {"angle_error_rms_deg", &sim::MissionMetrics::angle_error_rms_deg},
+      {"gesture_success_rate", &sim::MissionMetrics::gesture_success_rate},
+      {"gesture_mean_latency_s", &sim::MissionMetrics::gesture_mean_latency_s},
+      {"planning_ms_median", &sim::MissionMetrics::planning_ms_median},
+      {"planning_ms_p99", &sim::MissionMetrics::planning_ms_p99},
+      {"human_estimate_error_rms_m", &sim::MissionMetrics::human_estimate_error_rms_m},
+      {"real_time_factor", &sim::MissionMetrics::real_time_factor}};
+  const std::vector<std::pair<const char*, int sim::MissionMetrics::*>> ikeys = {
+      {"collisions", &sim::MissionMetrics::collisions},
+      {"requests_applied", &sim::MissionMetrics::requests_applied},
+      {"false_adaptations", &sim::MissionMetrics::false_adaptations},
+      {"plans_fallback_brake", &sim::MissionMetrics::plans_fallback_brake}};
+  std::ostringstream js;
+  js << "{\n  \"seeds\": [" << seed_lo << ", " << seed_hi << "],\n";
+  std::cout << "\n" << all.size() << " seeds " << seed_lo << ".." << seed_hi << ":\n"
+            << std::left << std::setw(28) << "metric" << std::right << std::setw(12) << "min" << std::setw(12) << "median"
+            << std::setw(12) << "max" << "\n";
+  auto row = [&](const char* name, std::vector<double> v) {
+    v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
+    std::sort(v.begin(), v.end());
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const double lo = v.empty() ? nan : v.front(), hi = v.empty() ? nan : v.back();
+    const double med = v.empty() ? nan : (v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]));
+    std::cout << std::left << std::setw(28) << name << std::right << std::fixed << std::setprecision(3) << std::setw(12)
+              << lo << std::setw(12) << med << std::setw(12) << hi << "\n";
+    auto n = [](double x) { return std::isfinite(x) ? formatDouble(x) : std::string("null"); };
+    js << "  \"" << name << "\": {\"min\": " << n(lo) << ", \"median\": " << n(med) << ", \"max\": " << n(hi) << "},\n";
+  };
+  for (const auto& [name, ptr] : dkeys) {
+    std::vector<double> v;
+    for (const auto& m : all) v.push_back(m.*ptr);
+    row(name, v);
+  }
+  for (const auto& [name, ptr] : ikeys) {
+    std::vector<double> v;
+    for (const auto& m : all) v.push_back(static_cast<double>(m.*ptr));
+    row(name, v);
+  }
+  js << "  \"runs\": " << all.size() << "\n}\n";
+  writeText(out + "/summary.json", js.str());
+  return kExitOk;
+}
+
+}  // namespace
+
+}  // namespace gesture_formation::gfctl

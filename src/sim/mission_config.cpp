@@ -1,0 +1,449 @@
+#include "gesture_formation/sim/mission_config.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <yaml-cpp/yaml.h>
+
+#include "gesture_formation/common/config_reader.hpp"
+#include "validate_util.hpp"
+
+namespace gesture_formation::sim {
+
+using common::ConfigReader;
+using common::Range;
+using detail::check;
+
+std::vector<std::string> LinkConfig::validate(const std::string& prefix) const {
+  std::vector<std::string> e;
+  check(e, delay_s >= 0, delay_s, prefix, "delay_s", ">= 0");
+  check(e, jitter_s >= 0, jitter_s, prefix, "jitter_s", ">= 0");
+  check(e, loss >= 0 && loss <= 1, loss, prefix, "loss", "in [0, 1]");
+  check(e, duplicate >= 0 && duplicate <= 1, duplicate, prefix, "duplicate", "in [0, 1]");
+  return e;
+}
+
+std::vector<std::string> FaultConfig::validate(const std::string& prefix) const {
+  std::vector<std::string> e;
+  for (std::size_t i = 0; i < camera_blackouts.size(); ++i) {
+    const auto& [a, b] = camera_blackouts[i];
+    if (!(std::isfinite(a) && std::isfinite(b) && a < b)) {
+      e.push_back(prefix + "camera_blackouts[" + std::to_string(i) + "] must be [from, to] with from < to");
+    }
+  }
+  for (std::size_t i = 0; i < planner_outages.size(); ++i) {
+    const auto& o = planner_outages[i];
+    if (!(o.from_s < o.to_s)) e.push_back(prefix + "planner_outages[" + std::to_string(i) + "] needs from_s < to_s");
+  }
+  check(e, max_share_age_s > 0, max_share_age_s, prefix, "max_share_age_s", "> 0");
+  return e;
+}
+
+common::Result<formation::CommandTarget> parseTarget(const std::string& text) {
+  using R = common::Result<formation::CommandTarget>;
+  if (text == "all") return R::ok(formation::CommandTarget::all());
+  if (text == "leader") return R::ok(formation::CommandTarget::leader());
+  if (text == "followers") return R::ok(formation::CommandTarget::followers());
+  if (text.rfind("follower", 0) == 0 && text.size() > 8) {
+    const std::string n = text.substr(8);
+    if (n.find_first_not_of("0123456789") == std::string::npos && n.size() < 4) {
+      const int i = std::stoi(n);
+      if (i >= 1) return R::ok(formation::CommandTarget::list({i}));
+    }
+  }
+  return R::fail("target must be all | leader | followers | follower<i> | a list of UAV indices, got '" + text + "'");
+}
+
+namespace {
+
+std::string joinPath(const std::string& base, const std::string& p) {
+  if (p.empty() || p[0] == '/' || base.empty()) return p;
+  return base + "/" + p;
+}
+
+Eigen::Vector3d vec3(ConfigReader& r, const std::string& key, const Eigen::Vector3d& def, bool* present = nullptr) {
+  std::vector<double> v{def.x(), def.y(), def.z()};
+  if (present) *present = r.has(key);
+  r.readDoubleList(key, v, 3, 3, Range::any());
+  if (v.size() != 3) return def;
+  return Eigen::Vector3d(v[0], v[1], v[2]);
+}
+
+/// Runs `fn` on a sub-reader over the node at `key` (a top-level-keyed reader for the other
+/// modules' loaders) and copies its errors (named "<file> <key>: field: message").
+template <class Fn>
+void withSubReader(ConfigReader& r, const std::string& key, ConfigReader::MissingKeys mode, Fn fn) {
+  const YAML::Node n = r.node(key);
+  std::string text = "{}";
+  if (n.IsDefined() && !n.IsNull()) {
+    if (!n.IsMap()) {
+      r.addError(key, "must be a mapping");
+      return;
+    }
+    YAML::Emitter em;
+    em << n;
+    text = em.c_str();
+  }
+  ConfigReader sub = ConfigReader::fromString(text, r.source() + " " + key, mode);
+  fn(sub);
+  const std::string sub_prefix = sub.source() + ": ";
+  for (const auto& e : sub.errors()) {
+    // "<file> <key>: field: message" → "<file>: <key>.field: message"
+    const std::string rest = e.rfind(sub_prefix, 0) == 0 ? e.substr(sub_prefix.size()) : e;
+    const auto colon = rest.find(": ");
+    if (colon == std::string::npos || rest.find(' ') < colon) {
+      r.addError(key, rest);
+    } else {
+      r.addError(key + "." + rest.substr(0, colon), rest.substr(colon + 2));
+    }
+  }
+  for (const auto& u : sub.unusedKeys()) r.addError(key + "." + u, "unknown key");
+}
+
+const std::vector<std::pair<std::string, gesture::Motion>>& motionNames() {
+  static const std::vector<std::pair<std::string, gesture::Motion>> names = [] {
+    std::vector<std::pair<std::string, gesture::Motion>> v;
+    for (int i = 0; i < static_cast<int>(gesture::Motion::kCount); ++i) {
+      const auto m = static_cast<gesture::Motion>(i);
+      v.emplace_back(gesture::toString(m), m);
+    }
+    return v;
+  }();
+  return names;
+}
+
+void readPlant(ConfigReader& r, const std::string& p, MultirotorParams& m) {
+  // Physical limits: every key required (STYLE rule 4).
+  const auto req = [&](const std::string& k, double& v, const Range& range) {
+    if (!r.has(p + k)) {
+      r.addError(p + k, "missing (required: physical limits have no defaults)");
+      return;
+    }
+    r.readDouble(p + k, v, range);
+  };
+  req("mass_kg", m.mass_kg, Range::positive());
+  req("max_thrust_to_weight", m.max_thrust_to_weight, Range{1.0, 10.0, false, true});
+  req("min_thrust_to_weight", m.min_thrust_to_weight, Range{0.0, 1.0, true, false});
+  req("max_tilt_deg", m.max_tilt_deg, Range::openClosed(0.0, 80.0));
+  req("attitude_time_constant_s", m.attitude_time_constant_s, Range::positive());
+  req("drag_linear_ns_per_m", m.drag_linear_ns_per_m, Range::nonNegative());
+  req("drag_quadratic_ns2_per_m2", m.drag_quadratic_ns2_per_m2, Range::nonNegative());
+  req("max_yaw_rate_dps", m.max_yaw_rate_dps, Range::positive());
+  req("max_pitch_rate_dps", m.max_pitch_rate_dps, Range::positive());
+  req("min_pitch_deg", m.min_pitch_deg, Range::closed(-90.0, 90.0));
+  req("max_pitch_deg", m.max_pitch_deg, Range::closed(-90.0, 90.0));
+  req("body_radius_m", m.body_radius_m, Range::positive());
+  for (const auto& e : m.validate()) r.addError(p.substr(0, p.size() - 1), e);
+}
+
+void readRoute(ConfigReader& r, const std::string& p, WorkerConfig& w) {
+  const YAML::Node route = r.node(p + "route");
+  if (!route.IsDefined() || !route.IsSequence()) {
+    r.addError(p + "route", "missing or not a list (required)");
+    return;
+  }
+  for (std::size_t i = 0; i < route.size(); ++i) {
+    const std::string k = p + "route[" + std::to_string(i) + "].";
+    RouteLeg leg;
+    int kinds = 0;
+    const std::pair<const char*, RouteLeg::Kind> moving[] = {
+        {"walk_to", RouteLeg::Kind::kWalk}, {"climb_to", RouteLeg::Kind::kClimb}, {"descend_to", RouteLeg::Kind::kDescend}};
+    for (const auto& [name, kind] : moving) {
+      if (r.has(k + name)) {
+        ++kinds;
+        leg.kind = kind;
+        leg.to_feet_world = vec3(r, k + name, Eigen::Vector3d::Zero());
+        r.readDouble(k + "speed_mps", leg.speed_mps, Range::openClosed(0.0, 3.0));
+      }
+    }
+    const std::pair<const char*, RouteLeg::Kind> still[] = {{"work_s", RouteLeg::Kind::kWork},
+                                                            {"wait_s", RouteLeg::Kind::kWait}};
+    for (const auto& [name, kind] : still) {
+      if (r.has(k + name)) {
+        ++kinds;
+        leg.kind = kind;
+        r.readDouble(k + name, leg.duration_s, Range::positive());
+      }
+    }
+    if (kinds != 1) {
+      r.addError(k.substr(0, k.size() - 1), "needs exactly one of walk_to, climb_to, descend_to, work_s, wait_s");
+    }
+    if (r.has(k + "facing_deg")) {
+      double f = 0.0;
+      r.readDouble(k + "facing_deg", f, Range::closed(-360.0, 360.0));
+      leg.facing_deg = f;
+    }
+    w.route.push_back(leg);
+  }
+}
+
+}  // namespace
+
+common::Result<MissionConfig> parseMissionConfig(const std::string& yaml, const std::string& source_name,
+                                                 const std::string& base_dir) {
+  using R = common::Result<MissionConfig>;
+  ConfigReader r = ConfigReader::fromString(yaml, source_name, ConfigReader::MissingKeys::kUseDefaults);
+  MissionConfig c;
+  c.source = source_name;
+  if (!r.has("mission")) {
+    r.addError("mission", "missing: the scenario has no mission section");
+    return R::fail(r.errorReport());
+  }
+  const std::string m = "mission.";
+  r.readDouble(m + "step_s", c.step_s, Range::openClosed(0.0, 0.05));
+  r.readDouble(m + "replanning_period_s", c.replanning_period_s, Range::openClosed(0.0, 5.0));
+  r.readDouble(m + "horizon_dt_s", c.horizon_dt_s, Range::openClosed(0.0, 2.0));
+  r.readInt(m + "horizon_steps", c.horizon_steps, Range::closed(2, formation::kMaxHorizonSteps));
+  r.readDouble(m + "timeline_rate_hz", c.timeline_rate_hz, Range::openClosed(0.0, 100.0));
+  r.readDouble(m + "gesture_match_window_s", c.gesture_match_window_s, Range::positive());
+  if (r.has(m + "gesture_model")) {
+    r.readString(m + "gesture_model", c.gesture_model);
+    c.gesture_model = joinPath(base_dir, c.gesture_model);
+  }
+
+  // --- worker ---------------------------------------------------------------------------
+  WorkerConfig& w = c.worker;
+  const std::string wk = m + "worker.";
+  r.readDouble(wk + "height_m", w.height_m, Range::closed(1.0, 2.3));
+  if (!r.has(wk + "start")) r.addError(wk + "start", "missing (required)");
+  w.start_feet_world = vec3(r, wk + "start", Eigen::Vector3d::Zero());
+  r.readDouble(wk + "start_facing_deg", w.start_facing_deg, Range::closed(-360.0, 360.0));
+  r.readDouble(wk + "gesture_hold_min_s", w.gesture_hold_min_s, Range::positive());
+  r.readDouble(wk + "gesture_hold_max_s", w.gesture_hold_max_s, Range::positive());
+  readRoute(r, wk, w);
+  const YAML::Node gestures = r.node(wk + "gestures");
+  if (gestures.IsDefined() && gestures.IsSequence()) {
+    for (std::size_t i = 0; i < gestures.size(); ++i) {
+      const std::string k = wk + "gestures[" + std::to_string(i) + "].";
+      ScheduledGesture g;
+      if (!r.has(k + "t_s") || !r.has(k + "gesture")) r.addError(k + "t_s", "each gesture needs t_s and gesture");
+      r.readDouble(k + "t_s", g.t_s, Range::nonNegative());
+      r.readInt(k + "gesture", g.gesture_id, Range::closed(1, 4));
+      w.gestures.push_back(g);
+    }
+  } else if (gestures.IsDefined() && !gestures.IsNull()) {
+    r.addError(wk + "gestures", "must be a list");
+  }
+  const YAML::Node motions = r.node(wk + "work_motions");
+  if (motions.IsDefined()) {
+    if (!motions.IsSequence()) {
+      r.addError(wk + "work_motions", "must be a list of motion names");
+    } else {
+      w.work_motions.clear();
+      for (std::size_t i = 0; i < motions.size(); ++i) {
+        const std::string name = motions[i].IsScalar() ? motions[i].Scalar() : "";
+        bool found = false;
+        for (const auto& [n, mo] : motionNames()) {
+          if (n == name) {
+            w.work_motions.push_back(mo);
+            found = true;
+          }
+        }
+        if (!found) r.addError(wk + "work_motions[" + std::to_string(i) + "]", "unknown motion '" + name + "'");
+      }
+    }
+  }
+  r.readDouble(wk + "synth.keypoint_noise_max", w.synth.keypoint_noise_max, Range::closed(0.0, 0.2));
+  r.readDouble(wk + "synth.dropout_max", w.synth.dropout_max, Range::closed(0.0, 0.9));
+  r.readDouble(wk + "synth.box_jitter", w.synth.box_jitter, Range::closed(0.0, 0.3));
+  r.readDouble(wk + "synth.tempo_min", w.synth.tempo_min, Range::closed(0.1, 5.0));
+  r.readDouble(wk + "synth.tempo_max", w.synth.tempo_max, Range::closed(0.1, 5.0));
+
+  // --- UAVs ------------------------------------------------------------------------------
+  const YAML::Node uavs = r.node(m + "uavs");
+  if (!uavs.IsDefined() || !uavs.IsSequence() || uavs.size() == 0) {
+    r.addError(m + "uavs", "missing or empty (required: the leader first, then the followers)");
+  } else {
+    for (std::size_t i = 0; i < uavs.size(); ++i) {
+      const std::string k = m + "uavs[" + std::to_string(i) + "].";
+      UavConfig u;
+      u.name = i == 0 ? "leader" : "follower" + std::to_string(i);
+      r.readString(k + "name", u.name);
+      readPlant(r, k + "plant.", u.plant);
+      bool present = false;
+      const Eigen::Vector3d p = vec3(r, k + "initial_position", Eigen::Vector3d::Zero(), &present);
+      if (present) u.initial_position = p;
+      c.uavs.push_back(u);
+    }
+  }
+
+  // --- controller, odometry, wind, sensors, links, faults ------------------------------
+  auto& ct = c.controller;
+  const std::string ck = m + "controller.";
+  for (auto [name, v] : std::initializer_list<std::pair<const char*, double*>>{
+           {"kp_xy", &ct.kp_xy}, {"kp_z", &ct.kp_z}, {"kd_xy", &ct.kd_xy}, {"kd_z", &ct.kd_z},
+           {"ki_xy", &ct.ki_xy}, {"ki_z", &ct.ki_z}, {"integral_limit_mps2", &ct.integral_limit_mps2},
+           {"integral_zone_m", &ct.integral_zone_m}, {"integral_zone_mps", &ct.integral_zone_mps},
+           {"max_accel_mps2", &ct.max_accel_mps2}, {"k_heading", &ct.k_heading}, {"k_pitch", &ct.k_pitch},
+           {"brake_accel_mps2", &ct.brake_accel_mps2}, {"hover_speed_mps", &ct.hover_speed_mps}}) {
+    r.readDouble(ck + name, *v, Range::nonNegative());
+  }
+  for (const auto& e : ct.validate()) r.addError(m + "controller", e);
+
+  auto& od = c.odometry;
+  const std::string ok = m + "odometry.";
+  r.readDouble(ok + "position_noise_m", od.position_noise_m, Range::nonNegative());
+  r.readDouble(ok + "velocity_noise_mps", od.velocity_noise_mps, Range::nonNegative());
+  r.readDouble(ok + "heading_noise_deg", od.heading_noise_deg, Range::nonNegative());
+  r.readDouble(ok + "pitch_noise_deg", od.pitch_noise_deg, Range::nonNegative());
+  r.readDouble(ok + "bias_std_m", od.bias_std_m, Range::nonNegative());
+  r.readDouble(ok + "bias_time_constant_s", od.bias_time_constant_s, Range::positive());
+
+  auto& wd = c.wind;
+  const std::string wdk = m + "wind.";
+  wd.mean_mps = vec3(r, wdk + "mean_mps", wd.mean_mps);
+  r.readDouble(wdk + "turbulence_std_mps", wd.turbulence_std_mps, Range::nonNegative());
+  r.readDouble(wdk + "turbulence_time_constant_s", wd.turbulence_time_constant_s, Range::positive());
+  r.readDouble(wdk + "gusts_per_minute", wd.gusts_per_minute, Range::nonNegative());
+  r.readDouble(wdk + "gust_peak_mps", wd.gust_peak_mps, Range::nonNegative());
+  r.readDouble(wdk + "gust_duration_s", wd.gust_duration_s, Range::positive());
+
+  const std::string sk = m + "sensors.";
+  r.readDouble(sk + "camera.rate_hz", c.camera.rate_hz, Range::openClosed(0.0, 60.0));
+  r.readDouble(sk + "camera.pixel_noise_px", c.camera.pixel_noise_px, Range::nonNegative());
+  r.readDouble(sk + "camera.detection_dropout", c.camera.detection_dropout, Range{0.0, 1.0, true, false});
+  r.readDouble(sk + "camera.max_detection_range_m", c.camera.max_detection_range_m, Range::positive());
+  r.readDouble(sk + "camera.min_box_height_px", c.camera.min_box_height_px, Range::atLeast(1.0));
+  r.readDouble(sk + "camera.min_visible_fraction", c.camera.min_visible_fraction, Range::openClosed(0.0, 1.0));
+  r.readDouble(sk + "camera.occlusion_ignore_near_worker_m", c.camera.occlusion_ignore_near_worker_m,
+               Range::nonNegative());
+  for (auto [name, rs] : std::initializer_list<std::pair<const char*, RangeSensorConfig*>>{{"stereo", &c.stereo},
+                                                                                         {"uwb", &c.uwb}}) {
+    const std::string k = sk + name + ".";
+    r.readDouble(k + "noise_m", rs->noise_m, Range::nonNegative());
+    r.readDouble(k + "max_range_m", rs->max_range_m, Range::positive());
+    r.readDouble(k + "dropout", rs->dropout, Range::closed(0.0, 1.0));
+  }
+  for (auto [name, lc] : std::initializer_list<std::pair<const char*, LinkConfig*>>{{"links.uav", &c.link},
+                                                                                  {"links.operator", &c.operator_link}}) {
+    const std::string k = m + name + ".";
+    r.readDouble(k + "delay_s", lc->delay_s, Range::nonNegative());
+    r.readDouble(k + "jitter_s", lc->jitter_s, Range::nonNegative());
+    r.readDouble(k + "loss", lc->loss, Range::closed(0.0, 1.0));
+    r.readDouble(k + "duplicate", lc->duplicate, Range::closed(0.0, 1.0));
+  }
+  const std::string fk = m + "faults.";
+  r.readDouble(fk + "max_share_age_s", c.faults.max_share_age_s, Range::positive());
+  const YAML::Node bl = r.node(fk + "camera_blackouts");
+  if (bl.IsDefined() && bl.IsSequence()) {
+    for (std::size_t i = 0; i < bl.size(); ++i) {
+      std::vector<double> v;
+      r.readDoubleList(fk + "camera_blackouts[" + std::to_string(i) + "]", v, 2, 2, Range::nonNegative());
+      if (v.size() == 2) c.faults.camera_blackouts.emplace_back(v[0], v[1]);
+    }
+  }
+  const YAML::Node po = r.node(fk + "planner_outages");
+  if (po.IsDefined() && po.IsSequence()) {
+    for (std::size_t i = 0; i < po.size(); ++i) {
+      const std::string k = fk + "planner_outages[" + std::to_string(i) + "].";
+      PlannerOutage o;
+      r.readInt(k + "uav", o.uav, Range::closed(0, 63));
+      r.readDouble(k + "from_s", o.from_s, Range::nonNegative());
+      r.readDouble(k + "to_s", o.to_s, Range::nonNegative());
+      c.faults.planner_outages.push_back(o);
+    }
+  }
+  for (const auto& e : c.faults.validate()) r.addError(m + "faults", e);
+
+  // --- other modules' configs (their own loaders on sub-readers) -----------------------
+  withSubReader(r, m + "formation", ConfigReader::MissingKeys::kUseDefaults,
+                [&](ConfigReader& s) { c.formation = formation::readFormationConfig(s); });
+  withSubReader(r, m + "gestures", ConfigReader::MissingKeys::kUseDefaults, [&](ConfigReader& s) {
+    c.gesture_filter = gesture::readGestureFilterConfig(s);
+    gesture::readGestureMapping(s, c.gesture_filter.max_gesture_id,
+                                static_cast<int>(c.formation.params.followers.size()), c.gesture_mapping);
+  });
+  withSubReader(r, m + "planner", ConfigReader::MissingKeys::kUseDefaults,
+                [&](ConfigReader& s) { c.planner = planning::readPlannerConfig(s); });
+  withSubReader(r, m + "estimator", ConfigReader::MissingKeys::kUseDefaults,
+                [&](ConfigReader& s) { c.estimator = estimation::readEstimatorConfig(s); });
+  c.camera.camera = c.estimator.camera;  // one camera: what the sensor sees is what the estimator models
+  c.worker.synth.camera = c.estimator.camera;
+  c.worker.synth.fps = c.camera.rate_hz;
+  for (const auto& e : c.formation.validate()) r.addError(m + "formation", e);
+
+  const int n_uavs = c.formation.params.uavCount();
+  if (!c.uavs.empty() && static_cast<int>(c.uavs.size()) != n_uavs) {
+    r.addError(m + "uavs", "has " + std::to_string(c.uavs.size()) + " entries but mission.formation has " +
+                               std::to_string(n_uavs) + " UAVs (leader + followers)");
+  }
+  for (const auto& o : c.faults.planner_outages) {
+    if (o.uav >= n_uavs) r.addError(fk + "planner_outages", "uav " + std::to_string(o.uav) + " does not exist");
+  }
+
+  // --- operator requests ----------------------------------------------------------------
+  const YAML::Node reqs = r.node(m + "requests");
+  if (reqs.IsDefined() && reqs.IsSequence()) {
+    for (std::size_t i = 0; i < reqs.size(); ++i) {
+      const std::string k = m + "requests[" + std::to_string(i) + "].";
+      OperatorRequest q;
+      if (!r.has(k + "t_s")) r.addError(k + "t_s", "missing (required)");
+      r.readDouble(k + "t_s", q.t_s, Range::nonNegative());
+      const YAML::Node tn = r.node(k + "target");
+      if (!tn.IsDefined()) {
+        r.addError(k + "target", "missing (required)");
+      } else if (tn.IsSequence()) {
+        std::vector<int> ids;
+        std::string text = "[";
+        for (std::size_t j = 0; j < tn.size(); ++j) {
+          int id = -1;
+          try {
+            id = tn[j].as<int>();
+          } catch (const YAML::Exception&) {
+          }
+          if (id < 0 || id >= n_uavs) {
+            r.addError(k + "target[" + std::to_string(j) + "]", "must be a UAV index in [0, " + std::to_string(n_uavs - 1) + "]");
+          }
+          ids.push_back(id);
+          text += (j ? "," : "") + std::to_string(id);
+        }
+        if (ids.empty()) r.addError(k + "target", "empty list");
+        q.target = formation::CommandTarget::list(ids);
+        q.target_text = text + "]";
+      } else {
+        q.target_text = tn.IsScalar() ? tn.Scalar() : "";
+        const auto t = parseTarget(q.target_text);
+        if (!t) {
+          r.addError(k + "target", t.reason());
+        } else {
+          q.target = *t;
+          if (!q.target.resolve(n_uavs)) r.addError(k + "target", "'" + q.target_text + "' does not exist in the formation");
+        }
+      }
+      std::string param;
+      r.readString(k + "parameter", param, {"beta_deg", "gamma_deg", "distance_m"});
+      if (!r.has(k + "parameter")) r.addError(k + "parameter", "missing (required)");
+      q.parameter = param == "gamma_deg" ? formation::Parameter::kGamma
+                    : param == "distance_m" ? formation::Parameter::kDistance
+                                            : formation::Parameter::kBeta;
+      const bool inc = r.has(k + "increment"), set = r.has(k + "set");
+      if (inc == set) r.addError(k.substr(0, k.size() - 1), "needs exactly one of increment, set");
+      q.kind = set ? formation::CommandKind::kSet : formation::CommandKind::kIncrement;
+      r.readDouble(k + (set ? "set" : "increment"), q.amount, Range::any());
+      if (i > 0 && q.t_s < c.requests.back().t_s) r.addError(k + "t_s", "requests must be in time order");
+      c.requests.push_back(q);
+    }
+  }
+
+  for (const auto& e : c.worker.validate(m + "worker.")) r.addError(m + "worker", e);
+  c.duration_s = c.worker.routeDuration();
+  r.readDouble(m + "duration_s", c.duration_s, Range::positive());
+  for (const auto& u : r.unusedKeys()) {
+    if (u.rfind("mission.", 0) == 0) r.addError(u, "unknown key");
+  }
+  if (!r.ok()) return R::fail(r.errorReport());
+  return R::ok(c);
+}
+
+common::Result<MissionConfig> loadMissionConfig(const std::string& scenario_path) {
+  std::ifstream in(scenario_path);
+  if (!in) return common::Result<MissionConfig>::fail(scenario_path + ": cannot open file\n");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const auto slash = scenario_path.find_last_of('/');
+  const std::string dir = slash == std::string::npos ? "." : scenario_path.substr(0, slash);
+  return parseMissionConfig(ss.str(), scenario_path, dir);
+}
+
+}  // namespace gesture_formation::sim

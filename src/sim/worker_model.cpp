@@ -1,0 +1,252 @@
+#include "gesture_formation/sim/worker_model.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "gesture_formation/common/angles.hpp"
+#include "gesture_formation/sim/random.hpp"
+#include "validate_util.hpp"
+
+namespace gesture_formation::sim {
+
+using common::degToRad;
+using common::radToDeg;
+using detail::check;
+using detail::num;
+
+const char* toString(RouteLeg::Kind k) {
+  switch (k) {
+    case RouteLeg::Kind::kWalk: return "walk";
+    case RouteLeg::Kind::kClimb: return "climb";
+    case RouteLeg::Kind::kDescend: return "descend";
+    case RouteLeg::Kind::kWork: return "work";
+    case RouteLeg::Kind::kWait: return "wait";
+  }
+  return "?";
+}
+
+gesture::Motion motionOfGesture(int gesture_id) {
+  switch (gesture_id) {
+    case 1: return gesture::Motion::kCrossArms;
+    case 2: return gesture::Motion::kExtendArmSide;
+    case 3: return gesture::Motion::kPalmsTogether;
+    case 4: return gesture::Motion::kRaiseArmUp;
+    default: return gesture::Motion::kIdle;
+  }
+}
+
+namespace {
+bool moving(RouteLeg::Kind k) {
+  return k == RouteLeg::Kind::kWalk || k == RouteLeg::Kind::kClimb || k == RouteLeg::Kind::kDescend;
+}
+}  // namespace
+
+std::vector<std::string> WorkerConfig::validate(const std::string& prefix) const {
+  std::vector<std::string> e;
+  check(e, height_m >= 1.0 && height_m <= 2.3, height_m, prefix, "height_m", "in [1.0, 2.3]");
+  if (!start_feet_world.allFinite()) e.push_back(prefix + "start must be finite");
+  check(e, true, start_facing_deg, prefix, "start_facing_deg", "finite");
+  if (route.empty()) e.push_back(prefix + "route must have at least one leg");
+  for (std::size_t i = 0; i < route.size(); ++i) {
+    const RouteLeg& l = route[i];
+    const std::string p = prefix + "route[" + std::to_string(i) + "].";
+    if (moving(l.kind)) {
+      if (!l.to_feet_world.allFinite()) e.push_back(p + "to must be finite");
+      check(e, l.speed_mps > 0 && l.speed_mps <= 3.0, l.speed_mps, p, "speed_mps", "in (0, 3]");
+    } else {
+      check(e, l.duration_s > 0, l.duration_s, p, "duration_s", "> 0");
+    }
+    if (l.facing_deg) check(e, true, *l.facing_deg, p, "facing_deg", "finite");
+  }
+  check(e, gesture_hold_min_s > 0 && gesture_hold_min_s <= gesture_hold_max_s, gesture_hold_min_s, prefix,
+        "gesture_hold_min_s", "in (0, gesture_hold_max_s]");
+  check(e, gesture_hold_max_s <= 30, gesture_hold_max_s, prefix, "gesture_hold_max_s", "<= 30");
+  if (work_motions.empty()) e.push_back(prefix + "work_motions must not be empty");
+  for (std::size_t i = 0; i < work_motions.size(); ++i) {
+    if (gesture::gestureIdOf(work_motions[i]) != 0) {
+      e.push_back(prefix + "work_motions[" + std::to_string(i) + "] must be a non-gesture motion, got " +
+                  gesture::toString(work_motions[i]));
+    }
+  }
+  for (const auto& s : synth.validate()) e.push_back(prefix + "synth: " + s);
+  // Gestures: ascending, ids 1..4, inside a work/wait leg with room for the longest gesture.
+  const double longest = gesture_hold_max_s + 2.0 * 0.9 / synth.tempo_min + 2.0 * synth.lead_max_s;
+  double leg_t = 0.0;
+  std::vector<std::pair<double, double>> stationary;
+  Eigen::Vector3d at = start_feet_world;
+  for (const auto& l : route) {
+    double d = l.duration_s;
+    if (moving(l.kind)) {
+      d = (l.to_feet_world - at).norm() / std::max(1e-9, l.speed_mps);
+      at = l.to_feet_world;
+    } else {
+      stationary.emplace_back(leg_t, leg_t + d);
+    }
+    leg_t += d;
+  }
+  for (std::size_t i = 0; i < gestures.size(); ++i) {
+    const auto& g = gestures[i];
+    const std::string p = prefix + "gestures[" + std::to_string(i) + "].";
+    if (g.gesture_id < 1 || g.gesture_id > 4) e.push_back(p + "gesture must be in [1, 4], got " + std::to_string(g.gesture_id));
+    if (i > 0 && !(g.t_s > gestures[i - 1].t_s)) e.push_back(p + "t_s must increase, got " + num(g.t_s));
+    if (i > 0 && g.t_s - gestures[i - 1].t_s < longest) {
+      e.push_back(p + "t_s " + num(g.t_s) + " is within " + num(longest) + " s of the previous gesture");
+    }
+    bool inside = false;
+    for (const auto& [a, b] : stationary) inside = inside || (g.t_s >= a && g.t_s + longest <= b);
+    if (!inside) {
+      e.push_back(p + "t_s " + num(g.t_s) + " must lie in a work or wait leg with " + num(longest) +
+                  " s left (the worker stands still while gesturing)");
+    }
+  }
+  return e;
+}
+
+double WorkerConfig::routeDuration() const {
+  double t = 0.0;
+  Eigen::Vector3d at = start_feet_world;
+  for (const auto& l : route) {
+    if (moving(l.kind)) {
+      t += (l.to_feet_world - at).norm() / l.speed_mps;
+      at = l.to_feet_world;
+    } else {
+      t += l.duration_s;
+    }
+  }
+  return t;
+}
+
+namespace {
+gesture::SynthConfig synthFor(gesture::SynthConfig c, double height_m) {
+  c.height_min_m = height_m;
+  c.height_max_m = height_m;
+  return c;
+}
+gesture::SynthConfig gestureSynthFor(gesture::SynthConfig c, const WorkerConfig& w) {
+  c = synthFor(c, w.height_m);
+  c.hold_min_s = w.gesture_hold_min_s;
+  c.hold_max_s = w.gesture_hold_max_s;
+  return c;
+}
+}  // namespace
+
+WorkerModel::WorkerModel(const WorkerConfig& config, std::uint64_t seed)
+    : config_(config),
+      synth_(synthFor(config.synth, config.height_m), mixSeed(seed ^ 0x5EED0001ULL)),
+      gesture_synth_(gestureSynthFor(config.synth, config), mixSeed(seed ^ 0x5EED0002ULL)) {
+  double t = 0.0;
+  Eigen::Vector3d at = config_.start_feet_world;
+  double heading = degToRad(config_.start_facing_deg);
+  for (const auto& l : config_.route) {
+    leg_start_s_.push_back(t);
+    leg_start_feet_.push_back(at);
+    if (l.facing_deg) {
+      heading = degToRad(*l.facing_deg);
+    } else if (l.kind == RouteLeg::Kind::kWalk) {
+      const Eigen::Vector3d d = l.to_feet_world - at;
+      if (d.head<2>().norm() > 0.1) heading = std::atan2(d.y(), d.x());
+    }
+    leg_heading_rad_.push_back(common::wrapAngle(heading));
+    if (moving(l.kind)) {
+      t += (l.to_feet_world - at).norm() / l.speed_mps;
+      at = l.to_feet_world;
+    } else {
+      t += l.duration_s;
+    }
+  }
+  leg_start_s_.push_back(t);
+  leg_start_feet_.push_back(at);
+  leg_heading_rad_.push_back(leg_heading_rad_.empty() ? degToRad(config_.start_facing_deg) : leg_heading_rad_.back());
+}
+
+WorkerState WorkerModel::stateAt(double t_s) const {
+  WorkerState s;
+  const std::size_t n = config_.route.size();
+  std::size_t leg = 0;
+  while (leg < n && t_s >= leg_start_s_[leg + 1]) ++leg;
+  s.leg = static_cast<int>(leg);
+  const Eigen::Vector3d half(0.0, 0.0, 0.5 * config_.height_m);
+  if (leg >= n || t_s < 0.0) {
+    const std::size_t i = t_s < 0.0 ? 0 : n;
+    s.feet_world = leg_start_feet_[i];
+    s.p_world = s.feet_world + half;
+    s.heading_rad = t_s < 0.0 ? degToRad(config_.start_facing_deg) : leg_heading_rad_[n];
+    s.kind = RouteLeg::Kind::kWait;
+    return s;
+  }
+  const RouteLeg& l = config_.route[leg];
+  s.kind = l.kind;
+  s.heading_rad = leg_heading_rad_[leg];
+  if (moving(l.kind)) {
+    const Eigen::Vector3d a = leg_start_feet_[leg];
+    const Eigen::Vector3d d = l.to_feet_world - a;
+    const double len = d.norm();
+    const double along = std::min(len, (t_s - leg_start_s_[leg]) * l.speed_mps);
+    s.feet_world = len > 0 ? Eigen::Vector3d(a + d * (along / len)) : a;
+    s.v_world = len > 0 ? Eigen::Vector3d(d * (l.speed_mps / len)) : Eigen::Vector3d::Zero();
+  } else {
+    s.feet_world = leg_start_feet_[leg];
+  }
+  s.p_world = s.feet_world + half;
+  return s;
+}
+
+gesture::Motion WorkerModel::motionFor(const WorkerState& s) {
+  switch (s.kind) {
+    case RouteLeg::Kind::kWalk: return gesture::Motion::kWalking;
+    case RouteLeg::Kind::kClimb:
+    case RouteLeg::Kind::kDescend: return gesture::Motion::kClimbingLadder;
+    case RouteLeg::Kind::kWork: {
+      const auto m = config_.work_motions[next_work_motion_ % config_.work_motions.size()];
+      ++next_work_motion_;
+      return m;
+    }
+    case RouteLeg::Kind::kWait: return gesture::Motion::kIdle;
+  }
+  return gesture::Motion::kIdle;
+}
+
+void WorkerModel::startMotion(double t_s, gesture::Motion motion, const Eigen::Vector3d& camera_world,
+                              bool is_scheduled, double scheduled_s) {
+  const WorkerState s = stateAt(t_s);
+  const Eigen::Vector3d diff = camera_world - s.p_world;
+  const double d = std::max(1.5, diff.norm());
+  const double el = radToDeg(std::asin(std::clamp(diff.z() / std::max(1e-9, diff.norm()), -1.0, 1.0)));
+  const double az = radToDeg(common::wrapAngle(std::atan2(diff.y(), diff.x()) - s.heading_rad));
+  gesture::SkeletonSynthesizer& synth = is_scheduled ? gesture_synth_ : synth_;
+  current_ = synth.generateFrom(motion, d, el, az);
+  current_start_s_ = t_s;
+  has_current_ = true;
+  if (is_scheduled) {
+    GestureEpisode ep;
+    ep.gesture_id = gesture::gestureIdOf(motion);
+    ep.scheduled_s = scheduled_s;
+    ep.start_s = t_s + current_.motion_start_s;
+    ep.end_s = t_s + current_.motion_end_s;
+    episodes_.push_back(ep);
+  }
+}
+
+gesture::SynthFrame WorkerModel::skeletonAt(double t_s, const Eigen::Vector3d& camera_world) {
+  const double fps = config_.synth.fps;
+  if (next_gesture_ < config_.gestures.size() && t_s >= config_.gestures[next_gesture_].t_s) {
+    const auto& g = config_.gestures[next_gesture_++];
+    startMotion(t_s, motionOfGesture(g.gesture_id), camera_world, true, g.t_s);
+  } else if (!has_current_ || t_s - current_start_s_ >= static_cast<double>(current_.frames.size()) / fps) {
+    startMotion(t_s, motionFor(stateAt(t_s)), camera_world, false, 0.0);
+  }
+  const auto last = static_cast<long>(current_.frames.size()) - 1;
+  const long k = std::clamp(static_cast<long>(std::floor((t_s - current_start_s_) * fps + 0.5)), 0L, last);
+  gesture::SynthFrame f = current_.frames[static_cast<std::size_t>(k)];
+  f.t_s = t_s;
+  return f;
+}
+
+int WorkerModel::performingAt(double t_s) const {
+  for (auto it = episodes_.rbegin(); it != episodes_.rend(); ++it) {
+    if (t_s >= it->start_s && t_s <= it->end_s) return it->gesture_id;
+  }
+  return 0;
+}
+
+}  // namespace gesture_formation::sim

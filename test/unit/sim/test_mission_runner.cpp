@@ -1,0 +1,127 @@
+// The mission runner with a test-only stand-in planner (the product uses planning::UavPlanner):
+// the plan is the stage-1 reference itself, which is safe in an empty world.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "gesture_formation/planning/distance_field.hpp"
+#include "gesture_formation/planning/occupancy_map.hpp"
+#include "gesture_formation/sim/mission_runner.hpp"
+
+namespace gf = gesture_formation;
+
+namespace {
+
+/// Test-only: returns the reference as the plan (or nothing when `fail` is set).
+class ReferencePlanner : public gf::sim::MissionPlanner {
+ public:
+  explicit ReferencePlanner(bool fail) : fail_(fail) {}
+  gf::planning::PlanResult plan(const gf::planning::PlanRequest& r) override {
+    gf::planning::PlanResult res;
+    if (fail_) {
+      res.status = gf::planning::PlanStatus::kFallbackBrake;
+      return res;  // empty trajectory: the controller must brake to hover
+    }
+    res.status = gf::planning::PlanStatus::kOptimized;
+    res.trajectory.uav_index = r.uav_index;
+    res.trajectory.t0_s = r.t_now_s;
+    res.trajectory.dt_s = r.dt_s;
+    for (int k = 0; k < r.reference.steps(); ++k) {
+      gf::planning::TrajectorySample s;
+      s.p_world = r.reference.p_world.col(k);
+      const int k1 = std::min(k + 1, r.reference.steps() - 1), k0 = k1 - 1;
+      s.v_world = (r.reference.p_world.col(k1) - r.reference.p_world.col(k0)) / r.dt_s;
+      s.heading_rad = r.reference.heading_rad(k);
+      s.pitch_rad = r.reference.pitch_rad(k);
+      res.trajectory.samples.push_back(s);
+    }
+    return res;
+  }
+
+ private:
+  bool fail_;
+};
+
+struct World {
+  gf::planning::OccupancyMap map;
+  gf::planning::DistanceField field;
+  World() : map(makeMap()), field(map) {}
+  static gf::planning::OccupancyMap makeMap() {
+    gf::planning::MapConfig mc;
+    mc.resolution_m = 0.4;
+    mc.bounds = gf::planning::Aabb{Eigen::Vector3d(-30, -30, 0), Eigen::Vector3d(30, 30, 20)};
+    return gf::planning::OccupancyMap::fromPrimitives(mc, gf::planning::PrimitiveSet{}, gf::planning::GroundSpec{true, 0.0});
+  }
+};
+
+gf::sim::MissionConfig openFieldMission() {
+  const auto m = gf::sim::loadMissionConfig(std::string(GF_SOURCE_DIR) + "/config/scenarios/open_field.yaml");
+  EXPECT_TRUE(m) << m.reason();
+  gf::sim::MissionConfig c = *m;
+  c.requests.clear();
+  gf::sim::OperatorRequest q;
+  q.t_s = 5.0;
+  q.target_text = "[2]";
+  q.target = gf::formation::CommandTarget::list({2});
+  q.parameter = gf::formation::Parameter::kDistance;
+  q.amount = 2.0;
+  c.requests.push_back(q);
+  return c;
+}
+
+}  // namespace
+
+TEST(MissionRunnerTest, SubsetRequestChangesOnlyItsUavAndRunIsDeterministic) {
+  World w;
+  const auto cfg = openFieldMission();
+  gf::sim::MissionWorld world{&w.map, &w.field, 0.0};
+  const gf::sim::PlannerFactory factory = [](int) { return std::make_unique<ReferencePlanner>(false); };
+  const auto a = gf::sim::runMission(cfg, world, factory, nullptr, 7, 20.0);
+  const auto b = gf::sim::runMission(cfg, world, factory, nullptr, 7, 20.0);
+  ASSERT_TRUE(a) << a.reason();
+  ASSERT_TRUE(b);
+  ASSERT_EQ(a->timeline.size(), b->timeline.size());
+  for (std::size_t i = 0; i < a->timeline.size(); ++i) {
+    for (std::size_t u = 0; u < 3; ++u) ASSERT_EQ(a->timeline[i].uavs[u].p_world, b->timeline[i].uavs[u].p_world);
+  }
+  EXPECT_EQ(a->metrics.requests_applied, 1);
+  ASSERT_EQ(a->requests.size(), 1u);
+  EXPECT_EQ(a->requests[0].uavs, std::vector<int>({2}));
+  EXPECT_NEAR(a->requests[0].applied_s, 5.1, 1e-9);  // operator link 0.1 s
+  EXPECT_GE(a->requests[0].adaptation_start_s, a->requests[0].applied_s);
+  for (const auto& row : a->timeline) {
+    EXPECT_EQ(row.uavs[0].d_ref, 10.0);
+    EXPECT_EQ(row.uavs[1].d_ref, 8.0);
+    EXPECT_EQ(row.uavs[2].d_ref, row.t_s < 5.1 ? 8.0 : 10.0);
+  }
+  EXPECT_NEAR(a->timeline.back().uavs[2].d_t, 10.0, 1.0);  // follower 2 moved out
+  EXPECT_NEAR(a->timeline.back().uavs[1].d_t, 8.0, 1.0);   // follower 1 stayed
+  EXPECT_EQ(a->metrics.collisions, 0);
+  EXPECT_LT(a->metrics.human_estimate_error_rms_m, 0.5);
+  EXPECT_GT(a->metrics.visible_fraction, 0.8);
+}
+
+TEST(MissionRunnerTest, UavWithoutPlanBrakesToHover) {
+  World w;
+  const auto cfg = openFieldMission();
+  gf::sim::MissionWorld world{&w.map, &w.field, 0.0};
+  const gf::sim::PlannerFactory factory = [](int i) { return std::make_unique<ReferencePlanner>(i == 1); };
+  const auto out = gf::sim::runMission(cfg, world, factory, nullptr, 3, 20.0);
+  ASSERT_TRUE(out) << out.reason();
+  // Follower 1 never gets a plan: it stays near its start while the worker walks away.
+  const Eigen::Vector3d start = out->timeline.front().uavs[1].p_world;
+  for (const auto& row : out->timeline) EXPECT_LT((row.uavs[1].p_world - start).norm(), 1.0) << row.t_s;
+  EXPECT_GT((out->timeline.back().uavs[0].p_world - out->timeline.front().uavs[0].p_world).norm(), 5.0);
+  EXPECT_GT(out->metrics.plans_fallback_brake, 0);
+}
+
+TEST(MissionRunnerTest, InitialPositionInsideObstacleIsRefused) {
+  World w;
+  auto cfg = openFieldMission();
+  cfg.uavs[1].initial_position = Eigen::Vector3d(0, 0, 0.1);  // in the ground
+  gf::sim::MissionWorld world{&w.map, &w.field, 0.0};
+  const gf::sim::PlannerFactory factory = [](int) { return std::make_unique<ReferencePlanner>(false); };
+  const auto out = gf::sim::runMission(cfg, world, factory, nullptr, 1, 5.0);
+  ASSERT_FALSE(out);
+  EXPECT_NE(out.reason().find("mission.uavs[1].initial_position"), std::string::npos) << out.reason();
+}
