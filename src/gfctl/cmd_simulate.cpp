@@ -127,6 +127,7 @@ struct Loaded {
   std::shared_ptr<const planning::OccupancyMap> map;
   std::shared_ptr<const planning::DistanceField> field;
   std::unique_ptr<sim::MissionClassifier> classifier;
+  planning::PrimitiveSet solids;  ///< exact geometry for the obstacle-distance metric
 };
 
 int runOne(const Args& args, Loaded& L, std::uint64_t seed, double duration, const std::string& dir, bool plot,
@@ -136,6 +137,7 @@ int runOne(const Args& args, Loaded& L, std::uint64_t seed, double duration, con
   world.map = L.map.get();
   world.field = L.field.get();
   world.ground_height_m = L.scenario.ground.enabled ? L.scenario.ground.height_m : -1e9;
+  world.solids = &L.solids;
   const auto planners = sim::uavPlannerFactory(L.mission.planner, L.map, L.field);
   const auto out = sim::runMission(L.mission, world, planners, L.classifier.get(), seed, duration);
   if (!out) return badInput(args, out.reason());
@@ -213,6 +215,7 @@ int cmdSimulate(const Args& args) {
     return kExitBadInput;
   }
   L.scenario = std::move(*sc);
+  L.solids = L.scenario.primitives();
   L.mission = std::move(*mission);
   const std::string model = args.has("model") ? args.get("model") : L.mission.gesture_model;
   if (!model.empty()) {

@@ -28,6 +28,13 @@ using common::wrapAngle;
 // Product adapters
 namespace {
 
+/// The obstacle-distance metric (MissionWorld::solids).
+double obstacleDistance(const MissionWorld& world, const Eigen::Vector3d& p) {
+  const double field = world.field->clearance(p);
+  if (world.solids == nullptr || field >= 2.5) return field;
+  return std::min(world.solids->distance(p), p.z() - world.ground_height_m);
+}
+
 /// The planner's first failure reason without its numbers (so equal causes group together).
 std::string reasonKey(const std::string& reason) {
   std::string first = reason.substr(0, reason.find(';'));
@@ -479,7 +486,7 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
       UavRuntime& u = *uavs[static_cast<std::size_t>(i)];
       const Eigen::Vector3d& p = u.plant.state().p_world;
       const double r = u.plant.params().body_radius_m;
-      const double d_o = world.field->clearance(p);
+      const double d_o = obstacleDistance(world, p);
       if (d_o < M.min_obstacle_distance_m) {
         M.min_obstacle_distance_m = d_o;
         M.min_obstacle_uav = i;
@@ -528,7 +535,7 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
         const Eigen::Vector3d to_worker = ws.p_world - s.p_world;
         us.d_t = to_worker.norm();
         us.d_ref = P.uav(i).distance_m;
-        us.d_o = world.field->clearance(s.p_world);
+        us.d_o = obstacleDistance(world, s.p_world);
         us.phi_deg = radToDeg(std::atan2(to_worker.y(), to_worker.x()));
         us.phi_ref_deg = radToDeg(ref.heading_rad);
         us.elev_deg = radToDeg(std::asin(std::clamp(-to_worker.z() / std::max(1e-9, us.d_t), -1.0, 1.0)));

@@ -31,6 +31,7 @@
 
 #include "gesture_formation/common/result.hpp"
 #include "gesture_formation/gesture/gesture_classifier.hpp"
+#include "gesture_formation/planning/shapes.hpp"
 #include "gesture_formation/planning/uav_planner.hpp"
 #include "gesture_formation/sim/mission_config.hpp"
 
@@ -147,6 +148,11 @@ struct MissionWorld {
   const planning::OccupancyMap* map = nullptr;     ///< occlusion ray casts (may be null: none)
   const planning::DistanceField* field = nullptr;  ///< obstacle clearance metrics (required)
   double ground_height_m = 0.0;
+  /// Exact obstacle geometry for the obstacle-distance metrics (d_o, min_obstacle_distance_m):
+  /// within 2.5 m of an obstacle the distance to these solids and the ground, farther the
+  /// field's value. Null: the field's value everywhere (distance to occupied voxel centres,
+  /// quantised to the voxel size).
+  const planning::PrimitiveSet* solids = nullptr;
 };
 
 /// \brief Runs one mission. `classifier` may be null (no gesture pipeline: gestures are not
