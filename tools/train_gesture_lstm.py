@@ -5,10 +5,11 @@
     /opt/gesture_formation/venv-train/bin/python tools/train_gesture_lstm.py \
         --gfctl build/devel/lib/gesture_formation/gfctl --out third_party_models/gesture_lstm
 
-Data: `gfctl synth-gestures` with the training seed (default 1001, 6000 sequences) and a
-validation seed (1002, 600 sequences), both from the default (training) distribution.
-Model: LSTM(51 → 64) over N = 9 frames, the final hidden state h_n (not output[:, -1]:
-OpenCV 4.6 rejects the negative-index Slice that exports) → Linear(64 → 5) → softmax.
+Data: `gfctl synth-gestures` with the training seed (default 1001, 6000 sequences, the
+default distribution), an extra training set (seed 1003, 4000 sequences,
+tools/gesture/train_extra.yaml: more work motions, longer holds) and a validation seed
+(1002, 600 sequences, default distribution). Model: LSTM(51 → 128) over N = 9 frames, the final hidden state h_n (not output[:, -1]:
+OpenCV 4.6 rejects the negative-index Slice that exports) → Linear(128 → 5) → softmax.
 Deterministic: fixed torch seed, 2 threads, deterministic algorithms. Writes
 <out>/gesture_lstm.onnx, <out>/training.json (command, seeds, figures) and the C++/OpenCV
 equality reference test/data/gesture/lstm_reference.csv.
@@ -51,11 +52,17 @@ def main():
     ap.add_argument("--out", default="third_party_models/gesture_lstm")
     ap.add_argument("--train-seed", type=int, default=1001)
     ap.add_argument("--train-count", type=int, default=6000)
+    ap.add_argument("--extra-seed", type=int, default=1003,
+                    help="a second training set with more work motions and longer holds")
+    ap.add_argument("--extra-count", type=int, default=4000)
+    ap.add_argument("--extra-config", default=os.path.join(os.path.dirname(os.path.abspath(__file__)),
+                                                           "gesture", "train_extra.yaml"))
+    ap.add_argument("--class-weights", choices=["none", "balanced"], default="none")
     ap.add_argument("--val-seed", type=int, default=1002)
     ap.add_argument("--val-count", type=int, default=600)
     ap.add_argument("--torch-seed", type=int, default=7)
-    ap.add_argument("--epochs", type=int, default=25)
-    ap.add_argument("--hidden", type=int, default=64)
+    ap.add_argument("--epochs", type=int, default=30)
+    ap.add_argument("--hidden", type=int, default=128)
     ap.add_argument("--work", default=None, help="where datasets are cached (default: a temp dir)")
     a = ap.parse_args()
     torch.manual_seed(a.torch_seed)
@@ -65,13 +72,23 @@ def main():
     work = a.work or tempfile.mkdtemp(prefix="gf_lstm_")
     t0 = time.time()
     train_dir = gesture_data.synthesize(a.gfctl, a.train_seed, a.train_count, os.path.join(work, f"train_{a.train_seed}"))
+    extra_dir = None
+    if a.extra_count > 0:
+        extra_dir = gesture_data.synthesize(a.gfctl, a.extra_seed, a.extra_count,
+                                            os.path.join(work, f"extra_{a.extra_seed}"), a.extra_config)
     val_dir = gesture_data.synthesize(a.gfctl, a.val_seed, a.val_count, os.path.join(work, f"val_{a.val_seed}"))
     xtr, ytr, _ = gesture_data.windows(gesture_data.load_frames(train_dir))
+    if extra_dir:
+        xex, yex, _ = gesture_data.windows(gesture_data.load_frames(extra_dir))
+        xtr, ytr = np.concatenate([xtr, xex]), np.concatenate([ytr, yex])
     xva, yva, _ = gesture_data.windows(gesture_data.load_frames(val_dir))
     print(f"windows: train {len(xtr)} {np.bincount(ytr, minlength=5).tolist()}, val {len(xva)} "
           f"{np.bincount(yva, minlength=5).tolist()} ({time.time() - t0:.0f} s)")
     counts = np.bincount(ytr, minlength=5).astype(np.float64)
-    weights = torch.tensor(counts.sum() / (5 * counts), dtype=torch.float32)
+    # "balanced" up-weights the gestures (the minority) and buys recall with false gestures
+    # on work motions; "none" (default) keeps the data's prior.
+    weights = (torch.tensor(counts.sum() / (5 * counts), dtype=torch.float32) if a.class_weights == "balanced"
+               else torch.ones(5))
     model = GestureLstm(a.hidden)
     opt = torch.optim.Adam(model.parameters(), lr=2e-3)
     sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, a.epochs)
@@ -119,7 +136,10 @@ def main():
             f.write(",".join("%.9g" % v for v in list(x.reshape(-1)) + list(p)) + "\n")
     report = {
         "command": " ".join(sys.argv),
-        "train": {"seed": a.train_seed, "sequences": a.train_count, "windows": int(len(xtr))},
+        "train": {"seed": a.train_seed, "sequences": a.train_count, "windows": int(len(xtr)),
+                  "extra": {"seed": a.extra_seed, "sequences": a.extra_count,
+                            "config": os.path.relpath(a.extra_config, os.path.join(os.path.dirname(__file__), ".."))}},
+        "class_weights": a.class_weights,
         "validation": {"seed": a.val_seed, "sequences": a.val_count, "windows": int(len(xva)),
                        "accuracy": history[-1]["val_accuracy"]},
         "torch_seed": a.torch_seed, "epochs": a.epochs, "hidden": a.hidden, "torch": torch.__version__,
