@@ -1,20 +1,18 @@
 #!/usr/bin/env bash
-# The main job (README): installs what is missing, builds gfctl and replays the worker
-# position estimator on the sample flight log shipped in test/data/flights/, then prints a
-# summary against the ground truth and draws build/demo/estimate.png.
-# (It grows into the simulated power-tower mission when that lands.)
+# The main job (README): installs what is missing, builds gfctl and flies the paper's
+# simulated power-tower mission (config/scenarios/power_towers.yaml: 3 UAVs, the worker at
+# both towers, 25 view-adaptation requests incl. 6 gestures) in closed loop, then prints the
+# metrics and draws build/demo/mission/timeline.png (docs/simulation.md).
+#   tools/run_demo.sh            # seed 1
+#   GF_DEMO_SEED=7 tools/run_demo.sh
 set -eo pipefail
 cd "$(dirname "$0")/.."
 tools/setup.sh > /dev/null
 tools/build.sh gfctl > /dev/null
 BUILD_DIR=${GF_BUILD_DIR:-build}
 GFCTL=$BUILD_DIR/devel/lib/gesture_formation/gfctl
-mkdir -p "$BUILD_DIR/demo"
-echo "== gfctl estimate on test/data/flights/sample_flight.csv (75 s, 15 Hz, leader at Table II view)"
-"$GFCTL" estimate --config config/estimator.yaml --in test/data/flights/sample_flight.csv \
-  --out "$BUILD_DIR/demo/states.csv"
-PY=/opt/gesture_formation/venv/bin/python
-[ -x "$PY" ] || PY=/usr/bin/python3
-"$PY" tools/summarize_estimate.py --states "$BUILD_DIR/demo/states.csv" \
-  --truth test/data/flights/sample_flight_truth.csv --plot "$BUILD_DIR/demo/estimate.png"
-echo "states: $BUILD_DIR/demo/states.csv   gfctl: $GFCTL"
+OUT=$BUILD_DIR/demo/mission
+mkdir -p "$OUT"
+echo "== gfctl simulate: power-tower mission, seed ${GF_DEMO_SEED:-1} (451 s simulated)"
+"$GFCTL" simulate --scenario config/scenarios/power_towers.yaml --out "$OUT" --seed "${GF_DEMO_SEED:-1}"
+echo "outputs: $OUT/{metrics.json,timeline.csv,events.csv,scene.json,timeline.png}   gfctl: $GFCTL"
