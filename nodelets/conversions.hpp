@@ -1,13 +1,26 @@
 #pragma once
 // All message <-> core conversions of the nodelets (house style: one header, no math).
 #include <cmath>
+#include <string>
 
+#include <Eigen/Geometry>
 #include <geometry_msgs/TransformStamped.h>
+#include <nav_msgs/Odometry.h>
+#include <trajectory_msgs/MultiDOFJointTrajectory.h>
 
+#include "gesture_formation/FormationCommand.h"
+#include "gesture_formation/FormationParams.h"
+#include "gesture_formation/PlannedTrajectory.h"
 #include "gesture_formation/WorkerDetection.h"
 #include "gesture_formation/WorkerState.h"
+#include "gesture_formation/comm/payloads.hpp"
+#include "gesture_formation/common/result.hpp"
 #include "gesture_formation/estimation/human_kalman.hpp"
 #include "gesture_formation/estimation/measurement_model.hpp"
+#include "gesture_formation/formation/formation_commands.hpp"
+#include "gesture_formation/formation/formation_params.hpp"
+#include "gesture_formation/planning/uav_planner.hpp"
+#include "gesture_formation/sim/mission_config.hpp"
 
 namespace gesture_formation::nodelets {
 
@@ -35,6 +48,236 @@ inline gesture_formation::WorkerState toWorkerState(const estimation::Vector6d& 
   for (int r = 0; r < 6; ++r) {
     for (int c = 0; c < 6; ++c) s.covariance[static_cast<std::size_t>(6 * r + c)] = P(r, c);
   }
+  return s;
+}
+
+
+// ---- points and vectors ----------------------------------------------------------------
+inline geometry_msgs::Point toPoint(const Eigen::Vector3d& p) {
+  geometry_msgs::Point m;
+  m.x = p.x();
+  m.y = p.y();
+  m.z = p.z();
+  return m;
+}
+inline geometry_msgs::Vector3 toVector3(const Eigen::Vector3d& v) {
+  geometry_msgs::Vector3 m;
+  m.x = v.x();
+  m.y = v.y();
+  m.z = v.z();
+  return m;
+}
+inline Eigen::Vector3d toEigen(const geometry_msgs::Point& p) { return Eigen::Vector3d(p.x, p.y, p.z); }
+inline Eigen::Vector3d toEigen(const geometry_msgs::Vector3& v) { return Eigen::Vector3d(v.x, v.y, v.z); }
+
+// ---- odometry: pose orientation = the camera's forward axis (docs/ros.md) ---------------
+// The orientation of nav_msgs/Odometry published for a UAV is the FLU body whose x axis is the
+// camera's optical axis: yaw = camera heading φ, pitch about body y = −ξ (ξ positive up), no roll.
+inline geometry_msgs::Quaternion cameraAxisOrientation(double heading_rad, double pitch_rad) {
+  const Eigen::Quaterniond q = Eigen::AngleAxisd(heading_rad, Eigen::Vector3d::UnitZ()) *
+                               Eigen::AngleAxisd(-pitch_rad, Eigen::Vector3d::UnitY());
+  geometry_msgs::Quaternion m;
+  m.w = q.w();
+  m.x = q.x();
+  m.y = q.y();
+  m.z = q.z();
+  return m;
+}
+inline void cameraHeadingPitch(const geometry_msgs::Quaternion& q, double& heading_rad, double& pitch_rad) {
+  const Eigen::Vector3d x_axis = Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized() * Eigen::Vector3d::UnitX();
+  heading_rad = std::atan2(x_axis.y(), x_axis.x());
+  pitch_rad = std::asin(std::max(-1.0, std::min(1.0, x_axis.z())));
+}
+inline planning::UavKinematicState toKinematicState(const nav_msgs::Odometry& odom) {
+  planning::UavKinematicState s;
+  s.t_s = odom.header.stamp.toSec();
+  s.p_world = toEigen(odom.pose.pose.position);
+  s.v_world = toEigen(odom.twist.twist.linear);  // world frame (child_frame_id = world_frame)
+  cameraHeadingPitch(odom.pose.pose.orientation, s.heading_rad, s.pitch_rad);
+  return s;
+}
+
+// ---- planned trajectories --------------------------------------------------------------
+inline gesture_formation::PlannedTrajectory toMsg(const planning::PlannedTrajectory& plan) {
+  gesture_formation::PlannedTrajectory m;
+  m.header.stamp = ros::Time(plan.t0_s);
+  m.uav_index = plan.uav_index;
+  m.sequence = plan.sequence;
+  m.dt_s = plan.dt_s;
+  for (const auto& s : plan.samples) {
+    m.positions.push_back(toPoint(s.p_world));
+    m.velocities.push_back(toVector3(s.v_world));
+    m.accelerations.push_back(toVector3(s.a_world));
+    m.heading_rad.push_back(s.heading_rad);
+    m.pitch_rad.push_back(s.pitch_rad);
+  }
+  m.status = "optimized";
+  return m;
+}
+inline gesture_formation::PlannedTrajectory toMsg(const planning::PlanResult& r) {
+  gesture_formation::PlannedTrajectory m = toMsg(r.trajectory);
+  m.status = planning::toString(r.status);
+  m.fallback = r.status != planning::PlanStatus::kOptimized;
+  m.reason = r.reason;
+  m.planning_ms = r.timings.total_ms;
+  for (const auto& p : r.path_world) m.path.push_back(toPoint(p));
+  return m;
+}
+/// Fails naming the field when the arrays disagree in length or dt is not positive.
+inline common::Result<planning::PlannedTrajectory> fromMsg(const gesture_formation::PlannedTrajectory& m) {
+  using R = common::Result<planning::PlannedTrajectory>;
+  const std::size_t n = m.positions.size();
+  if (m.velocities.size() != n || m.accelerations.size() != n || m.heading_rad.size() != n || m.pitch_rad.size() != n) {
+    return R::fail("PlannedTrajectory: positions, velocities, accelerations, heading_rad, pitch_rad differ in length");
+  }
+  if (!(m.dt_s > 0.0)) return R::fail("PlannedTrajectory.dt_s: must be > 0");
+  planning::PlannedTrajectory p;
+  p.uav_index = m.uav_index;
+  p.sequence = m.sequence;
+  p.t0_s = m.header.stamp.toSec();
+  p.dt_s = m.dt_s;
+  p.samples.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    p.samples[k].p_world = toEigen(m.positions[k]);
+    p.samples[k].v_world = toEigen(m.velocities[k]);
+    p.samples[k].a_world = toEigen(m.accelerations[k]);
+    p.samples[k].heading_rad = m.heading_rad[k];
+    p.samples[k].pitch_rad = m.pitch_rad[k];
+  }
+  return R::ok(std::move(p));
+}
+/// The flight stack's input (DESIGN §6): positions, velocities, accelerations, heading as yaw.
+inline trajectory_msgs::MultiDOFJointTrajectory toMultiDof(const gesture_formation::PlannedTrajectory& m,
+                                                           const std::string& joint_name) {
+  trajectory_msgs::MultiDOFJointTrajectory t;
+  t.header = m.header;
+  t.joint_names.push_back(joint_name);
+  for (std::size_t k = 0; k < m.positions.size(); ++k) {
+    trajectory_msgs::MultiDOFJointTrajectoryPoint pt;
+    geometry_msgs::Transform tf;
+    tf.translation.x = m.positions[k].x;
+    tf.translation.y = m.positions[k].y;
+    tf.translation.z = m.positions[k].z;
+    tf.rotation = cameraAxisOrientation(m.heading_rad[k], 0.0);
+    geometry_msgs::Twist v, a;
+    v.linear = m.velocities[k];
+    a.linear = m.accelerations[k];
+    pt.transforms.push_back(tf);
+    pt.velocities.push_back(v);
+    pt.accelerations.push_back(a);
+    pt.time_from_start = ros::Duration(m.dt_s * static_cast<double>(k));
+    t.points.push_back(pt);
+  }
+  return t;
+}
+
+// ---- formation parameters and commands -------------------------------------------------
+inline gesture_formation::FormationParams toMsg(const formation::FormationParams& p, std::uint64_t version) {
+  gesture_formation::FormationParams m;
+  m.version = version;
+  for (int i = 0; i < p.uavCount(); ++i) {
+    gesture_formation::UavObservation o;
+    o.beta_deg = p.uav(i).beta_deg;
+    o.gamma_deg = p.uav(i).gamma_deg;
+    o.distance_m = p.uav(i).distance_m;
+    m.uavs.push_back(o);
+  }
+  return m;
+}
+inline common::Result<formation::FormationParams> fromMsg(const gesture_formation::FormationParams& m) {
+  using R = common::Result<formation::FormationParams>;
+  if (m.uavs.empty()) return R::fail("FormationParams.uavs: empty (needs the leader)");
+  formation::FormationParams p;
+  p.followers.clear();
+  for (std::size_t i = 0; i < m.uavs.size(); ++i) {
+    const formation::UavObservation o{m.uavs[i].beta_deg, m.uavs[i].gamma_deg, m.uavs[i].distance_m};
+    if (i == 0) {
+      p.leader = o;
+    } else {
+      p.followers.push_back(o);
+    }
+  }
+  return R::ok(std::move(p));
+}
+inline common::Result<formation::Parameter> parameterFromName(const std::string& name) {
+  using R = common::Result<formation::Parameter>;
+  for (const auto p : {formation::Parameter::kBeta, formation::Parameter::kGamma, formation::Parameter::kDistance}) {
+    if (name == formation::parameterName(p)) return R::ok(p);
+  }
+  return R::fail("parameter '" + name + "': expected beta_deg | gamma_deg | distance_m");
+}
+inline gesture_formation::FormationCommand toMsg(const formation::FormationCommand& c) {
+  gesture_formation::FormationCommand m;
+  m.sender = c.id.sender;
+  m.sequence = c.id.sequence;
+  m.source = formation::toString(c.source);
+  switch (c.target.group) {
+    case formation::TargetGroup::kLeader: m.target = "leader"; break;
+    case formation::TargetGroup::kFollowers: m.target = "followers"; break;
+    case formation::TargetGroup::kAll: m.target = "all"; break;
+    case formation::TargetGroup::kList:
+      m.target = "list";
+      m.uavs.assign(c.target.uavs.begin(), c.target.uavs.end());
+      break;
+  }
+  m.parameter = formation::parameterName(c.parameter);
+  m.kind = c.kind == formation::CommandKind::kSet ? "set" : "increment";
+  m.amount = c.amount;
+  return m;
+}
+inline common::Result<formation::FormationCommand> fromMsg(const gesture_formation::FormationCommand& m) {
+  using R = common::Result<formation::FormationCommand>;
+  formation::FormationCommand c;
+  c.id = {m.sender, m.sequence};
+  if (m.source == "operator") {
+    c.source = formation::CommandSource::kOperator;
+  } else if (m.source == "gesture") {
+    c.source = formation::CommandSource::kGesture;
+  } else {
+    return R::fail("FormationCommand.source '" + m.source + "': expected operator | gesture");
+  }
+  if (m.target == "list") {
+    c.target = formation::CommandTarget::list(std::vector<formation::UavIndex>(m.uavs.begin(), m.uavs.end()));
+  } else {
+    auto t = sim::parseTarget(m.target);
+    if (!t) return R::fail("FormationCommand.target: " + t.reason());
+    c.target = *t;
+  }
+  auto p = parameterFromName(m.parameter);
+  if (!p) return R::fail("FormationCommand." + p.reason());
+  c.parameter = *p;
+  if (m.kind == "increment") {
+    c.kind = formation::CommandKind::kIncrement;
+  } else if (m.kind == "set") {
+    c.kind = formation::CommandKind::kSet;
+  } else {
+    return R::fail("FormationCommand.kind '" + m.kind + "': expected increment | set");
+  }
+  if (!std::isfinite(m.amount)) return R::fail("FormationCommand.amount: not finite");
+  c.amount = m.amount;
+  return R::ok(std::move(c));
+}
+
+// ---- worker state over LCM -------------------------------------------------------------
+inline comm::WorkerStateMessage toWire(const gesture_formation::WorkerState& s) {
+  comm::WorkerStateMessage w;
+  w.t_s = s.header.stamp.toSec();
+  w.p_world = toEigen(s.position);
+  w.v_world = toEigen(s.velocity);
+  for (std::size_t i = 0; i < 6; ++i) w.covariance_diag[i] = std::max(0.0, s.covariance[7 * i]);
+  w.lost = s.lost;
+  return w;
+}
+inline gesture_formation::WorkerState fromWire(const comm::WorkerStateMessage& w) {
+  estimation::Vector6d x;
+  x << w.p_world, w.v_world;
+  estimation::Matrix6d P = estimation::Matrix6d::Zero();
+  for (int i = 0; i < 6; ++i) P(i, i) = w.covariance_diag[static_cast<std::size_t>(i)];
+  gesture_formation::WorkerState s = toWorkerState(x, P);
+  s.header.stamp = ros::Time(w.t_s);
+  s.lost = w.lost;
+  s.predicted = true;
+  s.source = "lcm";
   return s;
 }
 

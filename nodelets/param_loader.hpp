@@ -31,6 +31,37 @@ class ParamLoader {
     }
     loaded_ << "  " << name << " = " << value << "\n";
   }
+  void load(const std::string& name, int& value, int lo, int hi) {
+    if (!nh_.getParam(name, value)) {
+      missing(name);
+      return;
+    }
+    if (value < lo || value > hi) {
+      std::ostringstream os;
+      os << nh_.resolveName(name) << ": value " << value << " out of range [" << lo << ", " << hi << "]";
+      errors_.push_back(os.str());
+    }
+    loaded_ << "  " << name << " = " << value << "\n";
+  }
+  void load(const std::string& name, bool& value) {
+    if (!nh_.getParam(name, value)) missing(name);
+    loaded_ << "  " << name << " = " << (value ? "true" : "false") << "\n";
+  }
+  void load(const std::string& name, std::vector<int>& value) {
+    if (!nh_.getParam(name, value)) {
+      missing(name);
+      return;
+    }
+    loaded_ << "  " << name << " = [";
+    for (std::size_t i = 0; i < value.size(); ++i) loaded_ << (i ? ", " : "") << value[i];
+    loaded_ << "]\n";
+  }
+  /// \brief An optional string: absent → `fallback` (never an error).
+  void loadOptional(const std::string& name, std::string& value, const std::string& fallback) {
+    if (!nh_.getParam(name, value)) value = fallback;
+    loaded_ << "  " << name << " = " << value << "\n";
+  }
+  void addError(const std::string& error) { errors_.push_back(error); }
   void addErrors(const std::vector<std::string>& errors) { errors_.insert(errors_.end(), errors.begin(), errors.end()); }
 
   bool ok() const { return errors_.empty(); }

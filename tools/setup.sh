@@ -35,18 +35,18 @@ PACKAGES=(
   libgtest-dev googletest libbenchmark-dev
   catkin catkin-tools libroscpp-dev libnodeletlib-dev libnodeletlib-tools pluginlib-dev libtf2-ros-dev
   libstd-msgs-dev libsensor-msgs-dev libgeometry-msgs-dev libnav-msgs-dev libvisualization-msgs-dev
-  libstd-srvs-dev libtrajectory-msgs-dev
+  libstd-srvs-dev libtrajectory-msgs-dev libros-rosgraph-msgs-dev
   ros-message-generation ros-message-runtime
   ros-std-msgs ros-geometry-msgs ros-sensor-msgs ros-nav-msgs ros-visualization-msgs ros-std-srvs ros-trajectory-msgs
   librostest-dev python3-rostest python3-roslaunch python3-rostopic python3-rosbag
   python3-rosnode python3-rosservice python3-rosmsg rosbash
-  python3-tf2-ros python3-std-srvs python3-geometry-msgs python3-sensor-msgs python3-nav-msgs python3-visualization-msgs python3-tf2-msgs
+  python3-tf2-ros python3-std-srvs python3-geometry-msgs python3-sensor-msgs python3-nav-msgs python3-visualization-msgs python3-tf2-msgs python3-trajectory-msgs
   libeigen3-dev libopencv-dev libopencv-contrib-dev libompl-dev liboctomap-dev libfcl-dev libceres-dev
   liblcm-dev liblcm-bin libyaml-cpp-dev libssl-dev
   libcereal-dev libsimde-dev
   python3-venv python3-pip python3-yaml python3-numpy
   opencv-doc
-  rviz xvfb xauth imagemagick graphviz
+  rviz xvfb xauth imagemagick graphviz iproute2
   clang libclang-rt-14-dev                      # libFuzzer + ASan/UBSan runtimes for fuzz/ (tools/fuzz/run_fuzzers.sh)
 )
 

@@ -1,0 +1,90 @@
+#pragma once
+// Where a nodelet's algorithm configs come from (docs/ros.md): onboard, the product files
+// (config/formation.yaml, config/planner.yaml, config/gestures.yaml, every key required);
+// in simulation, the `mission` section of a scenario file, so that the ROS simulation runs
+// with exactly the parameters of `gfctl simulate` (parameter `mission_file`).
+#include <memory>
+#include <string>
+
+#include "gesture_formation/formation/formation_config.hpp"
+#include "gesture_formation/gesture/gesture_filter.hpp"
+#include "gesture_formation/gesture/gesture_mapping.hpp"
+#include "gesture_formation/planning/distance_field.hpp"
+#include "gesture_formation/planning/occupancy_map.hpp"
+#include "gesture_formation/planning/planner_config.hpp"
+#include "gesture_formation/planning/scenario.hpp"
+#include "gesture_formation/sim/mission_config.hpp"
+#include "param_loader.hpp"
+
+namespace gesture_formation::nodelets {
+
+/// The scenario's map and distance field (built once per process that loads it).
+struct WorldMap {
+  std::shared_ptr<const planning::OccupancyMap> map;
+  std::shared_ptr<const planning::DistanceField> field;
+};
+
+inline bool loadWorldMap(const std::string& scenario_file, ParamLoader& params, WorldMap& out) {
+  if (scenario_file.empty()) return false;
+  auto sc = planning::loadScenario(scenario_file);
+  if (!sc) {
+    params.addError("scenario_file: " + sc.reason());
+    return false;
+  }
+  auto map = planning::OccupancyMap::fromScenario(*sc);
+  if (!map) {
+    params.addError("scenario_file: " + scenario_file + ": map: " + map.reason());
+    return false;
+  }
+  out.map = std::make_shared<const planning::OccupancyMap>(std::move(*map));
+  out.field = std::make_shared<const planning::DistanceField>(*out.map);
+  return true;
+}
+
+/// Loads the mission of `mission_file` (every problem into `params`).
+inline bool loadMission(const std::string& mission_file, ParamLoader& params, sim::MissionConfig& out) {
+  auto m = sim::loadMissionConfig(mission_file);
+  if (!m) {
+    params.addError("mission_file: " + m.reason());
+    return false;
+  }
+  out = std::move(*m);
+  return true;
+}
+
+inline bool loadFormation(const std::string& path, ParamLoader& params, formation::FormationConfig& out) {
+  auto c = formation::loadFormationConfig(path, common::ConfigReader::MissingKeys::kError);
+  if (!c) {
+    params.addError("formation_config: " + c.reason());
+    return false;
+  }
+  out = *c;
+  return true;
+}
+
+inline bool loadPlanner(const std::string& path, ParamLoader& params, planning::PlannerConfig& out) {
+  auto c = planning::loadPlannerConfig(path, common::ConfigReader::MissingKeys::kError);
+  if (!c) {
+    params.addError("planner_config: " + c.reason());
+    return false;
+  }
+  out = *c;
+  return true;
+}
+
+/// config/gestures.yaml: the filter keys and `mapping` (checked against `follower_count`).
+inline bool loadGestures(const std::string& path, int follower_count, ParamLoader& params,
+                         gesture::GestureFilterConfig& filter, gesture::GestureMapping& mapping) {
+  auto reader = common::ConfigReader::fromFile(path, common::ConfigReader::MissingKeys::kError);
+  filter = gesture::readGestureFilterConfig(reader);
+  mapping = gesture::GestureMapping::paperDefault();
+  gesture::readGestureMapping(reader, filter.max_gesture_id, follower_count, mapping);
+  if (!reader.ok()) {
+    for (const auto& e : reader.errors()) params.addError("gesture_config: " + e);
+    return false;
+  }
+  for (const auto& e : filter.validate()) params.addError("gesture_config: " + path + ": " + e);
+  return true;
+}
+
+}  // namespace gesture_formation::nodelets

@@ -1,0 +1,265 @@
+// FormationPlanner nodelet: one UAV's replanning (planning::UavPlanner, DESIGN §4) at a fixed
+// period, staggered by UAV index. A thin adapter: stage-1 references from the formation core
+// (formation::leaderHorizon / followerHorizon) on the worker's constant-velocity prediction,
+// the plans received from the other UAVs, and the planner's verified plan (or its fallback:
+// previous plan / brake, flagged `fallback` so that every other UAV plans around it).
+// The leader's instance also owns the formation's parameters (formation::FormationState):
+// commands arrive on formation_command_in (gestures, operator over LCM) and the parameters go
+// out on formation_params_out.
+//
+// Topics: odometry_in (nav_msgs/Odometry, orientation = camera axis, docs/ros.md),
+//   worker_state_in (WorkerState: the leader's estimator, or the leader's share over LCM),
+//   plans_in (PlannedTrajectory of other UAVs), formation_params_in (followers),
+//   formation_command_in (leader) → plan_out (PlannedTrajectory), trajectory_out
+//   (trajectory_msgs/MultiDOFJointTrajectory), formation_params_out (leader, latched).
+// Parameters (all required unless noted): ~uav_index, ~uav_count, ~world_frame,
+//   ~scenario_file (the map), ~mission_file (optional: take formation + planner from a
+//   scenario's mission) or ~formation_config + ~planner_config, ~replanning_period_s,
+//   ~horizon_dt_s, ~horizon_steps, ~max_share_age_s, ~params_rate_hz.
+#include <map>
+#include <mutex>
+#include <optional>
+
+#include <nodelet/nodelet.h>
+#include <pluginlib/class_list_macros.hpp>
+#include <ros/ros.h>
+
+#include "config_sources.hpp"
+#include "conversions.hpp"
+#include "gesture_formation/formation/formation_geometry.hpp"
+#include "gesture_formation/formation/worker_heading.hpp"
+#include "param_loader.hpp"
+
+namespace gesture_formation::nodelets {
+
+class FormationPlannerNodelet : public nodelet::Nodelet {
+ private:
+  void onInit() override {
+    ros::NodeHandle& nh = getNodeHandle();
+    ParamLoader params(getPrivateNodeHandle());
+    params.load("uav_index", uav_index_, 0, comm::kMaxUavIndex);
+    params.load("uav_count", uav_count_, 1, comm::kMaxUavIndex + 1);
+    params.load("world_frame", world_frame_);
+    std::string scenario_file, mission_file, formation_file, planner_file;
+    params.load("scenario_file", scenario_file);
+    params.loadOptional("mission_file", mission_file, "");
+    params.load("replanning_period_s", period_s_, 0.05, 5.0);
+    params.load("horizon_dt_s", horizon_dt_s_, 0.02, 1.0);
+    params.load("horizon_steps", horizon_steps_, 2, formation::kMaxHorizonSteps);
+    params.load("max_share_age_s", max_share_age_s_, 0.1, 10.0);
+    double params_rate_hz = 0.0;
+    params.load("params_rate_hz", params_rate_hz, 0.1, 50.0);
+    formation::FormationConfig fcfg;
+    planning::PlannerConfig pcfg;
+    if (!mission_file.empty()) {
+      sim::MissionConfig mission;
+      if (loadMission(mission_file, params, mission)) {
+        fcfg = mission.formation;
+        pcfg = mission.planner;
+      }
+    } else {
+      params.load("formation_config", formation_file);
+      params.load("planner_config", planner_file);
+      if (!formation_file.empty()) loadFormation(formation_file, params, fcfg);
+      if (!planner_file.empty()) loadPlanner(planner_file, params, pcfg);
+    }
+    if (params.ok() && fcfg.params.uavCount() != uav_count_) {
+      params.addError("uav_count: " + std::to_string(uav_count_) + " but the formation config has " +
+                      std::to_string(fcfg.params.uavCount()) + " UAVs");
+    }
+    if (params.ok() && uav_index_ >= uav_count_) params.addError("uav_index: must be < uav_count");
+    WorldMap world;
+    if (params.ok()) loadWorldMap(scenario_file, params, world);
+    if (!params.ok()) {
+      NODELET_ERROR_STREAM("FormationPlanner refuses to start; fix these parameters:\n" << params.report());
+      return;
+    }
+    NODELET_INFO_STREAM("FormationPlanner (UAV " << uav_index_ << ") loaded:\n" << params.loaded());
+    params_ = fcfg.params;
+    heading_.emplace(fcfg.worker_heading);
+    if (uav_index_ == formation::kLeader) {
+      auto st = formation::FormationState::create(fcfg.params, fcfg.limits, fcfg.duplicates);
+      state_.emplace(std::move(*st));  // the config was validated by its loader
+    }
+    planner_ = std::make_unique<planning::UavPlanner>(pcfg, world.map, world.field);
+    received_.resize(static_cast<std::size_t>(uav_count_));
+
+    plan_pub_ = nh.advertise<gesture_formation::PlannedTrajectory>("plan_out", 5);
+    traj_pub_ = nh.advertise<trajectory_msgs::MultiDOFJointTrajectory>("trajectory_out", 5);
+    odom_sub_ = nh.subscribe("odometry_in", 5, &FormationPlannerNodelet::onOdometry, this);
+    worker_sub_ = nh.subscribe("worker_state_in", 5, &FormationPlannerNodelet::onWorker, this);
+    plans_sub_ = nh.subscribe("plans_in", 20, &FormationPlannerNodelet::onPlan, this);
+    if (uav_index_ == formation::kLeader) {
+      params_pub_ = nh.advertise<gesture_formation::FormationParams>("formation_params_out", 5, true);
+      command_sub_ = nh.subscribe("formation_command_in", 20, &FormationPlannerNodelet::onCommand, this);
+      params_timer_ = nh.createTimer(ros::Duration(1.0 / params_rate_hz), [this](const ros::TimerEvent&) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        publishParams();
+      });
+    } else {
+      params_sub_ = nh.subscribe("formation_params_in", 5, &FormationPlannerNodelet::onParams, this);
+    }
+    // Staggered replanning: UAV i plans at k·period + i·period/n (as in gfctl simulate).
+    offset_s_ = period_s_ * uav_index_ / uav_count_;
+    timer_ = nh.createTimer(ros::Duration(period_s_ / 8.0), &FormationPlannerNodelet::onTimer, this);
+  }
+
+  void onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    odom_ = toKinematicState(*msg);
+  }
+  void onWorker(const gesture_formation::WorkerState::ConstPtr& msg) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    worker_ = *msg;
+  }
+  void onPlan(const gesture_formation::PlannedTrajectory::ConstPtr& msg) {
+    if (msg->uav_index == uav_index_ || msg->uav_index < 0 || msg->uav_index >= uav_count_) return;
+    auto plan = fromMsg(*msg);
+    if (!plan) {
+      NODELET_WARN_STREAM_THROTTLE(1.0, "FormationPlanner: plan dropped: " << plan.reason());
+      return;
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto& slot = received_[static_cast<std::size_t>(msg->uav_index)];
+    if (!slot || plan->t0_s >= slot->plan.t0_s) slot = Received{std::move(*plan), msg->fallback != 0};
+  }
+  void onParams(const gesture_formation::FormationParams::ConstPtr& msg) {
+    auto p = fromMsg(*msg);
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!p || p->uavCount() != uav_count_) {
+      NODELET_WARN_STREAM_THROTTLE(1.0, "FormationPlanner: formation parameters dropped: "
+                                            << (p ? "wrong UAV count" : p.reason()));
+      return;
+    }
+    params_ = *p;
+  }
+  void onCommand(const gesture_formation::FormationCommand::ConstPtr& msg) {
+    auto cmd = fromMsg(*msg);
+    std::lock_guard<std::mutex> lock(mutex_);
+    last_command_ = msg->source + " " + msg->sender + "#" + std::to_string(msg->sequence) + ": " + msg->target +
+                    "." + msg->parameter + (msg->kind == "set" ? " = " : " += ") + std::to_string(msg->amount);
+    if (!cmd) {
+      last_outcome_ = "rejected: " + cmd.reason();
+    } else {
+      const auto out = state_->apply(*cmd);
+      last_outcome_ = formation::toString(out.status);
+      if (!out.reason.empty()) last_outcome_ += ": " + out.reason;
+      for (const auto& c : out.changes) {
+        if (c.clamped) last_outcome_ += " (clamped by " + c.clamp_rule + ")";
+      }
+      if (out.status == formation::CommandStatus::kApplied) {
+        ++version_;
+        params_ = state_->params();
+      }
+    }
+    NODELET_INFO_STREAM("FormationPlanner: command " << last_command_ << " → " << last_outcome_);
+    publishParams();
+  }
+  void publishParams() {
+    auto m = toMsg(params_, version_);
+    m.header.stamp = ros::Time::now();
+    m.header.frame_id = world_frame_;
+    m.last_command = last_command_;
+    m.last_outcome = last_outcome_;
+    params_pub_.publish(m);
+  }
+
+  void onTimer(const ros::TimerEvent&) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const double t = ros::Time::now().toSec();
+    if (t <= 0.0) return;
+    if (next_plan_s_ < 0.0) next_plan_s_ = (std::floor(t / period_s_) + 1.0) * period_s_ + offset_s_;
+    if (t < next_plan_s_) return;
+    next_plan_s_ += period_s_ * std::max(1.0, std::ceil((t - next_plan_s_) / period_s_ + 1e-9));
+    replan(t);
+  }
+
+  void replan(double t) {
+    if (!odom_ || !worker_) return;
+    const double age = t - worker_->header.stamp.toSec();
+    if (age > max_share_age_s_) {
+      NODELET_WARN_STREAM_THROTTLE(2.0, "FormationPlanner: worker state " << age << " s old: not planning");
+      return;  // never act on data older than its configured age (the controller keeps the plan / brakes)
+    }
+    const Eigen::Vector3d v0 = worker_->lost ? Eigen::Vector3d::Zero() : toEigen(worker_->velocity);
+    const Eigen::Vector3d p0 = toEigen(worker_->position) + std::max(0.0, age) * v0;
+    const double hphi = heading_->update(v0);
+    formation::WorkerHorizon wh;
+    wh.p_world.resize(3, horizon_steps_);
+    wh.heading_rad.resize(1, horizon_steps_);
+    for (int k = 0; k < horizon_steps_; ++k) {
+      wh.p_world.col(k) = p0 + (k * horizon_dt_s_) * v0;
+      wh.heading_rad(k) = hphi;
+    }
+    planning::PlanRequest req;
+    req.uav_index = uav_index_;
+    req.t_now_s = t;
+    req.dt_s = horizon_dt_s_;
+    req.state = *odom_;
+    req.state.t_s = t;
+    const auto& last = planner_->lastVerifiedPlan();
+    if (!last.empty()) req.state.a_world = last.sampleAt(t).a_world;
+    req.worker = wh;
+    if (uav_index_ == formation::kLeader) {
+      formation::leaderHorizon(wh, params_.leader, req.reference);
+    } else {
+      const auto& leader = received_[0];
+      const bool has_plan = leader && !leader->plan.empty() && t - leader->plan.t0_s <= max_share_age_s_;
+      formation::LeaderPlan lp;
+      if (has_plan) {
+        lp.heading_rad.resize(1, horizon_steps_);
+        lp.pitch_rad.resize(1, horizon_steps_);
+        for (int k = 0; k < horizon_steps_; ++k) {
+          const auto s = leader->plan.sampleAt(t + k * horizon_dt_s_);
+          lp.heading_rad(k) = s.heading_rad;
+          lp.pitch_rad(k) = s.pitch_rad;
+        }
+        req.higher_priority_plans.push_back(leader->plan);
+      }
+      formation::followerHorizon(wh, params_.leader, has_plan ? &lp : nullptr,
+                                 params_.followers[static_cast<std::size_t>(uav_index_ - 1)], req.reference);
+    }
+    for (int j = 1; j < uav_count_; ++j) {
+      const auto& m = received_[static_cast<std::size_t>(j)];
+      if (j != uav_index_ && m && !m->plan.empty() && (j < uav_index_ || m->fallback)) {
+        req.higher_priority_plans.push_back(m->plan);
+      }
+    }
+    const planning::PlanResult res = planner_->plan(req);
+    if (res.status != planning::PlanStatus::kOptimized) {
+      NODELET_WARN_STREAM_THROTTLE(2.0, "FormationPlanner UAV " << uav_index_ << ": " << planning::toString(res.status)
+                                                                << ": " << res.reason);
+    }
+    auto msg = toMsg(res);
+    msg.header.frame_id = world_frame_;
+    msg.uav_index = uav_index_;
+    for (int k = 0; k < req.reference.steps(); ++k) msg.reference.push_back(toPoint(req.reference.p_world.col(k)));
+    plan_pub_.publish(msg);
+    traj_pub_.publish(toMultiDof(msg, "uav" + std::to_string(uav_index_)));
+  }
+
+  struct Received {
+    planning::PlannedTrajectory plan;
+    bool fallback = false;
+  };
+  std::mutex mutex_;
+  int uav_index_ = 0, uav_count_ = 0, horizon_steps_ = 0;
+  std::string world_frame_;
+  double period_s_ = 0.0, horizon_dt_s_ = 0.0, max_share_age_s_ = 0.0, offset_s_ = 0.0, next_plan_s_ = -1.0;
+  formation::FormationParams params_;
+  std::optional<formation::WorkerHeading> heading_;
+  std::optional<formation::FormationState> state_;
+  std::uint64_t version_ = 0;
+  std::string last_command_, last_outcome_;
+  std::unique_ptr<planning::UavPlanner> planner_;
+  std::optional<planning::UavKinematicState> odom_;
+  std::optional<gesture_formation::WorkerState> worker_;
+  std::vector<std::optional<Received>> received_;
+  ros::Publisher plan_pub_, traj_pub_, params_pub_;
+  ros::Subscriber odom_sub_, worker_sub_, plans_sub_, params_sub_, command_sub_;
+  ros::Timer timer_, params_timer_;
+};
+
+}  // namespace gesture_formation::nodelets
+
+PLUGINLIB_EXPORT_CLASS(gesture_formation::nodelets::FormationPlannerNodelet, nodelet::Nodelet)

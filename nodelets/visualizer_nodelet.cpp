@@ -1,0 +1,268 @@
+// Visualizer nodelet: rviz markers of what the formation thinks (config/rviz/gesture_formation.rviz).
+// Namespaces: uavs (body spheres), frusta (camera frusta, line lists), worker (estimate),
+// worker_cov (3σ covariance ellipsoid of the position), worker_truth (simulation only),
+// references (stage-1 references), plans (planned trajectories), paths (stage-2 paths:
+// the centre lines of the safe corridors), map (occupied voxels of ~scenario_file), status
+// (gesture filter and last command text). Colours per UAV: leader red, follower 1 green,
+// follower 2 blue, then orange, purple.
+//
+// Topics: uav<i>/odometry, uav<i>/plan (i < ~uav_count), worker_state_in, worker_truth_in,
+//   formation_params_in, gesture_status_in → markers_out (MarkerArray at ~rate_hz), map_out
+//   (latched MarkerArray). No math beyond drawing (the ellipsoid's axes: eigen decomposition
+//   of the 3×3 position covariance).
+// Parameters (required): ~uav_count, ~world_frame, ~rate_hz, ~frustum_range_m,
+//   ~frustum_hfov_deg, ~frustum_vfov_deg, ~scenario_file ("" = no map).
+#include <mutex>
+#include <optional>
+
+#include <Eigen/Eigenvalues>
+#include <nodelet/nodelet.h>
+#include <pluginlib/class_list_macros.hpp>
+#include <ros/ros.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include "config_sources.hpp"
+#include "conversions.hpp"
+#include "gesture_formation/GestureStatus.h"
+#include "param_loader.hpp"
+
+namespace gesture_formation::nodelets {
+
+namespace {
+std_msgs::ColorRGBA color(int uav, float alpha = 1.0f) {
+  static const float kColors[5][3] = {{0.9f, 0.1f, 0.1f}, {0.1f, 0.8f, 0.1f}, {0.1f, 0.3f, 1.0f}, {1.0f, 0.6f, 0.0f}, {0.6f, 0.2f, 0.8f}};
+  const auto& c = kColors[uav % 5];
+  std_msgs::ColorRGBA m;
+  m.r = c[0];
+  m.g = c[1];
+  m.b = c[2];
+  m.a = alpha;
+  return m;
+}
+std_msgs::ColorRGBA rgba(float r, float g, float b, float a) {
+  std_msgs::ColorRGBA m;
+  m.r = r;
+  m.g = g;
+  m.b = b;
+  m.a = a;
+  return m;
+}
+}  // namespace
+
+class VisualizerNodelet : public nodelet::Nodelet {
+ private:
+  void onInit() override {
+    ros::NodeHandle& nh = getNodeHandle();
+    ParamLoader params(getPrivateNodeHandle());
+    double rate_hz = 0.0;
+    std::string scenario_file;
+    params.load("uav_count", uav_count_, 1, 32);
+    params.load("world_frame", world_frame_);
+    params.load("rate_hz", rate_hz, 0.1, 60.0);
+    params.load("frustum_range_m", frustum_range_m_, 0.1, 100.0);
+    params.load("frustum_hfov_deg", hfov_deg_, 1.0, 179.0);
+    params.load("frustum_vfov_deg", vfov_deg_, 1.0, 179.0);
+    params.load("scenario_file", scenario_file);
+    WorldMap world;
+    if (params.ok() && !scenario_file.empty()) loadWorldMap(scenario_file, params, world);
+    if (!params.ok()) {
+      NODELET_ERROR_STREAM("Visualizer refuses to start; fix these parameters:\n" << params.report());
+      return;
+    }
+    NODELET_INFO_STREAM("Visualizer loaded:\n" << params.loaded());
+    odom_.resize(static_cast<std::size_t>(uav_count_));
+    plans_.resize(static_cast<std::size_t>(uav_count_));
+    for (int i = 0; i < uav_count_; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      subs_.push_back(nh.subscribe<nav_msgs::Odometry>("uav" + std::to_string(i) + "/odometry", 5,
+                                                       [this, k](const nav_msgs::Odometry::ConstPtr& m) {
+                                                         std::lock_guard<std::mutex> lock(mutex_);
+                                                         odom_[k] = m;
+                                                       }));
+      subs_.push_back(nh.subscribe<gesture_formation::PlannedTrajectory>(
+          "uav" + std::to_string(i) + "/plan", 5, [this, k](const gesture_formation::PlannedTrajectory::ConstPtr& m) {
+            std::lock_guard<std::mutex> lock(mutex_);
+            plans_[k] = m;
+          }));
+    }
+    subs_.push_back(nh.subscribe<gesture_formation::WorkerState>("worker_state_in", 5,
+                                                                 [this](const gesture_formation::WorkerState::ConstPtr& m) {
+                                                                   std::lock_guard<std::mutex> lock(mutex_);
+                                                                   worker_ = m;
+                                                                 }));
+    subs_.push_back(nh.subscribe<nav_msgs::Odometry>("worker_truth_in", 5, [this](const nav_msgs::Odometry::ConstPtr& m) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      truth_ = m;
+    }));
+    subs_.push_back(nh.subscribe<gesture_formation::FormationParams>(
+        "formation_params_in", 5, [this](const gesture_formation::FormationParams::ConstPtr& m) {
+          std::lock_guard<std::mutex> lock(mutex_);
+          params_ = m;
+        }));
+    subs_.push_back(nh.subscribe<gesture_formation::GestureStatus>(
+        "gesture_status_in", 5, [this](const gesture_formation::GestureStatus::ConstPtr& m) {
+          std::lock_guard<std::mutex> lock(mutex_);
+          gesture_ = m;
+        }));
+    pub_ = nh.advertise<visualization_msgs::MarkerArray>("markers_out", 2);
+    map_pub_ = nh.advertise<visualization_msgs::MarkerArray>("map_out", 1, true);
+    if (world.map) publishMap(*world.map);
+    timer_ = nh.createTimer(ros::Duration(1.0 / rate_hz), &VisualizerNodelet::onTimer, this);
+  }
+
+  visualization_msgs::Marker marker(const std::string& ns, int id, int type) const {
+    visualization_msgs::Marker m;
+    m.header.frame_id = world_frame_;
+    // Stamp 0: rviz draws at the latest transform instead of waiting in its tf message filter (with
+    // the mission's /tf in a replayed bag, stamped markers were never drawn).
+    m.header.stamp = ros::Time(0);
+    m.ns = ns;
+    m.id = id;
+    m.type = type;
+    m.action = visualization_msgs::Marker::ADD;
+    m.pose.orientation.w = 1.0;
+    m.lifetime = ros::Duration(2.0);
+    return m;
+  }
+
+  void publishMap(const planning::OccupancyMap& map) {
+    visualization_msgs::MarkerArray a;
+    auto m = marker("map", 0, visualization_msgs::Marker::CUBE_LIST);
+    m.lifetime = ros::Duration(0.0);
+    m.scale.x = m.scale.y = m.scale.z = map.resolution();
+    m.color = rgba(0.55f, 0.55f, 0.6f, 0.6f);
+    for (const auto& c : map.occupiedCenters()) {
+      if (c.z() > map.resolution()) m.points.push_back(toPoint(c));  // the ground is drawn by rviz' grid
+    }
+    a.markers.push_back(m);
+    map_pub_.publish(a);
+  }
+
+  void onTimer(const ros::TimerEvent&) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    visualization_msgs::MarkerArray a;
+    const double th = std::tan(hfov_deg_ * M_PI / 360.0), tv = std::tan(vfov_deg_ * M_PI / 360.0);
+    for (int i = 0; i < uav_count_; ++i) {
+      const auto& o = odom_[static_cast<std::size_t>(i)];
+      if (o) {
+        auto body = marker("uavs", i, visualization_msgs::Marker::SPHERE);
+        body.pose = o->pose.pose;
+        body.scale.x = body.scale.y = body.scale.z = 0.7;
+        body.color = color(i);
+        a.markers.push_back(body);
+        // Frustum: apex at the UAV, four corners at frustum_range_m along the camera axis.
+        auto f = marker("frusta", i, visualization_msgs::Marker::LINE_LIST);
+        f.pose = o->pose.pose;
+        f.scale.x = 0.06;
+        f.color = color(i, 0.9f);
+        const double r = frustum_range_m_;
+        const Eigen::Vector3d corners[4] = {{r, r * th, r * tv}, {r, -r * th, r * tv}, {r, -r * th, -r * tv}, {r, r * th, -r * tv}};
+        for (int c = 0; c < 4; ++c) {
+          f.points.push_back(toPoint(Eigen::Vector3d::Zero()));
+          f.points.push_back(toPoint(corners[c]));
+          f.points.push_back(toPoint(corners[c]));
+          f.points.push_back(toPoint(corners[(c + 1) % 4]));
+        }
+        a.markers.push_back(f);
+      }
+      const auto& p = plans_[static_cast<std::size_t>(i)];
+      if (p) {
+        auto line = marker("plans", i, visualization_msgs::Marker::LINE_STRIP);
+        line.scale.x = 0.12;
+        line.color = color(i);
+        line.points = p->positions;
+        if (line.points.size() >= 2) a.markers.push_back(line);
+        auto ref = marker("references", i, visualization_msgs::Marker::LINE_STRIP);
+        ref.scale.x = 0.3;
+        ref.color = color(i, 0.3f);
+        ref.points = p->reference;
+        if (ref.points.size() >= 2) a.markers.push_back(ref);
+        auto path = marker("paths", i, visualization_msgs::Marker::LINE_STRIP);
+        path.scale.x = 0.05;
+        path.color = rgba(1.0f, 1.0f, 1.0f, 0.8f);
+        path.points = p->path;
+        if (path.points.size() >= 2) a.markers.push_back(path);
+      }
+    }
+    geometry_msgs::Point text_at;
+    if (worker_) {
+      auto w = marker("worker", 0, visualization_msgs::Marker::SPHERE);
+      w.pose.position = worker_->position;
+      w.scale.x = w.scale.y = w.scale.z = 0.4;
+      w.color = rgba(1.0f, 0.9f, 0.0f, 1.0f);
+      a.markers.push_back(w);
+      Eigen::Matrix3d P;
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) P(r, c) = worker_->covariance[static_cast<std::size_t>(6 * r + c)];
+      }
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(P);
+      Eigen::Matrix3d R = es.eigenvectors();
+      if (R.determinant() < 0) R.col(2) = -R.col(2);
+      const Eigen::Quaterniond q(R);
+      auto cov = marker("worker_cov", 0, visualization_msgs::Marker::SPHERE);
+      cov.pose.position = worker_->position;
+      cov.pose.orientation.w = q.w();
+      cov.pose.orientation.x = q.x();
+      cov.pose.orientation.y = q.y();
+      cov.pose.orientation.z = q.z();
+      cov.scale.x = std::max(0.05, 6.0 * std::sqrt(std::max(0.0, es.eigenvalues()(0))));  // 3σ
+      cov.scale.y = std::max(0.05, 6.0 * std::sqrt(std::max(0.0, es.eigenvalues()(1))));
+      cov.scale.z = std::max(0.05, 6.0 * std::sqrt(std::max(0.0, es.eigenvalues()(2))));
+      cov.color = rgba(1.0f, 0.9f, 0.0f, 0.35f);
+      a.markers.push_back(cov);
+      text_at = worker_->position;
+    }
+    if (truth_) {
+      auto t = marker("worker_truth", 0, visualization_msgs::Marker::CYLINDER);
+      t.pose.position = truth_->pose.pose.position;
+      t.scale.x = t.scale.y = 0.6;
+      t.scale.z = 1.78;
+      t.color = rgba(0.9f, 0.5f, 0.1f, 0.5f);
+      a.markers.push_back(t);
+      if (!worker_) text_at = truth_->pose.pose.position;
+    }
+    std::string text;
+    if (gesture_) {
+      text += "gesture " + std::to_string(gesture_->gesture_id) + "  dominant " + std::to_string(gesture_->dominant_id) +
+              " f_d " + std::to_string(gesture_->dominant_ratio).substr(0, 4) + "  " + gesture_->verdict;
+      if (!gesture_->last_fired.empty()) text += "\nlast fired: " + gesture_->last_fired;
+    }
+    if (params_) {
+      text += "\nparams v" + std::to_string(params_->version);
+      for (std::size_t i = 0; i < params_->uavs.size(); ++i) {
+        const auto& u = params_->uavs[i];
+        text += std::string("\n") + (i == 0 ? "L" : std::to_string(i)) + ": beta " + std::to_string(static_cast<int>(std::lround(u.beta_deg))) +
+                " gamma " + std::to_string(static_cast<int>(std::lround(u.gamma_deg))) + " d " + std::to_string(u.distance_m).substr(0, 4);
+      }
+      if (!params_->last_command.empty()) text += "\n" + params_->last_command + " -> " + params_->last_outcome;
+    }
+    if (!text.empty()) {
+      auto t = marker("status", 0, visualization_msgs::Marker::TEXT_VIEW_FACING);
+      t.pose.position = text_at;
+      t.pose.position.z += 4.0;
+      t.scale.z = 0.8;
+      t.color = rgba(1.0f, 1.0f, 1.0f, 1.0f);
+      t.text = text;
+      a.markers.push_back(t);
+    }
+    pub_.publish(a);
+  }
+
+  std::mutex mutex_;
+  int uav_count_ = 0;
+  std::string world_frame_;
+  double frustum_range_m_ = 3.0, hfov_deg_ = 69.0, vfov_deg_ = 42.0;
+  std::vector<nav_msgs::Odometry::ConstPtr> odom_;
+  std::vector<gesture_formation::PlannedTrajectory::ConstPtr> plans_;
+  gesture_formation::WorkerState::ConstPtr worker_;
+  nav_msgs::Odometry::ConstPtr truth_;
+  gesture_formation::FormationParams::ConstPtr params_;
+  gesture_formation::GestureStatus::ConstPtr gesture_;
+  std::vector<ros::Subscriber> subs_;
+  ros::Publisher pub_, map_pub_;
+  ros::Timer timer_;
+};
+
+}  // namespace gesture_formation::nodelets
+
+PLUGINLIB_EXPORT_CLASS(gesture_formation::nodelets::VisualizerNodelet, nodelet::Nodelet)

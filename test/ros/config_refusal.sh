@@ -1,0 +1,44 @@
+#!/bin/bash
+# Broken configs make the nodelets refuse to start, each problem named (parameter or YAML key),
+# and nothing is advertised: FormationPlanner (a formation.yaml missing a key + an out-of-range
+# ROS parameter + a missing one), GestureCommander (a gestures.yaml with an out-of-range ratio),
+# LcmBridge (a key file readable by others), SimWorld/SimUav (no mission).
+set -o pipefail
+source "$(dirname "$0")/common.bash"
+start_master
+CFG=$SRC/config
+grep -v "distance_max_m" "$CFG/formation.yaml" > "$T/formation_broken.yaml"
+sed 's/^ratio_threshold: .*/ratio_threshold: 1.7/' "$CFG/gestures.yaml" > "$T/gestures_broken.yaml"
+runs=()
+run() {  # name, nodelet type, then ROS args (in the background; its pid in runs)
+  local name=$1 type=$2; shift 2
+  timeout 8 rosrun nodelet nodelet standalone "gesture_formation/$type" __name:="$name" "$@" > "$T/$name.log" 2>&1 &
+  runs+=($!)
+}
+run fp_bad FormationPlanner _uav_index:=0 _uav_count:=3 _world_frame:=world \
+  _scenario_file:="$CFG/scenarios/power_towers.yaml" _formation_config:="$T/formation_broken.yaml" \
+  _planner_config:="$CFG/planner.yaml" _replanning_period_s:=99.0 _horizon_dt_s:=0.2 _horizon_steps:=40 \
+  _params_rate_hz:=2.0 plan_out:=fp_bad_plan
+run gc_bad GestureCommander _uav_count:=3 _sender_name:=gesture _gesture_config:="$T/gestures_broken.yaml"
+make_key "$T/keys"; chmod 644 "$T/keys"
+run lb_bad LcmBridge _sender_id:=1 _known_senders:="[0,1,2]" _lcm_url:="memq://" _channel_prefix:=GF_ \
+  _key_file:="$T/keys" _max_age_s:=1.0 _heartbeat_rate_hz:=5.0 _world_frame:=world
+run sw_bad SimWorld
+sleep 6
+rostopic list 2>/dev/null | grep -q fp_bad_plan && fail "FormationPlanner advertised its output although it refused to start"
+wait "${runs[@]}"
+check() {  # log, pattern, what
+  grep -q -- "$2" "$T/$1.log" || { fail "$1: $3 not reported"; sed 's/^/    /' "$T/$1.log" | head -20; }
+}
+for f in fp_bad gc_bad lb_bad sw_bad; do check $f "refuses to start" "refusal"; done
+check fp_bad "fp_bad/replanning_period_s: value 99 out of range" "out-of-range replanning_period_s"
+check fp_bad "fp_bad/max_share_age_s: missing" "missing max_share_age_s"
+check fp_bad "limits.distance_max_m" "the missing YAML key limits.distance_max_m"
+check gc_bad "ratio_threshold" "the out-of-range YAML key ratio_threshold"
+check lb_bad "key_file: .*chmod 600" "the key file's permissions"
+for p in mission_file seed real_time_factor clock_step_s duration_s output_dir world_frame leader_camera_frame; do
+  check sw_bad "sw_bad/$p: missing" "missing $p"
+done
+[ -n "$GF_TEST_VERBOSE" ] && cat "$T"/*_bad.log
+[ $fails -eq 0 ] && echo "PASS: every broken config refused, every problem named"
+exit $fails

@@ -1,0 +1,49 @@
+#!/bin/bash
+# replay.launch under Xvfb: rviz loads config/rviz/gesture_formation.rviz and renders a bag
+# replay (rosbag play --clock); the screenshot must show the Visualizer's colours: leader red,
+# follower 1 green, follower 2 blue, the worker's covariance yellow, the map grey.
+# Optional third argument: a bag to replay instead of the synthetic one (e.g. a mission bag);
+# GF_RVIZ_SHOT=path keeps the screenshot.
+set -o pipefail
+source "$(dirname "$0")/common.bash"
+BAG=${3:+$(realpath "$3")}
+START=${GF_RVIZ_START:-0}
+if [ -z "$BAG" ]; then
+  BAG=$T/markers.bag
+  python3 "$SRC/test/ros/make_marker_bag.py" "$BAG" || { echo "FAIL: cannot write the bag"; exit 1; }
+fi
+# roslaunch starts the master (-p PORT)
+SHOT=${GF_RVIZ_SHOT:-$T/shot.png}
+xvfb-run -a -s "-screen 0 1200x800x24" bash -c "
+  roslaunch -p $PORT gesture_formation replay.launch bag:=$BAG start:=$START loop:=true > '$T/replay.log' 2>&1 &
+  l=\$!
+  sleep ${GF_RVIZ_WAIT:-10}
+  import -window root '$SHOT'
+  kill -INT \$l; wait \$l" || true
+[ -s "$SHOT" ] || { echo "FAIL: no screenshot"; tail -20 "$T/replay.log"; exit 1; }
+grep -q "ERROR.*rviz\|Could not load" "$T/replay.log" && fail "rviz reported an error: $(grep -m1 ERROR "$T/replay.log")"
+PY=/opt/gesture_formation/venv/bin/python
+[ -x "$PY" ] || PY=python3
+"$PY" - "$SHOT" <<'PY' || fails=$((fails + 1))
+import sys
+import numpy as np
+from PIL import Image
+img = np.asarray(Image.open(sys.argv[1]).convert("RGB")).astype(int)
+H, W = img.shape[:2]
+img = img[int(0.1 * H):int(0.95 * H), int(0.02 * W):int(0.98 * W)]  # the 3D view only (no menus, status bar)
+r, g, b = img[..., 0], img[..., 1], img[..., 2]
+checks = {
+    "leader red": (r > 150) & (g < 90) & (b < 90),
+    "follower 1 green": (g > 130) & (r < 90) & (b < 90),
+    "follower 2 blue": (b > 150) & (r < 90) & (g < 140),
+    "worker covariance yellow": (r > 150) & (g > 130) & (b < 90),
+}
+bad = 0
+for name, mask in checks.items():
+    n = int(mask.sum())
+    ok = n >= 20
+    bad += 0 if ok else 1
+    print(f"{'PASS' if ok else 'FAIL'}: {name}: {n} pixels")
+sys.exit(bad)
+PY
+exit $fails

@@ -1,0 +1,121 @@
+#!/usr/bin/env python3
+"""Checks a running simulation.launch (test/ros/simulation_launch.sh): message rates over a
+sim-time window, then injects a gesture at the leader and checks that the followers' formation
+parameters (received over LCM) and their planned references change accordingly.
+Prints one line per check; exit code = number of failures."""
+import math
+import sys
+
+import rospy
+from gesture_formation.msg import FormationParams, Gesture, PlannedTrajectory, WorkerState
+from nav_msgs.msg import Odometry
+from rosgraph_msgs.msg import Clock
+from visualization_msgs.msg import MarkerArray
+
+WINDOW = (3.0, 8.0)      # sim seconds over which rates are measured
+# then a gesture is injected (operator commands come next; the mission's own first request is at t = 20 s)
+RATES = {                # topic: (type, expected Hz, tolerance factor)
+    "/clock": (Clock, 100.0, 0.2),
+    "/uav0/odometry": (Odometry, 50.0, 0.2),
+    "/uav1/odometry": (Odometry, 50.0, 0.2),
+    "/uav2/odometry": (Odometry, 50.0, 0.2),
+    "/uav0/plan": (PlannedTrajectory, 2.5, 0.25),
+    "/uav1/plan": (PlannedTrajectory, 2.5, 0.25),
+    "/uav2/plan": (PlannedTrajectory, 2.5, 0.25),
+    "/uav0/worker_state": (WorkerState, 20.0, None),      # timer 20 Hz + one per detection: >= 20
+    "/uav1/worker_state": (WorkerState, 20.0, None),      # the leader's, over LCM
+    "/uav0/formation_params": (FormationParams, 2.0, 0.3),
+    "/visualization/markers": (MarkerArray, 10.0, 0.2),
+}
+counts = {t: 0 for t in RATES}
+state = {"params1": None, "plan1": None, "worker1": None}
+
+
+def counter(topic):
+    def cb(_msg):
+        t = rospy.Time.now().to_sec()
+        if WINDOW[0] <= t < WINDOW[1]:
+            counts[topic] += 1
+    return cb
+
+
+def main():
+    rospy.init_node("sim_check")
+    for topic, (typ, _, _) in RATES.items():
+        rospy.Subscriber(topic, typ, counter(topic), queue_size=200)
+    rospy.Subscriber("/uav1/formation_params", FormationParams, lambda m: state.__setitem__("params1", m))
+    history = []  # the leader's estimate as follower 1 received it: (stamp, position, velocity)
+    rospy.Subscriber("/uav1/worker_state", WorkerState, lambda m: history.append(
+        (m.header.stamp.to_sec(), (m.position.x, m.position.y, m.position.z), (m.velocity.x, m.velocity.y, m.velocity.z))))
+    ref_dist = []  # per follower-1 plan: |reference(t0) - worker(t0)| with the estimate it had (the last one received)
+
+    def on_plan(p):
+        if not p.reference or not history:
+            return
+        t0 = p.header.stamp.to_sec()
+        ts, w, v = history[-1]
+        r = p.reference[0]
+        x = [w[k] + (t0 - ts) * v[k] for k in range(3)]
+        ref_dist.append(math.sqrt((r.x - x[0]) ** 2 + (r.y - x[1]) ** 2 + (r.z - x[2]) ** 2))
+    rospy.Subscriber("/uav1/plan", PlannedTrajectory, on_plan)
+    gesture_pub = rospy.Publisher("/uav0/perception/gesture", Gesture, queue_size=50)
+    fails = 0
+    deadline = rospy.get_time() + 200  # wall guard below
+    import time
+    wall0 = time.time()
+    while not rospy.is_shutdown() and rospy.Time.now().to_sec() < WINDOW[1]:
+        if time.time() - wall0 > 45:
+            print("FAIL: sim time did not reach %.0f s within 45 s wall (now %.1f)" % (WINDOW[1], rospy.Time.now().to_sec()))
+            return 1
+        time.sleep(0.05)
+    dt = WINDOW[1] - WINDOW[0]
+    for topic, (_, hz, tol) in RATES.items():
+        rate = counts[topic] / dt
+        ok = rate >= hz * 0.95 if tol is None else abs(rate - hz) <= tol * hz
+        print("%s: %s %.1f Hz (sim time; expected %s%.1f Hz)" % ("PASS" if ok else "FAIL", topic, rate,
+                                                             ">= " if tol is None else "", hz))
+        fails += 0 if ok else 1
+
+    def follower_ref_distance():
+        # median over the last 5 plans (the estimate a plan used is only approximately the last
+        # one this checker received)
+        last = sorted(ref_dist[-5:])
+        return last[len(last) // 2] if last else float("nan")
+
+    d_before = state["params1"].uavs[1].distance_m if state["params1"] else float("nan")
+    ref_before = follower_ref_distance()
+    # Inject gesture 2 (power_towers mapping: all.distance_m +1) at the leader's classifier output,
+    # 15 Hz for 2 s: 30 measurements, dominant ratio 1 > 0.8 → the GestureCommander fires once.
+    t_inject = rospy.Time.now().to_sec()
+    rate = rospy.Rate(15)
+    for _ in range(30):
+        g = Gesture()
+        g.header.stamp = rospy.Time.now()
+        g.gesture_id = 2
+        g.probabilities = [0.0, 0.0, 1.0, 0.0, 0.0]
+        gesture_pub.publish(g)
+        rate.sleep()
+    wall1 = time.time()
+    changed_at = None
+    while time.time() - wall1 < 15 and not rospy.is_shutdown():
+        p = state["params1"]
+        if changed_at is None and p is not None and abs(p.uavs[1].distance_m - (d_before + 1.0)) < 1e-9:
+            changed_at = rospy.Time.now().to_sec()
+        if changed_at is not None and rospy.Time.now().to_sec() > changed_at + 2.5:
+            break
+        time.sleep(0.05)
+    ref_after = follower_ref_distance()
+    ok = changed_at is not None
+    print("%s: follower 1's formation parameters over LCM: d %.2f -> %s m after gesture 2 at t=%.1f s%s" % (
+        "PASS" if ok else "FAIL", d_before, "%.2f" % state["params1"].uavs[1].distance_m if state["params1"] else "none",
+        t_inject, " (changed at t=%.1f s)" % changed_at if ok else ""))
+    fails += 0 if ok else 1
+    ok = abs(ref_after - ref_before - 1.0) < 0.05
+    print("%s: follower 1's planned reference distance to the worker %.2f -> %.2f m (expected +1)" % (
+        "PASS" if ok else "FAIL", ref_before, ref_after))
+    fails += 0 if ok else 1
+    return fails
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,51 @@
+#!/bin/bash
+# simulation.launch end to end (3 UAV managers + world, LCM inside a private network namespace):
+# every stream publishes at its rate (sim time), and a gesture injected at the leader changes
+# the followers' formation parameters and planned references through LCM (test/ros/sim_check.py).
+set -o pipefail
+source "$(dirname "$0")/common.bash"
+[ "$(id -u)" -eq 0 ] || { echo "SKIP: needs root (unshare -n keeps LCM on this machine)"; exit 0; }
+make_key "$T/keys"
+mkdir -p "$T/out"
+cat > "$T/inner.sh" <<INNER
+ip link set lo up && ip route add 224.0.0.0/4 dev lo || exit 1
+roslaunch -p $PORT gesture_formation simulation.launch key_file:=$T/keys output_dir:=$T/out duration:=40 \
+  real_time_factor:=1.5 gesture_topic:=/world/sim_gesture_unused > "$T/launch.log" 2>&1 &
+launch=\$!
+for _ in \$(seq 50); do rosparam get /use_sim_time > /dev/null 2>&1 && break; sleep 0.2; done
+timeout 80 python3 "$SRC/test/ros/sim_check.py"
+rc=\$?
+# The operator's CLI: a valid command is sent (and reaches follower 2 over LCM), a bad one refused.
+# (Watch first: the mission's own request at t = 20 s changes the distances again.)
+timeout 20 python3 -c "
+import rospy, time
+from gesture_formation.msg import FormationParams as F
+rospy.init_node('d2', anonymous=True)
+d = [None]
+def cb(m):
+    if m.uavs[2].distance_m == 10.0: d[0] = 10.0
+sub = rospy.Subscriber('/uav2/formation_params', F, cb)
+t0 = time.time()
+while sub.get_num_connections() == 0 and time.time() - t0 < 5:
+    time.sleep(0.05)
+time.sleep(0.5)
+open('$T/d2.ready', 'w').close()
+while time.time() - t0 < 10 and d[0] is None:
+    time.sleep(0.05)
+print(d[0])" > "$T/d2.txt" 2>/dev/null &
+watch=\$!
+for _ in \$(seq 100); do [ -f "$T/d2.ready" ] && break; sleep 0.1; done
+python3 "$SRC/tools/gf_command.py" followers distance_m 1 || { echo "FAIL: gf_command.py followers distance_m 1"; rc=\$((rc+1)); }
+wait \$watch
+d2=\$(cat "$T/d2.txt")
+[ "\$d2" = "10.0" ] && echo "PASS: operator command via tools/gf_command.py: follower 2 d = \$d2 m over LCM" \
+  || { echo "FAIL: follower 2 d never 10.0 after the operator command (got '\$d2')"; rc=\$((rc+1)); }
+python3 "$SRC/tools/gf_command.py" follower7 distance_m 1 2>&1 | grep -q "refused" && echo "PASS: bad target refused by the OperatorInterface" \
+  || { echo "FAIL: follower7 not refused"; rc=\$((rc+1)); }
+kill -INT \$launch; wait \$launch
+exit \$rc
+INNER
+timeout 85 unshare -n bash "$T/inner.sh"
+rc=$?
+[ $rc -eq 0 ] || { echo "--- launch.log (errors, commands)"; grep -aE "ERROR|refuses|FAIL|command" "$T/launch.log" | grep -v "^ \*\|_command" | head -20; }
+exit $rc

@@ -1,0 +1,101 @@
+#!/usr/bin/env bash
+# Runs the power-tower mission headless through launch/simulation.launch (the real nodelets:
+# 3 UAV manager processes + world/ground station, LCM between them), records a bag, writes
+# metrics.json, timeline.csv, events.csv and timeline.png, prints a summary and exits
+# (docs/ros.md). LCM stays on this machine: everything runs in a private network namespace
+# (unshare -n; needs root) whose loopback carries the multicast route.
+#   tools/run_ros_mission.sh [--out DIR] [--duration S] [--rtf X] [--seed N] [--mission FILE] [--rviz]
+# Defaults: --out results/demo, the whole mission (451 s), --rtf 2 (sim seconds per wall second).
+set -eo pipefail  # not -u: devel/setup.bash reads unset variables
+cd "$(dirname "$0")/.."
+SRC=$PWD
+BUILD=${GF_BUILD_DIR:-build}
+OUT=results/demo
+DURATION=-1
+RTF=2.0
+SEED=1
+MISSION=$SRC/config/scenarios/power_towers.yaml
+RVIZ=false
+while [ $# -gt 0 ]; do
+  case $1 in
+    --out) OUT=$2; shift 2 ;;
+    --duration) DURATION=$2; shift 2 ;;
+    --rtf) RTF=$2; shift 2 ;;
+    --seed) SEED=$2; shift 2 ;;
+    --mission) MISSION=$(realpath "$2"); shift 2 ;;
+    --rviz) RVIZ=true; shift ;;
+    *) echo "usage: $0 [--out DIR] [--duration S] [--rtf X] [--seed N] [--mission FILE] [--rviz]" >&2; exit 2 ;;
+  esac
+done
+[ -f "$BUILD/devel/lib/libgesture_formation_nodelets.so" ] || { echo "$0: build first (tools/build.sh; GF_BUILD_DIR=$BUILD)" >&2; exit 2; }
+[ "$(id -u)" -eq 0 ] || { echo "$0: needs root for the private network namespace (unshare -n) that keeps LCM on this machine" >&2; exit 2; }
+mkdir -p "$OUT"
+OUT=$(realpath "$OUT")
+rm -f "$OUT/metrics.json" "$OUT/mission.bag" "$OUT/mission.bag.active"
+T=$(mktemp -d)
+trap 'rm -rf "$T"' EXIT
+# A fresh pre-shared key for this run (owner-only permissions, docs/security.md §5).
+umask 077
+printf '1 %s active\n' "$(od -An -N32 -tx1 /dev/urandom | tr -d ' \n')" > "$T/keys"
+umask 022
+export PATH=/usr/bin:/bin:$PATH
+export ROS_MASTER_URI=http://127.0.0.1:11311 ROS_IP=127.0.0.1 ROS_HOME=$T/ros ROS_LOG_DIR=$T/log
+# shellcheck disable=SC1091
+source "$BUILD/devel/setup.bash"
+cat > "$T/inner.sh" <<INNER
+set -e
+ip link set lo up
+ip route add 224.0.0.0/4 dev lo
+roslaunch --screen -p 11311 gesture_formation simulation.launch mission:=$MISSION seed:=$SEED \
+  real_time_factor:=$RTF duration:=$DURATION output_dir:=$OUT key_file:=$T/keys record:=true \
+  bag:=$OUT/mission.bag rviz:=$RVIZ > "$T/launch.log" 2>&1 &
+launch=\$!
+# The world writes metrics.json when the mission ends; then stop everything (rosbag closes the bag).
+while kill -0 \$launch 2>/dev/null && [ ! -f "$OUT/metrics.json" ]; do sleep 1; done
+sleep 2
+# CPU time and memory of every process of the launch (nodelet managers: one per UAV + world).
+ps -eo pid,cputime,rss,args --sort=-cputime | grep -F "$T/log" | grep -E "nodelet manager|record|rosmaster|rviz" | grep -v grep > "$OUT/processes.txt" || true
+kill -INT \$launch 2>/dev/null || true
+wait \$launch || true
+INNER
+start=$(date +%s)
+echo "running the mission through simulation.launch (real-time factor $RTF; log: $OUT/launch.log) ..."
+unshare -n bash "$T/inner.sh"
+cp "$T/launch.log" "$OUT/launch.log"
+[ -f "$OUT/metrics.json" ] || { echo "$0: the mission did not finish; see $OUT/launch.log" >&2; tail -30 "$OUT/launch.log" >&2; exit 1; }
+# scene.json for the plot's side views: the scenario's solids, as gfctl simulate writes them.
+GFCTL=$BUILD/devel/lib/gesture_formation/gfctl
+if [ -x "$GFCTL" ] && "$GFCTL" simulate --scenario "$MISSION" --out "$T/scene" --duration 0.1 --no-plot > /dev/null 2>&1; then
+  cp "$T/scene/scene.json" "$OUT/scene.json"
+fi
+PY=/opt/gesture_formation/venv/bin/python
+[ -x "$PY" ] || PY=python3
+"$PY" tools/plot_timeline.py "$OUT" > /dev/null 2>&1 && echo "wrote $OUT/timeline.png" || echo "timeline.png not drawn (needs matplotlib: $PY tools/plot_timeline.py $OUT)"
+python3 - "$OUT/metrics.json" "$(( $(date +%s) - start ))" <<'PY'
+import json, sys
+m = json.load(open(sys.argv[1]))
+f = lambda k, u="": f"{m[k]:.2f}{u}" if isinstance(m.get(k), (int, float)) else str(m.get(k))
+print(f"mission through ROS: {f('sim_time_s',' s')} simulated in {sys.argv[2]} s wall")
+print(f"  min mutual {f('min_mutual_distance_m',' m')}, min obstacle {f('min_obstacle_distance_m',' m')}, "
+      f"min human {f('min_human_distance_m',' m')}, collisions {m['collisions']}")
+print(f"  requests applied {m['requests_applied']}/{m['requests_total']} (operator {m['operator_requests_applied']}, "
+      f"gestures {m['gesture_requests_applied']}/{m['gestures_performed']}), gesture success {f('gesture_success_rate')}, "
+      f"latency {f('gesture_mean_latency_s',' s')}, false adaptations {m['false_adaptations']}")
+print(f"  distance error rms {f('distance_error_rms_m',' m')}, angle error rms {f('angle_error_rms_deg',' deg')}, "
+      f"estimate error rms {f('human_estimate_error_rms_m',' m')}, planning median {f('planning_ms_median',' ms')} "
+      f"p99 {f('planning_ms_p99',' ms')} ({m['plans']} plans, {m['plans_fallback_previous']} previous, {m['plans_fallback_brake']} brake)")
+PY
+echo "  CPU time / memory per process (wall $(( $(date +%s) - start )) s):"
+python3 - "$OUT/processes.txt" <<'PY2' || true
+import re, sys
+for line in open(sys.argv[1]):
+    f = line.split(None, 3)
+    if len(f) < 4:
+        continue
+    log = re.search(r"__log:=\S*/([^/ ]+?)(-\d+)?\.log", f[3])
+    name = log.group(1) if log else f[3].split()[0].split("/")[-1]
+    print(f"    {name:<24} cpu {f[1]}  rss {int(f[2]) / 1024:.0f} MB")
+PY2
+python3 tools/bag_latency.py "$OUT/mission.bag" 2>/dev/null || true
+ls -la "$OUT/mission.bag" 2>/dev/null | awk '{print "  bag: " $NF " (" $5 " bytes)"}'
+echo "replay: roslaunch gesture_formation replay.launch bag:=$OUT/mission.bag"
