@@ -1,4 +1,5 @@
 // gfctl simulate --scenario FILE --out DIR [--seed N] [--seeds A..B] [--duration S] [--model ONNX] [--no-plot]
+//                [--faults FILE | --fault-profile NAME]
 // (DESIGN §8.4; docs/simulation.md)
 #include <sys/stat.h>
 
@@ -29,8 +30,10 @@ using common::formatDouble;
 int cmdSimulate(const Args& args);
 const Registrar kRegistrar{
     "simulate",
-    "--scenario FILE --out DIR [--seed N | --seeds A..B] [--duration S] [--model ONNX] [--no-plot]   closed-loop "
-    "mission: metrics.json, timeline.csv, events.csv, timeline.png (DESIGN 8.4)",
+    "--scenario FILE --out DIR [--seed N | --seeds A..B] [--duration S] [--model ONNX] [--no-plot] "
+    "[--faults FILE | --fault-profile NAME]   closed-loop mission: metrics.json, timeline.csv, events.csv, modes.csv, "
+    "timeline.png (DESIGN 8.4); --faults replaces mission.faults with FILE's faults: section, --fault-profile NAME "
+    "uses <scenario dir>/../faults/NAME.yaml (config/faults/; docs/safety.md)",
     cmdSimulate};
 
 bool makeDir(const std::string& path) {
@@ -145,7 +148,7 @@ int runOne(const Args& args, Loaded& L, std::uint64_t seed, double duration, con
   std::string err;
   if (!writeText(dir + "/metrics.json", sim::metricsJson(m))) return badInput(args, dir + "/metrics.json: write failed");
   if (!sim::writeTimelineCsv(dir + "/timeline.csv", *out, L.mission.formation.params.uavCount(), &err) ||
-      !sim::writeEventsCsv(dir + "/events.csv", *out, &err)) {
+      !sim::writeEventsCsv(dir + "/events.csv", *out, &err) || !sim::writeModesCsv(dir + "/modes.csv", *out, &err)) {
     return badInput(args, err);
   }
   if (!writeText(dir + "/scene.json", sceneJson(L.scenario))) return badInput(args, dir + "/scene.json: write failed");
@@ -161,7 +164,11 @@ int runOne(const Args& args, Loaded& L, std::uint64_t seed, double duration, con
             << "  distance error rms " << m.distance_error_rms_m << " m, angle error rms " << m.angle_error_rms_deg
             << " deg, estimate error rms " << m.human_estimate_error_rms_m << " m, planning median "
             << m.planning_ms_median << " ms p99 " << m.planning_ms_p99 << " ms (fallback previous "
-            << m.plans_fallback_previous << ", brake " << m.plans_fallback_brake << " of " << m.plans << ")\n";
+            << m.plans_fallback_previous << ", brake " << m.plans_fallback_brake << " of " << m.plans << ")\n"
+            << "  faults: hold plans " << m.plans_hold << ", skipped " << m.plans_skipped << ", stale commands "
+            << m.commands_stale << ", duplicate commands " << m.commands_duplicate << ", range outliers "
+            << m.range_outliers << ", inter-UAV messages " << m.messages_sent << " (lost " << m.messages_lost
+            << ", duplicated " << m.messages_duplicated << ", reordered " << m.messages_reordered << ")\n";
   {
     std::vector<std::pair<int, std::string>> reasons;
     for (const auto& [why, count] : m.plan_failure_reasons) reasons.emplace_back(count, why);
@@ -186,7 +193,9 @@ int runOne(const Args& args, Loaded& L, std::uint64_t seed, double duration, con
 }
 
 int cmdSimulate(const Args& args) {
-  if (!checkOptions(args, {"scenario", "out"}, {"seed", "seeds", "duration", "model", "no-plot"})) return kExitBadInput;
+  if (!checkOptions(args, {"scenario", "out"}, {"seed", "seeds", "duration", "model", "no-plot", "faults", "fault-profile"})) {
+    return kExitBadInput;
+  }
   std::uint64_t seed = 1, seed_lo = 0, seed_hi = 0;
   bool batch = false;
   if (args.has("seed") && !parseUint(args.get("seed"), seed)) return badInput(args, "--seed: expected a non-negative integer, got '" + args.get("seed") + "'");
@@ -209,7 +218,20 @@ int cmdSimulate(const Args& args) {
   const std::string path = args.get("scenario");
   Loaded L;
   auto sc = planning::loadScenario(path);
-  auto mission = sim::loadMissionConfig(path);
+  if (args.has("faults") && args.has("fault-profile")) return badInput(args, "--faults and --fault-profile are exclusive");
+  std::string faults_path;
+  if (args.has("faults")) faults_path = args.get("faults");
+  if (args.has("fault-profile")) {
+    const std::string name = args.get("fault-profile");
+    if (name.empty() || name.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789_-") != std::string::npos) {
+      return badInput(args, "--fault-profile: expected a name of [a-z0-9_-], got '" + name + "'");
+    }
+    const auto slash = path.find_last_of('/');
+    const std::string dir = slash == std::string::npos ? "." : path.substr(0, slash);
+    faults_path = dir + "/../faults/" + name + ".yaml";
+    if (!fileExists(faults_path)) return badInput(args, "--fault-profile: " + faults_path + " does not exist");
+  }
+  auto mission = faults_path.empty() ? sim::loadMissionConfig(path) : sim::loadMissionConfig(path, faults_path);
   if (!sc || !mission) {
     std::cerr << "gfctl simulate: invalid scenario:\n" << (sc ? "" : sc.reason()) << (mission ? "" : mission.reason());
     return kExitBadInput;
@@ -259,7 +281,9 @@ int cmdSimulate(const Args& args) {
       {"collisions", &sim::MissionMetrics::collisions},
       {"requests_applied", &sim::MissionMetrics::requests_applied},
       {"false_adaptations", &sim::MissionMetrics::false_adaptations},
-      {"plans_fallback_brake", &sim::MissionMetrics::plans_fallback_brake}};
+      {"plans_fallback_brake", &sim::MissionMetrics::plans_fallback_brake},
+      {"plans_hold", &sim::MissionMetrics::plans_hold},
+      {"commands_stale", &sim::MissionMetrics::commands_stale}};
   std::ostringstream js;
   js << "{\n  \"seeds\": [" << seed_lo << ", " << seed_hi << "],\n";
   std::cout << "\n" << all.size() << " seeds " << seed_lo << ".." << seed_hi << ":\n"

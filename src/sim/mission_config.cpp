@@ -21,23 +21,53 @@ std::vector<std::string> LinkConfig::validate(const std::string& prefix) const {
   check(e, jitter_s >= 0, jitter_s, prefix, "jitter_s", ">= 0");
   check(e, loss >= 0 && loss <= 1, loss, prefix, "loss", "in [0, 1]");
   check(e, duplicate >= 0 && duplicate <= 1, duplicate, prefix, "duplicate", "in [0, 1]");
+  check(e, reorder >= 0 && reorder <= 1, reorder, prefix, "reorder", "in [0, 1]");
+  check(e, reorder_extra_delay_s >= 0, reorder_extra_delay_s, prefix, "reorder_extra_delay_s", ">= 0");
   return e;
 }
 
 std::vector<std::string> FaultConfig::validate(const std::string& prefix) const {
   std::vector<std::string> e;
-  for (std::size_t i = 0; i < camera_blackouts.size(); ++i) {
-    const auto& [a, b] = camera_blackouts[i];
-    if (!(std::isfinite(a) && std::isfinite(b) && a < b)) {
-      e.push_back(prefix + "camera_blackouts[" + std::to_string(i) + "] must be [from, to] with from < to");
+  auto windows = [&](const std::vector<std::pair<double, double>>& w, const char* name) {
+    for (std::size_t i = 0; i < w.size(); ++i) {
+      const auto& [a, b] = w[i];
+      if (!(std::isfinite(a) && std::isfinite(b) && a < b)) {
+        e.push_back(prefix + name + "[" + std::to_string(i) + "] must be [from, to] with from < to, got [" +
+                    detail::num(a) + ", " + detail::num(b) + "]");
+      }
     }
-  }
+  };
+  windows(camera_blackouts, "camera_blackouts");
+  windows(uwb_dropouts, "uwb_dropouts");
+  windows(stereo_dropouts, "stereo_dropouts");
   for (std::size_t i = 0; i < planner_outages.size(); ++i) {
     const auto& o = planner_outages[i];
     if (!(o.from_s < o.to_s)) e.push_back(prefix + "planner_outages[" + std::to_string(i) + "] needs from_s < to_s");
   }
+  for (std::size_t i = 0; i < follower_dropouts.size(); ++i) {
+    const auto& o = follower_dropouts[i];
+    const std::string k = prefix + "follower_dropouts[" + std::to_string(i) + "]";
+    if (!(o.from_s < o.to_s)) {
+      e.push_back(k + " needs from_s < to_s, got from_s " + detail::num(o.from_s) + ", to_s " + detail::num(o.to_s));
+    }
+    if (o.uav < 1) e.push_back(k + ".uav must be a follower (>= 1), got " + std::to_string(o.uav));
+  }
+  const RangeOutlierConfig& ro = range_outliers;
+  check(e, ro.probability >= 0 && ro.probability <= 1, ro.probability, prefix, "range_outliers.probability", "in [0, 1]");
+  check(e, ro.min_error_m >= 0, ro.min_error_m, prefix, "range_outliers.min_error_m", ">= 0");
+  check(e, ro.max_error_m >= ro.min_error_m, ro.max_error_m, prefix, "range_outliers.max_error_m", ">= min_error_m");
   check(e, max_share_age_s > 0, max_share_age_s, prefix, "max_share_age_s", "> 0");
+  check(e, max_worker_age_s > 0, max_worker_age_s, prefix, "max_worker_age_s", "> 0");
+  check(e, max_command_age_s > 0, max_command_age_s, prefix, "max_command_age_s", "> 0");
+  check(e, max_plan_age_s > 0, max_plan_age_s, prefix, "max_plan_age_s", "> 0");
   return e;
+}
+
+bool inWindow(const std::vector<std::pair<double, double>>& windows, double t_s) {
+  for (const auto& [a, b] : windows) {
+    if (t_s >= a && t_s < b) return true;
+  }
+  return false;
 }
 
 common::Result<formation::CommandTarget> parseTarget(const std::string& text) {
@@ -322,17 +352,51 @@ common::Result<MissionConfig> parseMissionConfig(const std::string& yaml, const 
     r.readDouble(k + "jitter_s", lc->jitter_s, Range::nonNegative());
     r.readDouble(k + "loss", lc->loss, Range::closed(0.0, 1.0));
     r.readDouble(k + "duplicate", lc->duplicate, Range::closed(0.0, 1.0));
+    r.readDouble(k + "reorder", lc->reorder, Range::closed(0.0, 1.0));
+    r.readDouble(k + "reorder_extra_delay_s", lc->reorder_extra_delay_s, Range::nonNegative());
   }
   const std::string fk = m + "faults.";
+  // Fault overlays of links and wind: key by key over mission.links.* / mission.wind.
+  for (auto [name, lc] : std::initializer_list<std::pair<const char*, LinkConfig*>>{{"link", &c.link},
+                                                                                  {"operator_link", &c.operator_link}}) {
+    const std::string k = fk + name + ".";
+    r.readDouble(k + "delay_s", lc->delay_s, Range::nonNegative());
+    r.readDouble(k + "jitter_s", lc->jitter_s, Range::nonNegative());
+    r.readDouble(k + "loss", lc->loss, Range::closed(0.0, 1.0));
+    r.readDouble(k + "duplicate", lc->duplicate, Range::closed(0.0, 1.0));
+    r.readDouble(k + "reorder", lc->reorder, Range::closed(0.0, 1.0));
+    r.readDouble(k + "reorder_extra_delay_s", lc->reorder_extra_delay_s, Range::nonNegative());
+  }
+  {
+    const std::string k = fk + "wind.";
+    wd.mean_mps = vec3(r, k + "mean_mps", wd.mean_mps);
+    r.readDouble(k + "turbulence_std_mps", wd.turbulence_std_mps, Range::nonNegative());
+    r.readDouble(k + "turbulence_time_constant_s", wd.turbulence_time_constant_s, Range::positive());
+    r.readDouble(k + "gusts_per_minute", wd.gusts_per_minute, Range::nonNegative());
+    r.readDouble(k + "gust_peak_mps", wd.gust_peak_mps, Range::nonNegative());
+    r.readDouble(k + "gust_duration_s", wd.gust_duration_s, Range::positive());
+  }
   r.readDouble(fk + "max_share_age_s", c.faults.max_share_age_s, Range::positive());
-  const YAML::Node bl = r.node(fk + "camera_blackouts");
-  if (bl.IsDefined() && bl.IsSequence()) {
+  r.readDouble(fk + "max_worker_age_s", c.faults.max_worker_age_s, Range::positive());
+  r.readDouble(fk + "max_command_age_s", c.faults.max_command_age_s, Range::positive());
+  r.readDouble(fk + "max_plan_age_s", c.faults.max_plan_age_s, Range::positive());
+  r.readBool(fk + "avoid_all_plans", c.faults.avoid_all_plans);
+  auto readWindows = [&](const char* name, std::vector<std::pair<double, double>>& out) {
+    const YAML::Node bl = r.node(fk + name);
+    if (!bl.IsDefined()) return;
+    if (!bl.IsSequence()) {
+      r.addError(fk + name, "must be a list of [from_s, to_s] windows");
+      return;
+    }
     for (std::size_t i = 0; i < bl.size(); ++i) {
       std::vector<double> v;
-      r.readDoubleList(fk + "camera_blackouts[" + std::to_string(i) + "]", v, 2, 2, Range::nonNegative());
-      if (v.size() == 2) c.faults.camera_blackouts.emplace_back(v[0], v[1]);
+      r.readDoubleList(fk + name + "[" + std::to_string(i) + "]", v, 2, 2, Range::nonNegative());
+      if (v.size() == 2) out.emplace_back(v[0], v[1]);
     }
-  }
+  };
+  readWindows("camera_blackouts", c.faults.camera_blackouts);
+  readWindows("uwb_dropouts", c.faults.uwb_dropouts);
+  readWindows("stereo_dropouts", c.faults.stereo_dropouts);
   const YAML::Node po = r.node(fk + "planner_outages");
   if (po.IsDefined() && po.IsSequence()) {
     for (std::size_t i = 0; i < po.size(); ++i) {
@@ -343,6 +407,28 @@ common::Result<MissionConfig> parseMissionConfig(const std::string& yaml, const 
       r.readDouble(k + "to_s", o.to_s, Range::nonNegative());
       c.faults.planner_outages.push_back(o);
     }
+  }
+  const YAML::Node fd = r.node(fk + "follower_dropouts");
+  if (fd.IsDefined() && fd.IsSequence()) {
+    for (std::size_t i = 0; i < fd.size(); ++i) {
+      const std::string k = fk + "follower_dropouts[" + std::to_string(i) + "].";
+      UavDropout o;
+      for (const char* key : {"uav", "from_s", "to_s"}) {
+        if (!r.has(k + key)) r.addError(k + key, "missing (required)");
+      }
+      r.readInt(k + "uav", o.uav, Range::closed(1, 63));
+      r.readDouble(k + "from_s", o.from_s, Range::nonNegative());
+      r.readDouble(k + "to_s", o.to_s, Range::nonNegative());
+      c.faults.follower_dropouts.push_back(o);
+    }
+  } else if (fd.IsDefined()) {
+    r.addError(fk + "follower_dropouts", "must be a list of {uav, from_s, to_s}");
+  }
+  {
+    const std::string k = fk + "range_outliers.";
+    r.readDouble(k + "probability", c.faults.range_outliers.probability, Range::closed(0.0, 1.0));
+    r.readDouble(k + "min_error_m", c.faults.range_outliers.min_error_m, Range::nonNegative());
+    r.readDouble(k + "max_error_m", c.faults.range_outliers.max_error_m, Range::nonNegative());
   }
   for (const auto& e : c.faults.validate()) r.addError(m + "faults", e);
 
@@ -370,6 +456,9 @@ common::Result<MissionConfig> parseMissionConfig(const std::string& yaml, const 
   }
   for (const auto& o : c.faults.planner_outages) {
     if (o.uav >= n_uavs) r.addError(fk + "planner_outages", "uav " + std::to_string(o.uav) + " does not exist");
+  }
+  for (const auto& o : c.faults.follower_dropouts) {
+    if (o.uav >= n_uavs) r.addError(fk + "follower_dropouts", "uav " + std::to_string(o.uav) + " does not exist");
   }
 
   // --- operator requests ----------------------------------------------------------------
@@ -444,6 +533,48 @@ common::Result<MissionConfig> loadMissionConfig(const std::string& scenario_path
   const auto slash = scenario_path.find_last_of('/');
   const std::string dir = slash == std::string::npos ? "." : scenario_path.substr(0, slash);
   return parseMissionConfig(ss.str(), scenario_path, dir);
+}
+
+common::Result<MissionConfig> loadMissionConfig(const std::string& scenario_path, const std::string& faults_path) {
+  using R = common::Result<MissionConfig>;
+  std::ifstream in(scenario_path);
+  if (!in) return R::fail(scenario_path + ": cannot open file\n");
+  std::ifstream fin(faults_path);
+  if (!fin) return R::fail(faults_path + ": cannot open file\n");
+  std::stringstream ss, fs;
+  ss << in.rdbuf();
+  fs << fin.rdbuf();
+  YAML::Node root, faults;
+  try {
+    root = YAML::Load(ss.str());
+  } catch (const YAML::Exception& e) {
+    return R::fail(scenario_path + ": YAML: " + e.what() + "\n");
+  }
+  try {
+    faults = YAML::Load(fs.str());
+  } catch (const YAML::Exception& e) {
+    return R::fail(faults_path + ": YAML: " + e.what() + "\n");
+  }
+  std::string problems;
+  if (!faults.IsMap() || !faults["faults"].IsDefined()) {
+    problems += faults_path + ": faults: missing (a fault file has one top-level key, faults)\n";
+  } else {
+    for (const auto& kv : faults) {
+      const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : std::string("?");
+      if (key != "faults") problems += faults_path + ": " + key + ": unknown key (a fault file has only faults)\n";
+    }
+    if (!faults["faults"].IsMap() && !faults["faults"].IsNull()) {
+      problems += faults_path + ": faults: must be a mapping of mission.faults keys\n";
+    }
+  }
+  if (!root.IsMap() || !root["mission"].IsMap()) problems += scenario_path + ": mission: missing\n";
+  if (!problems.empty()) return R::fail(problems);
+  root["mission"]["faults"] = faults["faults"].IsNull() ? YAML::Node(YAML::NodeType::Map) : faults["faults"];
+  YAML::Emitter emitter;
+  emitter << root;
+  const auto slash = scenario_path.find_last_of('/');
+  const std::string dir = slash == std::string::npos ? "." : scenario_path.substr(0, slash);
+  return parseMissionConfig(emitter.c_str(), scenario_path + " + " + faults_path, dir);
 }
 
 }  // namespace gesture_formation::sim

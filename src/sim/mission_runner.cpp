@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 #include <optional>
+#include <random>
 #include <regex>
 #include <sstream>
 
@@ -86,6 +87,7 @@ namespace {
 /// What the leader shares every replanning (DESIGN §1: human state, leader plan, formation params).
 struct LeaderShare {
   double stamp_s = 0.0;
+  double worker_stamp_s = 0.0;  ///< time of the leader's last fused worker measurement
   Eigen::Vector3d p_world = Eigen::Vector3d::Zero();
   Eigen::Vector3d v_world = Eigen::Vector3d::Zero();
   double human_heading_rad = 0.0;
@@ -103,6 +105,7 @@ struct PlanMessage {
 
 struct OperatorMessage {
   std::size_t record = 0;
+  double sent_s = 0.0;
   formation::FormationCommand command;
 };
 
@@ -121,6 +124,10 @@ struct UavRuntime {
   std::vector<std::optional<PlanMessage>> received;  ///< plans received from the followers
   int last_status = -1;
   bool in_obstacle = false, in_worker = false;
+  bool offline = false;                                      ///< follower dropout in progress
+  double rejoined_s = -std::numeric_limits<double>::infinity();  ///< end of the last dropout
+  std::string mode = "start";                                ///< last mode recorded (ModeChange)
+  std::optional<Eigen::Vector3d> hold_p;                     ///< latched hold point while holding
 };
 
 double percentile(std::vector<double> v, double q) {
@@ -142,6 +149,13 @@ std::string describe(const formation::FormationCommand& c, const std::string& ta
   os << target_text << '.' << formation::parameterName(c.parameter) << ' '
      << (c.kind == formation::CommandKind::kSet ? "= " : (c.amount >= 0 ? "+" : "")) << c.amount;
   return os.str();
+}
+
+void addCounters(MissionMetrics& M, const LinkCounters& c) {
+  M.messages_sent += static_cast<long>(c.sent);
+  M.messages_lost += static_cast<long>(c.lost);
+  M.messages_duplicated += static_cast<long>(c.duplicated);
+  M.messages_reordered += static_cast<long>(c.reordered);
 }
 
 /// Distance from p to a vertical cylinder (radius r) from z0 to z1 around axis (x, y).
@@ -234,6 +248,9 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
   std::size_t next_request = 0;
   int last_class = -1;
   double last_ratio = 0.0, last_skeleton_t = -1e9;
+  double last_fused_s = -std::numeric_limits<double>::infinity();  // the leader's last fused worker measurement
+  std::mt19937_64 fault_rng = makeRng(seed, Stream::kFault);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
 
   const double dt = cfg.step_s;
   const long steps = std::lround(duration / dt);
@@ -246,6 +263,8 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
 
   auto applyCommand = [&](RequestRecord& rec, const formation::FormationCommand& cmd, double t) {
     const auto outcome = fstate.apply(cmd);
+    if (outcome.status == formation::CommandStatus::kDuplicate) ++M.commands_duplicate;
+    if (rec.status == "applied") return;  // a duplicate copy of an applied command changes nothing
     rec.status = formation::toString(outcome.status);
     if (outcome.status == formation::CommandStatus::kApplied) {
       rec.applied_s = t;
@@ -256,11 +275,23 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
     }
   };
 
+  auto setMode = [&](int i, double t, const std::string& mode, const std::string& reason) {
+    UavRuntime& u = *uavs[static_cast<std::size_t>(i)];
+    if (u.mode == mode) return;
+    u.mode = mode;
+    out.modes.push_back(ModeChange{t, i, mode, reason});
+  };
+
   auto replan = [&](int i, double t) {
     UavRuntime& u = *uavs[static_cast<std::size_t>(i)];
+    if (u.offline) {
+      ++M.plans_skipped;
+      return;
+    }
     for (const auto& o : cfg.faults.planner_outages) {
       if (o.uav == i && t >= o.from_s && t < o.to_s) {
         ++M.plans_skipped;
+        setMode(i, t, "outage", "planner outage: the loaded plan is flown to its end and held");
         return;
       }
     }
@@ -269,29 +300,55 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
     formation::FormationParams params;
     std::uint64_t version = 0;
     const LeaderShare* share = nullptr;
+    double worker_stamp = 0.0;
+    std::string hold;  // non-empty: hold a safe position (docs/safety.md), the reason
     if (i == 0) {
       if (!kf.initialized()) {
         ++M.plans_skipped;
         return;
       }
       const estimation::Vector6d& x = kf.state();
-      const bool lost = kf.lost(t);
-      v0 = lost ? Eigen::Vector3d::Zero() : Eigen::Vector3d(x.tail<3>());
-      p0 = x.head<3>() + (lost ? 0.0 : (t - kf.time())) * v0;
-      hphi = human_heading.update(v0);
+      worker_stamp = last_fused_s;
+      if (t - worker_stamp > cfg.faults.max_worker_age_s) hold = "worker not seen for more than max_worker_age_s";
+      const bool stale = !hold.empty() || kf.lost(t);
+      v0 = stale ? Eigen::Vector3d::Zero() : Eigen::Vector3d(x.tail<3>());
+      p0 = x.head<3>() + (stale ? 0.0 : (t - kf.time())) * v0;
+      hphi = stale ? human_heading.heading() : human_heading.update(v0);
       params = fstate.params();
       version = params_version;
     } else {
-      if (!u.share || t - u.share->stamp_s > cfg.faults.max_share_age_s) {
-        ++M.plans_skipped;  // never act on data older than its configured age
+      if (!u.share) {
+        ++M.plans_skipped;  // nothing known about the worker: the controller holds (its plan's end, or brakes)
+        setMode(i, t, "hold", "no leader share received yet");
         return;
       }
       share = &*u.share;
-      v0 = share->v_world;
-      p0 = share->p_world + (t - share->stamp_s) * v0;
+      worker_stamp = share->worker_stamp_s;
+      if (t - share->stamp_s > cfg.faults.max_share_age_s) {
+        hold = "leader share older than max_share_age_s";
+      } else if (t - worker_stamp > cfg.faults.max_worker_age_s) {
+        hold = "worker estimate older than max_worker_age_s";
+      } else if (u.rejoined_s > -std::numeric_limits<double>::infinity()) {
+        for (int j = 1; j < n && hold.empty(); ++j) {
+          const auto& m = u.received[static_cast<std::size_t>(j)];
+          if (j != i && !uavs[static_cast<std::size_t>(j)]->offline && (!m || m->plan.t0_s < u.rejoined_s)) {
+            hold = "rejoined: waiting for a plan from every other UAV";
+          }
+        }
+        if (hold.empty()) u.rejoined_s = -std::numeric_limits<double>::infinity();
+      }
+      const bool stale = !hold.empty();
+      v0 = stale ? Eigen::Vector3d::Zero() : Eigen::Vector3d(share->v_world);
+      p0 = share->p_world + (stale ? 0.0 : (t - share->stamp_s)) * v0;
       hphi = share->human_heading_rad;
       params = share->params;
       version = share->params_version;
+    }
+    if (!hold.empty()) {
+      ++M.plans_hold;
+      setMode(i, t, "hold", hold);
+    } else {
+      setMode(i, t, "track", "fresh data");
     }
     formation::WorkerHorizon wh;
     wh.p_world.resize(3, hsteps);
@@ -311,7 +368,18 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
     req.state.heading_rad = u.est.heading_rad;
     req.state.pitch_rad = u.est.pitch_rad;
     req.worker = wh;
-    if (i == 0) {
+    if (!hold.empty()) {
+      // Hold: stop where braking at the controller's deceleration ends, camera on the last
+      // known worker position; the stale data serve only as an obstacle and camera target.
+      if (!u.hold_p) u.hold_p = brakingPoint(u.est, cfg.controller.brake_accel_mps2);  // latched: no drift
+      req.reference = holdReference(*u.hold_p, p0, u.est.heading_rad, hsteps);
+      if (share != nullptr && !share->plan.empty()) req.higher_priority_plans.push_back(share->plan);
+      for (int j = 1; j < n; ++j) {
+        const auto& m = u.received[static_cast<std::size_t>(j)];
+        if (j != i && m && !m->plan.empty()) req.higher_priority_plans.push_back(m->plan);
+      }
+    } else if (i == 0) {
+      u.hold_p.reset();
       formation::leaderHorizon(wh, params.leader, req.reference);
     } else {
       formation::LeaderPlan lp;
@@ -325,13 +393,21 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
           lp.pitch_rad(k) = s.pitch_rad;
         }
       }
+      u.hold_p.reset();
       formation::followerHorizon(wh, params.leader, has_plan ? &lp : nullptr,
                                  params.followers[static_cast<std::size_t>(i - 1)], req.reference);
       if (has_plan) req.higher_priority_plans.push_back(share->plan);
     }
-    for (int j = 1; j < n; ++j) {
-      const auto& m = u.received[static_cast<std::size_t>(j)];
-      if (j != i && m && !m->plan.empty() && (j < i || m->fallback)) req.higher_priority_plans.push_back(m->plan);
+    if (hold.empty()) {
+      for (int j = 1; j < n; ++j) {
+        const auto& m = u.received[static_cast<std::size_t>(j)];
+        // A UAV not heard from for max_plan_age_s (dropout, outage, lost link) cannot be
+        // expected to dodge: it has right of way, like one that fell back.
+        const bool silent = m && t - m->plan.t0_s > cfg.faults.max_plan_age_s;
+        if (j != i && m && !m->plan.empty() && (j < i || m->fallback || silent || cfg.faults.avoid_all_plans)) {
+          req.higher_priority_plans.push_back(m->plan);
+        }
+      }
     }
     const planning::PlanResult res = u.planner->plan(req);
     ++M.plans;
@@ -354,6 +430,7 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
     if (i == 0) {
       LeaderShare s;
       s.stamp_s = t;
+      s.worker_stamp_s = worker_stamp;
       s.p_world = p0;
       s.v_world = v0;
       s.human_heading_rad = hphi;
@@ -362,7 +439,7 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
       s.plan = res.trajectory;
       for (int j = 1; j < n; ++j) share_links[static_cast<std::size_t>(j)]->send(t, s);
     } else {
-      const PlanMessage msg{res.trajectory, res.status != planning::PlanStatus::kOptimized};
+      const PlanMessage msg{res.trajectory, res.status != planning::PlanStatus::kOptimized || !hold.empty()};
       for (int j = 0; j < n; ++j) {
         if (j != i) plan_links[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)]->send(t, msg);
       }
@@ -389,15 +466,41 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
       rec.description = describe(cmd, q.target_text);
       rec.status = "lost";
       out.requests.push_back(rec);
-      operator_link.send(t, OperatorMessage{out.requests.size() - 1, cmd});
+      operator_link.send(t, OperatorMessage{out.requests.size() - 1, t, cmd});
     }
-    for (const auto& msg : operator_link.receive(t)) applyCommand(out.requests[msg.record], msg.command, t);
+    for (const auto& msg : operator_link.receive(t)) {
+      RequestRecord& rec = out.requests[msg.record];
+      if (t - msg.sent_s > cfg.faults.max_command_age_s) {  // never act on a command older than its age
+        ++M.commands_stale;
+        if (rec.status == "lost") rec.status = "stale";
+        continue;
+      }
+      applyCommand(rec, msg.command, t);
+    }
 
-    // Inter-UAV messages.
+    // Follower dropouts: offline → nothing runs; back online → a rebooted computer with no memory.
+    for (int i = 1; i < n; ++i) {
+      UavRuntime& u = *uavs[static_cast<std::size_t>(i)];
+      bool off = false;
+      for (const auto& o : cfg.faults.follower_dropouts) off = off || (o.uav == i && t >= o.from_s && t < o.to_s);
+      if (off && !u.offline) {
+        setMode(i, t, "offline", "follower dropout: the loaded plan is flown to its end and held");
+      } else if (!off && u.offline) {
+        u.share.reset();
+        for (auto& r : u.received) r.reset();
+        u.planner = planners(i);
+        u.rejoined_s = t;
+        setMode(i, t, "rejoin", "back online: listening before it moves");
+      }
+      u.offline = off;
+    }
+
+    // Inter-UAV messages (an offline UAV's radio drops what arrives).
     for (int i = 1; i < n; ++i) {
       UavRuntime& u = *uavs[static_cast<std::size_t>(i)];
       for (auto& s : share_links[static_cast<std::size_t>(i)]->receive(t)) {
-        if (!u.share || s.stamp_s >= u.share->stamp_s) u.share = std::move(s);
+        if (u.offline) continue;
+        if (!u.share || s.stamp_s > u.share->stamp_s) u.share = std::move(s);
       }
     }
     for (int i = 0; i < n; ++i) {
@@ -405,8 +508,9 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
       for (int j = 1; j < n; ++j) {
         if (j == i) continue;
         for (auto& p : plan_links[static_cast<std::size_t>(j)][static_cast<std::size_t>(i)]->receive(t)) {
+          if (u.offline) continue;
           auto& slot = u.received[static_cast<std::size_t>(j)];
-          if (!slot || p.plan.t0_s >= slot->plan.t0_s) slot = std::move(p);
+          if (!slot || p.plan.t0_s > slot->plan.t0_s) slot = std::move(p);  // duplicates and late copies ignored
         }
       }
     }
@@ -422,7 +526,18 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
       const estimation::CameraPose true_pose = cameraPose(ls.p_world, ls.heading_rad, ls.pitch_rad);
       bool blackout = false;
       for (const auto& [a, b] : cfg.faults.camera_blackouts) blackout = blackout || (t >= a && t < b);
-      const SensorFrame frame = sensors.observe(true_pose, ws.feet_world, ws.p_world, cfg.worker.height_m, blackout);
+      SensorFrame frame = sensors.observe(true_pose, ws.feet_world, ws.p_world, cfg.worker.height_m, blackout);
+      if (inWindow(cfg.faults.uwb_dropouts, t)) frame.d_uwb_m = std::numeric_limits<double>::quiet_NaN();
+      if (inWindow(cfg.faults.stereo_dropouts, t)) frame.d_stereo_m = std::numeric_limits<double>::quiet_NaN();
+      for (double* d : {&frame.d_uwb_m, &frame.d_stereo_m}) {
+        const double u_hit = u01(fault_rng), u_size = u01(fault_rng), u_sign = u01(fault_rng);  // fixed draws per frame
+        if (std::isfinite(*d) && u_hit < cfg.faults.range_outliers.probability) {
+          const RangeOutlierConfig& ro = cfg.faults.range_outliers;
+          const double err = ro.min_error_m + u_size * (ro.max_error_m - ro.min_error_m);
+          *d = std::max(0.1, *d + (u_sign < 0.5 ? -err : err));
+          ++M.range_outliers;
+        }
+      }
       const gesture::SynthFrame sk = worker.skeletonAt(t, true_pose.t_world_camera);
       ++frames;
       if (frame.visible()) {
@@ -431,7 +546,7 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
         const estimation::CameraPose est_pose = cameraPose(L.est.p_world, L.est.heading_rad, L.est.pitch_rad);
         const auto meas = estimation::makeMeasurement(cam_model, est_pose, frame.box, frame.d_uwb_m, frame.d_stereo_m,
                                                       cfg.estimator.human_height_m, cfg.estimator.noise);
-        if (meas) kf.step(t, *meas);
+        if (meas && estimation::accepted(kf.step(t, *meas))) last_fused_s = t;
         if (t - last_skeleton_t > 0.5) window.clear();  // a gap breaks the FIFO's temporal consistency
         window.push(sk.skeleton);
         last_skeleton_t = t;
@@ -605,6 +720,12 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
   M.distance_error_rms_m = dist_n > 0 ? std::sqrt(dist_sq / static_cast<double>(dist_n)) : nan;
   M.angle_error_rms_deg = dist_n > 0 ? std::sqrt(angle_sq / static_cast<double>(dist_n)) : nan;
   M.human_estimate_error_rms_m = est_n > 0 ? std::sqrt(est_sq / static_cast<double>(est_n)) : nan;
+  for (const auto& l : share_links) addCounters(M, l->counters());
+  for (const auto& row : plan_links) {
+    for (const auto& l : row) {
+      if (l) addCounters(M, l->counters());
+    }
+  }
   M.planning_ms_median = median(plan_ms);
   M.planning_ms_p99 = percentile(plan_ms, 0.99);
   M.visible_fraction = frames > 0 ? static_cast<double>(visible_frames) / static_cast<double>(frames) : 0.0;
@@ -612,6 +733,27 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
   M.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   M.real_time_factor = M.wall_time_s > 0 ? M.sim_time_s / M.wall_time_s : nan;
   return R::ok(std::move(out));
+}
+
+Eigen::Vector3d brakingPoint(const EstimatedState& est, double brake_accel_mps2) {
+  const double a = std::max(1e-3, brake_accel_mps2);
+  return est.p_world + est.v_world * (est.v_world.norm() / (2.0 * a));
+}
+
+formation::ReferenceTrajectory holdReference(const Eigen::Vector3d& hold_world, const Eigen::Vector3d& worker_world,
+                                             double heading_rad, int steps) {
+  const Eigen::Vector3d to_worker = worker_world - hold_world;
+  const double horizontal = to_worker.head<2>().norm();
+  const double heading = horizontal > 1e-6 ? std::atan2(to_worker.y(), to_worker.x()) : heading_rad;
+  const double pitch = std::atan2(to_worker.z(), std::max(1e-6, horizontal));
+  formation::ReferenceTrajectory ref;
+  ref.resize(steps);
+  for (int k = 0; k < steps; ++k) {
+    ref.p_world.col(k) = hold_world;
+    ref.heading_rad(k) = heading;
+    ref.pitch_rad(k) = pitch;
+  }
+  return ref;
 }
 
 // --------------------------------------------------------------------------------------
@@ -643,6 +785,14 @@ std::string metricsJson(const MissionMetrics& m) {
   os << "  \"plans_fallback_previous\": " << m.plans_fallback_previous << ",\n";
   os << "  \"plans_fallback_brake\": " << m.plans_fallback_brake << ",\n";
   os << "  \"plans_skipped\": " << m.plans_skipped << ",\n";
+  os << "  \"plans_hold\": " << m.plans_hold << ",\n";
+  os << "  \"commands_stale\": " << m.commands_stale << ",\n";
+  os << "  \"commands_duplicate\": " << m.commands_duplicate << ",\n";
+  os << "  \"range_outliers\": " << m.range_outliers << ",\n";
+  os << "  \"messages_sent\": " << m.messages_sent << ",\n";
+  os << "  \"messages_lost\": " << m.messages_lost << ",\n";
+  os << "  \"messages_duplicated\": " << m.messages_duplicated << ",\n";
+  os << "  \"messages_reordered\": " << m.messages_reordered << ",\n";
   os << "  \"visible_fraction\": " << num(m.visible_fraction) << ",\n";
   os << "  \"sim_time_s\": " << num(m.sim_time_s) << ",\n";
   os << "  \"seed\": " << m.seed << ",\n";
@@ -725,6 +875,26 @@ bool writeEventsCsv(const std::string& path, const MissionOutput& out, std::stri
       f << formatDouble(g.start_s) << ",worker,gesture " << g.gesture_id << " not recognised,missed,nan,nan,"
         << g.gesture_id << ',' << formatDouble(g.start_s) << ',' << formatDouble(g.end_s) << ",\n";
     }
+  }
+  f.flush();
+  if (!f) {
+    if (error) *error = path + ": write failed";
+    return false;
+  }
+  return true;
+}
+
+bool writeModesCsv(const std::string& path, const MissionOutput& out, std::string* error) {
+  std::ofstream f(path);
+  if (!f) {
+    if (error) *error = path + ": cannot open for writing";
+    return false;
+  }
+  f << "t,uav,mode,reason\n";
+  for (const auto& m : out.modes) {
+    std::string why = m.reason;
+    std::replace(why.begin(), why.end(), ',', ';');
+    f << formatDouble(m.t_s) << ',' << formation::uavLabel(m.uav) << ',' << m.mode << ',' << why << '\n';
   }
   f.flush();
   if (!f) {

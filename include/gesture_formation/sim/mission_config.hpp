@@ -59,12 +59,47 @@ struct PlannerOutage {
   double from_s = 0.0, to_s = 0.0;
 };
 
+/// \brief A follower's onboard computer is down from `from_s` to `to_s` (reboot): it neither
+/// plans nor sends nor receives; its flight controller completes the last loaded (verified)
+/// plan and holds its end. After `to_s` it rejoins (docs/safety.md §2.4).
+struct UavDropout {
+  int uav = 1;
+  double from_s = 0.0, to_s = 0.0;
+};
+
+/// \brief Gross errors of the range sensors (UWB, stereo): with `probability` per available
+/// range, the range is off by ± U[min_error_m, max_error_m] (sign random).
+struct RangeOutlierConfig {
+  double probability = 0.0;  ///< [0, 1]
+  double min_error_m = 3.0;  ///< ≥ 0
+  double max_error_m = 15.0;  ///< ≥ min_error_m
+};
+
+/// \brief `mission.faults` (issue 9; docs/safety.md states what the UAVs do for each fault).
+/// Windows are [from, to) in mission seconds. `faults.link`, `faults.operator_link` and
+/// `faults.wind` override `mission.links.uav`, `mission.links.operator` and `mission.wind`
+/// key by key (the loader applies them; they are not kept here). The four ages are the
+/// freshness limits of docs/safety.md §1.
 struct FaultConfig {
   std::vector<std::pair<double, double>> camera_blackouts;  ///< [from, to] s: the leader sees no worker
   std::vector<PlannerOutage> planner_outages;
-  double max_share_age_s = 2.0;  ///< followers do not plan from a leader message older than this, > 0
+  std::vector<UavDropout> follower_dropouts;               ///< uav ≥ 1
+  std::vector<std::pair<double, double>> uwb_dropouts;     ///< [from, to] s: no UWB range
+  std::vector<std::pair<double, double>> stereo_dropouts;  ///< [from, to] s: no stereo range
+  RangeOutlierConfig range_outliers;
+  double max_share_age_s = 2.0;    ///< followers do not plan from a leader message older than this, > 0
+  double max_worker_age_s = 3.0;   ///< no fused worker measurement for this long → hold, > 0
+  double max_command_age_s = 5.0;  ///< an operator command older than this on arrival is rejected, > 0
+  double max_plan_age_s = 1.0;     ///< a UAV not heard from for this long is avoided by all (right of way), > 0
+  /// Every UAV avoids every other UAV's last plan (not only higher-priority, fallback or silent
+  /// ones): a higher-priority UAV no longer relies on a lower-priority one to dodge it, which a
+  /// late or lost fallback flag makes unsafe (docs/safety.md §2.1).
+  bool avoid_all_plans = true;
   std::vector<std::string> validate(const std::string& prefix = "") const;
 };
+
+/// \brief True when t_s lies in one of the [from, to) windows.
+bool inWindow(const std::vector<std::pair<double, double>>& windows, double t_s);
 
 struct MissionConfig {
   std::string source;             ///< scenario file
@@ -98,6 +133,11 @@ struct MissionConfig {
 
 /// \brief Reads `mission` of a scenario file. Fails listing every problem (file: key: message).
 common::Result<MissionConfig> loadMissionConfig(const std::string& scenario_path);
+/// \brief As loadMissionConfig with the `faults:` section of `faults_path` (a YAML file whose
+/// only top-level key is `faults`) replacing the scenario's `mission.faults` (gfctl simulate
+/// --faults / --fault-profile; docs/simulation.md §3). Problems name the field as
+/// `mission.faults.<key>` and both files.
+common::Result<MissionConfig> loadMissionConfig(const std::string& scenario_path, const std::string& faults_path);
 /// \brief As loadMissionConfig, from YAML text (`source_name` in messages; relative paths
 /// resolve against `base_dir`).
 common::Result<MissionConfig> parseMissionConfig(const std::string& yaml, const std::string& source_name,

@@ -9,10 +9,11 @@
 /// Data flow per UAV (DESIGN §1): the leader estimates the worker, owns the FormationState
 /// (commands from the operator link and the gesture filter), and every replanning shares
 /// {worker estimate, ^Hφ, parameters, its plan}; follower i plans from the last share it
-/// received (if not older than faults.max_share_age_s) and from the plans received from UAVs
-/// 0..i−1; it sends its own plan to every UAV. A UAV whose planner fell back (braking or on
-/// its previous plan) flags its plan, and then every other UAV — also a higher-priority one —
-/// plans around it (it has right of way: it cannot dodge). Replanning is staggered: UAV i plans at
+/// received (if not older than faults.max_share_age_s) and around the plans received from the
+/// other UAVs; it sends its own plan to every UAV. With faults.avoid_all_plans (default) every
+/// UAV plans around every other UAV's last plan; without it only around higher-priority ones
+/// and those flagged as fallback/hold or silent for faults.max_plan_age_s (right of way).
+/// Stale data → hold (docs/safety.md). Replanning is staggered: UAV i plans at
 /// k·period + i·period/n. A plan is executed only as returned by the planner (verified); a UAV
 /// without a plan brakes to hover (TrackingController).
 ///
@@ -90,6 +91,11 @@ struct MissionMetrics {
   int gestures_performed = 0;
   int gestures_successful = 0;
   int plans = 0, plans_fallback_previous = 0, plans_fallback_brake = 0, plans_skipped = 0;
+  int plans_hold = 0;          ///< replannings in hold mode (stale data, docs/safety.md)
+  int commands_stale = 0;      ///< operator commands older than faults.max_command_age_s on arrival (rejected)
+  int commands_duplicate = 0;  ///< duplicate command copies (ignored by the FormationState)
+  int range_outliers = 0;      ///< injected gross range errors (faults.range_outliers)
+  long messages_sent = 0, messages_lost = 0, messages_duplicated = 0, messages_reordered = 0;  ///< inter-UAV links
   /// Why replannings failed: the planner's first reason with numbers replaced by '#' → count.
   std::map<std::string, int> plan_failure_reasons;
   double visible_fraction = 0.0;       ///< camera frames with a detection
@@ -136,8 +142,20 @@ struct RequestRecord {
   std::uint64_t params_version = 0;
 };
 
+/// \brief A UAV's safety mode changed (docs/safety.md): track (fresh data, formation
+/// reference) | hold (stale or missing data: stop and keep position, avoid everyone) |
+/// outage (planner not running: loaded plan to its end) | offline (follower dropout) |
+/// rejoin (back online, listening before it moves).
+struct ModeChange {
+  double t_s = 0.0;
+  int uav = 0;
+  std::string mode;
+  std::string reason;
+};
+
 struct MissionOutput {
   MissionMetrics metrics;
+  std::vector<ModeChange> modes;
   std::vector<TimelineRow> timeline;
   std::vector<RequestRecord> requests;
   std::vector<GestureEpisode> gestures;  ///< performed by the worker
@@ -162,11 +180,21 @@ common::Result<MissionOutput> runMission(const MissionConfig& config, const Miss
                                          const PlannerFactory& planners, MissionClassifier* classifier,
                                          std::uint64_t seed, double duration_s = 0.0);
 
+/// \brief Where braking from the estimated velocity at `brake_accel_mps2` ends: p + v|v|/(2a).
+/// A UAV entering hold latches this point and holds it until it tracks again (docs/safety.md §1).
+Eigen::Vector3d brakingPoint(const EstimatedState& est, double brake_accel_mps2);
+/// \brief The hold reference: every step at `hold_world`, camera heading and pitch towards
+/// `worker_world` (the last known worker position; `heading_rad` when straight above/below).
+formation::ReferenceTrajectory holdReference(const Eigen::Vector3d& hold_world, const Eigen::Vector3d& worker_world,
+                                             double heading_rad, int steps);
+
 /// \brief metrics.json text (keys of DESIGN §8.4 first; NaN → null).
 std::string metricsJson(const MissionMetrics& m);
 /// \brief Writes timeline.csv (header documented in docs/simulation.md §5).
 bool writeTimelineCsv(const std::string& path, const MissionOutput& out, int uav_count, std::string* error);
 /// \brief Writes events.csv: one row per request.
 bool writeEventsCsv(const std::string& path, const MissionOutput& out, std::string* error);
+/// \brief Writes modes.csv: `t,uav,mode,reason`, one row per ModeChange.
+bool writeModesCsv(const std::string& path, const MissionOutput& out, std::string* error);
 
 }  // namespace gesture_formation::sim

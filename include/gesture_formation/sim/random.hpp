@@ -28,6 +28,7 @@ enum class Stream : std::uint64_t {
   kStereo = 23,
   kUwb = 24,
   kLink = 30,        ///< + link index
+  kFault = 40,       ///< injected sensor faults (range outliers)
 };
 
 /// \brief The RNG of stream `stream` (+ `index`) of a mission with seed `seed`.
