@@ -87,6 +87,16 @@ common::Result<formation::CommandTarget> parseTarget(const std::string& text) {
 
 namespace {
 
+/// The keys of one link (mission.links.* and their mission.faults.* overlays) under `k`.
+void readLinkKeys(ConfigReader& r, const std::string& k, LinkConfig& lc) {
+  r.readDouble(k + "delay_s", lc.delay_s, Range::nonNegative());
+  r.readDouble(k + "jitter_s", lc.jitter_s, Range::nonNegative());
+  r.readDouble(k + "loss", lc.loss, Range::closed(0.0, 1.0));
+  r.readDouble(k + "duplicate", lc.duplicate, Range::closed(0.0, 1.0));
+  r.readDouble(k + "reorder", lc.reorder, Range::closed(0.0, 1.0));
+  r.readDouble(k + "reorder_extra_delay_s", lc.reorder_extra_delay_s, Range::nonNegative());
+}
+
 std::string joinPath(const std::string& base, const std::string& p) {
   if (p.empty() || p[0] == '/' || base.empty()) return p;
   return base + "/" + p;
@@ -348,24 +358,14 @@ common::Result<MissionConfig> parseMissionConfig(const std::string& yaml, const 
   for (auto [name, lc] : std::initializer_list<std::pair<const char*, LinkConfig*>>{{"links.uav", &c.link},
                                                                                   {"links.operator", &c.operator_link}}) {
     const std::string k = m + name + ".";
-    r.readDouble(k + "delay_s", lc->delay_s, Range::nonNegative());
-    r.readDouble(k + "jitter_s", lc->jitter_s, Range::nonNegative());
-    r.readDouble(k + "loss", lc->loss, Range::closed(0.0, 1.0));
-    r.readDouble(k + "duplicate", lc->duplicate, Range::closed(0.0, 1.0));
-    r.readDouble(k + "reorder", lc->reorder, Range::closed(0.0, 1.0));
-    r.readDouble(k + "reorder_extra_delay_s", lc->reorder_extra_delay_s, Range::nonNegative());
+    readLinkKeys(r, k, *lc);
   }
   const std::string fk = m + "faults.";
   // Fault overlays of links and wind: key by key over mission.links.* / mission.wind.
   for (auto [name, lc] : std::initializer_list<std::pair<const char*, LinkConfig*>>{{"link", &c.link},
                                                                                   {"operator_link", &c.operator_link}}) {
     const std::string k = fk + name + ".";
-    r.readDouble(k + "delay_s", lc->delay_s, Range::nonNegative());
-    r.readDouble(k + "jitter_s", lc->jitter_s, Range::nonNegative());
-    r.readDouble(k + "loss", lc->loss, Range::closed(0.0, 1.0));
-    r.readDouble(k + "duplicate", lc->duplicate, Range::closed(0.0, 1.0));
-    r.readDouble(k + "reorder", lc->reorder, Range::closed(0.0, 1.0));
-    r.readDouble(k + "reorder_extra_delay_s", lc->reorder_extra_delay_s, Range::nonNegative());
+    readLinkKeys(r, k, *lc);
   }
   {
     const std::string k = fk + "wind.";
