@@ -184,13 +184,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     const Eigen::Vector3d v0 = worker_->lost ? Eigen::Vector3d::Zero() : toEigen(worker_->velocity);
     const Eigen::Vector3d p0 = toEigen(worker_->position) + std::max(0.0, age) * v0;
     const double hphi = heading_->update(v0);
-    formation::WorkerHorizon wh;
-    wh.p_world.resize(3, horizon_steps_);
-    wh.heading_rad.resize(1, horizon_steps_);
-    for (int k = 0; k < horizon_steps_; ++k) {
-      wh.p_world.col(k) = p0 + (k * horizon_dt_s_) * v0;
-      wh.heading_rad(k) = hphi;
-    }
+    const formation::WorkerHorizon wh = formation::constantVelocityHorizon(p0, v0, hphi, horizon_steps_, horizon_dt_s_);
     planning::PlanRequest req;
     req.uav_index = uav_index_;
     req.t_now_s = t;

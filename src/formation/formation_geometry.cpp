@@ -53,6 +53,18 @@ UavReference followerReference(const Eigen::Vector3d& p_human_world, double lead
   return r;
 }
 
+WorkerHorizon constantVelocityHorizon(const Eigen::Vector3d& p0_world, const Eigen::Vector3d& v_world,
+                                      double heading_rad, int steps, double dt_s) {
+  WorkerHorizon wh;
+  wh.p_world.resize(3, steps);
+  wh.heading_rad.resize(1, steps);
+  for (int k = 0; k < steps; ++k) {
+    wh.p_world.col(k) = p0_world + (k * dt_s) * v_world;
+    wh.heading_rad(k) = heading_rad;
+  }
+  return wh;
+}
+
 void leaderHorizon(const WorkerHorizon& worker, const UavObservation& leader, ReferenceTrajectory& out) {
   const int n = worker.steps();
   out.resize(n);

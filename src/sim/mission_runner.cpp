@@ -350,13 +350,7 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
     } else {
       setMode(i, t, "track", "fresh data");
     }
-    formation::WorkerHorizon wh;
-    wh.p_world.resize(3, hsteps);
-    wh.heading_rad.resize(1, hsteps);
-    for (int k = 0; k < hsteps; ++k) {
-      wh.p_world.col(k) = p0 + (k * hdt) * v0;
-      wh.heading_rad(k) = hphi;
-    }
+    const formation::WorkerHorizon wh = formation::constantVelocityHorizon(p0, v0, hphi, hsteps, hdt);
     planning::PlanRequest req;
     req.uav_index = i;
     req.t_now_s = t;

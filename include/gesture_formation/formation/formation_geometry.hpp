@@ -73,6 +73,11 @@ struct WorkerHorizon {
   int steps() const { return static_cast<int>(p_world.cols()); }
 };
 
+/// \brief The constant-velocity prediction p0 + k·dt·v0, k = 0..steps−1, with a constant
+/// heading (what the planners use from the estimator's state).
+WorkerHorizon constantVelocityHorizon(const Eigen::Vector3d& p0_world, const Eigen::Vector3d& v_world,
+                                      double heading_rad, int steps, double dt_s);
+
 /// \brief The leader's planned camera heading and pitch along the horizon (received over
 /// LCM by the followers). Same number of steps as the WorkerHorizon.
 struct LeaderPlan {
