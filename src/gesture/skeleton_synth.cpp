@@ -102,7 +102,7 @@ std::vector<std::string> SynthConfig::validate() const {
 }
 
 SkeletonSynthesizer::SkeletonSynthesizer(const SynthConfig& config, std::uint64_t seed)
-    : config_(config), camera_(config.camera), rng_(seed) {
+    : config_(config), camera_(config.camera), rng_(seed), seed_(seed) {
   drawShape();
 }
 
@@ -293,49 +293,110 @@ SynthSequence SkeletonSynthesizer::generate(Motion motion) {
   std::uniform_real_distribution<double> ue(config_.elevation_min_deg, config_.elevation_max_deg);
   std::uniform_real_distribution<double> ua(config_.azimuth_min_deg, config_.azimuth_max_deg);
   const double d = ud(rng_), e = ue(rng_), a = ua(rng_);
-  return render(motion, d, e, a);
+  return renderViews(motion, {View{d, e, a}}).front();
 }
 
 SynthSequence SkeletonSynthesizer::generateFrom(Motion motion, double distance_m, double elevation_deg,
                                                 double azimuth_deg) {
-  return render(motion, distance_m, elevation_deg, azimuth_deg);
+  return renderViews(motion, {View{distance_m, elevation_deg, azimuth_deg}}).front();
 }
 
-SynthSequence SkeletonSynthesizer::render(Motion motion, double distance_m, double elevation_deg, double azimuth_deg) {
-  drawShape();
+std::vector<SynthSequence> SkeletonSynthesizer::generateViewsFrom(Motion motion, const std::vector<View>& views) {
+  if (views.empty()) return {};
+  return renderViews(motion, views);
+}
+
+std::vector<SynthSequence> SkeletonSynthesizer::nextViews(const std::vector<double>& azimuth_offsets_deg) {
+  // The same draws as next() → generate(), in the same order.
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  Motion m;
+  if (u01(rng_) < config_.gesture_fraction) {
+    m = static_cast<Motion>(std::uniform_int_distribution<int>(0, 3)(rng_));
+  } else {
+    m = static_cast<Motion>(std::uniform_int_distribution<int>(4, static_cast<int>(Motion::kCount) - 1)(rng_));
+  }
+  std::uniform_real_distribution<double> ud(config_.distance_min_m, config_.distance_max_m);
+  std::uniform_real_distribution<double> ue(config_.elevation_min_deg, config_.elevation_max_deg);
+  std::uniform_real_distribution<double> ua(config_.azimuth_min_deg, config_.azimuth_max_deg);
+  const double d = ud(rng_), e = ue(rng_), a = ua(rng_);
+  std::vector<View> views{View{d, e, a}};
+  // Further distances from a stream of their own (the main stream must not move).
+  std::seed_seq ss{seed_, static_cast<std::uint64_t>(next_id_), std::uint64_t{0x5eedu}};
+  std::mt19937_64 extra(ss);
+  for (const double off : azimuth_offsets_deg) {
+    double az = a + off;
+    az = std::remainder(az, 360.0);
+    views.push_back(View{std::uniform_real_distribution<double>(config_.distance_min_m, config_.distance_max_m)(extra), e, az});
+  }
+  return renderViews(m, views);
+}
+
+SkeletonSynthesizer::Script SkeletonSynthesizer::drawScript(Motion motion) {
   std::uniform_real_distribution<double> u01(0.0, 1.0);
   auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * u01(rng_); };
+  Script sc;
+  sc.motion = motion;
+  sc.left_arm = u01(rng_) < 0.5;
+  const double tempo = uniform(config_.tempo_min, config_.tempo_max);
+  sc.lead = uniform(config_.lead_min_s, config_.lead_max_s);
+  sc.rise = uniform(0.4, 0.9) / tempo;
+  sc.hold = uniform(config_.hold_min_s, config_.hold_max_s);
+  sc.fall = uniform(0.4, 0.9) / tempo;
+  const double tail = uniform(config_.lead_min_s, config_.lead_max_s);
+  sc.duration = sc.lead + sc.rise + sc.hold + sc.fall + tail;
+  sc.cycle_hz = (motion == Motion::kWalking ? 0.9 : 0.45) * tempo;
+  sc.phase0 = uniform(0.0, 2.0 * common::kPi);
+  sc.noise_frac = uniform(config_.keypoint_noise_min, config_.keypoint_noise_max);
+  sc.dropout = uniform(0.0, config_.dropout_max);
+  return sc;
+}
+
+std::vector<SynthSequence> SkeletonSynthesizer::renderViews(Motion motion, const std::vector<View>& views) {
+  drawShape();
+  const Script script = drawScript(motion);
+  const int id = next_id_++;
+  std::vector<SynthSequence> out;
+  out.reserve(views.size());
+  out.push_back(project(script, id, views.front(), rng_));
+  for (std::size_t i = 1; i < views.size(); ++i) {
+    std::seed_seq ss{seed_, static_cast<std::uint64_t>(id), static_cast<std::uint64_t>(i)};
+    std::mt19937_64 rng(ss);
+    // Each camera's detector has its own noise level and dropouts.
+    Script own = script;
+    std::uniform_real_distribution<double> u01(0.0, 1.0);
+    own.noise_frac = config_.keypoint_noise_min + (config_.keypoint_noise_max - config_.keypoint_noise_min) * u01(rng);
+    own.dropout = config_.dropout_max * u01(rng);
+    out.push_back(project(own, id, views[i], rng));
+  }
+  return out;
+}
+
+SynthSequence SkeletonSynthesizer::project(const Script& script, int id, const View& view, std::mt19937_64& rng) const {
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * u01(rng); };
   std::normal_distribution<double> n01(0.0, 1.0);
+  const Motion motion = script.motion;
+  const double lead = script.lead, rise = script.rise, hold = script.hold, fall = script.fall;
+  const double duration = script.duration, cycle_hz = script.cycle_hz, phase0 = script.phase0;
+  const double noise_frac = script.noise_frac, dropout = script.dropout;
 
   SynthSequence seq;
-  seq.id = next_id_++;
+  seq.id = id;
   seq.motion = motion;
-  seq.left_arm = u01(rng_) < 0.5;
+  seq.left_arm = script.left_arm;
   seq.height_m = shape_.height;
-  seq.distance_m = distance_m;
-  seq.elevation_deg = elevation_deg;
-  seq.azimuth_deg = azimuth_deg;
-
-  const double tempo = uniform(config_.tempo_min, config_.tempo_max);
-  const double lead = uniform(config_.lead_min_s, config_.lead_max_s);
-  const double rise = uniform(0.4, 0.9) / tempo;
-  const double hold = uniform(config_.hold_min_s, config_.hold_max_s);
-  const double fall = uniform(0.4, 0.9) / tempo;
-  const double tail = uniform(config_.lead_min_s, config_.lead_max_s);
-  const double duration = lead + rise + hold + fall + tail;
+  seq.distance_m = view.distance_m;
+  seq.elevation_deg = view.elevation_deg;
+  seq.azimuth_deg = view.azimuth_deg;
   seq.motion_start_s = lead;
   seq.motion_end_s = lead + rise + hold + fall;
-  const double cycle_hz = (motion == Motion::kWalking ? 0.9 : 0.45) * tempo;
-  const double phase0 = uniform(0.0, 2.0 * common::kPi);
-  const double noise_frac = uniform(config_.keypoint_noise_min, config_.keypoint_noise_max);
-  const double dropout = uniform(0.0, config_.dropout_max);
   const double H = shape_.height;
 
   // Camera in the body frame, looking at the body centre (aim jitter ±3 % of the height).
-  const double el = degToRad(elevation_deg), az = degToRad(azimuth_deg);
+  const double el = degToRad(view.elevation_deg), az = degToRad(view.azimuth_deg);
   const Vector3d centre(0, 0, 0.55 * H);
-  const Vector3d cam = centre + distance_m * Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
-  const Vector3d aim = centre + 0.03 * H * Vector3d(n01(rng_), n01(rng_), n01(rng_));
+  const Vector3d cam = centre + view.distance_m * Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
+  const Vector3d aim = centre + 0.03 * H * Vector3d(n01(rng), n01(rng), n01(rng));
   const Vector3d zc = (aim - cam).normalized();
   const Vector3d xc = zc.cross(Vector3d::UnitZ()).normalized();
   const Vector3d yc = zc.cross(xc);
@@ -380,10 +441,10 @@ SynthSequence SkeletonSynthesizer::render(Motion motion, double distance_m, doub
     const double cx = 0.5 * (u0 + u1);
     double bu0 = cx - 0.5 * wpx - 0.08 * wpx, bu1 = cx + 0.5 * wpx + 0.08 * wpx;
     double bv0 = v0 - 0.02 * hpx, bv1 = v1 + 0.04 * hpx;
-    bu0 += config_.box_jitter * wpx * n01(rng_);
-    bu1 += config_.box_jitter * wpx * n01(rng_);
-    bv0 += config_.box_jitter * hpx * n01(rng_);
-    bv1 += config_.box_jitter * hpx * n01(rng_);
+    bu0 += config_.box_jitter * wpx * n01(rng);
+    bu1 += config_.box_jitter * wpx * n01(rng);
+    bv0 += config_.box_jitter * hpx * n01(rng);
+    bv1 += config_.box_jitter * hpx * n01(rng);
     sk.u = bu0;
     sk.v = bv0;
     sk.w = std::max(2.0, bu1 - bu0);
@@ -402,10 +463,10 @@ SynthSequence SkeletonSynthesizer::render(Motion motion, double distance_m, doub
         conf = uniform(0.05, 0.35);
         extra = 2.0;
       }
-      sk.x[i] += extra * sigma_px * n01(rng_);
-      sk.y[i] += extra * sigma_px * n01(rng_);
+      sk.x[i] += extra * sigma_px * n01(rng);
+      sk.y[i] += extra * sigma_px * n01(rng);
       const bool in_image = projected[i] && camera_.inImage(Eigen::Vector2d(sk.x[i], sk.y[i]));
-      if (!in_image || u01(rng_) < dropout) {
+      if (!in_image || u01(rng) < dropout) {
         sk.x[i] = 0.0;
         sk.y[i] = 0.0;
         conf = 0.0;

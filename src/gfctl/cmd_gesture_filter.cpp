@@ -8,6 +8,7 @@
 #include "gesture_formation/formation/formation_config.hpp"
 #include "gesture_formation/gesture/gesture_filter.hpp"
 #include "gesture_formation/gesture/gesture_mapping.hpp"
+#include "gesture_formation/gesture/view_fusion.hpp"
 
 namespace gesture_formation::gfctl {
 
@@ -30,6 +31,7 @@ int cmdGestureFilter(const Args& args) {
   const gesture::GestureFilterConfig gcfg = gesture::readGestureFilterConfig(r);
   gesture::GestureMapping mapping = gesture::GestureMapping::paperDefault();
   gesture::readGestureMapping(r, gcfg.max_gesture_id, static_cast<int>(fcfg.params.followers.size()), mapping);
+  (void)gesture::readViewFusionConfig(r);  // validated here too (used by fuse-views and the simulator)
   for (const auto& k : r.unusedKeys()) std::cerr << "gfctl gesture-filter: warning: " << path << ": unknown key '" << k << "' ignored\n";
   if (!r.ok()) {
     std::cerr << "gfctl gesture-filter: invalid configuration:\n" << r.errorReport();

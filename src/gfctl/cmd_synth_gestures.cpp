@@ -1,9 +1,13 @@
-// gfctl synth-gestures --seed S --count N --out DIR [--config FILE]
+// gfctl synth-gestures --seed S --count N --out DIR [--config FILE] [--views D1,D2,…]
 // Writes DIR/skeletons.csv (DESIGN §8.7 + label, sequence) and DIR/sequences.csv (what
 // produced each sequence). Config keys: the fields of gesture::SynthConfig (all optional).
+// --views: the same performances also seen by further cameras at these azimuth offsets [deg]
+// from the primary one (the formation's followers, e.g. 60,-60): DIR/skeletons_view1.csv, …
+// and DIR/sequences_view1.csv, … in the same layout; skeletons.csv is unchanged by it.
 #include <sys/stat.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -20,7 +24,7 @@ namespace {
 
 int cmdSynthGestures(const Args& args);
 const Registrar kRegistrar{"synth-gestures",
-                           "--seed S --count N --out DIR [--config FILE]   synthetic gesture/work-motion skeletons (DESIGN 8.7)",
+                           "--seed S --count N --out DIR [--config FILE] [--views D1,D2]   synthetic gesture/work-motion skeletons (DESIGN 8.7)",
                            cmdSynthGestures};
 
 bool readSynthConfig(const std::string& path, gesture::SynthConfig& c, std::string& report) {
@@ -54,7 +58,7 @@ bool readSynthConfig(const std::string& path, gesture::SynthConfig& c, std::stri
 }
 
 int cmdSynthGestures(const Args& args) {
-  if (!checkOptions(args, {"seed", "count", "out"}, {"config"})) return kExitBadInput;
+  if (!checkOptions(args, {"seed", "count", "out"}, {"config", "views"})) return kExitBadInput;
   const auto seed = common::parseDouble(args.get("seed"));
   const auto count = common::parseDouble(args.get("count"));
   if (!seed || *seed < 0 || *seed != static_cast<double>(static_cast<std::uint64_t>(*seed))) {
@@ -62,6 +66,23 @@ int cmdSynthGestures(const Args& args) {
   }
   if (!count || *count < 1 || *count > 1e6 || *count != static_cast<double>(static_cast<int>(*count))) {
     return badInput(args, "--count: expected an integer in [1, 1000000], got '" + args.get("count") + "'");
+  }
+  std::vector<double> offsets;
+  if (args.has("views")) {
+    std::string list = args.get("views");
+    std::size_t pos = 0;
+    while (pos <= list.size()) {
+      const std::size_t comma = std::min(list.find(',', pos), list.size());
+      const std::string item = list.substr(pos, comma - pos);
+      const auto v = common::parseDouble(item);
+      if (!v || !std::isfinite(*v) || *v < -360.0 || *v > 360.0) {
+        return badInput(args, "--views: expected comma-separated azimuth offsets in [-360, 360] deg, got '" + item + "' in '" +
+                                  list + "'");
+      }
+      offsets.push_back(*v);
+      pos = comma + 1;
+    }
+    if (offsets.size() > 8) return badInput(args, "--views: at most 8 further views, got " + std::to_string(offsets.size()));
   }
   gesture::SynthConfig config;
   if (args.has("config")) {
@@ -78,24 +99,36 @@ int cmdSynthGestures(const Args& args) {
     return badInput(args, dir + ": cannot create directory: " + (ec ? ec.message() : std::string("not a directory")));
   }
   gesture::SkeletonSynthesizer synth(config, static_cast<std::uint64_t>(*seed));
-  std::vector<gesture::SynthSequence> sequences;
-  sequences.reserve(static_cast<std::size_t>(*count));
+  const std::size_t n_views = 1 + offsets.size();
+  std::vector<std::vector<gesture::SynthSequence>> views(n_views);
+  for (auto& v : views) v.reserve(static_cast<std::size_t>(*count));
   std::size_t frames = 0;
   for (int i = 0; i < static_cast<int>(*count); ++i) {
-    sequences.push_back(synth.next());
-    frames += sequences.back().frames.size();
+    if (offsets.empty()) {
+      views[0].push_back(synth.next());
+    } else {
+      auto seqs = synth.nextViews(offsets);
+      for (std::size_t v = 0; v < n_views; ++v) views[v].push_back(std::move(seqs[v]));
+    }
+    frames += views[0].back().frames.size();
   }
-  std::string error;
-  if (!gesture::writeSkeletonCsv(dir + "/skeletons.csv", sequences, &error)) return badInput(args, error);
-  std::ofstream meta(dir + "/sequences.csv");
-  meta << "sequence,motion,gesture_id,left_arm,height_m,distance_m,elevation_deg,azimuth_deg,frames,motion_start_s,motion_end_s\n";
-  for (const auto& s : sequences) {
-    meta << s.id << ',' << gesture::toString(s.motion) << ',' << gesture::gestureIdOf(s.motion) << ',' << (s.left_arm ? 1 : 0)
-         << ',' << common::formatDouble(s.height_m) << ',' << common::formatDouble(s.distance_m) << ','
-         << common::formatDouble(s.elevation_deg) << ',' << common::formatDouble(s.azimuth_deg) << ',' << s.frames.size()
-         << ',' << common::formatDouble(s.motion_start_s) << ',' << common::formatDouble(s.motion_end_s) << '\n';
+  for (std::size_t v = 0; v < n_views; ++v) {
+    const std::string suffix = v == 0 ? "" : "_view" + std::to_string(v);
+    std::string error;
+    if (!gesture::writeSkeletonCsv(dir + "/skeletons" + suffix + ".csv", views[v], &error)) return badInput(args, error);
+    const std::string meta_path = dir + "/sequences" + suffix + ".csv";
+    std::ofstream meta(meta_path);
+    meta << "sequence,motion,gesture_id,left_arm,height_m,distance_m,elevation_deg,azimuth_deg,frames,motion_start_s,motion_end_s\n";
+    for (const auto& s : views[v]) {
+      meta << s.id << ',' << gesture::toString(s.motion) << ',' << gesture::gestureIdOf(s.motion) << ',' << (s.left_arm ? 1 : 0)
+           << ',' << common::formatDouble(s.height_m) << ',' << common::formatDouble(s.distance_m) << ','
+           << common::formatDouble(s.elevation_deg) << ',' << common::formatDouble(s.azimuth_deg) << ',' << s.frames.size()
+           << ',' << common::formatDouble(s.motion_start_s) << ',' << common::formatDouble(s.motion_end_s) << '\n';
+    }
+    meta.flush();
+    if (!meta) return badInput(args, meta_path + ": write failed");
   }
-  if (!meta) return badInput(args, dir + "/sequences.csv: write failed");
+  const auto& sequences = views[0];
   std::cout << "gfctl synth-gestures: " << sequences.size() << " sequences, " << frames << " frames → " << dir
             << "/skeletons.csv\n";
   return kExitOk;

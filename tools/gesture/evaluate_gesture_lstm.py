@@ -17,6 +17,13 @@ Definitions (docs/gestures.md):
 - a gesture sequence succeeds when the filter fires the right command while the worker
   still performs the gesture (motion_start_s ≤ t_fire ≤ motion_end_s); latency =
   t_fire − motion_start_s; any command fired during a "none" sequence is a false adaptation.
+
+Every set is also seen by the formation's two followers (cameras at ±60° azimuth from the
+leader's, Table II; `synth-gestures --views 60,-60`, the leader's file unchanged by it): each
+view is classified, `gfctl fuse-views` (gesture::ViewFusion, config/gestures.yaml) votes, and
+the fused ids go through the same filter — "filter_three_views" (the product's configuration),
+"filter_three_views_no_envelope" (the same without the envelope gate), next to the single-camera
+"filter_paper_parameters".
 """
 import argparse
 import csv
@@ -33,7 +40,8 @@ import gesture_data  # noqa: E402
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 CLASSES = ["none", "cross_arms", "extend_arm_side", "palms_together", "raise_arm_up"]
-SEQ_GAP_S = 100.0  # sequences are laid end to end this far apart (> max_age_s + cooldown_s)
+SEQ_GAP_S = 100.0
+FOLLOWER_OFFSETS_DEG = (60, -60)  # Table II: followers at ±60° from the leader  # sequences are laid end to end this far apart (> max_age_s + cooldown_s)
 
 # name, seed, sequences, config (None: the training distribution)
 CLASSIFIER_SETS = [
@@ -93,6 +101,34 @@ def classify(gfctl, model, laid_out_csv, keys, fps, work):
     return out, res
 
 
+def classify_view(gfctl, model, data_dir, suffix, fps, work):
+    """Classifies the view `suffix` ("_view1", …) and adds its camera geometry per row
+    (distance_m, elevation_deg of its sequence) for the envelope gate."""
+    vdir = os.path.join(work, "view" + suffix)
+    os.makedirs(vdir, exist_ok=True)
+    for name in ("skeletons", "sequences"):
+        src = os.path.join(data_dir, name + suffix + ".csv")
+        dst = os.path.join(vdir, name + ".csv")
+        if os.path.abspath(src) != os.path.abspath(dst):
+            with open(src) as fi, open(dst, "w") as fo:
+                fo.write(fi.read())
+    laid, keys, meta = laid_out(vdir, fps)
+    gcsv, _ = classify(gfctl, model, laid, keys, fps, vdir)
+    header, rows = read_csv(gcsv)
+    out = os.path.join(vdir, "gestures_geometry.csv")
+    with open(out, "w") as f:
+        f.write(",".join(header) + ",distance_m,elevation_deg\n")
+        for r in rows:
+            seq = int(float(r[0]) // SEQ_GAP_S)
+            f.write(",".join(r) + f",{meta[seq]['distance_m']},{meta[seq]['elevation_deg']}\n")
+    return out
+
+
+def fuse(gfctl, view_csvs, config, out):
+    run([gfctl, "fuse-views", "--in", ",".join(view_csvs), "--out", out, "--config", config])
+    return out
+
+
 def confusion(res):
     m = np.zeros((5, 5), dtype=np.int64)
     for _, _, _, y, p, _ in res:
@@ -129,7 +165,7 @@ def none_false_positives(res, meta, fps):
                           sorted(by_motion.items())}}
 
 
-def write_filter_config(path, window, min_meas, ratio):
+def write_filter_config(path, window, min_meas, ratio, gate_envelope=True):
     with open(os.path.join(ROOT, "config", "gestures.yaml")) as f:
         base = f.read()
     import yaml  # tools venv
@@ -137,6 +173,7 @@ def write_filter_config(path, window, min_meas, ratio):
     cfg["window_size"] = window
     cfg["min_measurements"] = min_meas
     cfg["ratio_threshold"] = ratio
+    cfg["view_fusion"]["gate_envelope"] = gate_envelope
     with open(path, "w") as f:
         yaml.safe_dump(cfg, f)
 
@@ -206,7 +243,7 @@ def plot_confusion(m, path, title):
     fig.savefig(path, dpi=110)
 
 
-def plot_sweep(sweep, path):
+def plot_sweep(sweep, path, label):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -220,7 +257,7 @@ def plot_sweep(sweep, path):
         a2.plot([s["ratio"] for s in pts], [s["mean_latency_s"] for s in pts], "o-", label=f"K = {K}")
     a1.set_xlabel("false commands per hour of work motions")
     a1.set_ylabel("gesture → command success [%]")
-    a1.set_title("success vs false commands (labels: ratio threshold Π_d)", fontsize=9)
+    a1.set_title(f"{label}: success vs false commands (labels: Π_d)", fontsize=9)
     a1.grid(alpha=0.3)
     a1.legend(fontsize=8)
     a2.set_xlabel("ratio threshold Π_d")
@@ -272,7 +309,7 @@ def main():
     dirs = []
     for name, seed, count, cfg in CLASSIFIER_SETS + [FILTER_SET]:
         d = gesture_data.synthesize(a.gfctl, seed, count, os.path.join(work, name),
-                                    os.path.join(ROOT, cfg) if cfg else None)
+                                    os.path.join(ROOT, cfg) if cfg else None, FOLLOWER_OFFSETS_DEG)
         laid, keys, meta = laid_out(d, fps)
         gcsv, res = classify(a.gfctl, a.model, laid, keys, fps, d)
         m = confusion(res)
@@ -281,25 +318,41 @@ def main():
                  "accuracy": round(acc, 4), "per_class": per_class(m), "confusion": m.tolist(),
                  "none_false_positives": none_false_positives(res, meta, fps),
                  "filter_paper_parameters": filter_eval(a.gfctl, gcsv, meta, os.path.join(ROOT, "config/gestures.yaml"), d)}
+        # The formation's three cameras: classify each, vote, filter.
+        views = [classify_view(a.gfctl, a.model, d, "", fps, d)]
+        views += [classify_view(a.gfctl, a.model, d, f"_view{i + 1}", fps, d) for i in range(len(FOLLOWER_OFFSETS_DEG))]
+        gesture_cfg = os.path.join(ROOT, "config/gestures.yaml")
+        fused = fuse(a.gfctl, views, gesture_cfg, os.path.join(d, "fused.csv"))
+        entry["filter_three_views"] = filter_eval(a.gfctl, fused, meta, gesture_cfg, d)
+        open_cfg = os.path.join(d, "gestures_no_envelope.yaml")
+        write_filter_config(open_cfg, 20, 20, 0.8, gate_envelope=False)
+        fused_open = fuse(a.gfctl, views, open_cfg, os.path.join(d, "fused_no_envelope.csv"))
+        entry["filter_three_views_no_envelope"] = filter_eval(a.gfctl, fused_open, meta, gesture_cfg, d)
         report["sets"][name] = entry
         print(f"{name}: accuracy {acc:.4f} on {m.sum()} windows; filter {entry['filter_paper_parameters']}")
+        print(f"{name}: three views {entry['filter_three_views']}")
+        print(f"{name}: three views, no envelope gate {entry['filter_three_views_no_envelope']}")
         if name != FILTER_SET[0]:
             all_m += m
             dirs.append(d)
         if name == FILTER_SET[0]:
-            sweep = []
+            sweep, sweep3 = [], []
             none_minutes = entry["filter_paper_parameters"]["none_minutes"]
             for K in (5, 10, 15, 20, 30):
                 for ratio in (0.5, 0.6, 0.7, 0.8, 0.9):
                     cfgp = os.path.join(d, f"filter_K{K}_r{ratio}.yaml")
                     write_filter_config(cfgp, K, K, ratio)
-                    fe = filter_eval(a.gfctl, gcsv, meta, cfgp, d)
-                    sweep.append({"K": K, "ratio": ratio, "success_rate": fe["success_rate"],
-                                  "mean_latency_s": fe["mean_latency_s"], "false_adaptations": fe["false_adaptations"],
-                                  "false_per_hour": round(60.0 * fe["false_adaptations"] / none_minutes, 2),
-                                  "wrong_commands": fe["wrong_commands"]})
+                    for src, lst in ((gcsv, sweep), (fused, sweep3)):
+                        fe = filter_eval(a.gfctl, src, meta, cfgp, d)
+                        lst.append({"K": K, "ratio": ratio, "success_rate": fe["success_rate"],
+                                    "mean_latency_s": fe["mean_latency_s"], "false_adaptations": fe["false_adaptations"],
+                                    "false_per_hour": round(60.0 * fe["false_adaptations"] / none_minutes, 2),
+                                    "wrong_commands": fe["wrong_commands"]})
             report["filter_sweep"] = sweep
-            plot_sweep(sweep, os.path.join(a.images, "gesture_filter_sweep.png"))
+            report["filter_sweep_three_views"] = sweep3
+            plot_sweep(sweep, os.path.join(a.images, "gesture_filter_sweep.png"), "one camera (the leader's)")
+            plot_sweep(sweep3, os.path.join(a.images, "gesture_filter_sweep_three_views.png"),
+                       "three cameras (leader, followers at ±60°), 2-of-3 vote")
     report["held_out_accuracy"] = round(float(np.trace(all_m) / all_m.sum()), 4)
     report["held_out_confusion"] = all_m.tolist()
     report["held_out_per_class"] = per_class(all_m)

@@ -11,11 +11,16 @@ N_FRAMES = 9
 N_FEATURES = 51
 
 
-def synthesize(gfctl, seed, count, out_dir, config=None):
-    if not os.path.exists(os.path.join(out_dir, "skeletons.csv")):
+def synthesize(gfctl, seed, count, out_dir, config=None, views=None):
+    """views: azimuth offsets [deg] of further cameras (skeletons_view1.csv, …); the primary
+    skeletons.csv is the same with or without them."""
+    last = "skeletons_view%d.csv" % len(views) if views else "skeletons.csv"
+    if not os.path.exists(os.path.join(out_dir, last)):
         cmd = [gfctl, "synth-gestures", "--seed", str(seed), "--count", str(count), "--out", out_dir]
         if config:
             cmd += ["--config", config]
+        if views:
+            cmd += ["--views", ",".join(str(v) for v in views)]
         subprocess.run(cmd, check=True)
     return out_dir
 

@@ -95,6 +95,21 @@ class SkeletonSynthesizer {
   /// actual camera). Box and keypoints are in that camera's image.
   SynthSequence generateFrom(Motion motion, double distance_m, double elevation_deg, double azimuth_deg);
 
+  /// \brief One viewpoint around the worker (the formation's other cameras).
+  struct View {
+    double distance_m = 10.0, elevation_deg = 0.0, azimuth_deg = 0.0;
+  };
+  /// The same performance (same body, motion, timing and pose variation) seen from several
+  /// cameras at once: element 0 is exactly what generateFrom(views[0]…) would have returned
+  /// (the same random draws, so single-view datasets stay reproducible); every further view
+  /// has its own aim jitter, keypoint noise, dropouts and box jitter, from a random stream
+  /// derived from (seed, sequence id, view index) that leaves the main stream untouched.
+  std::vector<SynthSequence> generateViewsFrom(Motion motion, const std::vector<View>& views);
+  /// A random motion (as next()) seen from a random primary viewpoint and from further
+  /// cameras at the given azimuth offsets [deg] from it (same elevation; distance drawn in
+  /// the configured range from the view's own stream). Element 0 equals next().
+  std::vector<SynthSequence> nextViews(const std::vector<double>& azimuth_offsets_deg);
+
   /// The body posed for `motion` at progress `s` ∈ [0, 1] (0 rest, 1 full pose) and cycle
   /// phase `phase` [rad] for cyclic motions. Exposed for tests of the pose definitions.
   Body3D pose(Motion motion, double s, double phase, bool left_arm) const;
@@ -110,7 +125,16 @@ class SkeletonSynthesizer {
   struct Variation {  // per-sequence pose variation
     double a = 0.5, b = 0.5, c = 0.5, d = 0.5;
   };
-  SynthSequence render(Motion motion, double distance_m, double elevation_deg, double azimuth_deg);
+  /// The per-sequence draws that do not depend on the camera.
+  struct Script {
+    Motion motion = Motion::kIdle;
+    bool left_arm = true;
+    double lead = 0, rise = 0, hold = 0, fall = 0, duration = 0, cycle_hz = 0, phase0 = 0;
+    double noise_frac = 0, dropout = 0;
+  };
+  Script drawScript(Motion motion);
+  SynthSequence project(const Script& script, int id, const View& view, std::mt19937_64& rng) const;
+  std::vector<SynthSequence> renderViews(Motion motion, const std::vector<View>& views);
   void drawShape();
 
   SynthConfig config_;
@@ -119,6 +143,7 @@ class SkeletonSynthesizer {
   BodyShape shape_;
   Variation var_;
   int next_id_ = 0;
+  std::uint64_t seed_ = 0;
 };
 
 /// \brief Writes sequences as DESIGN §8.7 CSV with `label` and `sequence` columns.

@@ -2,6 +2,7 @@
 
 #include "gesture_formation/gesture/gesture_filter.hpp"
 #include "gesture_formation/gesture/gesture_mapping.hpp"
+#include "gesture_formation/gesture/view_fusion.hpp"
 
 using namespace gesture_formation::gesture;
 using gesture_formation::common::ConfigReader;
@@ -91,8 +92,11 @@ TEST(GestureMappingTest, ShippedConfigIsThePapersAndComplete) {
   const GestureFilterConfig fc = readGestureFilterConfig(r);
   GestureMapping m;
   readGestureMapping(r, fc.max_gesture_id, 2, m);
+  const ViewFusionConfig vf = readViewFusionConfig(r);
   ASSERT_TRUE(r.ok()) << r.errorReport();
   EXPECT_TRUE(r.unusedKeys().empty());
+  EXPECT_TRUE(vf.validate().empty());
+  EXPECT_EQ(vf.min_agreeing_views, 2);
   EXPECT_EQ(fc.window_size, 20);
   EXPECT_EQ(m.actions.size(), 4u);
   EXPECT_EQ(m.find(2)->increment, 30.0);

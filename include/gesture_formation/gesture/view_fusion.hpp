@@ -1,0 +1,94 @@
+#pragma once
+/// \file
+/// \brief Multi-view vote over the gesture classifications of the formation's cameras
+/// (docs/gestures.md §6; beyond the paper, whose future work it is).
+///
+/// One camera sees the worker in 2-D, and some work postures project exactly like a gesture
+/// from some viewpoints: an arm pointing forward and outward, seen from ~30° beside the
+/// pointing direction, projects like an arm extended to the side. The formation watches the
+/// worker from several azimuths at once (the followers sit ±60° from the leader, Table II);
+/// a posture that looks like a gesture from one of them does not from the others. Each UAV
+/// classifies its own view (the same LSTM), the leader keeps the newest classification of
+/// every view and, per leader frame, fuses them into the one id that goes to the
+/// GestureFilter (whose parameters stay the paper's):
+///  - a view votes only when its classification is fresh (t_now − t ≤ max_age_s) and, with
+///    gate_envelope, its camera is inside the classifier's validated envelope (distance and
+///    elevation of the camera from the worker within the training ranges) — a view outside
+///    it, or of unknown geometry, does not vote;
+///  - the fused id is the gesture id (≠ 0) with the most votes when that count is unique and
+///    ≥ min_agreeing_views; otherwise 0 (none). "none" votes never outvote a gesture, so
+///    a gesture seen by two of three views passes; a posture seen as a gesture by one view
+///    does not.
+/// min_agreeing_views = 1 with one view is the paper's single-camera pipeline.
+/// Thread safety: none; one instance per thread.
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "gesture_formation/common/config_reader.hpp"
+
+namespace gesture_formation::gesture {
+
+/// \brief Parameters (YAML `view_fusion.*` of config/gestures.yaml).
+struct ViewFusionConfig {
+  int min_agreeing_views = 2;     ///< votes the winning gesture needs, ≥ 1 (1: single camera)
+  double max_age_s = 0.25;        ///< a classification votes while t_now − t ≤ this [s], > 0
+  bool gate_envelope = true;      ///< views outside the validated envelope do not vote
+  double distance_min_m = 5.0;    ///< envelope (the LSTM's training ranges, docs/gestures.md §2)
+  double distance_max_m = 20.0;
+  double elevation_min_deg = 0.0;
+  double elevation_max_deg = 45.0;
+
+  /// \brief Every problem, each naming the key; empty when valid.
+  std::vector<std::string> validate() const;
+};
+
+/// \brief Reads `view_fusion.{min_agreeing_views, max_age_s, gate_envelope, distance_min_m,
+/// distance_max_m, elevation_min_deg, elevation_max_deg}` (missing keys: the defaults above
+/// unless the reader requires every key).
+ViewFusionConfig readViewFusionConfig(common::ConfigReader& reader);
+
+/// \brief One camera's classification of one frame.
+struct ViewObservation {
+  int view = 0;                 ///< 0 = the leader, 1.. = followers
+  double t_s = 0.0;             ///< frame time [s]
+  int gesture_id = 0;           ///< the classifier's argmax, 0..max_gesture_id
+  double distance_m = -1.0;     ///< camera → worker [m]; < 0 or NaN: unknown
+  double elevation_deg = 0.0;   ///< camera above the worker [deg] (NaN: unknown)
+};
+
+/// \brief The fused verdict of one frame.
+struct FusedGesture {
+  int gesture_id = 0;      ///< what goes to the GestureFilter
+  int voting_views = 0;    ///< fresh views inside the envelope
+  int agreeing_views = 0;  ///< votes for gesture_id (for 0: votes of the best gesture, which fell short)
+};
+
+/// \brief Keeps the newest observation per view and fuses them.
+class ViewFusion {
+ public:
+  /// `views` cameras (ids 0..views−1), gesture ids 0..max_gesture_id. Call validate() on the
+  /// config first; an invalid config is clamped to something safe (min_agreeing_views ≥ 1).
+  ViewFusion(const ViewFusionConfig& config, int views, int max_gesture_id);
+
+  /// Stores `o` as its view's newest observation. Rejected (false, `reason` set, nothing
+  /// changed): unknown view id, t not finite or older than that view's stored observation,
+  /// gesture id outside 0..max_gesture_id.
+  bool observe(const ViewObservation& o, std::string* reason = nullptr);
+  /// The fused id at t_now from the stored observations.
+  FusedGesture fuse(double t_now) const;
+  /// Whether a view's geometry lies inside the validated envelope.
+  bool inEnvelope(double distance_m, double elevation_deg) const;
+
+  int views() const { return static_cast<int>(latest_.size()); }
+  const ViewFusionConfig& config() const { return config_; }
+
+ private:
+  ViewFusionConfig config_;
+  int max_gesture_id_;
+  std::vector<ViewObservation> latest_;
+  std::vector<bool> have_;
+};
+
+}  // namespace gesture_formation::gesture

@@ -1,0 +1,123 @@
+#include "gesture_formation/gesture/view_fusion.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "gesture_formation/common/csv.hpp"
+
+namespace gesture_formation::gesture {
+
+using common::ConfigReader;
+using common::Range;
+
+std::vector<std::string> ViewFusionConfig::validate() const {
+  std::vector<std::string> e;
+  const auto num = [](double v) { return common::formatDouble(v); };
+  if (min_agreeing_views < 1 || min_agreeing_views > 16) {
+    e.push_back("view_fusion.min_agreeing_views must be in [1, 16], got " + std::to_string(min_agreeing_views));
+  }
+  if (!(std::isfinite(max_age_s) && max_age_s > 0.0)) e.push_back("view_fusion.max_age_s must be > 0, got " + num(max_age_s));
+  if (!(std::isfinite(distance_min_m) && distance_min_m >= 0.0)) {
+    e.push_back("view_fusion.distance_min_m must be >= 0, got " + num(distance_min_m));
+  }
+  if (!(std::isfinite(distance_max_m) && distance_max_m > distance_min_m)) {
+    e.push_back("view_fusion.distance_max_m must exceed distance_min_m=" + num(distance_min_m) + ", got " + num(distance_max_m));
+  }
+  if (!(elevation_min_deg >= -90.0 && elevation_min_deg <= 90.0)) {
+    e.push_back("view_fusion.elevation_min_deg must be in [-90, 90], got " + num(elevation_min_deg));
+  }
+  if (!(elevation_max_deg > elevation_min_deg && elevation_max_deg <= 90.0)) {
+    e.push_back("view_fusion.elevation_max_deg must be in (elevation_min_deg=" + num(elevation_min_deg) + ", 90], got " +
+                num(elevation_max_deg));
+  }
+  return e;
+}
+
+ViewFusionConfig readViewFusionConfig(ConfigReader& r) {
+  ViewFusionConfig c;
+  const std::string k = "view_fusion.";
+  r.readInt(k + "min_agreeing_views", c.min_agreeing_views, Range::closed(1, 16));
+  r.readDouble(k + "max_age_s", c.max_age_s, Range::positive());
+  r.readBool(k + "gate_envelope", c.gate_envelope);
+  r.readDouble(k + "distance_min_m", c.distance_min_m, Range::nonNegative());
+  r.readDouble(k + "distance_max_m", c.distance_max_m, Range::positive());
+  r.readDouble(k + "elevation_min_deg", c.elevation_min_deg, Range::closed(-90.0, 90.0));
+  r.readDouble(k + "elevation_max_deg", c.elevation_max_deg, Range::closed(-90.0, 90.0));
+  if (c.distance_max_m <= c.distance_min_m) {
+    r.addError(k + "distance_max_m", "value " + common::formatDouble(c.distance_max_m) + " must exceed distance_min_m " +
+                                         common::formatDouble(c.distance_min_m));
+  }
+  if (c.elevation_max_deg <= c.elevation_min_deg) {
+    r.addError(k + "elevation_max_deg", "value " + common::formatDouble(c.elevation_max_deg) +
+                                            " must exceed elevation_min_deg " + common::formatDouble(c.elevation_min_deg));
+  }
+  return c;
+}
+
+ViewFusion::ViewFusion(const ViewFusionConfig& config, int views, int max_gesture_id)
+    : config_(config),
+      max_gesture_id_(std::max(1, max_gesture_id)),
+      latest_(static_cast<std::size_t>(std::max(1, views))),
+      have_(static_cast<std::size_t>(std::max(1, views)), false) {
+  config_.min_agreeing_views = std::max(1, config_.min_agreeing_views);
+}
+
+bool ViewFusion::observe(const ViewObservation& o, std::string* reason) {
+  const auto fail = [&](const std::string& why) {
+    if (reason) *reason = why;
+    return false;
+  };
+  if (o.view < 0 || o.view >= views()) {
+    return fail("view " + std::to_string(o.view) + " outside 0.." + std::to_string(views() - 1));
+  }
+  if (!std::isfinite(o.t_s)) return fail("view " + std::to_string(o.view) + ": t not finite");
+  if (o.gesture_id < 0 || o.gesture_id > max_gesture_id_) {
+    return fail("view " + std::to_string(o.view) + ": gesture_id " + std::to_string(o.gesture_id) + " outside 0.." +
+                std::to_string(max_gesture_id_));
+  }
+  const auto i = static_cast<std::size_t>(o.view);
+  if (have_[i] && o.t_s < latest_[i].t_s) {
+    return fail("view " + std::to_string(o.view) + ": t " + common::formatDouble(o.t_s) + " older than the stored " +
+                common::formatDouble(latest_[i].t_s));
+  }
+  latest_[i] = o;
+  have_[i] = true;
+  return true;
+}
+
+bool ViewFusion::inEnvelope(double distance_m, double elevation_deg) const {
+  if (!config_.gate_envelope) return true;
+  if (!(std::isfinite(distance_m) && distance_m >= 0.0 && std::isfinite(elevation_deg))) return false;  // unknown
+  return distance_m >= config_.distance_min_m && distance_m <= config_.distance_max_m &&
+         elevation_deg >= config_.elevation_min_deg && elevation_deg <= config_.elevation_max_deg;
+}
+
+FusedGesture ViewFusion::fuse(double t_now) const {
+  FusedGesture out;
+  std::vector<int> votes(static_cast<std::size_t>(max_gesture_id_ + 1), 0);
+  for (std::size_t i = 0; i < latest_.size(); ++i) {
+    if (!have_[i]) continue;
+    const ViewObservation& o = latest_[i];
+    if (!(t_now - o.t_s <= config_.max_age_s) || o.t_s > t_now + config_.max_age_s) continue;
+    if (!inEnvelope(o.distance_m, o.elevation_deg)) continue;
+    ++out.voting_views;
+    ++votes[static_cast<std::size_t>(o.gesture_id)];
+  }
+  int best = 0, best_votes = 0;
+  bool unique = false;
+  for (int g = 1; g <= max_gesture_id_; ++g) {
+    const int v = votes[static_cast<std::size_t>(g)];
+    if (v > best_votes) {
+      best = g;
+      best_votes = v;
+      unique = true;
+    } else if (v == best_votes && v > 0) {
+      unique = false;
+    }
+  }
+  out.agreeing_views = best_votes;
+  if (best_votes >= config_.min_agreeing_views && unique) out.gesture_id = best;
+  return out;
+}
+
+}  // namespace gesture_formation::gesture

@@ -1,0 +1,130 @@
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "gesture_formation/gesture/view_fusion.hpp"
+
+using namespace gesture_formation::gesture;
+using gesture_formation::common::ConfigReader;
+
+namespace {
+
+ViewObservation obs(int view, double t, int id, double d = 10.0, double el = 20.0) {
+  ViewObservation o;
+  o.view = view;
+  o.t_s = t;
+  o.gesture_id = id;
+  o.distance_m = d;
+  o.elevation_deg = el;
+  return o;
+}
+
+}  // namespace
+
+TEST(ViewFusionTest, TwoOfThreeAgreeingViewsPassAGesture) {
+  ViewFusion f(ViewFusionConfig{}, 3, 4);
+  ASSERT_TRUE(f.observe(obs(0, 1.0, 2)));
+  ASSERT_TRUE(f.observe(obs(1, 1.0, 0)));
+  ASSERT_TRUE(f.observe(obs(2, 1.0, 2)));
+  const FusedGesture g = f.fuse(1.0);
+  EXPECT_EQ(g.gesture_id, 2);
+  EXPECT_EQ(g.voting_views, 3);
+  EXPECT_EQ(g.agreeing_views, 2);
+}
+
+TEST(ViewFusionTest, OneViewSeeingAGestureIsNotEnough) {
+  ViewFusion f(ViewFusionConfig{}, 3, 4);
+  f.observe(obs(0, 1.0, 2));  // the leader sees "extend arm" (a pointing arm from the wrong side)
+  f.observe(obs(1, 1.0, 0));
+  f.observe(obs(2, 1.0, 0));
+  EXPECT_EQ(f.fuse(1.0).gesture_id, 0);
+  EXPECT_EQ(f.fuse(1.0).agreeing_views, 1);
+}
+
+TEST(ViewFusionTest, ConflictingGesturesWithEqualVotesFuseToNone) {
+  ViewFusionConfig c;
+  c.min_agreeing_views = 1;
+  ViewFusion f(c, 2, 4);
+  f.observe(obs(0, 1.0, 2));
+  f.observe(obs(1, 1.0, 4));
+  EXPECT_EQ(f.fuse(1.0).gesture_id, 0);  // a tie is no majority
+  f.observe(obs(1, 1.1, 2));
+  EXPECT_EQ(f.fuse(1.1).gesture_id, 2);
+}
+
+TEST(ViewFusionTest, SingleCameraConfigurationIsThePapersPipeline) {
+  ViewFusionConfig c;
+  c.min_agreeing_views = 1;
+  ViewFusion f(c, 1, 4);
+  for (int id = 0; id <= 4; ++id) {
+    ASSERT_TRUE(f.observe(obs(0, id, id)));
+    EXPECT_EQ(f.fuse(id).gesture_id, id);
+  }
+}
+
+TEST(ViewFusionTest, StaleViewsDoNotVote) {
+  ViewFusion f(ViewFusionConfig{}, 3, 4);  // max_age_s 0.25
+  f.observe(obs(0, 10.0, 3));
+  f.observe(obs(1, 9.70, 3));  // 0.30 s old at t = 10
+  f.observe(obs(2, 10.0, 0));
+  const FusedGesture g = f.fuse(10.0);
+  EXPECT_EQ(g.gesture_id, 0);
+  EXPECT_EQ(g.voting_views, 2);
+  f.observe(obs(1, 9.80, 3));  // 0.20 s old: votes
+  EXPECT_EQ(f.fuse(10.0).gesture_id, 3);
+}
+
+TEST(ViewFusionTest, ViewsOutsideTheEnvelopeOrOfUnknownGeometryDoNotVote) {
+  ViewFusion f(ViewFusionConfig{}, 3, 4);  // envelope 5–20 m, 0–45°
+  f.observe(obs(0, 1.0, 4, 10.0, 20.0));
+  f.observe(obs(1, 1.0, 4, 10.0, 55.0));          // too steep
+  f.observe(obs(2, 1.0, 4, 24.0, 20.0));          // too far
+  EXPECT_EQ(f.fuse(1.0).gesture_id, 0);
+  EXPECT_EQ(f.fuse(1.0).voting_views, 1);
+  f.observe(obs(2, 1.0, 4, std::nan(""), 20.0));  // unknown distance
+  EXPECT_EQ(f.fuse(1.0).voting_views, 1);
+  f.observe(obs(2, 1.0, 4, 19.9, 44.9));
+  EXPECT_EQ(f.fuse(1.0).gesture_id, 4);
+  ViewFusionConfig open;
+  open.gate_envelope = false;
+  ViewFusion g(open, 2, 4);
+  g.observe(obs(0, 1.0, 4, 30.0, 70.0));
+  g.observe(obs(1, 1.0, 4, std::nan(""), std::nan("")));
+  EXPECT_EQ(g.fuse(1.0).gesture_id, 4);
+}
+
+TEST(ViewFusionTest, BadObservationsAreRejectedAndChangeNothing) {
+  ViewFusion f(ViewFusionConfig{}, 2, 4);
+  ASSERT_TRUE(f.observe(obs(0, 5.0, 1)));
+  ASSERT_TRUE(f.observe(obs(1, 5.0, 1)));
+  std::string why;
+  EXPECT_FALSE(f.observe(obs(2, 5.0, 1), &why));
+  EXPECT_NE(why.find("view 2"), std::string::npos) << why;
+  EXPECT_FALSE(f.observe(obs(0, std::nan(""), 3), &why));
+  EXPECT_NE(why.find("not finite"), std::string::npos) << why;
+  EXPECT_FALSE(f.observe(obs(0, 5.1, 7), &why));
+  EXPECT_NE(why.find("gesture_id 7"), std::string::npos) << why;
+  EXPECT_FALSE(f.observe(obs(1, 4.0, 3), &why));  // older than the stored one
+  EXPECT_NE(why.find("older"), std::string::npos) << why;
+  EXPECT_EQ(f.fuse(5.0).gesture_id, 1);  // the stored observations are intact
+  EXPECT_EQ(f.fuse(5.0).agreeing_views, 2);
+}
+
+TEST(ViewFusionTest, ConfigReaderListsEveryBadKey) {
+  const std::string yaml =
+      "view_fusion: {min_agreeing_views: 0, max_age_s: -1, distance_min_m: 10, distance_max_m: 5, "
+      "elevation_min_deg: 30, elevation_max_deg: 10}\n";
+  ConfigReader r = ConfigReader::fromString(yaml, "test.yaml", ConfigReader::MissingKeys::kUseDefaults);
+  (void)readViewFusionConfig(r);
+  EXPECT_FALSE(r.ok());
+  const std::string report = r.errorReport();
+  for (const char* key : {"view_fusion.min_agreeing_views", "view_fusion.max_age_s", "view_fusion.distance_max_m",
+                          "view_fusion.elevation_max_deg"}) {
+    EXPECT_NE(report.find(key), std::string::npos) << key << " missing in:\n" << report;
+  }
+  ViewFusionConfig bad;
+  bad.elevation_max_deg = -5.0;
+  bad.max_age_s = std::nan("");
+  EXPECT_EQ(bad.validate().size(), 2u);
+  EXPECT_TRUE(ViewFusionConfig{}.validate().empty());
+}
