@@ -140,17 +140,23 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
       return;
     }
     params_ = *p;
+    received_version_ = msg->version;
   }
   void onCommand(const gesture_formation::FormationCommand::ConstPtr& msg) {
     auto cmd = fromMsg(*msg);
     std::lock_guard<std::mutex> lock(mutex_);
     last_command_ = msg->source + " " + msg->sender + "#" + std::to_string(msg->sequence) + ": " + msg->target +
                     "." + msg->parameter + (msg->kind == "set" ? " = " : " += ") + std::to_string(msg->amount);
+    last_source_ = msg->source;
+    last_stamp_ = msg->header.stamp;
+    last_uavs_.clear();
     if (!cmd) {
       last_outcome_ = "rejected: " + cmd.reason();
+      last_status_ = formation::toString(formation::CommandStatus::kRejected);
     } else {
       const auto out = state_->apply(*cmd);
       last_outcome_ = formation::toString(out.status);
+      last_status_ = last_outcome_;
       if (!out.reason.empty()) last_outcome_ += ": " + out.reason;
       for (const auto& c : out.changes) {
         if (c.clamped) last_outcome_ += " (clamped by " + c.clamp_rule + ")";
@@ -158,6 +164,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
       if (out.status == formation::CommandStatus::kApplied) {
         ++version_;
         params_ = state_->params();
+        for (const auto& c : out.changes) last_uavs_.push_back(c.uav);
       }
     }
     NODELET_INFO_STREAM("FormationPlanner: command " << last_command_ << " → " << last_outcome_);
@@ -169,6 +176,10 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     m.header.frame_id = world_frame_;
     m.last_command = last_command_;
     m.last_outcome = last_outcome_;
+    m.last_command_source = last_source_;
+    m.last_command_stamp = last_stamp_;
+    m.last_command_status = last_status_;
+    m.last_command_uavs = last_uavs_;
     params_pub_.publish(m);
   }
 
@@ -214,6 +225,8 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     auto msg = toMsg(res);
     msg.header.frame_id = world_frame_;
     msg.uav_index = uav_index_;
+    msg.params_version = uav_index_ == formation::kLeader ? version_ : received_version_;
+    msg.planned_at = ros::Time(t);
     for (int k = 0; k < req.reference.steps(); ++k) msg.reference.push_back(toPoint(req.reference.p_world.col(k)));
     plan_pub_.publish(msg);
     traj_pub_.publish(toMultiDof(msg, "uav" + std::to_string(uav_index_)));
@@ -226,9 +239,12 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   formation::FormationParams params_;
   std::optional<formation::WorkerHeading> heading_;
   std::optional<formation::FormationState> state_;
-  std::uint64_t version_ = 0;
+  std::uint64_t version_ = 0;           ///< leader: the parameters' version
+  std::uint64_t received_version_ = 0;  ///< followers: the version of the parameters received
   sim::AvoidanceRule rule_;
-  std::string last_command_, last_outcome_;
+  std::string last_command_, last_outcome_, last_source_, last_status_;
+  ros::Time last_stamp_;
+  std::vector<int> last_uavs_;
   std::unique_ptr<planning::UavPlanner> planner_;
   std::optional<planning::UavKinematicState> odom_;
   std::optional<gesture_formation::WorkerState> worker_;
