@@ -18,10 +18,13 @@
 
 namespace gesture_formation::nodelets {
 
-/// The scenario's map and distance field (built once per process that loads it).
+/// The scenario's map and distance field (built once per process that loads it), and its
+/// exact solids and ground height (the obstacle-distance metric, sim::ObstacleDistance).
 struct WorldMap {
   std::shared_ptr<const planning::OccupancyMap> map;
   std::shared_ptr<const planning::DistanceField> field;
+  std::shared_ptr<const planning::PrimitiveSet> solids;
+  double ground_height_m = -1e9;  ///< −1e9: the scenario has no ground
 };
 
 inline bool loadWorldMap(const std::string& scenario_file, ParamLoader& params, WorldMap& out) {
@@ -38,6 +41,8 @@ inline bool loadWorldMap(const std::string& scenario_file, ParamLoader& params, 
   }
   out.map = std::make_shared<const planning::OccupancyMap>(std::move(*map));
   out.field = std::make_shared<const planning::DistanceField>(*out.map);
+  out.solids = std::make_shared<const planning::PrimitiveSet>(sc->primitives());
+  out.ground_height_m = sc->ground.enabled ? sc->ground.height_m : -1e9;
   return true;
 }
 

@@ -21,6 +21,7 @@
 #include "gesture_formation/formation/formation_params.hpp"
 #include "gesture_formation/planning/uav_planner.hpp"
 #include "gesture_formation/sim/mission_config.hpp"
+#include "gesture_formation/sim/multirotor.hpp"
 
 namespace gesture_formation::nodelets {
 
@@ -97,6 +98,18 @@ inline planning::UavKinematicState toKinematicState(const nav_msgs::Odometry& od
   return s;
 }
 
+/// A true state (ground truth odometry) as the sim core's plant state: position, velocity,
+/// camera heading and pitch.
+inline sim::MultirotorState toMultirotorState(const nav_msgs::Odometry& odom) {
+  const planning::UavKinematicState k = toKinematicState(odom);
+  sim::MultirotorState s;
+  s.p_world = k.p_world;
+  s.v_world = k.v_world;
+  s.heading_rad = k.heading_rad;
+  s.pitch_rad = k.pitch_rad;
+  return s;
+}
+
 // ---- planned trajectories --------------------------------------------------------------
 inline gesture_formation::PlannedTrajectory toMsg(const planning::PlannedTrajectory& plan) {
   gesture_formation::PlannedTrajectory m;
@@ -122,6 +135,15 @@ inline gesture_formation::PlannedTrajectory toMsg(const planning::PlanResult& r)
   m.planning_ms = r.timings.total_ms;
   for (const auto& p : r.path_world) m.path.push_back(toPoint(p));
   return m;
+}
+/// PlannedTrajectory.status → PlanStatus (fails naming the value).
+inline common::Result<planning::PlanStatus> planStatusFromName(const std::string& name) {
+  using R = common::Result<planning::PlanStatus>;
+  for (const auto s : {planning::PlanStatus::kOptimized, planning::PlanStatus::kFallbackPrevious,
+                       planning::PlanStatus::kFallbackBrake}) {
+    if (name == planning::toString(s)) return R::ok(s);
+  }
+  return R::fail("PlannedTrajectory.status '" + name + "': expected optimized | fallback_previous | fallback_brake");
 }
 /// Fails naming the field when the arrays disagree in length or dt is not positive.
 inline common::Result<planning::PlannedTrajectory> fromMsg(const gesture_formation::PlannedTrajectory& m) {

@@ -5,7 +5,9 @@
 // previous plan / brake, flagged `fallback` so that every other UAV plans around it).
 // The leader's instance also owns the formation's parameters (formation::FormationState):
 // commands arrive on formation_command_in (gestures, operator over LCM) and the parameters go
-// out on formation_params_out.
+// out on formation_params_out. The request (reference + the other UAVs' plans to avoid) is
+// sim::buildPlanRequest, the same as gfctl simulate's: with avoid_all_plans every UAV plans
+// around every other UAV's received plan.
 //
 // Topics: odometry_in (nav_msgs/Odometry, orientation = camera axis, docs/ros.md),
 //   worker_state_in (WorkerState: the leader's estimator, or the leader's share over LCM),
@@ -15,7 +17,9 @@
 // Parameters (all required unless noted): ~uav_index, ~uav_count, ~world_frame,
 //   ~scenario_file (the map), ~mission_file (optional: take formation + planner from a
 //   scenario's mission) or ~formation_config + ~planner_config, ~replanning_period_s,
-//   ~horizon_dt_s, ~horizon_steps, ~max_share_age_s, ~params_rate_hz.
+//   ~horizon_dt_s, ~horizon_steps, ~max_share_age_s, ~params_rate_hz; without ~mission_file
+//   also ~avoid_all_plans, ~max_plan_age_s (with it: the mission's faults.avoid_all_plans and
+//   faults.max_plan_age_s, as gfctl simulate).
 #include <map>
 #include <mutex>
 #include <optional>
@@ -28,6 +32,7 @@
 #include "conversions.hpp"
 #include "gesture_formation/formation/formation_geometry.hpp"
 #include "gesture_formation/formation/worker_heading.hpp"
+#include "gesture_formation/sim/plan_request_builder.hpp"
 #include "param_loader.hpp"
 
 namespace gesture_formation::nodelets {
@@ -56,10 +61,13 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
       if (loadMission(mission_file, params, mission)) {
         fcfg = mission.formation;
         pcfg = mission.planner;
+        rule_ = sim::AvoidanceRule{mission.faults.avoid_all_plans, mission.faults.max_plan_age_s};
       }
     } else {
       params.load("formation_config", formation_file);
       params.load("planner_config", planner_file);
+      params.load("avoid_all_plans", rule_.avoid_all_plans);
+      params.load("max_plan_age_s", rule_.max_plan_age_s, 0.01, 60.0);
       if (!formation_file.empty()) loadFormation(formation_file, params, fcfg);
       if (!planner_file.empty()) loadPlanner(planner_file, params, pcfg);
     }
@@ -121,7 +129,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     }
     std::lock_guard<std::mutex> lock(mutex_);
     auto& slot = received_[static_cast<std::size_t>(msg->uav_index)];
-    if (!slot || plan->t0_s >= slot->plan.t0_s) slot = Received{std::move(*plan), msg->fallback != 0};
+    if (!slot || plan->t0_s >= slot->plan.t0_s) slot = sim::ReceivedPlan{std::move(*plan), msg->fallback != 0};
   }
   void onParams(const gesture_formation::FormationParams::ConstPtr& msg) {
     auto p = fromMsg(*msg);
@@ -132,17 +140,23 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
       return;
     }
     params_ = *p;
+    received_version_ = msg->version;
   }
   void onCommand(const gesture_formation::FormationCommand::ConstPtr& msg) {
     auto cmd = fromMsg(*msg);
     std::lock_guard<std::mutex> lock(mutex_);
     last_command_ = msg->source + " " + msg->sender + "#" + std::to_string(msg->sequence) + ": " + msg->target +
                     "." + msg->parameter + (msg->kind == "set" ? " = " : " += ") + std::to_string(msg->amount);
+    last_source_ = msg->source;
+    last_stamp_ = msg->header.stamp;
+    last_uavs_.clear();
     if (!cmd) {
       last_outcome_ = "rejected: " + cmd.reason();
+      last_status_ = formation::toString(formation::CommandStatus::kRejected);
     } else {
       const auto out = state_->apply(*cmd);
       last_outcome_ = formation::toString(out.status);
+      last_status_ = last_outcome_;
       if (!out.reason.empty()) last_outcome_ += ": " + out.reason;
       for (const auto& c : out.changes) {
         if (c.clamped) last_outcome_ += " (clamped by " + c.clamp_rule + ")";
@@ -150,6 +164,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
       if (out.status == formation::CommandStatus::kApplied) {
         ++version_;
         params_ = state_->params();
+        for (const auto& c : out.changes) last_uavs_.push_back(c.uav);
       }
     }
     NODELET_INFO_STREAM("FormationPlanner: command " << last_command_ << " → " << last_outcome_);
@@ -161,6 +176,10 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     m.header.frame_id = world_frame_;
     m.last_command = last_command_;
     m.last_outcome = last_outcome_;
+    m.last_command_source = last_source_;
+    m.last_command_stamp = last_stamp_;
+    m.last_command_status = last_status_;
+    m.last_command_uavs = last_uavs_;
     params_pub_.publish(m);
   }
 
@@ -184,41 +203,20 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     const Eigen::Vector3d v0 = worker_->lost ? Eigen::Vector3d::Zero() : toEigen(worker_->velocity);
     const Eigen::Vector3d p0 = toEigen(worker_->position) + std::max(0.0, age) * v0;
     const double hphi = heading_->update(v0);
-    const formation::WorkerHorizon wh = formation::constantVelocityHorizon(p0, v0, hphi, horizon_steps_, horizon_dt_s_);
-    planning::PlanRequest req;
-    req.uav_index = uav_index_;
-    req.t_now_s = t;
-    req.dt_s = horizon_dt_s_;
-    req.state = *odom_;
-    req.state.t_s = t;
+    sim::PlanRequestInputs in;
+    in.uav_index = uav_index_;
+    in.t_s = t;
+    in.dt_s = horizon_dt_s_;
+    in.state = *odom_;
     const auto& last = planner_->lastVerifiedPlan();
-    if (!last.empty()) req.state.a_world = last.sampleAt(t).a_world;
-    req.worker = wh;
-    if (uav_index_ == formation::kLeader) {
-      formation::leaderHorizon(wh, params_.leader, req.reference);
-    } else {
-      const auto& leader = received_[0];
-      const bool has_plan = leader && !leader->plan.empty() && t - leader->plan.t0_s <= max_share_age_s_;
-      formation::LeaderPlan lp;
-      if (has_plan) {
-        lp.heading_rad.resize(1, horizon_steps_);
-        lp.pitch_rad.resize(1, horizon_steps_);
-        for (int k = 0; k < horizon_steps_; ++k) {
-          const auto s = leader->plan.sampleAt(t + k * horizon_dt_s_);
-          lp.heading_rad(k) = s.heading_rad;
-          lp.pitch_rad(k) = s.pitch_rad;
-        }
-        req.higher_priority_plans.push_back(leader->plan);
-      }
-      formation::followerHorizon(wh, params_.leader, has_plan ? &lp : nullptr,
-                                 params_.followers[static_cast<std::size_t>(uav_index_ - 1)], req.reference);
-    }
-    for (int j = 1; j < uav_count_; ++j) {
-      const auto& m = received_[static_cast<std::size_t>(j)];
-      if (j != uav_index_ && m && !m->plan.empty() && (j < uav_index_ || m->fallback)) {
-        req.higher_priority_plans.push_back(m->plan);
-      }
-    }
+    if (!last.empty()) in.state.a_world = last.sampleAt(t).a_world;
+    in.worker = formation::constantVelocityHorizon(p0, v0, hphi, horizon_steps_, horizon_dt_s_);
+    in.params = &params_;
+    const auto& leader = received_[0];
+    if (leader && t - leader->plan.t0_s <= max_share_age_s_) in.leader_plan = &leader->plan;
+    in.received = &received_;
+    in.rule = rule_;
+    const planning::PlanRequest req = sim::buildPlanRequest(in);
     const planning::PlanResult res = planner_->plan(req);
     if (res.status != planning::PlanStatus::kOptimized) {
       NODELET_WARN_STREAM_THROTTLE(2.0, "FormationPlanner UAV " << uav_index_ << ": " << planning::toString(res.status)
@@ -227,15 +225,13 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     auto msg = toMsg(res);
     msg.header.frame_id = world_frame_;
     msg.uav_index = uav_index_;
+    msg.params_version = uav_index_ == formation::kLeader ? version_ : received_version_;
+    msg.planned_at = ros::Time(t);
     for (int k = 0; k < req.reference.steps(); ++k) msg.reference.push_back(toPoint(req.reference.p_world.col(k)));
     plan_pub_.publish(msg);
     traj_pub_.publish(toMultiDof(msg, "uav" + std::to_string(uav_index_)));
   }
 
-  struct Received {
-    planning::PlannedTrajectory plan;
-    bool fallback = false;
-  };
   std::mutex mutex_;
   int uav_index_ = 0, uav_count_ = 0, horizon_steps_ = 0;
   std::string world_frame_;
@@ -243,12 +239,16 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   formation::FormationParams params_;
   std::optional<formation::WorkerHeading> heading_;
   std::optional<formation::FormationState> state_;
-  std::uint64_t version_ = 0;
-  std::string last_command_, last_outcome_;
+  std::uint64_t version_ = 0;           ///< leader: the parameters' version
+  std::uint64_t received_version_ = 0;  ///< followers: the version of the parameters received
+  sim::AvoidanceRule rule_;
+  std::string last_command_, last_outcome_, last_source_, last_status_;
+  ros::Time last_stamp_;
+  std::vector<int> last_uavs_;
   std::unique_ptr<planning::UavPlanner> planner_;
   std::optional<planning::UavKinematicState> odom_;
   std::optional<gesture_formation::WorkerState> worker_;
-  std::vector<std::optional<Received>> received_;
+  std::vector<std::optional<sim::ReceivedPlan>> received_;  ///< by sender; [0] the leader's plan
   ros::Publisher plan_pub_, traj_pub_, params_pub_;
   ros::Subscriber odom_sub_, worker_sub_, plans_sub_, params_sub_, command_sub_;
   ros::Timer timer_, params_timer_;

@@ -44,7 +44,7 @@ class OperatorInterfaceNodelet : public nodelet::Nodelet {
     msg.sequence = ++sequence_;
     msg.source = "operator";
     if (msg.kind.empty()) msg.kind = "increment";
-    msg.header.stamp = ros::Time::now();
+    if (msg.header.stamp.isZero()) msg.header.stamp = ros::Time::now();  // keep the sender's (SimWorld: the request's time)
     const auto cmd = fromMsg(msg);
     if (!cmd) return cmd.reason();
     const auto uavs = cmd->target.resolve(uav_count_);

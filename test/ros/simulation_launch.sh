@@ -1,7 +1,9 @@
 #!/bin/bash
 # simulation.launch end to end (3 UAV managers + world, LCM inside a private network namespace):
 # every stream publishes at its rate (sim time), and a gesture injected at the leader changes
-# the followers' formation parameters and planned references through LCM (test/ros/sim_check.py).
+# the followers' formation parameters and planned references through LCM (test/ros/sim_check.py);
+# at the end (40 s) SimWorld's metrics.json / events.csv / timeline.csv carry gfctl simulate's
+# metrics, with the requests followed to their adaptation (test/ros/check_sim_metrics.py).
 set -o pipefail
 source "$(dirname "$0")/common.bash"
 [ "$(id -u)" -eq 0 ] || { echo "SKIP: needs root (unshare -n keeps LCM on this machine)"; exit 0; }
@@ -42,6 +44,10 @@ d2=\$(cat "$T/d2.txt")
   || { echo "FAIL: follower 2 d never 10.0 after the operator command (got '\$d2')"; rc=\$((rc+1)); }
 python3 "$SRC/tools/gf_command.py" follower7 distance_m 1 2>&1 | grep -q "refused" && echo "PASS: bad target refused by the OperatorInterface" \
   || { echo "FAIL: follower7 not refused"; rc=\$((rc+1)); }
+# SimWorld writes its files when the 40 s are over.
+for _ in \$(seq 80); do [ -f "$T/out/metrics.json" ] && break; sleep 0.5; done
+sleep 0.5
+python3 "$SRC/test/ros/check_sim_metrics.py" "$T/out" || rc=\$((rc+1))
 kill -INT \$launch; wait \$launch
 exit \$rc
 INNER

@@ -1,0 +1,64 @@
+#pragma once
+/// \file
+/// \brief One UAV's planning request from what it knows (DESIGN §4; docs/safety.md §1): the
+/// stage-1 reference (eq. leader_ref on the worker's predicted trajectory for the leader;
+/// eq. follower_ref relative to the leader's received plan — ^Lφ, ^Lξ per step — for a
+/// follower; or a given hold reference) and the other UAVs' plans it plans around. Shared by
+/// the simulated UAVs of `gfctl simulate` (sim::runMission) and the FormationPlanner nodelet,
+/// so that both apply one avoidance rule:
+/// - a follower always avoids the leader's received plan;
+/// - with AvoidanceRule::avoid_all_plans (mission `faults.avoid_all_plans`, default) every
+///   UAV avoids every other UAV's last received plan;
+/// - otherwise (the paper's priority rule) UAV i avoids the plans of followers j < i, and
+///   those flagged fallback or silent for longer than max_plan_age_s (right of way);
+/// - in hold, every received plan.
+/// Plans are added in the order: the leader's, then followers 1, 2, … (the planner's input).
+/// Thread safety: pure function.
+
+#include <optional>
+#include <vector>
+
+#include "gesture_formation/formation/formation_geometry.hpp"
+#include "gesture_formation/formation/formation_params.hpp"
+#include "gesture_formation/planning/uav_planner.hpp"
+
+namespace gesture_formation::sim {
+
+/// \brief A plan received from another UAV with its sender's fallback flag (the sender's
+/// planner returned its previous plan / braking, or it holds).
+struct ReceivedPlan {
+  planning::PlannedTrajectory plan;
+  bool fallback = false;
+};
+
+/// \brief Which received follower plans a UAV plans around (see the file comment).
+struct AvoidanceRule {
+  bool avoid_all_plans = true;  ///< every other UAV's plan (mission faults.avoid_all_plans)
+  double max_plan_age_s = 1.0;  ///< the priority rule: a UAV not heard from for this long has right of way, > 0
+};
+
+/// \brief What one replanning of UAV `uav_index` starts from.
+struct PlanRequestInputs {
+  int uav_index = 0;                 ///< 0 = leader, i = follower i (priority order)
+  double t_s = 0.0;                  ///< now; sample 0 of the reference
+  double dt_s = 0.2;                 ///< horizon step [s]
+  planning::UavKinematicState state;  ///< the UAV's current (estimated) state
+  formation::WorkerHorizon worker;    ///< the worker's predicted trajectory (its steps = the horizon's)
+  const formation::FormationParams* params = nullptr;  ///< required: the formation's parameters
+  /// Followers: the leader's last received plan (null or empty: none; the reference then
+  /// uses the leader's desired heading and pitch).
+  const planning::PlannedTrajectory* leader_plan = nullptr;
+  /// The plans received from the followers, indexed by sender (entries 0 and uav_index are
+  /// ignored); may be null.
+  const std::vector<std::optional<ReceivedPlan>>* received = nullptr;
+  /// Non-null: the UAV holds — this is its reference, and it avoids every received plan.
+  const formation::ReferenceTrajectory* hold_reference = nullptr;
+  AvoidanceRule rule;
+  EIGEN_MAKE_ALIGNED_OPERATOR_NEW
+};
+
+/// \brief The request (see the file comment). Preconditions: params non-null with a
+/// follower entry for uav_index; worker.steps() ≥ 1.
+planning::PlanRequest buildPlanRequest(const PlanRequestInputs& in);
+
+}  // namespace gesture_formation::sim

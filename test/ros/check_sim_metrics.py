@@ -1,0 +1,71 @@
+#!/usr/bin/env python3
+"""Checks what SimWorld wrote at the end of a short simulation.launch run (test/ros/
+simulation_launch.sh: 40 s of the power-tower mission; a gesture 2 injected at the leader at
+t ~ 8 s; the mission's first operator request at t = 20 s): metrics.json carries every DESIGN
+§8.4 key with the definitions of gfctl simulate (sim::MetricsAccumulator), and the requests
+were followed through the ROS system — applied by the leader (FormationParams.last_command_*)
+and adapted to by the UAVs' next plans (PlannedTrajectory.params_version / planned_at).
+usage: check_sim_metrics.py OUTPUT_DIR; prints one line per check; exit code = failures."""
+import csv
+import json
+import math
+import sys
+
+DESIGN_KEYS = ["min_mutual_distance_m", "min_obstacle_distance_m", "min_human_distance_m", "collisions",
+               "distance_error_rms_m", "angle_error_rms_deg", "requests_applied", "gesture_success_rate",
+               "gesture_mean_latency_s", "false_adaptations", "planning_ms_median", "planning_ms_p99",
+               "human_estimate_error_rms_m"]
+fails = 0
+
+
+def check(ok, what):
+    global fails
+    print(("PASS: " if ok else "FAIL: ") + what)
+    fails += 0 if ok else 1
+
+
+def num(x):
+    try:
+        return float(x)
+    except (TypeError, ValueError):
+        return float("nan")
+
+
+def main():
+    out = sys.argv[1]
+    m = json.load(open(f"{out}/metrics.json"))
+    missing = [k for k in DESIGN_KEYS if k not in m]
+    check(not missing, "metrics.json has every DESIGN 8.4 key" + (f" (missing {missing})" if missing else ""))
+    check(abs(num(m.get("sim_time_s")) - 40.0) < 0.05, f"the mission ran to its 40 s (sim_time_s {m.get('sim_time_s')})")
+    check(m.get("collisions") == 0, f"no collision ({m.get('collisions')})")
+    check(2.5 <= num(m.get("min_mutual_distance_m")) < 50, f"min mutual distance {m.get('min_mutual_distance_m')} m >= 2.5")
+    check(0.0 < num(m.get("min_obstacle_distance_m")) < 50 and m.get("min_obstacle_uav") in (0, 1, 2),
+          f"min obstacle distance {m.get('min_obstacle_distance_m')} m (exact near the solids) by UAV {m.get('min_obstacle_uav')}")
+    check(0.0 < num(m.get("human_estimate_error_rms_m")) < 1.0, f"estimate error {m.get('human_estimate_error_rms_m')} m RMS")
+    check(0.0 < num(m.get("distance_error_rms_m")) < 5.0, f"distance error {m.get('distance_error_rms_m')} m RMS")
+    check(m.get("plans", 0) > 3 * 2.5 * 30, f"{m.get('plans')} plans counted (3 UAVs at 2.5 Hz)")
+    check(m.get("gestures_performed") == 0 and m.get("false_adaptations") == 1,
+          f"the injected gesture (no worker gesture before 72 s) is 1 false adaptation "
+          f"(performed {m.get('gestures_performed')}, false {m.get('false_adaptations')})")
+    check("plans_hold" in m.get("not_measured_keys", []) and m.get("plans_hold") is None,
+          "what ROS cannot observe is null and listed (not_measured_keys)")
+    rows = list(csv.DictReader(open(f"{out}/events.csv")))
+    op = [r for r in rows if r["source"] == "operator" and abs(num(r["t"]) - 20.0) < 0.02]
+    ok = len(op) == 1 and op[0]["status"] == "applied" and \
+        num(op[0]["applied_t"]) <= num(op[0]["adaptation_start_t"]) < num(op[0]["applied_t"]) + 1.0 and \
+        op[0]["uavs"] == "L;1;2"
+    check(ok, "the operator request at 20 s (all.distance_m -1): applied by the leader, adapted to by the next plans "
+          + (str({k: op[0][k] for k in ("status", "applied_t", "adaptation_start_t", "uavs")}) if op else "(no row)"))
+    g = [r for r in rows if r["source"] == "gesture"]
+    ok = len(g) == 1 and g[0]["status"] == "applied" and num(g[0]["t"]) <= num(g[0]["applied_t"]) <= \
+        num(g[0]["adaptation_start_t"]) < num(g[0]["t"]) + 1.5 and g[0]["description"].startswith("gesture 2")
+    check(ok, "the injected gesture: fired, applied, adapted to " + (str(g) if len(g) != 1 else
+          str({k: g[0][k] for k in ("t", "description", "status", "applied_t", "adaptation_start_t")})))
+    tl = list(csv.DictReader(open(f"{out}/timeline.csv")))
+    check(len(tl) > 350 and "est_x" in tl[0] and "L_plan_status" in tl[0] and not math.isnan(num(tl[-1]["est_x"])),
+          f"timeline.csv in gfctl simulate's columns at 10 Hz ({len(tl)} rows)")
+    return fails
+
+
+if __name__ == "__main__":
+    sys.exit(main())
