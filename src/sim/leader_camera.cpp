@@ -31,10 +31,18 @@ LeaderCamera::LeaderCamera(const MissionConfig& config, const planning::Occupanc
     : cfg_(config),
       sensors_(config.camera, config.stereo, config.uwb, map, makeRng(seed, Stream::kCamera),
                makeRng(seed, Stream::kStereo), makeRng(seed, Stream::kUwb)),
-      fault_rng_(makeRng(seed, Stream::kFault)) {}
+      fault_rng_(makeRng(seed, Stream::kFault)),
+      map_(map),
+      seed_(seed) {}
 
 LeaderCameraFrame LeaderCamera::frame(double t, const MultirotorState& leader, const WorkerState& ws,
                                       WorkerModel& worker, MissionClassifier* classifier) {
+  return frame(t, leader, {}, {}, ws, worker, classifier);
+}
+
+LeaderCameraFrame LeaderCamera::frame(double t, const MultirotorState& leader, const std::vector<MultirotorState>& followers,
+                                      const std::vector<bool>& online, const WorkerState& ws, WorkerModel& worker,
+                                      MissionClassifier* classifier) {
   LeaderCameraFrame out;
   const FaultConfig& faults = cfg_.faults;
   const estimation::CameraPose true_pose = cameraPose(leader.p_world, leader.heading_rad, leader.pitch_rad);
@@ -53,15 +61,43 @@ LeaderCameraFrame LeaderCamera::frame(double t, const MultirotorState& leader, c
       ++out.range_outliers;
     }
   }
-  out.skeleton = worker.skeletonAt(t, true_pose.t_world_camera);
-  if (!frame.visible()) return out;
-  if (t - last_visible_s_ > kSkeletonGapS) window_.clear();  // a gap breaks the FIFO's temporal consistency
-  window_.push(out.skeleton.skeleton);
-  last_visible_s_ = t;
-  if (classifier != nullptr && window_.full()) {
-    auto c = classifier->classify(window_);
-    if (c) out.classification = *c;
+  std::vector<Eigen::Vector3d> cameras{true_pose.t_world_camera};
+  std::vector<estimation::CameraPose> follower_poses;
+  for (const MultirotorState& f : followers) {
+    follower_poses.push_back(cameraPose(f.p_world, f.heading_rad, f.pitch_rad));
+    cameras.push_back(follower_poses.back().t_world_camera);
   }
+  const std::vector<gesture::SynthFrame> skeletons = worker.skeletonsAt(t, cameras);
+  out.skeleton = skeletons.front();
+  // A camera's FIFO and classifier: a gap breaks the FIFO's temporal consistency.
+  const auto classify = [&](gesture::SkeletonWindow& window, double& last_visible, const gesture::Skeleton2D& sk)
+      -> std::optional<gesture::Classification> {
+    if (t - last_visible > kSkeletonGapS) window.clear();
+    window.push(sk);
+    last_visible = t;
+    if (classifier == nullptr || !window.full()) return std::nullopt;
+    auto c = classifier->classify(window);
+    if (!c) return std::nullopt;
+    return *c;
+  };
+  while (follower_cams_.size() < followers.size()) {
+    const auto i = static_cast<std::uint64_t>(follower_cams_.size());
+    follower_cams_.push_back(FollowerCamera{SyntheticSensors(cfg_.camera, cfg_.stereo, cfg_.uwb, map_,
+                                                             makeRng(seed_, Stream::kFollowerCamera, 3 * i),
+                                                             makeRng(seed_, Stream::kFollowerCamera, 3 * i + 1),
+                                                             makeRng(seed_, Stream::kFollowerCamera, 3 * i + 2)),
+                                            {}, -1e9});
+  }
+  for (std::size_t i = 0; i < followers.size(); ++i) {
+    FollowerView v;
+    FollowerCamera& fc = follower_cams_[i];
+    const SensorFrame seen = fc.sensors.observe(follower_poses[i], ws.feet_world, ws.p_world, cfg_.worker.height_m, false);
+    v.visible = (i >= online.size() || online[i]) && seen.visible();
+    if (v.visible) v.classification = classify(fc.window, fc.last_visible_s, skeletons[i + 1].skeleton);
+    out.followers.push_back(std::move(v));
+  }
+  if (!frame.visible()) return out;
+  out.classification = classify(window_, last_visible_s_, out.skeleton.skeleton);
   return out;
 }
 

@@ -439,7 +439,14 @@ common::Result<MissionConfig> parseMissionConfig(const std::string& yaml, const 
     c.gesture_filter = gesture::readGestureFilterConfig(s);
     gesture::readGestureMapping(s, c.gesture_filter.max_gesture_id,
                                 static_cast<int>(c.formation.params.followers.size()), c.gesture_mapping);
+    c.view_fusion = gesture::readViewFusionConfig(s);
   });
+  for (const auto& e : c.view_fusion.validate()) r.addError(m + "gestures", e);
+  if (c.view_fusion.min_agreeing_views > c.formation.params.uavCount()) {
+    r.addError(m + "gestures.view_fusion.min_agreeing_views",
+               "value " + std::to_string(c.view_fusion.min_agreeing_views) + " exceeds the number of UAVs (cameras) " +
+                   std::to_string(c.formation.params.uavCount()) + ": no gesture could ever be accepted");
+  }
   withSubReader(r, m + "planner", ConfigReader::MissingKeys::kUseDefaults,
                 [&](ConfigReader& s) { c.planner = planning::readPlannerConfig(s); });
   withSubReader(r, m + "estimator", ConfigReader::MissingKeys::kUseDefaults,

@@ -6,6 +6,7 @@
 #include <optional>
 #include <sstream>
 
+#include "gesture_formation/common/angles.hpp"
 #include "gesture_formation/estimation/human_kalman.hpp"
 #include "gesture_formation/estimation/measurement_model.hpp"
 #include "gesture_formation/formation/formation_geometry.hpp"
@@ -117,6 +118,10 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
   estimation::HumanKalman kf(cfg.estimator.filter);
   const estimation::CameraModel cam_model(cfg.estimator.camera);
   gesture::GestureFilter filter(cfg.gesture_filter);
+  // The formation's cameras vote (docs/gestures.md §4.1); min_agreeing_views 1 = the paper's
+  // pipeline on the leader's camera alone.
+  const bool follower_views = cfg.view_fusion.min_agreeing_views > 1;
+  gesture::ViewFusion fusion(cfg.view_fusion, follower_views ? n : 1, cfg.gesture_filter.max_gesture_id);
 
   // --- UAVs: initial states at the formation references around the worker's start -------
   const WorkerState w0 = worker.stateAt(0.0);
@@ -388,7 +393,15 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
 
     // Leader camera frame: box → estimator; skeleton → classifier → filter → command.
     if (camera_frames.due(k)) {
-      const LeaderCameraFrame cf = camera.frame(t, uavs[0]->plant.state(), ws, worker, classifier);
+      std::vector<MultirotorState> follower_states;
+      std::vector<bool> online;
+      if (follower_views) {
+        for (int i = 1; i < n; ++i) {
+          follower_states.push_back(uavs[static_cast<std::size_t>(i)]->plant.state());
+          online.push_back(!uavs[static_cast<std::size_t>(i)]->offline);
+        }
+      }
+      const LeaderCameraFrame cf = camera.frame(t, uavs[0]->plant.state(), follower_states, online, ws, worker, classifier);
       const SensorFrame& frame = cf.sensors;
       M.range_outliers += cf.range_outliers;
       if (frame.visible()) {
@@ -398,9 +411,31 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
                                                       cfg.estimator.human_height_m, cfg.estimator.noise);
         if (meas && estimation::accepted(kf.step(t, *meas))) last_fused_s = t;
       }
-      if (cf.classification) {
-        last_class = cf.classification->gesture_id;
-        const auto fo = filter.update(t, cf.classification->gesture_id);
+      // Each camera's classification → the vote (geometry from the leader's worker estimate
+      // and each UAV's odometry: a view votes only inside the classifier's envelope) → filter.
+      bool classified = false;
+      const auto observe = [&](int view, const gesture::Classification& c) {
+        gesture::ViewObservation o;
+        o.view = view;
+        o.t_s = t;
+        o.gesture_id = c.gesture_id;
+        o.distance_m = std::nan("");
+        o.elevation_deg = std::nan("");
+        if (kf.initialized()) {
+          const Eigen::Vector3d rel = uavs[static_cast<std::size_t>(view)]->est.p_world - kf.predicted(t).p_world;
+          o.distance_m = rel.norm();
+          o.elevation_deg = common::radToDeg(std::asin(std::clamp(rel.z() / std::max(1e-9, rel.norm()), -1.0, 1.0)));
+        }
+        classified = fusion.observe(o) || classified;
+      };
+      if (cf.classification) observe(0, *cf.classification);
+      for (std::size_t i = 0; i < cf.followers.size(); ++i) {
+        if (cf.followers[i].classification) observe(static_cast<int>(i) + 1, *cf.followers[i].classification);
+      }
+      if (classified) {
+        const int fused = follower_views ? fusion.fuse(t).gesture_id : cf.classification->gesture_id;
+        last_class = fused;
+        const auto fo = filter.update(t, fused);
         last_ratio = fo.dominant_ratio;
         if (fo.fired) {
           const std::size_t record = metrics.addRequest(firedGestureRecord(t, fo.dominant_id, cfg.gesture_mapping));

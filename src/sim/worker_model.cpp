@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 
 #include "gesture_formation/common/angles.hpp"
 #include "gesture_formation/sim/random.hpp"
@@ -206,15 +207,21 @@ gesture::Motion WorkerModel::motionFor(const WorkerState& s) {
   return gesture::Motion::kIdle;
 }
 
-void WorkerModel::startMotion(double t_s, gesture::Motion motion, const Eigen::Vector3d& camera_world,
+void WorkerModel::startMotion(double t_s, gesture::Motion motion, const std::vector<Eigen::Vector3d>& cameras,
                               bool is_scheduled, double scheduled_s) {
   const WorkerState s = stateAt(t_s);
-  const Eigen::Vector3d diff = camera_world - s.p_world;
-  const double d = std::max(1.5, diff.norm());
-  const double el = radToDeg(std::asin(std::clamp(diff.z() / std::max(1e-9, diff.norm()), -1.0, 1.0)));
-  const double az = radToDeg(common::wrapAngle(std::atan2(diff.y(), diff.x()) - s.heading_rad));
+  std::vector<gesture::SkeletonSynthesizer::View> views;
+  for (const Eigen::Vector3d& camera_world : cameras) {
+    const Eigen::Vector3d diff = camera_world - s.p_world;
+    const double d = std::max(1.5, diff.norm());
+    const double el = radToDeg(std::asin(std::clamp(diff.z() / std::max(1e-9, diff.norm()), -1.0, 1.0)));
+    const double az = radToDeg(common::wrapAngle(std::atan2(diff.y(), diff.x()) - s.heading_rad));
+    views.push_back({d, el, az});
+  }
   gesture::SkeletonSynthesizer& synth = is_scheduled ? gesture_synth_ : synth_;
-  current_ = synth.generateFrom(motion, d, el, az);
+  std::vector<gesture::SynthSequence> seqs = synth.generateViewsFrom(motion, views);
+  current_ = std::move(seqs.front());
+  other_views_.assign(std::make_move_iterator(seqs.begin() + 1), std::make_move_iterator(seqs.end()));
   current_start_s_ = t_s;
   has_current_ = true;
   if (is_scheduled) {
@@ -228,18 +235,26 @@ void WorkerModel::startMotion(double t_s, gesture::Motion motion, const Eigen::V
 }
 
 gesture::SynthFrame WorkerModel::skeletonAt(double t_s, const Eigen::Vector3d& camera_world) {
+  return skeletonsAt(t_s, {camera_world}).front();
+}
+
+std::vector<gesture::SynthFrame> WorkerModel::skeletonsAt(double t_s, const std::vector<Eigen::Vector3d>& cameras) {
   const double fps = config_.synth.fps;
   if (next_gesture_ < config_.gestures.size() && t_s >= config_.gestures[next_gesture_].t_s) {
     const auto& g = config_.gestures[next_gesture_++];
-    startMotion(t_s, motionOfGesture(g.gesture_id), camera_world, true, g.t_s);
-  } else if (!has_current_ || t_s - current_start_s_ >= static_cast<double>(current_.frames.size()) / fps) {
-    startMotion(t_s, motionFor(stateAt(t_s)), camera_world, false, 0.0);
+    startMotion(t_s, motionOfGesture(g.gesture_id), cameras, true, g.t_s);
+  } else if (!has_current_ || t_s - current_start_s_ >= static_cast<double>(current_.frames.size()) / fps ||
+             other_views_.size() + 1 != cameras.size()) {
+    startMotion(t_s, motionFor(stateAt(t_s)), cameras, false, 0.0);
   }
   const auto last = static_cast<long>(current_.frames.size()) - 1;
-  const long k = std::clamp(static_cast<long>(std::floor((t_s - current_start_s_) * fps + 0.5)), 0L, last);
-  gesture::SynthFrame f = current_.frames[static_cast<std::size_t>(k)];
-  f.t_s = t_s;
-  return f;
+  const auto k = static_cast<std::size_t>(std::clamp(static_cast<long>(std::floor((t_s - current_start_s_) * fps + 0.5)), 0L, last));
+  std::vector<gesture::SynthFrame> out;
+  out.reserve(cameras.size());
+  out.push_back(current_.frames[k]);
+  for (const auto& v : other_views_) out.push_back(v.frames[std::min(k, v.frames.size() - 1)]);
+  for (auto& f : out) f.t_s = t_s;
+  return out;
 }
 
 int WorkerModel::performingAt(double t_s) const {

@@ -18,6 +18,7 @@
 #include <optional>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "gesture_formation/common/result.hpp"
 #include "gesture_formation/gesture/gesture_classifier.hpp"
@@ -59,6 +60,12 @@ class StepSchedule {
   long next_k_ = 0, count_ = 0;
 };
 
+/// \brief One follower camera's view in the same frame (gesture voting, docs/gestures.md §4.1).
+struct FollowerView {
+  bool visible = false;  ///< the worker is in its field of view, not occluded, detected
+  std::optional<gesture::Classification> classification;  ///< as LeaderCameraFrame::classification
+};
+
 /// \brief One frame of the leader's camera.
 struct LeaderCameraFrame {
   SensorFrame sensors;         ///< box (when visible) and ranges after the injected faults
@@ -67,6 +74,8 @@ struct LeaderCameraFrame {
   /// The classifier's output: the worker was detected, the FIFO is full, a classifier was
   /// given and it succeeded.
   std::optional<gesture::Classification> classification;
+  /// The followers' cameras at the same instant (empty unless followers were given).
+  std::vector<FollowerView> followers;
 };
 
 class LeaderCamera {
@@ -83,6 +92,15 @@ class LeaderCamera {
   /// `classifier` may be null (no gesture pipeline).
   LeaderCameraFrame frame(double t_s, const MultirotorState& leader, const WorkerState& worker_state,
                           WorkerModel& worker, MissionClassifier* classifier);
+  /// \brief The same frame also seen by the followers' cameras (`followers[i]`: follower i+1's
+  /// true state; `online[i]` false: its computer is down, no view). The followers' cameras
+  /// see the same performance (WorkerModel::skeletonsAt) with their own field of view,
+  /// occlusion, detection dropouts (streams kFollowerCamera + i) and FIFO; the injected
+  /// leader faults (camera blackouts, range faults) are the leader's only. With no followers
+  /// this is exactly frame() above. Pass the same number of followers at every call.
+  LeaderCameraFrame frame(double t_s, const MultirotorState& leader, const std::vector<MultirotorState>& followers,
+                          const std::vector<bool>& online, const WorkerState& worker_state, WorkerModel& worker,
+                          MissionClassifier* classifier);
 
   /// \brief Time of the last frame in which the worker was detected (−1e9: never).
   double lastVisibleS() const { return last_visible_s_; }
@@ -94,6 +112,14 @@ class LeaderCamera {
   std::uniform_real_distribution<double> u01_{0.0, 1.0};
   gesture::SkeletonWindow window_;
   double last_visible_s_ = -1e9;
+  struct FollowerCamera {
+    SyntheticSensors sensors;
+    gesture::SkeletonWindow window;
+    double last_visible_s = -1e9;
+  };
+  const planning::OccupancyMap* map_;
+  std::uint64_t seed_;
+  std::vector<FollowerCamera> follower_cams_;
 };
 
 }  // namespace gesture_formation::sim

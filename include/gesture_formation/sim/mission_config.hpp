@@ -23,6 +23,7 @@
 #include "gesture_formation/formation/formation_config.hpp"
 #include "gesture_formation/gesture/gesture_filter.hpp"
 #include "gesture_formation/gesture/gesture_mapping.hpp"
+#include "gesture_formation/gesture/view_fusion.hpp"
 #include "gesture_formation/planning/planner_config.hpp"
 #include "gesture_formation/sim/link.hpp"
 #include "gesture_formation/sim/multirotor.hpp"
@@ -125,6 +126,7 @@ struct MissionConfig {
   FaultConfig faults;
   formation::FormationConfig formation;
   gesture::GestureFilterConfig gesture_filter;
+  gesture::ViewFusionConfig view_fusion;  ///< `gestures.view_fusion.*`: the formation's cameras vote
   gesture::GestureMapping gesture_mapping = gesture::GestureMapping::paperDefault();
   planning::PlannerConfig planner;
   estimation::EstimatorConfig estimator;

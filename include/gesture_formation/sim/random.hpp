@@ -29,6 +29,7 @@ enum class Stream : std::uint64_t {
   kUwb = 24,
   kLink = 30,        ///< + link index
   kFault = 40,       ///< injected sensor faults (range outliers)
+  kFollowerCamera = 50,  ///< + follower index: the followers' cameras (gesture views)
 };
 
 /// \brief The RNG of stream `stream` (+ `index`) of a mission with seed `seed`.

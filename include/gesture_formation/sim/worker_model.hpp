@@ -93,6 +93,11 @@ class WorkerModel {
   /// (the skeleton's viewpoint is fixed when each motion starts). Call with increasing
   /// times at the camera rate. Also returns the ground-truth gesture label of the frame.
   gesture::SynthFrame skeletonAt(double t_s, const Eigen::Vector3d& camera_world);
+  /// \brief The same performance seen at `t_s` by several cameras at once (the formation's:
+  /// element 0 the leader's, then the followers'); each viewpoint is fixed when a motion
+  /// starts. Element 0 is exactly what skeletonAt(t_s, cameras[0]) would return. Pass the
+  /// same number of cameras at every call (≥ 1).
+  std::vector<gesture::SynthFrame> skeletonsAt(double t_s, const std::vector<Eigen::Vector3d>& cameras);
 
   /// \brief Gestures started so far, in order.
   const std::vector<GestureEpisode>& episodes() const { return episodes_; }
@@ -101,7 +106,7 @@ class WorkerModel {
   const WorkerConfig& config() const { return config_; }
 
  private:
-  void startMotion(double t_s, gesture::Motion motion, const Eigen::Vector3d& camera_world, bool is_scheduled,
+  void startMotion(double t_s, gesture::Motion motion, const std::vector<Eigen::Vector3d>& cameras, bool is_scheduled,
                    double scheduled_s);
   gesture::Motion motionFor(const WorkerState& s);
 
@@ -112,6 +117,7 @@ class WorkerModel {
   gesture::SkeletonSynthesizer synth_;         ///< work motions
   gesture::SkeletonSynthesizer gesture_synth_;  ///< gestures (held longer)
   gesture::SynthSequence current_;
+  std::vector<gesture::SynthSequence> other_views_;  ///< the same motion from cameras 1..
   double current_start_s_ = -1e9;
   bool has_current_ = false;
   std::size_t next_gesture_ = 0;
