@@ -17,10 +17,20 @@ tools/setup.sh > /dev/null
 BUILD_DIR=${GF_BUILD_DIR:-build}
 mkdir -p "$BUILD_DIR"
 echo "== build: gfctl, the nodelets and their messages (tools/build.sh; log $BUILD_DIR/demo_build.log)"
-if ! tools/build.sh gfctl gesture_formation_nodelets gesture_formation_generate_messages > "$BUILD_DIR/demo_build.log" 2>&1; then
-  tail -30 "$BUILD_DIR/demo_build.log" >&2
-  echo "$0: the build failed (full log: $BUILD_DIR/demo_build.log)" >&2
-  exit 1
+LOG=$BUILD_DIR/demo_build.log
+build() { tools/build.sh gfctl gesture_formation_nodelets gesture_formation_generate_messages > "$LOG" 2>&1; }
+if ! build; then
+  built=false
+  if grep -q "Please rerun cmake" "$LOG"; then
+    # A build tree configured before a message changed its dependencies (catkin's check): configure again.
+    echo "   the messages' dependencies changed since $BUILD_DIR was configured: cmake again ($BUILD_DIR/demo_cmake.log)"
+    cmake -S . -B "$BUILD_DIR" > "$BUILD_DIR/demo_cmake.log" 2>&1 && build && built=true
+  fi
+  if ! $built; then
+    tail -30 "$LOG" >&2
+    echo "$0: the build failed (full log: $LOG)" >&2
+    exit 1
+  fi
 fi
 echo "== the power-tower mission through launch/simulation.launch, seed ${GF_DEMO_SEED:-1} (451 s simulated at 2x real time)"
 exec tools/run_ros_mission.sh --seed "${GF_DEMO_SEED:-1}" "$@"
