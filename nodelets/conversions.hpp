@@ -206,13 +206,14 @@ inline gesture_formation::FormationParams toMsg(const formation::FormationParams
   }
   return m;
 }
-inline common::Result<formation::FormationParams> fromMsg(const gesture_formation::FormationParams& m) {
+/// uavs[0] the leader, uavs[i] follower i (FormationParams.uavs, PlannedTrajectory.formation).
+inline common::Result<formation::FormationParams> fromMsg(const std::vector<gesture_formation::UavObservation>& uavs) {
   using R = common::Result<formation::FormationParams>;
-  if (m.uavs.empty()) return R::fail("FormationParams.uavs: empty (needs the leader)");
+  if (uavs.empty()) return R::fail("FormationParams.uavs: empty (needs the leader)");
   formation::FormationParams p;
   p.followers.clear();
-  for (std::size_t i = 0; i < m.uavs.size(); ++i) {
-    const formation::UavObservation o{m.uavs[i].beta_deg, m.uavs[i].gamma_deg, m.uavs[i].distance_m};
+  for (std::size_t i = 0; i < uavs.size(); ++i) {
+    const formation::UavObservation o{uavs[i].beta_deg, uavs[i].gamma_deg, uavs[i].distance_m};
     if (i == 0) {
       p.leader = o;
     } else {
@@ -220,6 +221,9 @@ inline common::Result<formation::FormationParams> fromMsg(const gesture_formatio
     }
   }
   return R::ok(std::move(p));
+}
+inline common::Result<formation::FormationParams> fromMsg(const gesture_formation::FormationParams& m) {
+  return fromMsg(m.uavs);
 }
 inline common::Result<formation::Parameter> parameterFromName(const std::string& name) {
   using R = common::Result<formation::Parameter>;

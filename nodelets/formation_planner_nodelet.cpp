@@ -227,6 +227,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     msg.uav_index = uav_index_;
     msg.params_version = uav_index_ == formation::kLeader ? version_ : received_version_;
     msg.planned_at = ros::Time(t);
+    msg.formation = toMsg(params_, 0).uavs;
     for (int k = 0; k < req.reference.steps(); ++k) msg.reference.push_back(toPoint(req.reference.p_world.col(k)));
     plan_pub_.publish(msg);
     traj_pub_.publish(toMultiDof(msg, "uav" + std::to_string(uav_index_)));
@@ -240,7 +241,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   std::optional<formation::WorkerHeading> heading_;
   std::optional<formation::FormationState> state_;
   std::uint64_t version_ = 0;           ///< leader: the parameters' version
-  std::uint64_t received_version_ = 0;  ///< followers: the version of the parameters received
+  std::uint64_t received_version_ = 0;  ///< followers: the version received (0 over LCM: not carried)
   sim::AvoidanceRule rule_;
   std::string last_command_, last_outcome_, last_source_, last_status_;
   ros::Time last_stamp_;

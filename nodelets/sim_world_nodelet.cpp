@@ -82,6 +82,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
     heading_.emplace(cfg_.formation.worker_heading);
     n_ = cfg_.formation.params.uavCount();
     params_ = cfg_.formation.params;
+    versions_.emplace_back(0, params_);
     truth_.resize(static_cast<std::size_t>(n_));
 
     clock_pub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
@@ -106,7 +107,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
               NODELET_WARN_STREAM_THROTTLE(5.0, "SimWorld: plan not counted: " << status.reason());
               return;
             }
-            metrics_->plan(i, m->planned_at.toSec(), m->params_version, *status, m->planning_ms, m->reason);
+            metrics_->plan(i, m->planned_at.toSec(), planVersion(*m), *status, m->planning_ms, m->reason);
           }));
     }
     params_sub_ = nh.subscribe("leader_params_in", 20, &SimWorldNodelet::onParams, this);
@@ -133,7 +134,10 @@ class SimWorldNodelet : public nodelet::Nodelet {
   void onParams(const gesture_formation::FormationParams::ConstPtr& m) {
     std::lock_guard<std::mutex> lock(mutex_);
     auto p = fromMsg(*m);
-    if (p && p->uavCount() == n_) params_ = *p;
+    if (p && p->uavCount() == n_) {
+      params_ = *p;
+      if (m->version > versions_.back().first) versions_.emplace_back(m->version, *p);
+    }
     if (finished_ || m->last_command.empty()) return;
     // Re-published parameters repeat the last command: one outcome per (command, status).
     const std::string key = m->last_command + "|" + m->last_command_status;
@@ -164,6 +168,26 @@ class SimWorldNodelet : public nodelet::Nodelet {
       metrics_->requestOutcome(*index, it->status, it->t_s, it->version, it->uavs);
       it = outcomes_.erase(it);
     }
+  }
+
+  /// The parameter version a plan was made with: the leader's says it; a follower's parameters
+  /// come over LCM without their version, so it is the latest version the leader published
+  /// with exactly the parameters the plan lists (PlannedTrajectory.formation).
+  std::uint64_t planVersion(const gesture_formation::PlannedTrajectory& m) const {
+    if (m.uav_index == formation::kLeader || m.params_version > 0 || m.formation.empty()) return m.params_version;
+    const auto used = fromMsg(m.formation);
+    if (!used || used->uavCount() != n_) return m.params_version;
+    for (auto it = versions_.rbegin(); it != versions_.rend(); ++it) {
+      if (sameParams(it->second, *used)) return it->first;
+    }
+    return m.params_version;
+  }
+  static bool sameParams(const formation::FormationParams& a, const formation::FormationParams& b) {
+    for (int i = 0; i < a.uavCount(); ++i) {
+      const auto &x = a.uav(i), &y = b.uav(i);
+      if (x.beta_deg != y.beta_deg || x.gamma_deg != y.gamma_deg || x.distance_m != y.distance_m) return false;
+    }
+    return true;
   }
 
   void onGestureStatus(const gesture_formation::GestureStatus::ConstPtr& m) {
@@ -349,6 +373,8 @@ class SimWorldNodelet : public nodelet::Nodelet {
   std::optional<sim::MetricsAccumulator> metrics_;
   std::optional<formation::WorkerHeading> heading_;
   formation::FormationParams params_;
+  /// Every parameter version the leader published (0: the mission's), for planVersion().
+  std::vector<std::pair<std::uint64_t, formation::FormationParams>> versions_;
   std::string output_dir_, world_frame_, camera_frame_, last_outcome_key_;
   double rtf_ = 1.0, clock_step_s_ = 0.01, duration_s_ = 0.0, t_ = 0.0, last_ratio_ = 0.0;
   long k_ = 0;

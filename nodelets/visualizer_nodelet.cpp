@@ -8,7 +8,8 @@
 //
 // Topics: uav<i>/odometry, uav<i>/plan (i < ~uav_count), worker_state_in, worker_truth_in,
 //   formation_params_in, gesture_status_in → markers_out (MarkerArray at ~rate_hz), map_out
-//   (latched MarkerArray). No math beyond drawing (the ellipsoid's axes: eigen decomposition
+//   (latched MarkerArray, published on the first tick with a valid time). Markers carry the time
+//   they were drawn (ros::Time::now(): sim time in simulation and replay). No math beyond drawing (the ellipsoid's axes: eigen decomposition
 //   of the 3×3 position covariance).
 // Parameters (required): ~uav_count, ~world_frame, ~rate_hz, ~frustum_range_m,
 //   ~frustum_hfov_deg, ~frustum_vfov_deg, ~scenario_file ("" = no map).
@@ -106,16 +107,14 @@ class VisualizerNodelet : public nodelet::Nodelet {
         }));
     pub_ = nh.advertise<visualization_msgs::MarkerArray>("markers_out", 2);
     map_pub_ = nh.advertise<visualization_msgs::MarkerArray>("map_out", 1, true);
-    if (world.map) publishMap(*world.map);
+    map_ = world.map;
     timer_ = nh.createTimer(ros::Duration(1.0 / rate_hz), &VisualizerNodelet::onTimer, this);
   }
 
-  visualization_msgs::Marker marker(const std::string& ns, int id, int type) const {
+  visualization_msgs::Marker marker(const std::string& ns, int id, int type, const ros::Time& stamp) const {
     visualization_msgs::Marker m;
     m.header.frame_id = world_frame_;
-    // Stamp 0: rviz draws at the latest transform instead of waiting in its tf message filter (with
-    // the mission's /tf in a replayed bag, stamped markers were never drawn).
-    m.header.stamp = ros::Time(0);
+    m.header.stamp = stamp;
     m.ns = ns;
     m.id = id;
     m.type = type;
@@ -125,9 +124,9 @@ class VisualizerNodelet : public nodelet::Nodelet {
     return m;
   }
 
-  void publishMap(const planning::OccupancyMap& map) {
+  void publishMap(const planning::OccupancyMap& map, const ros::Time& stamp) {
     visualization_msgs::MarkerArray a;
-    auto m = marker("map", 0, visualization_msgs::Marker::CUBE_LIST);
+    auto m = marker("map", 0, visualization_msgs::Marker::CUBE_LIST, stamp);
     m.lifetime = ros::Duration(0.0);
     m.scale.x = m.scale.y = m.scale.z = map.resolution();
     m.color = rgba(0.55f, 0.55f, 0.6f, 0.6f);
@@ -140,18 +139,24 @@ class VisualizerNodelet : public nodelet::Nodelet {
 
   void onTimer(const ros::TimerEvent&) {
     std::lock_guard<std::mutex> lock(mutex_);
+    const ros::Time now = ros::Time::now();
+    if (now.isZero()) return;  // sim time not started
+    if (map_) {
+      publishMap(*map_, now);
+      map_.reset();
+    }
     visualization_msgs::MarkerArray a;
     const double th = std::tan(hfov_deg_ * M_PI / 360.0), tv = std::tan(vfov_deg_ * M_PI / 360.0);
     for (int i = 0; i < uav_count_; ++i) {
       const auto& o = odom_[static_cast<std::size_t>(i)];
       if (o) {
-        auto body = marker("uavs", i, visualization_msgs::Marker::SPHERE);
+        auto body = marker("uavs", i, visualization_msgs::Marker::SPHERE, now);
         body.pose = o->pose.pose;
         body.scale.x = body.scale.y = body.scale.z = 0.7;
         body.color = color(i);
         a.markers.push_back(body);
         // Frustum: apex at the UAV, four corners at frustum_range_m along the camera axis.
-        auto f = marker("frusta", i, visualization_msgs::Marker::LINE_LIST);
+        auto f = marker("frusta", i, visualization_msgs::Marker::LINE_LIST, now);
         f.pose = o->pose.pose;
         f.scale.x = 0.06;
         f.color = color(i, 0.9f);
@@ -167,17 +172,17 @@ class VisualizerNodelet : public nodelet::Nodelet {
       }
       const auto& p = plans_[static_cast<std::size_t>(i)];
       if (p) {
-        auto line = marker("plans", i, visualization_msgs::Marker::LINE_STRIP);
+        auto line = marker("plans", i, visualization_msgs::Marker::LINE_STRIP, now);
         line.scale.x = 0.12;
         line.color = color(i);
         line.points = p->positions;
         if (line.points.size() >= 2) a.markers.push_back(line);
-        auto ref = marker("references", i, visualization_msgs::Marker::LINE_STRIP);
+        auto ref = marker("references", i, visualization_msgs::Marker::LINE_STRIP, now);
         ref.scale.x = 0.3;
         ref.color = color(i, 0.3f);
         ref.points = p->reference;
         if (ref.points.size() >= 2) a.markers.push_back(ref);
-        auto path = marker("paths", i, visualization_msgs::Marker::LINE_STRIP);
+        auto path = marker("paths", i, visualization_msgs::Marker::LINE_STRIP, now);
         path.scale.x = 0.05;
         path.color = rgba(1.0f, 1.0f, 1.0f, 0.8f);
         path.points = p->path;
@@ -186,7 +191,7 @@ class VisualizerNodelet : public nodelet::Nodelet {
     }
     geometry_msgs::Point text_at;
     if (worker_) {
-      auto w = marker("worker", 0, visualization_msgs::Marker::SPHERE);
+      auto w = marker("worker", 0, visualization_msgs::Marker::SPHERE, now);
       w.pose.position = worker_->position;
       w.scale.x = w.scale.y = w.scale.z = 0.4;
       w.color = rgba(1.0f, 0.9f, 0.0f, 1.0f);
@@ -199,7 +204,7 @@ class VisualizerNodelet : public nodelet::Nodelet {
       Eigen::Matrix3d R = es.eigenvectors();
       if (R.determinant() < 0) R.col(2) = -R.col(2);
       const Eigen::Quaterniond q(R);
-      auto cov = marker("worker_cov", 0, visualization_msgs::Marker::SPHERE);
+      auto cov = marker("worker_cov", 0, visualization_msgs::Marker::SPHERE, now);
       cov.pose.position = worker_->position;
       cov.pose.orientation.w = q.w();
       cov.pose.orientation.x = q.x();
@@ -213,7 +218,7 @@ class VisualizerNodelet : public nodelet::Nodelet {
       text_at = worker_->position;
     }
     if (truth_) {
-      auto t = marker("worker_truth", 0, visualization_msgs::Marker::CYLINDER);
+      auto t = marker("worker_truth", 0, visualization_msgs::Marker::CYLINDER, now);
       t.pose.position = truth_->pose.pose.position;
       t.scale.x = t.scale.y = 0.6;
       t.scale.z = 1.78;
@@ -237,7 +242,7 @@ class VisualizerNodelet : public nodelet::Nodelet {
       if (!params_->last_command.empty()) text += "\n" + params_->last_command + " -> " + params_->last_outcome;
     }
     if (!text.empty()) {
-      auto t = marker("status", 0, visualization_msgs::Marker::TEXT_VIEW_FACING);
+      auto t = marker("status", 0, visualization_msgs::Marker::TEXT_VIEW_FACING, now);
       t.pose.position = text_at;
       t.pose.position.z += 4.0;
       t.scale.z = 0.8;
@@ -258,6 +263,7 @@ class VisualizerNodelet : public nodelet::Nodelet {
   nav_msgs::Odometry::ConstPtr truth_;
   gesture_formation::FormationParams::ConstPtr params_;
   gesture_formation::GestureStatus::ConstPtr gesture_;
+  std::shared_ptr<const planning::OccupancyMap> map_;  ///< to publish once (then released)
   std::vector<ros::Subscriber> subs_;
   ros::Publisher pub_, map_pub_;
   ros::Timer timer_;

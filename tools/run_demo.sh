@@ -1,18 +1,36 @@
 #!/usr/bin/env bash
-# The main job (README): installs what is missing, builds gfctl and flies the paper's
-# simulated power-tower mission (config/scenarios/power_towers.yaml: 3 UAVs, the worker at
-# both towers, 25 view-adaptation requests incl. 6 gestures) in closed loop, then prints the
-# metrics and draws build/demo/mission/timeline.png (docs/simulation.md).
-#   tools/run_demo.sh            # seed 1
-#   GF_DEMO_SEED=7 tools/run_demo.sh
+# The main job (README): installs what is missing (tools/setup.sh), builds gfctl and the
+# nodelets, and flies the paper's simulated power-tower mission (config/scenarios/power_towers.yaml:
+# 3 UAVs, the worker at both towers, 25 view-adaptation requests incl. 6 gestures) through the
+# ROS system — launch/simulation.launch headless: one nodelet manager per UAV, LCM between them
+# in a private network namespace, sim time (tools/run_ros_mission.sh, docs/ros.md). Records
+# results/demo/mission.bag, writes metrics.json, timeline.csv, events.csv and timeline.png,
+# prints a summary. As root, or as a user with sudo (setup and the network namespace only).
+#   tools/run_demo.sh                     # seed 1 → results/demo/
+#   tools/run_demo.sh --rviz              # the same with rviz open
+#   GF_DEMO_SEED=7 tools/run_demo.sh      # another seed (any run_ros_mission.sh option may follow)
+# Exit code: non-zero when the setup, the build or the mission failed (did not finish, or a
+# collision). The one-process variant without ROS is `gfctl simulate` (README).
 set -eo pipefail
 cd "$(dirname "$0")/.."
 tools/setup.sh > /dev/null
-tools/build.sh gfctl > /dev/null
 BUILD_DIR=${GF_BUILD_DIR:-build}
-GFCTL=$BUILD_DIR/devel/lib/gesture_formation/gfctl
-OUT=$BUILD_DIR/demo/mission
-mkdir -p "$OUT"
-echo "== gfctl simulate: power-tower mission, seed ${GF_DEMO_SEED:-1} (451 s simulated)"
-"$GFCTL" simulate --scenario config/scenarios/power_towers.yaml --out "$OUT" --seed "${GF_DEMO_SEED:-1}"
-echo "outputs: $OUT/{metrics.json,timeline.csv,events.csv,scene.json,timeline.png}   gfctl: $GFCTL"
+mkdir -p "$BUILD_DIR"
+echo "== build: gfctl, the nodelets and their messages (tools/build.sh; log $BUILD_DIR/demo_build.log)"
+LOG=$BUILD_DIR/demo_build.log
+build() { tools/build.sh gfctl gesture_formation_nodelets gesture_formation_generate_messages > "$LOG" 2>&1; }
+if ! build; then
+  built=false
+  if grep -q "Please rerun cmake" "$LOG"; then
+    # A build tree configured before a message changed its dependencies (catkin's check): configure again.
+    echo "   the messages' dependencies changed since $BUILD_DIR was configured: cmake again ($BUILD_DIR/demo_cmake.log)"
+    cmake -S . -B "$BUILD_DIR" > "$BUILD_DIR/demo_cmake.log" 2>&1 && build && built=true
+  fi
+  if ! $built; then
+    tail -30 "$LOG" >&2
+    echo "$0: the build failed (full log: $LOG)" >&2
+    exit 1
+  fi
+fi
+echo "== the power-tower mission through launch/simulation.launch, seed ${GF_DEMO_SEED:-1} (451 s simulated at 2x real time)"
+exec tools/run_ros_mission.sh --seed "${GF_DEMO_SEED:-1}" "$@"

@@ -1,11 +1,15 @@
 #!/usr/bin/env bash
 # Runs the power-tower mission headless through launch/simulation.launch (the real nodelets:
 # 3 UAV manager processes + world/ground station, LCM between them), records a bag, writes
-# metrics.json, timeline.csv, events.csv and timeline.png, prints a summary and exits
-# (docs/ros.md). LCM stays on this machine: everything runs in a private network namespace
-# (unshare -n; needs root) whose loopback carries the multicast route.
+# metrics.json (the metrics of gfctl simulate, sim::MetricsAccumulator), timeline.csv, events.csv
+# and timeline.png, prints a summary and exits (docs/ros.md). LCM stays on this machine:
+# everything runs in a private network namespace (unshare -n) whose loopback carries the
+# multicast route. Root runs it directly; another user needs sudo, used for that namespace only
+# (the launch itself runs as the user, setpriv).
 #   tools/run_ros_mission.sh [--out DIR] [--duration S] [--rtf X] [--seed N] [--mission FILE] [--rviz]
 # Defaults: --out results/demo, the whole mission (451 s), --rtf 2 (sim seconds per wall second).
+# Exit code: 0 when the mission finished without a collision; 1 when it did not finish or a UAV
+# collided; 2 for bad arguments or a missing build.
 set -eo pipefail  # not -u: devel/setup.bash reads unset variables
 cd "$(dirname "$0")/.."
 SRC=$PWD
@@ -28,24 +32,38 @@ while [ $# -gt 0 ]; do
   esac
 done
 [ -f "$BUILD/devel/lib/libgesture_formation_nodelets.so" ] || { echo "$0: build first (tools/build.sh; GF_BUILD_DIR=$BUILD)" >&2; exit 2; }
-[ "$(id -u)" -eq 0 ] || { echo "$0: needs root for the private network namespace (unshare -n) that keeps LCM on this machine" >&2; exit 2; }
+NETNS=(unshare -n)
+if [ "$(id -u)" -ne 0 ]; then
+  command -v sudo > /dev/null || { echo "$0: not root and no sudo: the private network namespace (unshare -n) that keeps LCM on this machine needs root" >&2; exit 2; }
+  NETNS=(sudo unshare -n)
+fi
 mkdir -p "$OUT"
 OUT=$(realpath "$OUT")
 rm -f "$OUT/metrics.json" "$OUT/mission.bag" "$OUT/mission.bag.active"
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
+BUILD_ABS=$(realpath "$BUILD")
 # A fresh pre-shared key for this run (owner-only permissions, docs/security.md §5).
 umask 077
 printf '1 %s active\n' "$(od -An -N32 -tx1 /dev/urandom | tr -d ' \n')" > "$T/keys"
 umask 022
 export PATH=/usr/bin:/bin:$PATH
-export ROS_MASTER_URI=http://127.0.0.1:11311 ROS_IP=127.0.0.1 ROS_HOME=$T/ros ROS_LOG_DIR=$T/log
 # shellcheck disable=SC1091
 source "$BUILD/devel/setup.bash"
-cat > "$T/inner.sh" <<INNER
+# In the namespace: the loopback with the multicast route (root), then the launch as the caller.
+if [ "$(id -u)" -eq 0 ]; then as_caller=""; else as_caller="setpriv --reuid=$(id -u) --regid=$(id -g) --init-groups"; fi
+cat > "$T/netns.sh" <<NETNS
 set -e
 ip link set lo up
 ip route add 224.0.0.0/4 dev lo
+exec $as_caller bash "$T/inner.sh"
+NETNS
+# The launch (self-contained: sudo resets the environment).
+cat > "$T/inner.sh" <<INNER
+export PATH=/usr/bin:/bin:\$PATH
+export ROS_MASTER_URI=http://127.0.0.1:11311 ROS_IP=127.0.0.1 ROS_HOME=$T/ros ROS_LOG_DIR=$T/log
+export DISPLAY=${DISPLAY:-} XAUTHORITY=${XAUTHORITY:-${HOME:-/root}/.Xauthority}
+source "$BUILD_ABS/devel/setup.bash"
 roslaunch --screen -p 11311 gesture_formation simulation.launch mission:=$MISSION seed:=$SEED \
   real_time_factor:=$RTF duration:=$DURATION output_dir:=$OUT key_file:=$T/keys record:=true \
   bag:=$OUT/mission.bag rviz:=$RVIZ > "$T/launch.log" 2>&1 &
@@ -60,7 +78,7 @@ wait \$launch || true
 INNER
 start=$(date +%s)
 echo "running the mission through simulation.launch (real-time factor $RTF; log: $OUT/launch.log) ..."
-unshare -n bash "$T/inner.sh"
+"${NETNS[@]}" bash "$T/netns.sh"
 cp "$T/launch.log" "$OUT/launch.log"
 [ -f "$OUT/metrics.json" ] || { echo "$0: the mission did not finish; see $OUT/launch.log" >&2; tail -30 "$OUT/launch.log" >&2; exit 1; }
 # scene.json for the plot's side views: the scenario's solids, as gfctl simulate writes them.
@@ -71,19 +89,23 @@ fi
 PY=/opt/gesture_formation/venv/bin/python
 [ -x "$PY" ] || PY=python3
 "$PY" tools/plot_timeline.py "$OUT" > /dev/null 2>&1 && echo "wrote $OUT/timeline.png" || echo "timeline.png not drawn (needs matplotlib: $PY tools/plot_timeline.py $OUT)"
-python3 - "$OUT/metrics.json" "$(( $(date +%s) - start ))" <<'PY'
+# The summary, in the words of gfctl simulate's (same metric definitions: docs/simulation.md §4).
+python3 - "$OUT/metrics.json" "$(( $(date +%s) - start ))" "$SEED" <<'PY'
 import json, sys
 m = json.load(open(sys.argv[1]))
-f = lambda k, u="": f"{m[k]:.2f}{u}" if isinstance(m.get(k), (int, float)) else str(m.get(k))
-print(f"mission through ROS: {f('sim_time_s',' s')} simulated in {sys.argv[2]} s wall")
-print(f"  min mutual {f('min_mutual_distance_m',' m')}, min obstacle {f('min_obstacle_distance_m',' m')}, "
-      f"min human {f('min_human_distance_m',' m')}, collisions {m['collisions']}")
-print(f"  requests applied {m['requests_applied']}/{m['requests_total']} (operator {m['operator_requests_applied']}, "
+f = lambda k, u="": f"{m[k]:.2f}{u}" if isinstance(m.get(k), (int, float)) else "n/a"
+print(f"seed {sys.argv[3]} through ROS: {f('sim_time_s', ' s')} simulated in {sys.argv[2]} s wall "
+      f"(real-time factor {f('real_time_factor')}x after start-up)")
+print(f"  min mutual {f('min_mutual_distance_m', ' m')}, min obstacle {f('min_obstacle_distance_m', ' m')}, "
+      f"min human {f('min_human_distance_m', ' m')}, collisions {m['collisions']}")
+n_operator = m['requests_total'] - m['gestures_performed']
+print(f"  requests applied {m['requests_applied']}/{m['requests_total']} (operator {m['operator_requests_applied']}/{n_operator}, "
       f"gestures {m['gesture_requests_applied']}/{m['gestures_performed']}), gesture success {f('gesture_success_rate')}, "
-      f"latency {f('gesture_mean_latency_s',' s')}, false adaptations {m['false_adaptations']}")
-print(f"  distance error rms {f('distance_error_rms_m',' m')}, angle error rms {f('angle_error_rms_deg',' deg')}, "
-      f"estimate error rms {f('human_estimate_error_rms_m',' m')}, planning median {f('planning_ms_median',' ms')} "
-      f"p99 {f('planning_ms_p99',' ms')} ({m['plans']} plans, {m['plans_fallback_previous']} previous, {m['plans_fallback_brake']} brake)")
+      f"latency {f('gesture_mean_latency_s', ' s')}, false adaptations {m['false_adaptations']}")
+print(f"  distance error rms {f('distance_error_rms_m', ' m')}, angle error rms {f('angle_error_rms_deg', ' deg')}, "
+      f"estimate error rms {f('human_estimate_error_rms_m', ' m')}, planning median {f('planning_ms_median', ' ms')} "
+      f"p99 {f('planning_ms_p99', ' ms')} (fallback previous {m['plans_fallback_previous']}, "
+      f"brake {m['plans_fallback_brake']} of {m['plans']})")
 PY
 echo "  CPU time / memory per process (wall $(( $(date +%s) - start )) s):"
 python3 - "$OUT/processes.txt" <<'PY2' || true
@@ -99,3 +121,6 @@ PY2
 python3 tools/bag_latency.py "$OUT/mission.bag" 2>/dev/null || true
 ls -la "$OUT/mission.bag" 2>/dev/null | awk '{print "  bag: " $NF " (" $5 " bytes)"}'
 echo "replay: roslaunch gesture_formation replay.launch bag:=$OUT/mission.bag"
+collisions=$(python3 -c "import json, sys; print(json.load(open(sys.argv[1]))['collisions'])" "$OUT/metrics.json")
+[ -s "$OUT/mission.bag" ] || { echo "$0: FAILED: no bag recorded ($OUT/mission.bag)" >&2; exit 1; }
+[ "$collisions" = 0 ] || { echo "$0: FAILED: $collisions collision(s)" >&2; exit 1; }
