@@ -41,6 +41,26 @@ double supportAlong(const NormPolygon& poly, const Eigen::Vector3d& d) {
   return s;
 }
 
+/// Greedy simplification: every dropped point lies within `tolerance` of the segment that
+/// replaces it, so the simplified polyline is within `tolerance` of every original point.
+std::vector<Eigen::Vector3d> simplifyPolyline(const std::vector<Eigen::Vector3d>& p, double tolerance) {
+  if (p.size() < 3) return p;
+  std::vector<Eigen::Vector3d> out{p.front()};
+  std::size_t i = 0;
+  while (i + 1 < p.size()) {
+    std::size_t j = i + 1;
+    while (j + 1 < p.size()) {
+      bool ok = true;
+      for (std::size_t m = i + 1; m <= j && ok; ++m) ok = (p[m] - closestPointOnSegment(p[i], p[j + 1], p[m])).norm() <= tolerance;
+      if (!ok) break;
+      ++j;
+    }
+    out.push_back(p[j]);
+    i = j;
+  }
+  return out;
+}
+
 std::string checkRequest(const PlanRequest& r) {
   std::ostringstream e;
   const auto& s = r.state;
@@ -122,22 +142,9 @@ PlannedTrajectory UavPlanner::brakePlan(const PlanRequest& req) const {
   const int n = std::max(2, req.reference.steps());
   const Eigen::Vector3d p0 = req.state.p_world;
   const Eigen::Vector3d v0 = req.state.v_world.allFinite() ? req.state.v_world : Eigen::Vector3d::Zero();
-  const double speed = v0.norm();
-  Eigen::Vector3d dir = Eigen::Vector3d::Zero();
-  double decel = 0.0, t_stop = 0.0;
-  if (speed > 1e-9) {
-    dir = v0 / speed;
-    // Largest deceleration along −dir with ‖a‖ ≤ a_max and |a_z| ≤ a_z,max, then lowered so
-    // that the stop falls on a sample (the braking curve is then one quadratic per interval,
-    // which the Hermite spline reproduces exactly).
-    double amax = config_.limits.max_acceleration_mps2;
-    if (std::abs(dir.z()) * amax > config_.limits.max_vertical_acceleration_mps2) {
-      amax = config_.limits.max_vertical_acceleration_mps2 / std::abs(dir.z());
-    }
-    const double steps = std::ceil(speed / amax / tr.dt_s - 1e-9);
-    t_stop = steps * tr.dt_s;
-    decel = speed / t_stop;
-  }
+  const BrakeProfile brake = brakeProfile(v0, config_.limits, tr.dt_s);
+  const Eigen::Vector3d dir = brake.dir;
+  const double decel = brake.decel_mps2, t_stop = brake.t_stop_s;
   const Eigen::Vector3d p_stop = p0 + v0 * t_stop - 0.5 * decel * dir * t_stop * t_stop;
   std::vector<Eigen::Vector3d> positions;
   for (int k = 0; k < n; ++k) {
@@ -499,13 +506,9 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
   const auto linPoint = [&](int k) {
     return have_prev ? evaluateTrajectory(last_verified_, req.t_now_s + k * dt).p : p0;
   };
-  const auto addSeparation = [&](int k, const Eigen::Vector3d& o, double margin, double d0, PositionConstraint::Kind kind) {
+  // Half-space keeping x_k at least `margin` from o, linearised at the last plan.
+  const auto addSeparation = [&](int k, const Eigen::Vector3d& o, double margin, PositionConstraint::Kind kind) {
     if ((o - p0).norm() - margin > vmax * k * dt) return;  // cannot get that close by t_k
-    // Already inside at t0 (d0: the distance at t0): recover at the pace of
-    // PlannerConfig::recovery_speed_mps, 1.2× and half the slack of what the verifier asks.
-    if (d0 < margin) {
-      margin = std::min(margin, d0 - 0.5 * config_.recovery_slack_m + 1.2 * recoveryAllowance(config_, k * dt));
-    }
     Eigen::Vector3d n = linPoint(k) - o;
     if (n.norm() < 1e-6) n = guide[static_cast<std::size_t>(k)] - o;
     if (n.norm() < 1e-6) n = Eigen::Vector3d::UnitZ();
@@ -513,19 +516,49 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
     // n·(x − o) ≥ margin  ⇔  (−n)·x ≤ −n·o − margin
     qp.constraints.push_back(PositionConstraint{k, -n, -n.dot(o) - margin, kind});
   };
+  const double buffer = config_.qp_distance_buffer_m;
   for (const auto& other : req.higher_priority_plans) {
     const double age = std::max(0.0, req.t_now_s - other.t0_s);
-    const double margin = config_.mutual_distance_m + config_.age_margin_speed_mps * age + config_.qp_distance_buffer_m;
+    const double margin = config_.mutual_distance_m + config_.age_margin_speed_mps * age + buffer;
     const double d0 = (p0 - evaluateTrajectory(other, req.t_now_s).p).norm();
     for (int k = 1; k <= N; ++k) {
-      addSeparation(k, evaluateTrajectory(other, req.t_now_s + k * dt).p, margin, d0, PositionConstraint::Kind::kUav);
+      // Already inside at t0: recover at 1.2× the verifier's pace (recoveringDistance).
+      addSeparation(k, evaluateTrajectory(other, req.t_now_s + k * dt).p, recoveringDistance(config_, margin, d0, k * dt, true),
+                    PositionConstraint::Kind::kUav);
+    }
+    if (age <= config_.brake_envelope_age_s) continue;
+    // An old plan may have been replaced by a brake plan that did not arrive: keep Γ_dis from
+    // every point where its UAV could have stopped (one half-space per envelope segment and
+    // step, through the segment's point nearest to the linearisation point: the whole segment
+    // lies on its far side).
+    // Fewer segments: the polyline simplified to within kEnvelopeTolerance, which the margin adds.
+    constexpr double kEnvelopeTolerance = 0.05;
+    const std::vector<Eigen::Vector3d> env = simplifyPolyline(brakeEnvelope(other, req.t_now_s, config_.limits), kEnvelopeTolerance);
+    const double d0_env = distanceToPolyline(env, p0);
+    const std::size_t segments = env.size() > 1 ? env.size() - 1 : env.size();
+    for (std::size_t i = 0; i < segments; ++i) {
+      const Eigen::Vector3d& a = env[i];
+      const Eigen::Vector3d& b = env[std::min(i + 1, env.size() - 1)];
+      const double d_seg = (p0 - closestPointOnSegment(a, b, p0)).norm();
+      for (int k = 1; k <= N; ++k) {
+        const double m = recoveringDistance(config_, config_.mutual_distance_m + buffer, d0_env, k * dt, true) + kEnvelopeTolerance;
+        if (d_seg - m > vmax * k * dt) continue;  // cannot get that close by t_k
+        const Eigen::Vector3d c = closestPointOnSegment(a, b, linPoint(k));
+        Eigen::Vector3d n = linPoint(k) - c;
+        if (n.norm() < 1e-6) n = guide[static_cast<std::size_t>(k)] - c;
+        if (n.norm() < 1e-6) n = p0 - c;
+        if (n.norm() < 1e-6) n = Eigen::Vector3d::UnitZ();
+        n.normalize();
+        qp.constraints.push_back(PositionConstraint{k, -n, -n.dot(c) - m, PositionConstraint::Kind::kUav});
+      }
     }
   }
   if (has_worker) {
     const double d0 = (p0 - req.worker.p_world.col(0)).norm();
+    const double margin = config_.worker_safety_distance_m + config_.qp_distance_buffer_m;
     for (int k = 1; k <= N; ++k) {
-      addSeparation(k, req.worker.p_world.col(k), config_.worker_safety_distance_m + config_.qp_distance_buffer_m, d0,
-                    PositionConstraint::Kind::kWorker);
+      // Already inside at t0 (the worker walked up): recover (recoveringDistance).
+      addSeparation(k, req.worker.p_world.col(k), recoveringDistance(config_, margin, d0, k * dt, true), PositionConstraint::Kind::kWorker);
     }
   }
   // Warm start: the last verified plan re-timed (primal only; the constraint set changes).

@@ -457,3 +457,76 @@ TEST(UavPlannerTest, StartCloserThanCorridorClearanceMovesAway) {
   }
   EXPECT_GE(w.field->clearance(s.p_world), cfg.obstacle_clearance_m - 0.05) << "from " << c0 << " m at " << start.transpose();
 }
+
+// brakeEnvelope: where a UAV following the plan stops if it brakes at a sample time in
+// [t0, t_now], against the closed form (1.2 m/s, 3 m/s²: 0.4 s = two samples, stop 0.24 m ahead).
+TEST(BrakeEnvelopeTest, StopPointsAlongThePlanAgainstTheClosedForm) {
+  PlannerConfig cfg;
+  PlannedTrajectory plan;
+  plan.t0_s = 5.0;
+  plan.dt_s = 0.2;
+  const Eigen::Vector3d o(1, 2, 3), v(1.2, 0, 0);
+  for (int k = 0; k < 11; ++k) {
+    TrajectorySample s;
+    s.p_world = o + v * (0.2 * k);
+    s.v_world = k < 10 ? v : Eigen::Vector3d::Zero();  // stops at its end (the spline overshoots a little there)
+    plan.samples.push_back(s);
+  }
+  const auto env = brakeEnvelope(plan, 5.5, cfg.limits);
+  ASSERT_EQ(env.size(), 4u);  // t0, t0 + 0.2, t0 + 0.4, t_now
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_LT((env[i] - (o + v * (0.2 * static_cast<double>(i)) + Eigen::Vector3d(0.24, 0, 0))).norm(), 1e-9) << i;
+  }
+  EXPECT_LT((env[3] - (o + v * 0.5 + Eigen::Vector3d(0.24, 0, 0))).norm(), 1e-9);
+  EXPECT_NEAR(distanceToPolyline(env, o + Eigen::Vector3d(0.5, 1.0, 0)), 1.0, 1e-9);  // beside the polyline
+  EXPECT_NEAR(distanceToPolyline(env, o - Eigen::Vector3d(1.0, 0, 0)), 1.24, 1e-9);  // behind its first point
+  // Long after the plan's end: every stop up to the end, the hover point last.
+  const auto all = brakeEnvelope(plan, 60.0, cfg.limits);
+  EXPECT_LT((all.back() - plan.samples.back().p_world).norm(), 1e-9);
+  // Before (or at) t0: the one stop from the first sample.
+  EXPECT_EQ(brakeEnvelope(plan, 4.0, cfg.limits).size(), 1u);
+}
+
+// Another UAV braked right after its last plan, and its brake plan was lost (loss50 seed 6):
+// our UAV has only that old plan, which flies on away from us, and starts inside its age margin.
+// The recovery rule alone (no closer to the old plan than at t0) let it follow the old plan
+// into the stopped UAV; the braking envelope of the old plan keeps Γ_dis from it.
+TEST(UavPlannerTest, StalePlanOfAStoppedUavIsNotFollowedIntoIt) {
+  const World& w = towers();
+  PlannerConfig cfg = testConfig();
+  UavPlanner planner(cfg, w.map, w.field);
+  const Eigen::Vector3d o0(-4.2, -12, 10), v(1.2, 0, 0);  // the other's plan: +x at 1.2 m/s from t = 9 s
+  PlannedTrajectory other;
+  other.uav_index = 0;
+  other.t0_s = 9.0;
+  other.dt_s = 0.2;
+  for (int k = 0; k < 41; ++k) {
+    TrajectorySample s;
+    s.p_world = o0 + v * (0.2 * k);
+    s.v_world = v;
+    other.samples.push_back(s);
+  }
+  // Truth: it braked at 9.2 s (1.2 m/s at 3 m/s²: stopped 0.24 m further, 0.4 s later).
+  const Eigen::Vector3d stopped = o0 + v * 0.2 + Eigen::Vector3d(0.24, 0, 0);
+  const Eigen::Vector3d from(-8, -12, 10), to(6, -12, 10);  // our reference runs through it
+  UavKinematicState s = stateAt(from, 10.0);
+  double t = 10.0, closest = std::numeric_limits<double>::infinity();
+  for (int cycle = 0; cycle < 15; ++cycle) {  // until 16 s: the old plan ends at 17 s
+    PlanRequest req = straightRequest(1, t, s, from, to, 1.2, Eigen::Vector3d(-5, -3, 1));
+    for (int k = 0; k < req.reference.steps(); ++k) {  // the reference left `from` at t = 10 s
+      const double d = std::min(1.0, 1.2 * std::max(0.0, t - 10.0 + k * req.dt_s) / (to - from).norm());
+      req.reference.p_world.col(k) = from + d * (to - from);
+    }
+    req.higher_priority_plans = {other};  // never updated: the link lost the rest
+    const PlanResult r = planner.plan(req);
+    ASSERT_FALSE(r.trajectory.empty()) << r.reason;
+    for (double tt = t; tt <= t + 0.4 + 1e-9; tt += 0.02) {
+      const double d = (evaluateTrajectory(r.trajectory, tt).p - stopped).norm();
+      closest = std::min(closest, d);
+      ASSERT_GE(d, cfg.mutual_distance_m - 1e-3) << "cycle " << cycle << " t " << tt << ": " << toString(r.status);
+    }
+    t += 0.4;
+    s = advance(r.trajectory, t);
+  }
+  EXPECT_LT(closest, cfg.mutual_distance_m + 1.0);  // it did come up to the stopped UAV (the check bit)
+}
