@@ -129,6 +129,7 @@ UavPlanner& UavPlanner::operator=(UavPlanner&&) noexcept = default;
 
 void UavPlanner::reset() {
   last_verified_ = PlannedTrajectory{};
+  brake_ = PlannedTrajectory{};
   sequence_ = 0;
 }
 
@@ -146,7 +147,6 @@ PlannedTrajectory UavPlanner::brakePlan(const PlanRequest& req) const {
   const Eigen::Vector3d dir = brake.dir;
   const double decel = brake.decel_mps2, t_stop = brake.t_stop_s;
   const Eigen::Vector3d p_stop = p0 + v0 * t_stop - 0.5 * decel * dir * t_stop * t_stop;
-  std::vector<Eigen::Vector3d> positions;
   for (int k = 0; k < n; ++k) {
     const double t = k * tr.dt_s;
     TrajectorySample s;
@@ -157,18 +157,23 @@ PlannedTrajectory UavPlanner::brakePlan(const PlanRequest& req) const {
     } else {
       s.p_world = p_stop;
     }
-    positions.push_back(s.p_world);
     tr.samples.push_back(s);
   }
-  // Camera: keep looking at the worker within the rate limits (closed-form filter: no
-  // failure modes), else hold the current angles.
+  aimCamera(req, tr);
+  return tr;
+}
+
+void UavPlanner::aimCamera(const PlanRequest& req, PlannedTrajectory& tr) const {
+  // Keep looking at the worker within the rate limits (closed-form filter: no failure modes),
+  // else hold the current angles.
+  const int n = static_cast<int>(tr.samples.size());
   CameraTrackingProblem cam;
   cam.dt_s = tr.dt_s;
   cam.heading0_rad = std::isfinite(req.state.heading_rad) ? req.state.heading_rad : 0.0;
   cam.pitch0_rad = std::isfinite(req.state.pitch_rad) ? req.state.pitch_rad : 0.0;
   const bool worker_ok = req.worker.steps() == n && req.worker.p_world.allFinite();
   if (worker_ok) {
-    cam.p_world = positions;
+    for (const auto& s : tr.samples) cam.p_world.push_back(s.p_world);
     for (int k = 0; k < n; ++k) cam.target_world.push_back(req.worker.p_world.col(k));
     cam.max_heading_rate_radps = config_.limits.max_heading_rate_radps;
     cam.max_pitch_rate_radps = config_.limits.max_pitch_rate_radps;
@@ -177,10 +182,10 @@ PlannedTrajectory UavPlanner::brakePlan(const PlanRequest& req) const {
   }
   const CameraTrack track = worker_ok ? cameraFilter(cam) : CameraTrack{};
   for (int k = 0; k < n; ++k) {
-    tr.samples[static_cast<std::size_t>(k)].heading_rad = track.ok ? track.heading_rad[static_cast<std::size_t>(k)] : cam.heading0_rad;
-    tr.samples[static_cast<std::size_t>(k)].pitch_rad = track.ok ? track.pitch_rad[static_cast<std::size_t>(k)] : cam.pitch0_rad;
+    const auto i = static_cast<std::size_t>(k);
+    tr.samples[i].heading_rad = track.ok ? track.heading_rad[i] : cam.heading0_rad;
+    tr.samples[i].pitch_rad = track.ok ? track.pitch_rad[i] : cam.pitch0_rad;
   }
-  return tr;
 }
 
 PlanResult UavPlanner::fallback(const PlanRequest& req, PlanResult result, const std::string& reason) {
@@ -232,6 +237,7 @@ PlanResult UavPlanner::fallback(const PlanRequest& req, PlanResult result, const
         result.min_uav_margin_m = rep.min_uav_margin_m;
         result.min_worker_distance_m = rep.min_worker_distance_m;
         result.reason += "; reusing verified plan #" + std::to_string(last_verified_.sequence);
+        if (brake_.sequence != last_verified_.sequence) brake_ = PlannedTrajectory{};  // another plan is flown now
         result.trajectory.sequence = ++sequence_;
         result.timings.verify_ms += msSince(t_fb);
         return result;
@@ -250,8 +256,38 @@ PlanResult UavPlanner::fallback(const PlanRequest& req, PlanResult result, const
     result.timings.verify_ms += msSince(t_fb);
     return result;
   }
-  result.trajectory = brakePlan(req);
+  // Keep the brake point while the failures go on (docs/planning.md §8): re-anchoring the brake
+  // plan at the state every replanning lets the UAV drift with its tracking error (wind).
+  std::string held;
+  if (!brake_.empty() && std::isfinite(req.t_now_s)) {
+    const double deviation = (evaluateTrajectory(brake_, req.t_now_s).p - req.state.p_world).norm();
+    if (deviation <= config_.fallback_max_deviation_m) {
+      PlannedTrajectory again;
+      again.uav_index = req.uav_index;
+      again.t0_s = req.t_now_s;
+      again.dt_s = dt;
+      for (int k = 0; k < n; ++k) {
+        const TrajectoryPoint x = evaluateTrajectory(brake_, req.t_now_s + k * dt);  // after its end: the stop point
+        TrajectorySample s;
+        s.p_world = x.p;
+        s.v_world = x.v;
+        s.a_world = x.a;
+        again.samples.push_back(s);
+      }
+      aimCamera(req, again);
+      result.trajectory = again;
+      held = "; holding the brake point of plan #" + std::to_string(brake_.sequence);
+    } else {
+      std::ostringstream os;
+      os << "; the state is " << deviation << " m from the brake plan #" << brake_.sequence << ": braking anew";
+      held = os.str();
+      brake_ = PlannedTrajectory{};
+    }
+  }
+  if (brake_.empty()) result.trajectory = brakePlan(req);
+  result.reason += held;
   result.trajectory.sequence = ++sequence_;
+  brake_ = result.trajectory;  // held: the same curve (re-timed), now under this sequence number
   if (verifier_) {
     const VerificationReport rep =
         verifier_->verify(result.trajectory, req.t_now_s, req.higher_priority_plans, req.worker, req.t_now_s, dt);
@@ -671,6 +707,7 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
   result.min_uav_margin_m = rep.min_uav_margin_m;
   result.min_worker_distance_m = rep.min_worker_distance_m;
   last_verified_ = tr;
+  brake_ = PlannedTrajectory{};
   return finish(result);
 }
 

@@ -166,6 +166,7 @@ class UavPlanner {
   struct Stage2;
   PlanResult fallback(const PlanRequest& request, PlanResult result, const std::string& reason);
   PlannedTrajectory brakePlan(const PlanRequest& request) const;
+  void aimCamera(const PlanRequest& request, PlannedTrajectory& trajectory) const;
 
   PlannerConfig config_;
   std::string config_error_;
@@ -176,6 +177,9 @@ class UavPlanner {
   std::unique_ptr<GridPathSearch> search_;
   std::unique_ptr<TrajectoryQp> qp_;
   PlannedTrajectory last_verified_;
+  /// The brake plan being flown while replanning keeps failing (verified or not): its stop
+  /// point is kept instead of braking anew from each state (empty when not braking).
+  PlannedTrajectory brake_;
   std::uint32_t sequence_ = 0;
   bool keep_last_qp_ = false;
   std::unique_ptr<TrajectoryQpProblem> last_qp_;

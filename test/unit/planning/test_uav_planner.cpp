@@ -530,3 +530,55 @@ TEST(UavPlannerTest, StalePlanOfAStoppedUavIsNotFollowedIntoIt) {
   }
   EXPECT_LT(closest, cfg.mutual_distance_m + 1.0);  // it did come up to the stopped UAV (the check bit)
 }
+
+// Replanning keeps failing and the brake plan does not verify (another UAV hovers inside
+// Γ_dis, so a hover does not recover): the brake point must stay where the first brake plan put
+// it. It used to be re-anchored at the state every replanning, so a UAV pushed 0.1 m per period
+// towards the other (tracking error in wind) drifted into it (docs/safety.md §3).
+TEST(UavPlannerTest, RepeatedBrakeFallbacksHoldTheBrakePoint) {
+  const World& w = towers();
+  PlannerConfig cfg = testConfig();
+  UavPlanner planner(cfg, w.map, w.field);
+  const Eigen::Vector3d start(-8, -12, 10), other_p(-8, -9.8, 10), push(0, 0.1, 0);  // 2.2 m apart
+  PlannedTrajectory other;
+  other.uav_index = 0;
+  other.dt_s = 0.2;
+  for (int k = 0; k < 41; ++k) {
+    TrajectorySample s;
+    s.p_world = other_p;
+    other.samples.push_back(s);
+  }
+  UavKinematicState s = stateAt(start, 10.0);
+  s.v_world = Eigen::Vector3d(1.0, 0, 0);  // braking from 1 m/s: stops 0.2 m further along x
+  double t = 10.0;
+  Eigen::Vector3d first_stop = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  for (int cycle = 0; cycle < 12; ++cycle) {
+    PlanRequest req = straightRequest(1, t, s, start, start, 0.0, Eigen::Vector3d(-5, -3, 1));
+    req.reference.p_world(0, 5) = std::numeric_limits<double>::quiet_NaN();  // every replanning fails
+    other.t0_s = t;                                                          // fresh every time
+    req.higher_priority_plans = {other};
+    const PlanResult r = planner.plan(req);
+    ASSERT_EQ(r.status, PlanStatus::kFallbackBrake) << "cycle " << cycle << ": " << r.reason;
+    ASSERT_FALSE(r.verified) << "cycle " << cycle << ": the test needs an unverified brake plan";
+    const Eigen::Vector3d stop = r.trajectory.samples.back().p_world;
+    if (cycle == 0) {
+      first_stop = stop;
+      EXPECT_LT((stop - (start + Eigen::Vector3d(0.2, 0, 0))).norm(), 1e-9);
+    } else {
+      EXPECT_LT((stop - first_stop).norm(), 1e-9) << "cycle " << cycle << ": the brake point moved";
+      EXPECT_NE(r.reason.find("holding the brake point"), std::string::npos) << r.reason;
+    }
+    EXPECT_LT((evaluateTrajectory(r.trajectory, t).p - s.p_world).norm(), cfg.fallback_max_deviation_m);
+    t += 0.4;
+    s = advance(r.trajectory, t);
+    s.p_world += push;  // the wind pushes it off the plan towards the other UAV
+  }
+  // Pushed farther than fallback_max_deviation_m from it: brake anew from where it is.
+  PlanRequest far = straightRequest(1, t, s, start, start, 0.0, Eigen::Vector3d(-5, -3, 1));
+  far.reference.p_world(0, 5) = std::numeric_limits<double>::quiet_NaN();
+  far.state.p_world = first_stop + Eigen::Vector3d(0, -1.5, 0);
+  far.state.v_world.setZero();
+  const PlanResult r = planner.plan(far);
+  EXPECT_LT((r.trajectory.samples.back().p_world - far.state.p_world).norm(), 1e-9);
+  EXPECT_NE(r.reason.find("braking anew"), std::string::npos) << r.reason;
+}
