@@ -49,6 +49,10 @@ std::vector<std::string> PlannerConfig::validate() const {
   require(e, pos(obstacle_clearance_m), "path.obstacle_clearance_m", obstacle_clearance_m, "must be > 0");
   require(e, std::isfinite(path_clearance_m) && path_clearance_m >= obstacle_clearance_m, "path.path_clearance_m",
           path_clearance_m, "must be >= path.obstacle_clearance_m");
+  require(e, nonneg(tracking_allowance_min_m), "path.tracking_allowance_min_m", tracking_allowance_min_m, "must be >= 0");
+  require(e, nonneg(tracking_allowance_max_m) && tracking_allowance_max_m >= tracking_allowance_min_m,
+          "path.tracking_allowance_max_m", tracking_allowance_max_m, "must be >= path.tracking_allowance_min_m");
+  require(e, pos(tracking_allowance_decay_mps), "path.tracking_allowance_decay_mps", tracking_allowance_decay_mps, "must be > 0");
   require(e, pos(max_projection_m), "path.max_projection_m", max_projection_m, "must be > 0");
   require(e, nonneg(path_merge_tolerance_m), "path.merge_tolerance_m", path_merge_tolerance_m, "must be >= 0");
   require(e, pos(search_margin_m), "path.search_margin_m", search_margin_m, "must be > 0");
@@ -101,6 +105,9 @@ PlannerConfig readPlannerConfig(ConfigReader& r, const std::string& prefix) {
 
   r.readDouble(key("path.obstacle_clearance_m"), c.obstacle_clearance_m, Range::positive());
   r.readDouble(key("path.path_clearance_m"), c.path_clearance_m, Range::positive());
+  r.readDouble(key("path.tracking_allowance_min_m"), c.tracking_allowance_min_m, Range::nonNegative());
+  r.readDouble(key("path.tracking_allowance_max_m"), c.tracking_allowance_max_m, Range::nonNegative());
+  r.readDouble(key("path.tracking_allowance_decay_mps"), c.tracking_allowance_decay_mps, Range::positive());
   r.readDouble(key("path.max_projection_m"), c.max_projection_m, Range::positive());
   r.readDouble(key("path.merge_tolerance_m"), c.path_merge_tolerance_m, Range::nonNegative());
   r.readDouble(key("path.search_margin_m"), c.search_margin_m, Range::positive());

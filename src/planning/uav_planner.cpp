@@ -130,7 +130,22 @@ UavPlanner& UavPlanner::operator=(UavPlanner&&) noexcept = default;
 void UavPlanner::reset() {
   last_verified_ = PlannedTrajectory{};
   brake_ = PlannedTrajectory{};
+  flown_ = PlannedTrajectory{};
+  tracking_deviation_m_ = 0.0;
   sequence_ = 0;
+}
+
+void UavPlanner::updateTrackingAllowance(const PlanRequest& req) {
+  if (!std::isfinite(req.t_now_s)) return;
+  // The held deviation decays with the time since the last measurement ...
+  const double elapsed = std::max(0.0, req.t_now_s - allowance_t_s_);
+  tracking_deviation_m_ = std::max(0.0, tracking_deviation_m_ - config_.tracking_allowance_decay_mps * elapsed);
+  allowance_t_s_ = req.t_now_s;
+  // ... and grows to the deviation of the state from the plan being flown.
+  if (!flown_.empty() && req.state.p_world.allFinite()) {
+    const double d = (evaluateTrajectory(flown_, req.t_now_s).p - req.state.p_world).norm();
+    if (std::isfinite(d)) tracking_deviation_m_ = std::max(tracking_deviation_m_, d);
+  }
 }
 
 // ---- fallbacks -------------------------------------------------------------------------------
@@ -311,7 +326,12 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
   const auto t_start = Clock::now();
   PlanResult result;
   result.trajectory.uav_index = req.uav_index;
+  updateTrackingAllowance(req);
+  const double allowance =
+      std::clamp(tracking_deviation_m_, config_.tracking_allowance_min_m, config_.tracking_allowance_max_m);
+  result.tracking_allowance_m = allowance;
   const auto finish = [&](PlanResult r) {
+    flown_ = r.trajectory;
     r.timings.total_ms = msSince(t_start);
     return r;
   };
@@ -332,6 +352,9 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
   auto t_stage = Clock::now();
   std::vector<Eigen::Vector3d> ref(static_cast<std::size_t>(N) + 1, p0);
   const double worker_keep = config_.worker_safety_distance_m + config_.qp_distance_buffer_m;
+  // Obstacle clearances of planning (not of verification) grown by the tracking allowance.
+  const double path_clear = config_.path_clearance_m + allowance;
+  const double seg_clear = config_.obstacle_clearance_m + allowance;
   for (int k = 1; k <= N; ++k) {
     Eigen::Vector3d r = req.reference.p_world.col(k);
     bool moved = false;
@@ -348,7 +371,7 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
         moved = true;
       }
     }
-    const auto proj = projectToClearance(field, map, r, config_.path_clearance_m, config_.max_projection_m);
+    const auto proj = projectToClearance(field, map, r, path_clear, config_.max_projection_m);
     if (proj) {
       moved = moved || (*proj - r).norm() > 1e-9;
       r = *proj;
@@ -361,7 +384,6 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
   }
   // Waypoints: the current position, then the projected references (duplicates dropped),
   // with A* detours where the straight segment is not clear.
-  const double seg_clear = config_.obstacle_clearance_m;
   const double start_clear = field.clearance(p0);
   std::vector<Eigen::Vector3d> raw{p0};
   bool truncated = false;
@@ -375,7 +397,7 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
       continue;
     }
     ++result.path_searches;
-    const auto detour = search_->search(raw.back(), target, config_.path_clearance_m, seg_clear, config_.search_margin_m,
+    const auto detour = search_->search(raw.back(), target, path_clear, seg_clear, config_.search_margin_m,
                                         config_.search_max_expansions);
     if (!detour) {
       truncated = true;  // the rest of the reference is unreachable for now
@@ -420,8 +442,15 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
   t_stage = Clock::now();
   std::vector<SegmentCorridor> corridors;
   corridors.reserve(path.size() - 1);
+  std::unique_ptr<CorridorBuilder> inflated;
+  if (allowance > 0.0) {
+    CorridorConfig cc = corridors_->config();
+    cc.clearance_m += allowance;
+    inflated = std::make_unique<CorridorBuilder>(cc);
+  }
+  const CorridorBuilder& builder = inflated ? *inflated : *corridors_;
   for (std::size_t i = 0; i + 1 < path.size(); ++i) {
-    auto c = corridors_->buildSegment(path[i], path[i + 1], map);
+    auto c = builder.buildSegment(path[i], path[i + 1], map);
     if (!c) {
       result.timings.corridor_ms = msSince(t_stage);
       return finish(fallback(req, result, "corridor " + std::to_string(i) + ": " + c.reason()));
@@ -519,7 +548,7 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
   // until the clearance is back, instead of hovering where the last plan left the UAV.
   {
     const double d_start = field.clearance(p0);
-    if (d_start < config_.obstacle_clearance_m) {
+    if (d_start < seg_clear) {
       Eigen::Vector3d g;
       for (int i = 0; i < 3; ++i) {
         const Eigen::Vector3d e = Eigen::Vector3d::Unit(i) * res;
@@ -528,7 +557,7 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
       if (g.allFinite() && g.norm() > 1e-6) {
         const Eigen::Vector3d away = g.normalized();
         for (int k = 1; k <= N; ++k) {
-          const double gain = std::min(config_.obstacle_clearance_m - d_start,
+          const double gain = std::min(seg_clear - d_start,
                                        -0.5 * config_.recovery_slack_m + 1.2 * recoveryAllowance(config_, k * dt));
           // away·(x_k − p0) ≥ gain  ⇔  (−away)·x_k ≤ −away·p0 − gain
           qp.constraints.push_back(PositionConstraint{k, -away, -away.dot(p0) - gain, PositionConstraint::Kind::kCorridor});

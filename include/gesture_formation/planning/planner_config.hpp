@@ -53,6 +53,19 @@ struct PlannerConfig {
   /// Clearance a reference point / path segment needs (≥ obstacle_clearance_m): references
   /// closer to a voxel centre are projected to the nearest point with this clearance.
   double path_clearance_m = 1.0;
+  /// Tracking allowance (docs/safety.md §2.6): the controller does not fly the plan exactly
+  /// (wind gusts), so planning keeps obstacle_clearance_m and path_clearance_m *plus* an
+  /// allowance for the tracking error, while verification keeps verify_clearance_m. The
+  /// allowance is the largest deviation measured between the state and the plan being flown
+  /// (at each replanning), decaying at tracking_allowance_decay_mps, clamped to
+  /// [tracking_allowance_min_m, tracking_allowance_max_m] (m, 0 ≤ min ≤ max; decay > 0).
+  /// The floor is the tracking error expected in the strongest wind of the mission — a gust
+  /// arrives faster than any measurement: 0.3 m kept the F450 followers ≥ 0.5 m from the
+  /// towers in 8 m/s gusts (the `gusts` profile, docs/reliability.md), where a fallback plan
+  /// was flown while the gust pushed 0.34 m beyond it.
+  double tracking_allowance_min_m = 0.3;
+  double tracking_allowance_max_m = 0.5;
+  double tracking_allowance_decay_mps = 0.02;
   /// Largest distance (m) a reference may be moved by the projection; > 0.
   double max_projection_m = 6.0;
   /// Consecutive reference points are merged into one path segment while every merged point

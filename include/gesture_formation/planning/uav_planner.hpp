@@ -120,6 +120,10 @@ struct PlanResult {
   int corridor_count = 0;
   int projected_references = 0;  ///< reference steps moved out of obstacles / the worker zone
   int path_searches = 0;         ///< A* searches run for blocked segments
+  /// Tracking allowance (m) this replanning added to the planning clearances
+  /// (PlannerConfig::tracking_allowance_*): the largest recent deviation of the state from the
+  /// plan being flown.
+  double tracking_allowance_m = 0.0;
 };
 
 class TrajectoryVerifier;
@@ -167,6 +171,7 @@ class UavPlanner {
   PlanResult fallback(const PlanRequest& request, PlanResult result, const std::string& reason);
   PlannedTrajectory brakePlan(const PlanRequest& request) const;
   void aimCamera(const PlanRequest& request, PlannedTrajectory& trajectory) const;
+  void updateTrackingAllowance(const PlanRequest& request);
 
   PlannerConfig config_;
   std::string config_error_;
@@ -180,6 +185,11 @@ class UavPlanner {
   /// The brake plan being flown while replanning keeps failing (verified or not): its stop
   /// point is kept instead of braking anew from each state (empty when not braking).
   PlannedTrajectory brake_;
+  /// The trajectory returned last (what the controller flies) and the tracking allowance
+  /// measured against it (PlannerConfig::tracking_allowance_*), updated at allowance_t_s_.
+  PlannedTrajectory flown_;
+  double tracking_deviation_m_ = 0.0;
+  double allowance_t_s_ = 0.0;
   std::uint32_t sequence_ = 0;
   bool keep_last_qp_ = false;
   std::unique_ptr<TrajectoryQpProblem> last_qp_;

@@ -278,6 +278,7 @@ TEST(UavPlannerTest, FailedVerificationFallsBack) {
   const World& w = towers();
   PlannerConfig cfg = testConfig();
   cfg.verify_clearance_m = 0.75;
+  cfg.tracking_allowance_min_m = 0.0;  // no extra planning clearance: the corridors keep 0.63 m
   UavPlanner planner(cfg, w.map, w.field);
   const Eigen::Vector3d from(-6, -6, 6), worker(-8, -10, 1);
   const PlanResult first = planner.plan(straightRequest(0, 0.0, stateAt(from), from, from, 1.0, worker));
@@ -582,3 +583,83 @@ TEST(UavPlannerTest, RepeatedBrakeFallbacksHoldTheBrakePoint) {
   EXPECT_LT((r.trajectory.samples.back().p_world - far.state.p_world).norm(), 1e-9);
   EXPECT_NE(r.reason.find("braking anew"), std::string::npos) << r.reason;
 }
+
+TEST(UavPlannerTest, TrackingAllowanceKeysAreValidated) {
+  PlannerConfig c;
+  c.tracking_allowance_min_m = 0.4;
+  c.tracking_allowance_max_m = 0.3;  // < min
+  c.tracking_allowance_decay_mps = 0.0;
+  std::string all;
+  for (const auto& s : c.validate()) all += s + "\n";
+  EXPECT_NE(all.find("path.tracking_allowance_max_m"), std::string::npos) << all;
+  EXPECT_NE(all.find("path.tracking_allowance_decay_mps"), std::string::npos) << all;
+  EXPECT_EQ(("\n" + all).find("\npath.tracking_allowance_min_m"), std::string::npos) << all;
+  c.tracking_allowance_min_m = -0.1;
+  c.tracking_allowance_max_m = 0.3;
+  c.tracking_allowance_decay_mps = 0.02;
+  ASSERT_EQ(c.validate().size(), 1u);
+  EXPECT_NE(c.validate().front().find("path.tracking_allowance_min_m"), std::string::npos);
+}
+
+// The UAV is 0.3 m off the plan it flies (a gust): the next plans keep the obstacle clearance
+// plus that much from the tower, and the allowance decays once it tracks again (gusts seed 6:
+// plans verified at 0.5 m, the gust took the rest).
+TEST(UavPlannerTest, TrackingErrorGrowsTheObstacleClearanceOfPlanning) {
+  const World& w = towers();
+  PlannerConfig cfg = testConfig();
+  cfg.tracking_allowance_min_m = 0.0;  // measured only
+  const Eigen::Vector3d from(-6, 6, 6), to(2.7, 2.7, 6), worker(-8, 8, 1);  // ends hugging the tower
+  const Eigen::Vector3d off(0.0, 0.0, 0.3);
+  // Closest approach to occupied voxel centres of the plan from `t_from` on.
+  const auto closest = [&](const PlannedTrajectory& tr, double t_from) {
+    double d = std::numeric_limits<double>::infinity();
+    for (double t = t_from; t <= tr.tEnd() + 1e-9; t += tr.dt_s / 8) d = std::min(d, centreDistance(*w.map, evaluateTrajectory(tr, t).p, 3.0));
+    return d;
+  };
+  double with_allowance = 0.0, without = 0.0;
+  for (bool pushed : {false, true}) {
+    UavPlanner planner(cfg, w.map, w.field);
+    const PlanResult first = planner.plan(straightRequest(0, 0.0, stateAt(from), from, to, 2.0, worker));
+    ASSERT_EQ(first.status, PlanStatus::kOptimized) << first.reason;
+    EXPECT_EQ(first.tracking_allowance_m, 0.0);
+    UavKinematicState s = advance(first.trajectory, 0.4);
+    if (pushed) s.p_world += off;
+    const PlanResult r = planner.plan(straightRequest(0, 0.4, s, from, to, 2.0, worker));
+    ASSERT_EQ(r.status, PlanStatus::kOptimized) << r.reason;
+    EXPECT_NEAR(r.tracking_allowance_m, pushed ? 0.3 : 0.0, 1e-9);
+    expectSafe(r.trajectory, *w.map, cfg);
+    (pushed ? with_allowance : without) = closest(r.trajectory, 0.4);
+  }
+  EXPECT_LT(without, cfg.obstacle_clearance_m + 0.25);  // without it, the plan hugs the corridor clearance
+  EXPECT_GE(with_allowance, cfg.obstacle_clearance_m + 0.3 - cfg.corridor_margin_m) << "without: " << without;
+}
+
+TEST(UavPlannerTest, TrackingAllowanceDecaysAndIsClamped) {
+  const World& w = towers();
+  PlannerConfig cfg = testConfig();
+  cfg.tracking_allowance_min_m = 0.1;
+  cfg.tracking_allowance_max_m = 0.4;
+  UavPlanner planner(cfg, w.map, w.field);
+  const Eigen::Vector3d from(-8, -12, 10), worker(-5, -3, 1);
+  PlanResult r = planner.plan(straightRequest(0, 0.0, stateAt(from), from, from, 0.0, worker));
+  EXPECT_DOUBLE_EQ(r.tracking_allowance_m, 0.1);  // the floor
+  UavKinematicState s = advance(r.trajectory, 0.4);
+  s.p_world += Eigen::Vector3d(0.6, 0, 0);  // 0.6 m off: clamped to the cap
+  r = planner.plan(straightRequest(0, 0.4, s, from, from, 0.0, worker));
+  EXPECT_DOUBLE_EQ(r.tracking_allowance_m, 0.4);
+  double t = 0.4;
+  for (int cycle = 0; cycle < 25; ++cycle) {  // 10 s of perfect tracking: 0.6 − 0.02·10 = 0.4 ...
+    t += 0.4;
+    r = planner.plan(straightRequest(0, t, advance(r.trajectory, t), from, from, 0.0, worker));
+  }
+  EXPECT_NEAR(r.tracking_allowance_m, 0.4, 1e-9);
+  for (int cycle = 0; cycle < 25; ++cycle) {  // ... 0.2 after 10 s more
+    t += 0.4;
+    r = planner.plan(straightRequest(0, t, advance(r.trajectory, t), from, from, 0.0, worker));
+  }
+  EXPECT_NEAR(r.tracking_allowance_m, 0.2, 1e-6);
+  planner.reset();
+  r = planner.plan(straightRequest(0, t, stateAt(from + Eigen::Vector3d(0.6, 0, 0), t), from, from, 0.0, worker));
+  EXPECT_DOUBLE_EQ(r.tracking_allowance_m, 0.1);  // forgotten with the plan
+}
+
