@@ -543,6 +543,7 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
       if (s_prev == s_cur) break;
     }
   }
+  result.corridors = std::move(corridors);  // for display; not used below
   // Closer to obstacles than the corridor clearance (gusts, a corridor that had to shrink
   // around the start): move away along the distance field's gradient at the recovery pace
   // until the clearance is back, instead of hovering where the last plan left the UAV.

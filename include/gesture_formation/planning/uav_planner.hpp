@@ -27,6 +27,7 @@
 #include <Eigen/Core>
 
 #include "gesture_formation/formation/formation_geometry.hpp"
+#include "gesture_formation/planning/corridor_builder.hpp"
 #include "gesture_formation/planning/planner_config.hpp"
 
 namespace gesture_formation::planning {
@@ -117,6 +118,11 @@ struct PlanResult {
   double min_uav_margin_m = 0.0;       ///< min over plans/time of distance − required (m)
   double min_worker_distance_m = 0.0;  ///< min distance to the worker's prediction (m)
   std::vector<Eigen::Vector3d> path_world;  ///< stage-2 path (after merging), for display
+  /// Stage-3 corridors, one per segment of path_world (polytope `A x ≤ b`, world frame, with the
+  /// ellipsoid it was grown from), for display: filled when the QP stage ran (also when the QP
+  /// or a later stage failed and a fallback was returned), empty otherwise. The QP keeps its
+  /// samples qp.corridor_margin_m inside them.
+  std::vector<SegmentCorridor> corridors;
   int corridor_count = 0;
   int projected_references = 0;  ///< reference steps moved out of obstacles / the worker zone
   int path_searches = 0;         ///< A* searches run for blocked segments
@@ -127,7 +133,6 @@ struct PlanResult {
 };
 
 class TrajectoryVerifier;
-class CorridorBuilder;
 class GridPathSearch;
 class TrajectoryQp;
 struct TrajectoryQpProblem;

@@ -663,3 +663,33 @@ TEST(UavPlannerTest, TrackingAllowanceDecaysAndIsClamped) {
   EXPECT_DOUBLE_EQ(r.tracking_allowance_m, 0.1);  // forgotten with the plan
 }
 
+
+// PlanResult::corridors (for display): one per path segment when the QP stage ran, each
+// containing its segment, every sample after the first inside one of them; empty when the
+// request fails before the QP stage.
+TEST(UavPlannerTest, CorridorsOfTheQpStageAreReported) {
+  const World& w = towers();
+  PlannerConfig cfg = testConfig();
+  UavPlanner planner(cfg, w.map, w.field);
+  const Eigen::Vector3d from(-6, 6, 6), to(2.7, 2.7, 6), worker(-8, 8, 1);  // around the tower's corner
+  const PlanResult r = planner.plan(straightRequest(0, 0.0, stateAt(from), from, to, 2.0, worker));
+  ASSERT_EQ(r.status, PlanStatus::kOptimized) << r.reason;
+  ASSERT_FALSE(r.corridors.empty());
+  ASSERT_EQ(static_cast<int>(r.corridors.size()), r.corridor_count);
+  ASSERT_EQ(r.corridors.size() + 1, r.path_world.size());
+  for (std::size_t i = 0; i < r.corridors.size(); ++i) {
+    const Polytope& P = r.corridors[i].polytope;
+    EXPECT_TRUE(P.contains(r.path_world[i], 1e-9)) << "corridor " << i;
+    EXPECT_TRUE(P.contains(r.path_world[i + 1], 1e-9)) << "corridor " << i;
+  }
+  for (std::size_t k = 1; k < r.trajectory.samples.size(); ++k) {
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto& c : r.corridors) best = std::min(best, c.polytope.violation(r.trajectory.samples[k].p_world));
+    EXPECT_LE(best, -cfg.corridor_margin_m + 1e-4) << "sample " << k;
+  }
+  PlanRequest bad = straightRequest(0, 0.4, advance(r.trajectory, 0.4), from, to, 2.0, worker);
+  bad.reference.p_world(2, 3) = std::numeric_limits<double>::quiet_NaN();
+  const PlanResult b = planner.plan(bad);
+  EXPECT_NE(b.status, PlanStatus::kOptimized);
+  EXPECT_TRUE(b.corridors.empty());
+}
