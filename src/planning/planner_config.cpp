@@ -49,6 +49,10 @@ std::vector<std::string> PlannerConfig::validate() const {
   require(e, pos(obstacle_clearance_m), "path.obstacle_clearance_m", obstacle_clearance_m, "must be > 0");
   require(e, std::isfinite(path_clearance_m) && path_clearance_m >= obstacle_clearance_m, "path.path_clearance_m",
           path_clearance_m, "must be >= path.obstacle_clearance_m");
+  require(e, nonneg(tracking_allowance_min_m), "path.tracking_allowance_min_m", tracking_allowance_min_m, "must be >= 0");
+  require(e, nonneg(tracking_allowance_max_m) && tracking_allowance_max_m >= tracking_allowance_min_m,
+          "path.tracking_allowance_max_m", tracking_allowance_max_m, "must be >= path.tracking_allowance_min_m");
+  require(e, pos(tracking_allowance_decay_mps), "path.tracking_allowance_decay_mps", tracking_allowance_decay_mps, "must be > 0");
   require(e, pos(max_projection_m), "path.max_projection_m", max_projection_m, "must be > 0");
   require(e, nonneg(path_merge_tolerance_m), "path.merge_tolerance_m", path_merge_tolerance_m, "must be >= 0");
   require(e, pos(search_margin_m), "path.search_margin_m", search_margin_m, "must be > 0");
@@ -60,6 +64,7 @@ std::vector<std::string> PlannerConfig::validate() const {
           corridor_margin_m, "must be in [0, qp.corridor_box_margin_m)");
   require(e, pos(mutual_distance_m), "qp.mutual_distance_m", mutual_distance_m, "must be > 0");
   require(e, nonneg(age_margin_speed_mps), "qp.age_margin_speed_mps", age_margin_speed_mps, "must be >= 0");
+  require(e, nonneg(brake_envelope_age_s), "qp.brake_envelope_age_s", brake_envelope_age_s, "must be >= 0");
   require(e, pos(worker_safety_distance_m), "qp.worker_safety_distance_m", worker_safety_distance_m, "must be > 0");
   require(e, nonneg(qp_distance_buffer_m), "qp.distance_buffer_m", qp_distance_buffer_m, "must be >= 0");
   require(e, pos(qp_eps_abs) && qp_eps_abs <= 1e-3, "qp.eps_abs", qp_eps_abs, "must be in (0, 1e-3]");
@@ -100,6 +105,9 @@ PlannerConfig readPlannerConfig(ConfigReader& r, const std::string& prefix) {
 
   r.readDouble(key("path.obstacle_clearance_m"), c.obstacle_clearance_m, Range::positive());
   r.readDouble(key("path.path_clearance_m"), c.path_clearance_m, Range::positive());
+  r.readDouble(key("path.tracking_allowance_min_m"), c.tracking_allowance_min_m, Range::nonNegative());
+  r.readDouble(key("path.tracking_allowance_max_m"), c.tracking_allowance_max_m, Range::nonNegative());
+  r.readDouble(key("path.tracking_allowance_decay_mps"), c.tracking_allowance_decay_mps, Range::positive());
   r.readDouble(key("path.max_projection_m"), c.max_projection_m, Range::positive());
   r.readDouble(key("path.merge_tolerance_m"), c.path_merge_tolerance_m, Range::nonNegative());
   r.readDouble(key("path.search_margin_m"), c.search_margin_m, Range::positive());
@@ -109,6 +117,7 @@ PlannerConfig readPlannerConfig(ConfigReader& r, const std::string& prefix) {
   r.readDouble(key("qp.corridor_margin_m"), c.corridor_margin_m, Range::nonNegative());
   r.readDouble(key("qp.mutual_distance_m"), c.mutual_distance_m, Range::positive());
   r.readDouble(key("qp.age_margin_speed_mps"), c.age_margin_speed_mps, Range::nonNegative());
+  r.readDouble(key("qp.brake_envelope_age_s"), c.brake_envelope_age_s, Range::nonNegative());
   r.readDouble(key("qp.worker_safety_distance_m"), c.worker_safety_distance_m, Range::positive());
   r.readDouble(key("qp.distance_buffer_m"), c.qp_distance_buffer_m, Range::nonNegative());
   r.readDouble(key("qp.eps_abs"), c.qp_eps_abs, Range::openClosed(0.0, 1e-3));

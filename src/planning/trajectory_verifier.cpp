@@ -55,6 +55,58 @@ Eigen::Vector3d workerPositionAt(const formation::WorkerHorizon& w, double t0, d
   return (1.0 - s) * w.p_world.col(k) + s * w.p_world.col(k + 1);
 }
 
+BrakeProfile brakeProfile(const Eigen::Vector3d& v, const DynamicLimits& limits, double dt) {
+  BrakeProfile b;
+  const double speed = v.norm();
+  if (!(speed > 1e-9) || !std::isfinite(speed) || !(dt > 0.0)) return b;
+  b.speed_mps = speed;
+  b.dir = v / speed;
+  double amax = limits.max_acceleration_mps2;
+  if (std::abs(b.dir.z()) * amax > limits.max_vertical_acceleration_mps2) {
+    amax = limits.max_vertical_acceleration_mps2 / std::abs(b.dir.z());
+  }
+  // The stop on a sample: the braking curve is then one quadratic per interval, which the
+  // Hermite spline reproduces exactly.
+  b.t_stop_s = std::ceil(speed / amax / dt - 1e-9) * dt;
+  b.decel_mps2 = speed / b.t_stop_s;
+  return b;
+}
+
+Eigen::Vector3d brakeStop(const Eigen::Vector3d& p, const Eigen::Vector3d& v, const DynamicLimits& limits, double dt) {
+  const BrakeProfile b = brakeProfile(v, limits, dt);
+  return p + 0.5 * b.speed_mps * b.t_stop_s * b.dir;
+}
+
+std::vector<Eigen::Vector3d> brakeEnvelope(const PlannedTrajectory& plan, double t_now, const DynamicLimits& limits) {
+  std::vector<Eigen::Vector3d> out;
+  if (plan.samples.empty()) return out;
+  const double t_last = std::isfinite(t_now) ? std::min(std::max(t_now, plan.t0_s), plan.tEnd()) : plan.t0_s;
+  const auto add = [&](double t) {
+    const TrajectoryPoint x = evaluateTrajectory(plan, t);
+    const Eigen::Vector3d stop = brakeStop(x.p, x.v, limits, plan.dt_s);
+    if (out.empty() || (stop - out.back()).norm() > 1e-6) out.push_back(stop);
+  };
+  for (std::size_t k = 0; k < plan.samples.size() && plan.t0_s + static_cast<double>(k) * plan.dt_s < t_last; ++k) {
+    add(plan.t0_s + static_cast<double>(k) * plan.dt_s);
+  }
+  add(t_last);
+  return out;
+}
+
+Eigen::Vector3d closestPointOnSegment(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& x) {
+  const Eigen::Vector3d ab = b - a;
+  const double L2 = ab.squaredNorm();
+  if (!(L2 > 1e-18)) return a;
+  return a + std::clamp((x - a).dot(ab) / L2, 0.0, 1.0) * ab;
+}
+
+double distanceToPolyline(const std::vector<Eigen::Vector3d>& poly, const Eigen::Vector3d& x) {
+  double d = std::numeric_limits<double>::infinity();
+  if (poly.size() == 1) return (x - poly.front()).norm();
+  for (std::size_t i = 0; i + 1 < poly.size(); ++i) d = std::min(d, (x - closestPointOnSegment(poly[i], poly[i + 1], x)).norm());
+  return d;
+}
+
 TrajectoryVerifier::TrajectoryVerifier(const OccupancyMap& map, const DistanceField& field, const PlannerConfig& config)
     : map_(map), field_(field), config_(config), fcl_(map) {}
 
@@ -93,15 +145,23 @@ VerificationReport TrajectoryVerifier::verify(const PlannedTrajectory& tr, doubl
       return fail(os.str());
     }
   }
-  // Required distances to the other plans (age margin) and to the worker.
+  // Required distances to the other plans (age margin; recovery: requiredUavDistance) and to the worker.
   std::vector<double> required(others.size());
   for (std::size_t j = 0; j < others.size(); ++j) {
-    const double age = std::max(0.0, t_now - others[j].t0_s);
-    required[j] = config_.mutual_distance_m + config_.age_margin_speed_mps * age;
+    required[j] = config_.mutual_distance_m + config_.age_margin_speed_mps * std::max(0.0, t_now - others[j].t0_s);
   }
   const TrajectoryPoint start = evaluateTrajectory(tr, tr.t0_s);
   std::vector<double> start_dist(others.size());
   for (std::size_t j = 0; j < others.size(); ++j) start_dist[j] = (start.p - evaluateTrajectory(others[j], tr.t0_s).p).norm();
+  // Braking envelopes of the plans old enough to have been replaced by a brake plan we did not get.
+  std::vector<std::vector<Eigen::Vector3d>> envelope(others.size());
+  std::vector<double> start_envelope(others.size(), std::numeric_limits<double>::infinity());
+  for (std::size_t j = 0; j < others.size(); ++j) {
+    if (t_now - others[j].t0_s > config_.brake_envelope_age_s) {
+      envelope[j] = brakeEnvelope(others[j], t_now, L);
+      start_envelope[j] = distanceToPolyline(envelope[j], start.p);
+    }
+  }
   const bool has_worker = worker.steps() > 0;
   const double start_worker = has_worker ? (start.p - workerPositionAt(worker, worker_t0, worker_dt, tr.t0_s)).norm() : 0.0;
   const double start_clear = field_.clearance(start.p) - rho;
@@ -151,14 +211,21 @@ VerificationReport TrajectoryVerifier::verify(const PlannedTrajectory& tr, doubl
       // Other UAVs' plans.
       for (std::size_t j = 0; j < others.size(); ++j) {
         const double d = (x.p - evaluateTrajectory(others[j], t).p).norm();
-        const double req = start_dist[j] < required[j]
-                               ? std::min(required[j], start_dist[j] - config_.recovery_slack_m +
-                                                           recoveryAllowance(config_, t - tr.t0_s))
-                               : required[j];
+        const double req = recoveringDistance(config_, required[j], start_dist[j], t - tr.t0_s);
         rep.min_uav_margin_m = std::min(rep.min_uav_margin_m, d - required[j]);
         if (d < req - tol) {
           os << "verify: " << d << " m from UAV " << others[j].uav_index << "'s plan at t=" << t << " (need " << req << " m)";
           return fail(os.str());
+        }
+        if (!envelope[j].empty()) {
+          const double de = distanceToPolyline(envelope[j], x.p);
+          const double req_e = recoveringDistance(config_, config_.mutual_distance_m, start_envelope[j], t - tr.t0_s);
+          rep.min_uav_margin_m = std::min(rep.min_uav_margin_m, de - config_.mutual_distance_m);
+          if (de < req_e - tol) {
+            os << "verify: " << de << " m from UAV " << others[j].uav_index << "'s braking envelope at t=" << t << " (need "
+               << req_e << " m)";
+            return fail(os.str());
+          }
         }
       }
       // Worker.
@@ -166,9 +233,7 @@ VerificationReport TrajectoryVerifier::verify(const PlannedTrajectory& tr, doubl
         const double d = (x.p - workerPositionAt(worker, worker_t0, worker_dt, t)).norm();
         rep.min_worker_distance_m = std::min(rep.min_worker_distance_m, d);
         const double limit = config_.worker_safety_distance_m;
-        const double req = start_worker < limit ? std::min(limit, start_worker - config_.recovery_slack_m +
-                                                                      recoveryAllowance(config_, t - tr.t0_s))
-                                                : limit;
+        const double req = recoveringDistance(config_, limit, start_worker, t - tr.t0_s);
         if (d < req - tol) {
           os << "verify: " << d << " m from the worker at t=" << t << " (need " << req << " m)";
           return fail(os.str());

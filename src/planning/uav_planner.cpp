@@ -41,6 +41,26 @@ double supportAlong(const NormPolygon& poly, const Eigen::Vector3d& d) {
   return s;
 }
 
+/// Greedy simplification: every dropped point lies within `tolerance` of the segment that
+/// replaces it, so the simplified polyline is within `tolerance` of every original point.
+std::vector<Eigen::Vector3d> simplifyPolyline(const std::vector<Eigen::Vector3d>& p, double tolerance) {
+  if (p.size() < 3) return p;
+  std::vector<Eigen::Vector3d> out{p.front()};
+  std::size_t i = 0;
+  while (i + 1 < p.size()) {
+    std::size_t j = i + 1;
+    while (j + 1 < p.size()) {
+      bool ok = true;
+      for (std::size_t m = i + 1; m <= j && ok; ++m) ok = (p[m] - closestPointOnSegment(p[i], p[j + 1], p[m])).norm() <= tolerance;
+      if (!ok) break;
+      ++j;
+    }
+    out.push_back(p[j]);
+    i = j;
+  }
+  return out;
+}
+
 std::string checkRequest(const PlanRequest& r) {
   std::ostringstream e;
   const auto& s = r.state;
@@ -109,7 +129,23 @@ UavPlanner& UavPlanner::operator=(UavPlanner&&) noexcept = default;
 
 void UavPlanner::reset() {
   last_verified_ = PlannedTrajectory{};
+  brake_ = PlannedTrajectory{};
+  flown_ = PlannedTrajectory{};
+  tracking_deviation_m_ = 0.0;
   sequence_ = 0;
+}
+
+void UavPlanner::updateTrackingAllowance(const PlanRequest& req) {
+  if (!std::isfinite(req.t_now_s)) return;
+  // The held deviation decays with the time since the last measurement ...
+  const double elapsed = std::max(0.0, req.t_now_s - allowance_t_s_);
+  tracking_deviation_m_ = std::max(0.0, tracking_deviation_m_ - config_.tracking_allowance_decay_mps * elapsed);
+  allowance_t_s_ = req.t_now_s;
+  // ... and grows to the deviation of the state from the plan being flown.
+  if (!flown_.empty() && req.state.p_world.allFinite()) {
+    const double d = (evaluateTrajectory(flown_, req.t_now_s).p - req.state.p_world).norm();
+    if (std::isfinite(d)) tracking_deviation_m_ = std::max(tracking_deviation_m_, d);
+  }
 }
 
 // ---- fallbacks -------------------------------------------------------------------------------
@@ -122,24 +158,10 @@ PlannedTrajectory UavPlanner::brakePlan(const PlanRequest& req) const {
   const int n = std::max(2, req.reference.steps());
   const Eigen::Vector3d p0 = req.state.p_world;
   const Eigen::Vector3d v0 = req.state.v_world.allFinite() ? req.state.v_world : Eigen::Vector3d::Zero();
-  const double speed = v0.norm();
-  Eigen::Vector3d dir = Eigen::Vector3d::Zero();
-  double decel = 0.0, t_stop = 0.0;
-  if (speed > 1e-9) {
-    dir = v0 / speed;
-    // Largest deceleration along −dir with ‖a‖ ≤ a_max and |a_z| ≤ a_z,max, then lowered so
-    // that the stop falls on a sample (the braking curve is then one quadratic per interval,
-    // which the Hermite spline reproduces exactly).
-    double amax = config_.limits.max_acceleration_mps2;
-    if (std::abs(dir.z()) * amax > config_.limits.max_vertical_acceleration_mps2) {
-      amax = config_.limits.max_vertical_acceleration_mps2 / std::abs(dir.z());
-    }
-    const double steps = std::ceil(speed / amax / tr.dt_s - 1e-9);
-    t_stop = steps * tr.dt_s;
-    decel = speed / t_stop;
-  }
+  const BrakeProfile brake = brakeProfile(v0, config_.limits, tr.dt_s);
+  const Eigen::Vector3d dir = brake.dir;
+  const double decel = brake.decel_mps2, t_stop = brake.t_stop_s;
   const Eigen::Vector3d p_stop = p0 + v0 * t_stop - 0.5 * decel * dir * t_stop * t_stop;
-  std::vector<Eigen::Vector3d> positions;
   for (int k = 0; k < n; ++k) {
     const double t = k * tr.dt_s;
     TrajectorySample s;
@@ -150,18 +172,23 @@ PlannedTrajectory UavPlanner::brakePlan(const PlanRequest& req) const {
     } else {
       s.p_world = p_stop;
     }
-    positions.push_back(s.p_world);
     tr.samples.push_back(s);
   }
-  // Camera: keep looking at the worker within the rate limits (closed-form filter: no
-  // failure modes), else hold the current angles.
+  aimCamera(req, tr);
+  return tr;
+}
+
+void UavPlanner::aimCamera(const PlanRequest& req, PlannedTrajectory& tr) const {
+  // Keep looking at the worker within the rate limits (closed-form filter: no failure modes),
+  // else hold the current angles.
+  const int n = static_cast<int>(tr.samples.size());
   CameraTrackingProblem cam;
   cam.dt_s = tr.dt_s;
   cam.heading0_rad = std::isfinite(req.state.heading_rad) ? req.state.heading_rad : 0.0;
   cam.pitch0_rad = std::isfinite(req.state.pitch_rad) ? req.state.pitch_rad : 0.0;
   const bool worker_ok = req.worker.steps() == n && req.worker.p_world.allFinite();
   if (worker_ok) {
-    cam.p_world = positions;
+    for (const auto& s : tr.samples) cam.p_world.push_back(s.p_world);
     for (int k = 0; k < n; ++k) cam.target_world.push_back(req.worker.p_world.col(k));
     cam.max_heading_rate_radps = config_.limits.max_heading_rate_radps;
     cam.max_pitch_rate_radps = config_.limits.max_pitch_rate_radps;
@@ -170,10 +197,10 @@ PlannedTrajectory UavPlanner::brakePlan(const PlanRequest& req) const {
   }
   const CameraTrack track = worker_ok ? cameraFilter(cam) : CameraTrack{};
   for (int k = 0; k < n; ++k) {
-    tr.samples[static_cast<std::size_t>(k)].heading_rad = track.ok ? track.heading_rad[static_cast<std::size_t>(k)] : cam.heading0_rad;
-    tr.samples[static_cast<std::size_t>(k)].pitch_rad = track.ok ? track.pitch_rad[static_cast<std::size_t>(k)] : cam.pitch0_rad;
+    const auto i = static_cast<std::size_t>(k);
+    tr.samples[i].heading_rad = track.ok ? track.heading_rad[i] : cam.heading0_rad;
+    tr.samples[i].pitch_rad = track.ok ? track.pitch_rad[i] : cam.pitch0_rad;
   }
-  return tr;
 }
 
 PlanResult UavPlanner::fallback(const PlanRequest& req, PlanResult result, const std::string& reason) {
@@ -225,6 +252,7 @@ PlanResult UavPlanner::fallback(const PlanRequest& req, PlanResult result, const
         result.min_uav_margin_m = rep.min_uav_margin_m;
         result.min_worker_distance_m = rep.min_worker_distance_m;
         result.reason += "; reusing verified plan #" + std::to_string(last_verified_.sequence);
+        if (brake_.sequence != last_verified_.sequence) brake_ = PlannedTrajectory{};  // another plan is flown now
         result.trajectory.sequence = ++sequence_;
         result.timings.verify_ms += msSince(t_fb);
         return result;
@@ -243,8 +271,38 @@ PlanResult UavPlanner::fallback(const PlanRequest& req, PlanResult result, const
     result.timings.verify_ms += msSince(t_fb);
     return result;
   }
-  result.trajectory = brakePlan(req);
+  // Keep the brake point while the failures go on (docs/planning.md §8): re-anchoring the brake
+  // plan at the state every replanning lets the UAV drift with its tracking error (wind).
+  std::string held;
+  if (!brake_.empty() && std::isfinite(req.t_now_s)) {
+    const double deviation = (evaluateTrajectory(brake_, req.t_now_s).p - req.state.p_world).norm();
+    if (deviation <= config_.fallback_max_deviation_m) {
+      PlannedTrajectory again;
+      again.uav_index = req.uav_index;
+      again.t0_s = req.t_now_s;
+      again.dt_s = dt;
+      for (int k = 0; k < n; ++k) {
+        const TrajectoryPoint x = evaluateTrajectory(brake_, req.t_now_s + k * dt);  // after its end: the stop point
+        TrajectorySample s;
+        s.p_world = x.p;
+        s.v_world = x.v;
+        s.a_world = x.a;
+        again.samples.push_back(s);
+      }
+      aimCamera(req, again);
+      result.trajectory = again;
+      held = "; holding the brake point of plan #" + std::to_string(brake_.sequence);
+    } else {
+      std::ostringstream os;
+      os << "; the state is " << deviation << " m from the brake plan #" << brake_.sequence << ": braking anew";
+      held = os.str();
+      brake_ = PlannedTrajectory{};
+    }
+  }
+  if (brake_.empty()) result.trajectory = brakePlan(req);
+  result.reason += held;
   result.trajectory.sequence = ++sequence_;
+  brake_ = result.trajectory;  // held: the same curve (re-timed), now under this sequence number
   if (verifier_) {
     const VerificationReport rep =
         verifier_->verify(result.trajectory, req.t_now_s, req.higher_priority_plans, req.worker, req.t_now_s, dt);
@@ -268,7 +326,12 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
   const auto t_start = Clock::now();
   PlanResult result;
   result.trajectory.uav_index = req.uav_index;
+  updateTrackingAllowance(req);
+  const double allowance =
+      std::clamp(tracking_deviation_m_, config_.tracking_allowance_min_m, config_.tracking_allowance_max_m);
+  result.tracking_allowance_m = allowance;
   const auto finish = [&](PlanResult r) {
+    flown_ = r.trajectory;
     r.timings.total_ms = msSince(t_start);
     return r;
   };
@@ -289,6 +352,9 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
   auto t_stage = Clock::now();
   std::vector<Eigen::Vector3d> ref(static_cast<std::size_t>(N) + 1, p0);
   const double worker_keep = config_.worker_safety_distance_m + config_.qp_distance_buffer_m;
+  // Obstacle clearances of planning (not of verification) grown by the tracking allowance.
+  const double path_clear = config_.path_clearance_m + allowance;
+  const double seg_clear = config_.obstacle_clearance_m + allowance;
   for (int k = 1; k <= N; ++k) {
     Eigen::Vector3d r = req.reference.p_world.col(k);
     bool moved = false;
@@ -305,7 +371,7 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
         moved = true;
       }
     }
-    const auto proj = projectToClearance(field, map, r, config_.path_clearance_m, config_.max_projection_m);
+    const auto proj = projectToClearance(field, map, r, path_clear, config_.max_projection_m);
     if (proj) {
       moved = moved || (*proj - r).norm() > 1e-9;
       r = *proj;
@@ -318,7 +384,6 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
   }
   // Waypoints: the current position, then the projected references (duplicates dropped),
   // with A* detours where the straight segment is not clear.
-  const double seg_clear = config_.obstacle_clearance_m;
   const double start_clear = field.clearance(p0);
   std::vector<Eigen::Vector3d> raw{p0};
   bool truncated = false;
@@ -332,7 +397,7 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
       continue;
     }
     ++result.path_searches;
-    const auto detour = search_->search(raw.back(), target, config_.path_clearance_m, seg_clear, config_.search_margin_m,
+    const auto detour = search_->search(raw.back(), target, path_clear, seg_clear, config_.search_margin_m,
                                         config_.search_max_expansions);
     if (!detour) {
       truncated = true;  // the rest of the reference is unreachable for now
@@ -377,8 +442,15 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
   t_stage = Clock::now();
   std::vector<SegmentCorridor> corridors;
   corridors.reserve(path.size() - 1);
+  std::unique_ptr<CorridorBuilder> inflated;
+  if (allowance > 0.0) {
+    CorridorConfig cc = corridors_->config();
+    cc.clearance_m += allowance;
+    inflated = std::make_unique<CorridorBuilder>(cc);
+  }
+  const CorridorBuilder& builder = inflated ? *inflated : *corridors_;
   for (std::size_t i = 0; i + 1 < path.size(); ++i) {
-    auto c = corridors_->buildSegment(path[i], path[i + 1], map);
+    auto c = builder.buildSegment(path[i], path[i + 1], map);
     if (!c) {
       result.timings.corridor_ms = msSince(t_stage);
       return finish(fallback(req, result, "corridor " + std::to_string(i) + ": " + c.reason()));
@@ -471,12 +543,13 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
       if (s_prev == s_cur) break;
     }
   }
+  result.corridors = std::move(corridors);  // for display; not used below
   // Closer to obstacles than the corridor clearance (gusts, a corridor that had to shrink
   // around the start): move away along the distance field's gradient at the recovery pace
   // until the clearance is back, instead of hovering where the last plan left the UAV.
   {
     const double d_start = field.clearance(p0);
-    if (d_start < config_.obstacle_clearance_m) {
+    if (d_start < seg_clear) {
       Eigen::Vector3d g;
       for (int i = 0; i < 3; ++i) {
         const Eigen::Vector3d e = Eigen::Vector3d::Unit(i) * res;
@@ -485,7 +558,7 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
       if (g.allFinite() && g.norm() > 1e-6) {
         const Eigen::Vector3d away = g.normalized();
         for (int k = 1; k <= N; ++k) {
-          const double gain = std::min(config_.obstacle_clearance_m - d_start,
+          const double gain = std::min(seg_clear - d_start,
                                        -0.5 * config_.recovery_slack_m + 1.2 * recoveryAllowance(config_, k * dt));
           // away·(x_k − p0) ≥ gain  ⇔  (−away)·x_k ≤ −away·p0 − gain
           qp.constraints.push_back(PositionConstraint{k, -away, -away.dot(p0) - gain, PositionConstraint::Kind::kCorridor});
@@ -499,13 +572,9 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
   const auto linPoint = [&](int k) {
     return have_prev ? evaluateTrajectory(last_verified_, req.t_now_s + k * dt).p : p0;
   };
-  const auto addSeparation = [&](int k, const Eigen::Vector3d& o, double margin, double d0, PositionConstraint::Kind kind) {
+  // Half-space keeping x_k at least `margin` from o, linearised at the last plan.
+  const auto addSeparation = [&](int k, const Eigen::Vector3d& o, double margin, PositionConstraint::Kind kind) {
     if ((o - p0).norm() - margin > vmax * k * dt) return;  // cannot get that close by t_k
-    // Already inside at t0 (d0: the distance at t0): recover at the pace of
-    // PlannerConfig::recovery_speed_mps, 1.2× and half the slack of what the verifier asks.
-    if (d0 < margin) {
-      margin = std::min(margin, d0 - 0.5 * config_.recovery_slack_m + 1.2 * recoveryAllowance(config_, k * dt));
-    }
     Eigen::Vector3d n = linPoint(k) - o;
     if (n.norm() < 1e-6) n = guide[static_cast<std::size_t>(k)] - o;
     if (n.norm() < 1e-6) n = Eigen::Vector3d::UnitZ();
@@ -513,19 +582,49 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
     // n·(x − o) ≥ margin  ⇔  (−n)·x ≤ −n·o − margin
     qp.constraints.push_back(PositionConstraint{k, -n, -n.dot(o) - margin, kind});
   };
+  const double buffer = config_.qp_distance_buffer_m;
   for (const auto& other : req.higher_priority_plans) {
     const double age = std::max(0.0, req.t_now_s - other.t0_s);
-    const double margin = config_.mutual_distance_m + config_.age_margin_speed_mps * age + config_.qp_distance_buffer_m;
+    const double margin = config_.mutual_distance_m + config_.age_margin_speed_mps * age + buffer;
     const double d0 = (p0 - evaluateTrajectory(other, req.t_now_s).p).norm();
     for (int k = 1; k <= N; ++k) {
-      addSeparation(k, evaluateTrajectory(other, req.t_now_s + k * dt).p, margin, d0, PositionConstraint::Kind::kUav);
+      // Already inside at t0: recover at 1.2× the verifier's pace (recoveringDistance).
+      addSeparation(k, evaluateTrajectory(other, req.t_now_s + k * dt).p, recoveringDistance(config_, margin, d0, k * dt, true),
+                    PositionConstraint::Kind::kUav);
+    }
+    if (age <= config_.brake_envelope_age_s) continue;
+    // An old plan may have been replaced by a brake plan that did not arrive: keep Γ_dis from
+    // every point where its UAV could have stopped (one half-space per envelope segment and
+    // step, through the segment's point nearest to the linearisation point: the whole segment
+    // lies on its far side).
+    // Fewer segments: the polyline simplified to within kEnvelopeTolerance, which the margin adds.
+    constexpr double kEnvelopeTolerance = 0.05;
+    const std::vector<Eigen::Vector3d> env = simplifyPolyline(brakeEnvelope(other, req.t_now_s, config_.limits), kEnvelopeTolerance);
+    const double d0_env = distanceToPolyline(env, p0);
+    const std::size_t segments = env.size() > 1 ? env.size() - 1 : env.size();
+    for (std::size_t i = 0; i < segments; ++i) {
+      const Eigen::Vector3d& a = env[i];
+      const Eigen::Vector3d& b = env[std::min(i + 1, env.size() - 1)];
+      const double d_seg = (p0 - closestPointOnSegment(a, b, p0)).norm();
+      for (int k = 1; k <= N; ++k) {
+        const double m = recoveringDistance(config_, config_.mutual_distance_m + buffer, d0_env, k * dt, true) + kEnvelopeTolerance;
+        if (d_seg - m > vmax * k * dt) continue;  // cannot get that close by t_k
+        const Eigen::Vector3d c = closestPointOnSegment(a, b, linPoint(k));
+        Eigen::Vector3d n = linPoint(k) - c;
+        if (n.norm() < 1e-6) n = guide[static_cast<std::size_t>(k)] - c;
+        if (n.norm() < 1e-6) n = p0 - c;
+        if (n.norm() < 1e-6) n = Eigen::Vector3d::UnitZ();
+        n.normalize();
+        qp.constraints.push_back(PositionConstraint{k, -n, -n.dot(c) - m, PositionConstraint::Kind::kUav});
+      }
     }
   }
   if (has_worker) {
     const double d0 = (p0 - req.worker.p_world.col(0)).norm();
+    const double margin = config_.worker_safety_distance_m + config_.qp_distance_buffer_m;
     for (int k = 1; k <= N; ++k) {
-      addSeparation(k, req.worker.p_world.col(k), config_.worker_safety_distance_m + config_.qp_distance_buffer_m, d0,
-                    PositionConstraint::Kind::kWorker);
+      // Already inside at t0 (the worker walked up): recover (recoveringDistance).
+      addSeparation(k, req.worker.p_world.col(k), recoveringDistance(config_, margin, d0, k * dt, true), PositionConstraint::Kind::kWorker);
     }
   }
   // Warm start: the last verified plan re-timed (primal only; the constraint set changes).
@@ -638,6 +737,7 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
   result.min_uav_margin_m = rep.min_uav_margin_m;
   result.min_worker_distance_m = rep.min_worker_distance_m;
   last_verified_ = tr;
+  brake_ = PlannedTrajectory{};
   return finish(result);
 }
 

@@ -9,6 +9,7 @@
 /// *centres* (corridors, path search, distance field) unless the name says `cube`.
 /// Thread safety: value types and pure functions.
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -52,6 +53,19 @@ struct PlannerConfig {
   /// Clearance a reference point / path segment needs (≥ obstacle_clearance_m): references
   /// closer to a voxel centre are projected to the nearest point with this clearance.
   double path_clearance_m = 1.0;
+  /// Tracking allowance (docs/safety.md §2.6): the controller does not fly the plan exactly
+  /// (wind gusts), so planning keeps obstacle_clearance_m and path_clearance_m *plus* an
+  /// allowance for the tracking error, while verification keeps verify_clearance_m. The
+  /// allowance is the largest deviation measured between the state and the plan being flown
+  /// (at each replanning), decaying at tracking_allowance_decay_mps, clamped to
+  /// [tracking_allowance_min_m, tracking_allowance_max_m] (m, 0 ≤ min ≤ max; decay > 0).
+  /// The floor is the tracking error expected in the strongest wind of the mission — a gust
+  /// arrives faster than any measurement: 0.3 m kept the F450 followers ≥ 0.5 m from the
+  /// towers in 8 m/s gusts (the `gusts` profile, docs/reliability.md), where a fallback plan
+  /// was flown while the gust pushed 0.34 m beyond it.
+  double tracking_allowance_min_m = 0.3;
+  double tracking_allowance_max_m = 0.5;
+  double tracking_allowance_decay_mps = 0.02;
   /// Largest distance (m) a reference may be moved by the projection; > 0.
   double max_projection_m = 6.0;
   /// Consecutive reference points are merged into one path segment while every merged point
@@ -74,6 +88,15 @@ struct PlannerConfig {
   /// An older plan of another UAV gets margin Γ_dis + age_margin_speed_mps·age (its UAV may
   /// have replanned since and moved at up to this speed), ≥ 0.
   double age_margin_speed_mps = 5.0;
+  /// Another UAV's plan older than this (s, ≥ 0) may already have been replaced by one that did
+  /// not arrive — typically a brake plan lost on the link: its UAV stopped while the old plan
+  /// flies on, and the recovery rule (verify.recovery_*), which only asks a UAV already inside
+  /// the age margin to get no closer to the old plan, would let it follow the old plan into the
+  /// stopped UAV (docs/safety.md §4, loss50 seed 6). So every plan this old also adds its
+  /// *braking envelope* (brakeEnvelope(): where its UAV would have stopped had it braked at any
+  /// time between the plan's t0 and now), kept Γ_dis away with the same recovery rule.
+  /// Default: one replanning period (0.4 s) plus latency.
+  double brake_envelope_age_s = 0.5;
   /// Distance (m) kept from the worker's predicted (mid-body) position, > 0.
   double worker_safety_distance_m = 3.0;
   /// Extra distance (m) added to the inter-UAV and worker half-spaces in the QP only, so that
@@ -130,6 +153,19 @@ inline double recoveryAllowance(const PlannerConfig& c, double tau_s) {
   const double t1 = c.recovery_speed_mps / c.recovery_acceleration_mps2;
   if (tau_s <= t1) return 0.5 * c.recovery_acceleration_mps2 * tau_s * tau_s;
   return 0.5 * c.recovery_speed_mps * t1 + c.recovery_speed_mps * (tau_s - t1);
+}
+
+/// \brief The distance (m) a plan must keep at τ = t − t0 from something (another UAV's plan,
+/// a braking envelope, the worker) that must be `limit_m` away and is `d0_m` away at t0: the
+/// limit, or — when the start already violates it — the recovery requirement
+/// min(limit, d0 − recovery_slack_m + s(τ)) (docs/planning.md §7.1). The verifier uses it as
+/// is; the QP (`qp_form`) asks for 1.2·s(τ) with half the slack, so that a solved plan passes
+/// verification.
+inline double recoveringDistance(const PlannerConfig& c, double limit_m, double d0_m, double tau_s, bool qp_form = false) {
+  if (!(d0_m < limit_m)) return limit_m;
+  const double recover = qp_form ? d0_m - 0.5 * c.recovery_slack_m + 1.2 * recoveryAllowance(c, tau_s)
+                                 : d0_m - c.recovery_slack_m + recoveryAllowance(c, tau_s);
+  return std::min(limit_m, recover);
 }
 
 /// \brief Reads every key of PlannerConfig (the layout of config/planner.yaml) under

@@ -10,10 +10,14 @@
 ///     ball/cube test where the field cannot decide);
 ///   - ‖v‖ ≤ max_speed, |v_z| ≤ max_vertical_speed, ‖a‖ ≤ max_acceleration, |a_z| ≤ max
 ///     vertical acceleration (relative tolerance), heading/pitch steps within their rate limits;
-///   - distance ≥ Γ_dis + age_margin_speed·age to every other plan at the same time;
+///   - distance ≥ Γ_dis + age_margin_speed·age to every other plan at the same time, and ≥ Γ_dis
+///     to the braking envelope (brakeEnvelope()) of every other plan older than
+///     brake_envelope_age_s;
 ///   - distance ≥ worker_safety_distance_m to the worker's predicted position.
 /// On the first interval [t0, t0+dt], which starts from the measured state, a limit the state
-/// itself already violates only has to not get worse (min(limit, value at t0)).
+/// itself already violates only has to not get worse (min(limit, value at t0)); a separation
+/// from another plan, its braking envelope or the worker that the start violates must recover at
+/// the pace of recoveringDistance().
 /// Thread safety: not thread-safe (FCL).
 
 #include <string>
@@ -41,6 +45,35 @@ TrajectoryPoint evaluateTrajectory(const PlannedTrajectory& trajectory, double t
 /// \brief The worker's predicted position at time t: linear interpolation of the horizon whose
 /// step k is at t0_s + k·dt_s (clamped at both ends).
 Eigen::Vector3d workerPositionAt(const formation::WorkerHorizon& worker, double t0_s, double dt_s, double t_s);
+
+/// \brief Braking to hover from velocity v_world the way UavPlanner's brake plan does: constant
+/// deceleration along −v, as large as ‖a‖ ≤ max_acceleration_mps2 and |a_z| ≤
+/// max_vertical_acceleration_mps2 allow, lowered so that the stop falls on a sample of spacing
+/// dt_s. At rest (or non-finite v, dt ≤ 0): zero.
+struct BrakeProfile {
+  Eigen::Vector3d dir = Eigen::Vector3d::Zero();  ///< unit direction of v (zero at rest)
+  double decel_mps2 = 0.0;
+  double t_stop_s = 0.0;
+  double speed_mps = 0.0;
+};
+BrakeProfile brakeProfile(const Eigen::Vector3d& v_world, const DynamicLimits& limits, double dt_s);
+
+/// \brief Where a UAV at p_world with velocity v_world stops braking by brakeProfile().
+Eigen::Vector3d brakeStop(const Eigen::Vector3d& p_world, const Eigen::Vector3d& v_world, const DynamicLimits& limits,
+                          double dt_s);
+
+/// \brief The braking envelope of another UAV's plan at t_now_s (PlannerConfig::brake_envelope_age_s):
+/// brakeStop() of the plan's state at each of its sample times in [t0, min(t_now, tEnd)] and
+/// at that end time, in time order — a polyline of ≥ 1 point (empty only for an empty plan).
+/// A UAV that followed the plan and braked at any of those times stopped on it (between the
+/// sample times: within the chord error, a few cm at the limits).
+std::vector<Eigen::Vector3d> brakeEnvelope(const PlannedTrajectory& plan, double t_now_s, const DynamicLimits& limits);
+
+/// \brief The point of segment [a, b] nearest to x (a when a == b).
+Eigen::Vector3d closestPointOnSegment(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& x);
+
+/// \brief Distance (m) from x to a polyline (a single point: to that point; +inf when empty).
+double distanceToPolyline(const std::vector<Eigen::Vector3d>& polyline, const Eigen::Vector3d& x);
 
 struct VerificationReport {
   bool ok = false;

@@ -27,6 +27,7 @@
 #include <Eigen/Core>
 
 #include "gesture_formation/formation/formation_geometry.hpp"
+#include "gesture_formation/planning/corridor_builder.hpp"
 #include "gesture_formation/planning/planner_config.hpp"
 
 namespace gesture_formation::planning {
@@ -117,13 +118,21 @@ struct PlanResult {
   double min_uav_margin_m = 0.0;       ///< min over plans/time of distance − required (m)
   double min_worker_distance_m = 0.0;  ///< min distance to the worker's prediction (m)
   std::vector<Eigen::Vector3d> path_world;  ///< stage-2 path (after merging), for display
+  /// Stage-3 corridors, one per segment of path_world (polytope `A x ≤ b`, world frame, with the
+  /// ellipsoid it was grown from), for display: filled when the QP stage ran (also when the QP
+  /// or a later stage failed and a fallback was returned), empty otherwise. The QP keeps its
+  /// samples qp.corridor_margin_m inside them.
+  std::vector<SegmentCorridor> corridors;
   int corridor_count = 0;
   int projected_references = 0;  ///< reference steps moved out of obstacles / the worker zone
   int path_searches = 0;         ///< A* searches run for blocked segments
+  /// Tracking allowance (m) this replanning added to the planning clearances
+  /// (PlannerConfig::tracking_allowance_*): the largest recent deviation of the state from the
+  /// plan being flown.
+  double tracking_allowance_m = 0.0;
 };
 
 class TrajectoryVerifier;
-class CorridorBuilder;
 class GridPathSearch;
 class TrajectoryQp;
 struct TrajectoryQpProblem;
@@ -166,6 +175,8 @@ class UavPlanner {
   struct Stage2;
   PlanResult fallback(const PlanRequest& request, PlanResult result, const std::string& reason);
   PlannedTrajectory brakePlan(const PlanRequest& request) const;
+  void aimCamera(const PlanRequest& request, PlannedTrajectory& trajectory) const;
+  void updateTrackingAllowance(const PlanRequest& request);
 
   PlannerConfig config_;
   std::string config_error_;
@@ -176,6 +187,14 @@ class UavPlanner {
   std::unique_ptr<GridPathSearch> search_;
   std::unique_ptr<TrajectoryQp> qp_;
   PlannedTrajectory last_verified_;
+  /// The brake plan being flown while replanning keeps failing (verified or not): its stop
+  /// point is kept instead of braking anew from each state (empty when not braking).
+  PlannedTrajectory brake_;
+  /// The trajectory returned last (what the controller flies) and the tracking allowance
+  /// measured against it (PlannerConfig::tracking_allowance_*), updated at allowance_t_s_.
+  PlannedTrajectory flown_;
+  double tracking_deviation_m_ = 0.0;
+  double allowance_t_s_ = 0.0;
   std::uint32_t sequence_ = 0;
   bool keep_last_qp_ = false;
   std::unique_ptr<TrajectoryQpProblem> last_qp_;

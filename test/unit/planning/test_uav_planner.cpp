@@ -278,6 +278,7 @@ TEST(UavPlannerTest, FailedVerificationFallsBack) {
   const World& w = towers();
   PlannerConfig cfg = testConfig();
   cfg.verify_clearance_m = 0.75;
+  cfg.tracking_allowance_min_m = 0.0;  // no extra planning clearance: the corridors keep 0.63 m
   UavPlanner planner(cfg, w.map, w.field);
   const Eigen::Vector3d from(-6, -6, 6), worker(-8, -10, 1);
   const PlanResult first = planner.plan(straightRequest(0, 0.0, stateAt(from), from, from, 1.0, worker));
@@ -456,4 +457,239 @@ TEST(UavPlannerTest, StartCloserThanCorridorClearanceMovesAway) {
     s = advance(r.trajectory, t);
   }
   EXPECT_GE(w.field->clearance(s.p_world), cfg.obstacle_clearance_m - 0.05) << "from " << c0 << " m at " << start.transpose();
+}
+
+// brakeEnvelope: where a UAV following the plan stops if it brakes at a sample time in
+// [t0, t_now], against the closed form (1.2 m/s, 3 m/s²: 0.4 s = two samples, stop 0.24 m ahead).
+TEST(BrakeEnvelopeTest, StopPointsAlongThePlanAgainstTheClosedForm) {
+  PlannerConfig cfg;
+  PlannedTrajectory plan;
+  plan.t0_s = 5.0;
+  plan.dt_s = 0.2;
+  const Eigen::Vector3d o(1, 2, 3), v(1.2, 0, 0);
+  for (int k = 0; k < 11; ++k) {
+    TrajectorySample s;
+    s.p_world = o + v * (0.2 * k);
+    s.v_world = k < 10 ? v : Eigen::Vector3d::Zero();  // stops at its end (the spline overshoots a little there)
+    plan.samples.push_back(s);
+  }
+  const auto env = brakeEnvelope(plan, 5.5, cfg.limits);
+  ASSERT_EQ(env.size(), 4u);  // t0, t0 + 0.2, t0 + 0.4, t_now
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_LT((env[i] - (o + v * (0.2 * static_cast<double>(i)) + Eigen::Vector3d(0.24, 0, 0))).norm(), 1e-9) << i;
+  }
+  EXPECT_LT((env[3] - (o + v * 0.5 + Eigen::Vector3d(0.24, 0, 0))).norm(), 1e-9);
+  EXPECT_NEAR(distanceToPolyline(env, o + Eigen::Vector3d(0.5, 1.0, 0)), 1.0, 1e-9);  // beside the polyline
+  EXPECT_NEAR(distanceToPolyline(env, o - Eigen::Vector3d(1.0, 0, 0)), 1.24, 1e-9);  // behind its first point
+  // Long after the plan's end: every stop up to the end, the hover point last.
+  const auto all = brakeEnvelope(plan, 60.0, cfg.limits);
+  EXPECT_LT((all.back() - plan.samples.back().p_world).norm(), 1e-9);
+  // Before (or at) t0: the one stop from the first sample.
+  EXPECT_EQ(brakeEnvelope(plan, 4.0, cfg.limits).size(), 1u);
+}
+
+// Another UAV braked right after its last plan, and its brake plan was lost (loss50 seed 6):
+// our UAV has only that old plan, which flies on away from us, and starts inside its age margin.
+// The recovery rule alone (no closer to the old plan than at t0) let it follow the old plan
+// into the stopped UAV; the braking envelope of the old plan keeps Γ_dis from it.
+TEST(UavPlannerTest, StalePlanOfAStoppedUavIsNotFollowedIntoIt) {
+  const World& w = towers();
+  PlannerConfig cfg = testConfig();
+  UavPlanner planner(cfg, w.map, w.field);
+  const Eigen::Vector3d o0(-4.2, -12, 10), v(1.2, 0, 0);  // the other's plan: +x at 1.2 m/s from t = 9 s
+  PlannedTrajectory other;
+  other.uav_index = 0;
+  other.t0_s = 9.0;
+  other.dt_s = 0.2;
+  for (int k = 0; k < 41; ++k) {
+    TrajectorySample s;
+    s.p_world = o0 + v * (0.2 * k);
+    s.v_world = v;
+    other.samples.push_back(s);
+  }
+  // Truth: it braked at 9.2 s (1.2 m/s at 3 m/s²: stopped 0.24 m further, 0.4 s later).
+  const Eigen::Vector3d stopped = o0 + v * 0.2 + Eigen::Vector3d(0.24, 0, 0);
+  const Eigen::Vector3d from(-8, -12, 10), to(6, -12, 10);  // our reference runs through it
+  UavKinematicState s = stateAt(from, 10.0);
+  double t = 10.0, closest = std::numeric_limits<double>::infinity();
+  for (int cycle = 0; cycle < 15; ++cycle) {  // until 16 s: the old plan ends at 17 s
+    PlanRequest req = straightRequest(1, t, s, from, to, 1.2, Eigen::Vector3d(-5, -3, 1));
+    for (int k = 0; k < req.reference.steps(); ++k) {  // the reference left `from` at t = 10 s
+      const double d = std::min(1.0, 1.2 * std::max(0.0, t - 10.0 + k * req.dt_s) / (to - from).norm());
+      req.reference.p_world.col(k) = from + d * (to - from);
+    }
+    req.higher_priority_plans = {other};  // never updated: the link lost the rest
+    const PlanResult r = planner.plan(req);
+    ASSERT_FALSE(r.trajectory.empty()) << r.reason;
+    for (double tt = t; tt <= t + 0.4 + 1e-9; tt += 0.02) {
+      const double d = (evaluateTrajectory(r.trajectory, tt).p - stopped).norm();
+      closest = std::min(closest, d);
+      ASSERT_GE(d, cfg.mutual_distance_m - 1e-3) << "cycle " << cycle << " t " << tt << ": " << toString(r.status);
+    }
+    t += 0.4;
+    s = advance(r.trajectory, t);
+  }
+  EXPECT_LT(closest, cfg.mutual_distance_m + 1.0);  // it did come up to the stopped UAV (the check bit)
+}
+
+// Replanning keeps failing and the brake plan does not verify (another UAV hovers inside
+// Γ_dis, so a hover does not recover): the brake point must stay where the first brake plan put
+// it. It used to be re-anchored at the state every replanning, so a UAV pushed 0.1 m per period
+// towards the other (tracking error in wind) drifted into it (docs/safety.md §3).
+TEST(UavPlannerTest, RepeatedBrakeFallbacksHoldTheBrakePoint) {
+  const World& w = towers();
+  PlannerConfig cfg = testConfig();
+  UavPlanner planner(cfg, w.map, w.field);
+  const Eigen::Vector3d start(-8, -12, 10), other_p(-8, -9.8, 10), push(0, 0.1, 0);  // 2.2 m apart
+  PlannedTrajectory other;
+  other.uav_index = 0;
+  other.dt_s = 0.2;
+  for (int k = 0; k < 41; ++k) {
+    TrajectorySample s;
+    s.p_world = other_p;
+    other.samples.push_back(s);
+  }
+  UavKinematicState s = stateAt(start, 10.0);
+  s.v_world = Eigen::Vector3d(1.0, 0, 0);  // braking from 1 m/s: stops 0.2 m further along x
+  double t = 10.0;
+  Eigen::Vector3d first_stop = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  for (int cycle = 0; cycle < 12; ++cycle) {
+    PlanRequest req = straightRequest(1, t, s, start, start, 0.0, Eigen::Vector3d(-5, -3, 1));
+    req.reference.p_world(0, 5) = std::numeric_limits<double>::quiet_NaN();  // every replanning fails
+    other.t0_s = t;                                                          // fresh every time
+    req.higher_priority_plans = {other};
+    const PlanResult r = planner.plan(req);
+    ASSERT_EQ(r.status, PlanStatus::kFallbackBrake) << "cycle " << cycle << ": " << r.reason;
+    ASSERT_FALSE(r.verified) << "cycle " << cycle << ": the test needs an unverified brake plan";
+    const Eigen::Vector3d stop = r.trajectory.samples.back().p_world;
+    if (cycle == 0) {
+      first_stop = stop;
+      EXPECT_LT((stop - (start + Eigen::Vector3d(0.2, 0, 0))).norm(), 1e-9);
+    } else {
+      EXPECT_LT((stop - first_stop).norm(), 1e-9) << "cycle " << cycle << ": the brake point moved";
+      EXPECT_NE(r.reason.find("holding the brake point"), std::string::npos) << r.reason;
+    }
+    EXPECT_LT((evaluateTrajectory(r.trajectory, t).p - s.p_world).norm(), cfg.fallback_max_deviation_m);
+    t += 0.4;
+    s = advance(r.trajectory, t);
+    s.p_world += push;  // the wind pushes it off the plan towards the other UAV
+  }
+  // Pushed farther than fallback_max_deviation_m from it: brake anew from where it is.
+  PlanRequest far = straightRequest(1, t, s, start, start, 0.0, Eigen::Vector3d(-5, -3, 1));
+  far.reference.p_world(0, 5) = std::numeric_limits<double>::quiet_NaN();
+  far.state.p_world = first_stop + Eigen::Vector3d(0, -1.5, 0);
+  far.state.v_world.setZero();
+  const PlanResult r = planner.plan(far);
+  EXPECT_LT((r.trajectory.samples.back().p_world - far.state.p_world).norm(), 1e-9);
+  EXPECT_NE(r.reason.find("braking anew"), std::string::npos) << r.reason;
+}
+
+TEST(UavPlannerTest, TrackingAllowanceKeysAreValidated) {
+  PlannerConfig c;
+  c.tracking_allowance_min_m = 0.4;
+  c.tracking_allowance_max_m = 0.3;  // < min
+  c.tracking_allowance_decay_mps = 0.0;
+  std::string all;
+  for (const auto& s : c.validate()) all += s + "\n";
+  EXPECT_NE(all.find("path.tracking_allowance_max_m"), std::string::npos) << all;
+  EXPECT_NE(all.find("path.tracking_allowance_decay_mps"), std::string::npos) << all;
+  EXPECT_EQ(("\n" + all).find("\npath.tracking_allowance_min_m"), std::string::npos) << all;
+  c.tracking_allowance_min_m = -0.1;
+  c.tracking_allowance_max_m = 0.3;
+  c.tracking_allowance_decay_mps = 0.02;
+  ASSERT_EQ(c.validate().size(), 1u);
+  EXPECT_NE(c.validate().front().find("path.tracking_allowance_min_m"), std::string::npos);
+}
+
+// The UAV is 0.3 m off the plan it flies (a gust): the next plans keep the obstacle clearance
+// plus that much from the tower, and the allowance decays once it tracks again (gusts seed 6:
+// plans verified at 0.5 m, the gust took the rest).
+TEST(UavPlannerTest, TrackingErrorGrowsTheObstacleClearanceOfPlanning) {
+  const World& w = towers();
+  PlannerConfig cfg = testConfig();
+  cfg.tracking_allowance_min_m = 0.0;  // measured only
+  const Eigen::Vector3d from(-6, 6, 6), to(2.7, 2.7, 6), worker(-8, 8, 1);  // ends hugging the tower
+  const Eigen::Vector3d off(0.0, 0.0, 0.3);
+  // Closest approach to occupied voxel centres of the plan from `t_from` on.
+  const auto closest = [&](const PlannedTrajectory& tr, double t_from) {
+    double d = std::numeric_limits<double>::infinity();
+    for (double t = t_from; t <= tr.tEnd() + 1e-9; t += tr.dt_s / 8) d = std::min(d, centreDistance(*w.map, evaluateTrajectory(tr, t).p, 3.0));
+    return d;
+  };
+  double with_allowance = 0.0, without = 0.0;
+  for (bool pushed : {false, true}) {
+    UavPlanner planner(cfg, w.map, w.field);
+    const PlanResult first = planner.plan(straightRequest(0, 0.0, stateAt(from), from, to, 2.0, worker));
+    ASSERT_EQ(first.status, PlanStatus::kOptimized) << first.reason;
+    EXPECT_EQ(first.tracking_allowance_m, 0.0);
+    UavKinematicState s = advance(first.trajectory, 0.4);
+    if (pushed) s.p_world += off;
+    const PlanResult r = planner.plan(straightRequest(0, 0.4, s, from, to, 2.0, worker));
+    ASSERT_EQ(r.status, PlanStatus::kOptimized) << r.reason;
+    EXPECT_NEAR(r.tracking_allowance_m, pushed ? 0.3 : 0.0, 1e-9);
+    expectSafe(r.trajectory, *w.map, cfg);
+    (pushed ? with_allowance : without) = closest(r.trajectory, 0.4);
+  }
+  EXPECT_LT(without, cfg.obstacle_clearance_m + 0.25);  // without it, the plan hugs the corridor clearance
+  EXPECT_GE(with_allowance, cfg.obstacle_clearance_m + 0.3 - cfg.corridor_margin_m) << "without: " << without;
+}
+
+TEST(UavPlannerTest, TrackingAllowanceDecaysAndIsClamped) {
+  const World& w = towers();
+  PlannerConfig cfg = testConfig();
+  cfg.tracking_allowance_min_m = 0.1;
+  cfg.tracking_allowance_max_m = 0.4;
+  UavPlanner planner(cfg, w.map, w.field);
+  const Eigen::Vector3d from(-8, -12, 10), worker(-5, -3, 1);
+  PlanResult r = planner.plan(straightRequest(0, 0.0, stateAt(from), from, from, 0.0, worker));
+  EXPECT_DOUBLE_EQ(r.tracking_allowance_m, 0.1);  // the floor
+  UavKinematicState s = advance(r.trajectory, 0.4);
+  s.p_world += Eigen::Vector3d(0.6, 0, 0);  // 0.6 m off: clamped to the cap
+  r = planner.plan(straightRequest(0, 0.4, s, from, from, 0.0, worker));
+  EXPECT_DOUBLE_EQ(r.tracking_allowance_m, 0.4);
+  double t = 0.4;
+  for (int cycle = 0; cycle < 25; ++cycle) {  // 10 s of perfect tracking: 0.6 − 0.02·10 = 0.4 ...
+    t += 0.4;
+    r = planner.plan(straightRequest(0, t, advance(r.trajectory, t), from, from, 0.0, worker));
+  }
+  EXPECT_NEAR(r.tracking_allowance_m, 0.4, 1e-9);
+  for (int cycle = 0; cycle < 25; ++cycle) {  // ... 0.2 after 10 s more
+    t += 0.4;
+    r = planner.plan(straightRequest(0, t, advance(r.trajectory, t), from, from, 0.0, worker));
+  }
+  EXPECT_NEAR(r.tracking_allowance_m, 0.2, 1e-6);
+  planner.reset();
+  r = planner.plan(straightRequest(0, t, stateAt(from + Eigen::Vector3d(0.6, 0, 0), t), from, from, 0.0, worker));
+  EXPECT_DOUBLE_EQ(r.tracking_allowance_m, 0.1);  // forgotten with the plan
+}
+
+
+// PlanResult::corridors (for display): one per path segment when the QP stage ran, each
+// containing its segment, every sample after the first inside one of them; empty when the
+// request fails before the QP stage.
+TEST(UavPlannerTest, CorridorsOfTheQpStageAreReported) {
+  const World& w = towers();
+  PlannerConfig cfg = testConfig();
+  UavPlanner planner(cfg, w.map, w.field);
+  const Eigen::Vector3d from(-6, 6, 6), to(2.7, 2.7, 6), worker(-8, 8, 1);  // around the tower's corner
+  const PlanResult r = planner.plan(straightRequest(0, 0.0, stateAt(from), from, to, 2.0, worker));
+  ASSERT_EQ(r.status, PlanStatus::kOptimized) << r.reason;
+  ASSERT_FALSE(r.corridors.empty());
+  ASSERT_EQ(static_cast<int>(r.corridors.size()), r.corridor_count);
+  ASSERT_EQ(r.corridors.size() + 1, r.path_world.size());
+  for (std::size_t i = 0; i < r.corridors.size(); ++i) {
+    const Polytope& P = r.corridors[i].polytope;
+    EXPECT_TRUE(P.contains(r.path_world[i], 1e-9)) << "corridor " << i;
+    EXPECT_TRUE(P.contains(r.path_world[i + 1], 1e-9)) << "corridor " << i;
+  }
+  for (std::size_t k = 1; k < r.trajectory.samples.size(); ++k) {
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto& c : r.corridors) best = std::min(best, c.polytope.violation(r.trajectory.samples[k].p_world));
+    EXPECT_LE(best, -cfg.corridor_margin_m + 1e-4) << "sample " << k;
+  }
+  PlanRequest bad = straightRequest(0, 0.4, advance(r.trajectory, 0.4), from, to, 2.0, worker);
+  bad.reference.p_world(2, 3) = std::numeric_limits<double>::quiet_NaN();
+  const PlanResult b = planner.plan(bad);
+  EXPECT_NE(b.status, PlanStatus::kOptimized);
+  EXPECT_TRUE(b.corridors.empty());
 }
