@@ -10,6 +10,7 @@
 
 #include "gesture_formation/FormationCommand.h"
 #include "gesture_formation/FormationParams.h"
+#include "gesture_formation/GestureObservation.h"
 #include "gesture_formation/PlannedTrajectory.h"
 #include "gesture_formation/WorkerDetection.h"
 #include "gesture_formation/WorkerState.h"
@@ -19,6 +20,7 @@
 #include "gesture_formation/estimation/measurement_model.hpp"
 #include "gesture_formation/formation/formation_commands.hpp"
 #include "gesture_formation/formation/formation_params.hpp"
+#include "gesture_formation/gesture/view_fusion.hpp"
 #include "gesture_formation/planning/uav_planner.hpp"
 #include "gesture_formation/sim/mission_config.hpp"
 #include "gesture_formation/sim/multirotor.hpp"
@@ -305,6 +307,46 @@ inline gesture_formation::WorkerState fromWire(const comm::WorkerStateMessage& w
   s.predicted = true;
   s.source = "lcm";
   return s;
+}
+
+// ---- gesture observations (the multi-view vote) ---------------------------------------------
+/// The vote's input; an unknown geometry becomes NaN (the view votes only without the envelope gate).
+inline gesture::ViewObservation toViewObservation(const gesture_formation::GestureObservation& m) {
+  gesture::ViewObservation o;
+  o.view = m.uav_index;
+  o.t_s = m.header.stamp.toSec();
+  o.gesture_id = m.gesture_id;
+  o.distance_m = m.geometry_known ? m.distance_m : std::nan("");
+  o.elevation_deg = m.geometry_known ? m.elevation_deg : std::nan("");
+  return o;
+}
+/// Fails naming the field on what the payload encoder or a peer's decoder would refuse.
+inline common::Result<comm::GestureObservationMessage> toWire(const gesture_formation::GestureObservation& m) {
+  using R = common::Result<comm::GestureObservationMessage>;
+  if (m.gesture_id < 0 || m.gesture_id > comm::kMaxGestureId) {
+    return R::fail("GestureObservation.gesture_id " + std::to_string(m.gesture_id) + " outside [0, " +
+                   std::to_string(comm::kMaxGestureId) + "]");
+  }
+  comm::GestureObservationMessage w;
+  w.uav_index = m.uav_index;
+  w.t_s = m.header.stamp.toSec();
+  w.gesture_id = static_cast<std::uint8_t>(m.gesture_id);
+  w.probabilities.assign(m.probabilities.begin(), m.probabilities.end());
+  w.geometry_known = m.geometry_known;
+  w.distance_m = m.geometry_known ? m.distance_m : 0.0;
+  w.elevation_deg = m.geometry_known ? m.elevation_deg : 0.0;
+  return R::ok(std::move(w));
+}
+inline gesture_formation::GestureObservation fromWire(const comm::GestureObservationMessage& w) {
+  gesture_formation::GestureObservation m;
+  m.header.stamp = ros::Time(w.t_s);
+  m.uav_index = static_cast<std::uint8_t>(w.uav_index);
+  m.gesture_id = w.gesture_id;
+  m.probabilities.assign(w.probabilities.begin(), w.probabilities.end());
+  m.geometry_known = w.geometry_known;
+  m.distance_m = w.distance_m;
+  m.elevation_deg = w.elevation_deg;
+  return m;
 }
 
 }  // namespace gesture_formation::nodelets
