@@ -9,6 +9,7 @@
 #include "gesture_formation/formation/formation_config.hpp"
 #include "gesture_formation/gesture/gesture_filter.hpp"
 #include "gesture_formation/gesture/gesture_mapping.hpp"
+#include "gesture_formation/gesture/view_fusion.hpp"
 #include "gesture_formation/planning/distance_field.hpp"
 #include "gesture_formation/planning/occupancy_map.hpp"
 #include "gesture_formation/planning/planner_config.hpp"
@@ -77,18 +78,27 @@ inline bool loadPlanner(const std::string& path, ParamLoader& params, planning::
   return true;
 }
 
-/// config/gestures.yaml: the filter keys and `mapping` (checked against `follower_count`).
+/// config/gestures.yaml: the filter keys, `mapping` (checked against `follower_count`) and
+/// `view_fusion.*` (every key required; min_agreeing_views at most the follower_count + 1 cameras).
 inline bool loadGestures(const std::string& path, int follower_count, ParamLoader& params,
-                         gesture::GestureFilterConfig& filter, gesture::GestureMapping& mapping) {
+                         gesture::GestureFilterConfig& filter, gesture::GestureMapping& mapping,
+                         gesture::ViewFusionConfig& fusion) {
   auto reader = common::ConfigReader::fromFile(path, common::ConfigReader::MissingKeys::kError);
   filter = gesture::readGestureFilterConfig(reader);
   mapping = gesture::GestureMapping::paperDefault();
   gesture::readGestureMapping(reader, filter.max_gesture_id, follower_count, mapping);
+  fusion = gesture::readViewFusionConfig(reader);
   if (!reader.ok()) {
     for (const auto& e : reader.errors()) params.addError("gesture_config: " + e);
     return false;
   }
   for (const auto& e : filter.validate()) params.addError("gesture_config: " + path + ": " + e);
+  for (const auto& e : fusion.validate()) params.addError("gesture_config: " + path + ": " + e);
+  if (fusion.min_agreeing_views > follower_count + 1) {
+    params.addError("gesture_config: " + path + ": view_fusion.min_agreeing_views: value " +
+                    std::to_string(fusion.min_agreeing_views) + " exceeds the number of UAVs (cameras) " +
+                    std::to_string(follower_count + 1));
+  }
   return true;
 }
 

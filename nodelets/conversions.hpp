@@ -5,20 +5,27 @@
 
 #include <Eigen/Geometry>
 #include <geometry_msgs/TransformStamped.h>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
 #include <nav_msgs/Odometry.h>
 #include <trajectory_msgs/MultiDOFJointTrajectory.h>
 
 #include "gesture_formation/FormationCommand.h"
 #include "gesture_formation/FormationParams.h"
+#include "gesture_formation/GestureObservation.h"
 #include "gesture_formation/PlannedTrajectory.h"
 #include "gesture_formation/WorkerDetection.h"
 #include "gesture_formation/WorkerState.h"
 #include "gesture_formation/comm/payloads.hpp"
 #include "gesture_formation/common/result.hpp"
+#include "gesture_formation/estimation/camera_model.hpp"
 #include "gesture_formation/estimation/human_kalman.hpp"
 #include "gesture_formation/estimation/measurement_model.hpp"
 #include "gesture_formation/formation/formation_commands.hpp"
 #include "gesture_formation/formation/formation_params.hpp"
+#include "gesture_formation/gesture/view_fusion.hpp"
 #include "gesture_formation/planning/uav_planner.hpp"
 #include "gesture_formation/sim/mission_config.hpp"
 #include "gesture_formation/sim/multirotor.hpp"
@@ -305,6 +312,113 @@ inline gesture_formation::WorkerState fromWire(const comm::WorkerStateMessage& w
   s.predicted = true;
   s.source = "lcm";
   return s;
+}
+
+// ---- gesture observations (the multi-view vote) ---------------------------------------------
+/// The vote's input; an unknown geometry becomes NaN (the view votes only without the envelope gate).
+inline gesture::ViewObservation toViewObservation(const gesture_formation::GestureObservation& m) {
+  gesture::ViewObservation o;
+  o.view = m.uav_index;
+  o.t_s = m.header.stamp.toSec();
+  o.gesture_id = m.gesture_id;
+  o.distance_m = m.geometry_known ? m.distance_m : std::nan("");
+  o.elevation_deg = m.geometry_known ? m.elevation_deg : std::nan("");
+  return o;
+}
+/// Fails naming the field on what the payload encoder or a peer's decoder would refuse.
+inline common::Result<comm::GestureObservationMessage> toWire(const gesture_formation::GestureObservation& m) {
+  using R = common::Result<comm::GestureObservationMessage>;
+  if (m.gesture_id < 0 || m.gesture_id > comm::kMaxGestureId) {
+    return R::fail("GestureObservation.gesture_id " + std::to_string(m.gesture_id) + " outside [0, " +
+                   std::to_string(comm::kMaxGestureId) + "]");
+  }
+  comm::GestureObservationMessage w;
+  w.uav_index = m.uav_index;
+  w.t_s = m.header.stamp.toSec();
+  w.gesture_id = static_cast<std::uint8_t>(m.gesture_id);
+  w.probabilities.assign(m.probabilities.begin(), m.probabilities.end());
+  w.geometry_known = m.geometry_known;
+  w.distance_m = m.geometry_known ? m.distance_m : 0.0;
+  w.elevation_deg = m.geometry_known ? m.elevation_deg : 0.0;
+  return R::ok(std::move(w));
+}
+inline gesture_formation::GestureObservation fromWire(const comm::GestureObservationMessage& w) {
+  gesture_formation::GestureObservation m;
+  m.header.stamp = ros::Time(w.t_s);
+  m.uav_index = static_cast<std::uint8_t>(w.uav_index);
+  m.gesture_id = w.gesture_id;
+  m.probabilities.assign(w.probabilities.begin(), w.probabilities.end());
+  m.geometry_known = w.geometry_known;
+  m.distance_m = w.distance_m;
+  m.elevation_deg = w.elevation_deg;
+  return m;
+}
+
+// ---- images (no cv_bridge in the Debian ROS packages) ---------------------------------------
+/// A colour image (bgr8, rgb8, mono8) as an owned BGR cv::Mat.
+inline common::Result<cv::Mat> toBgr(const sensor_msgs::Image& m) {
+  using R = common::Result<cv::Mat>;
+  const int channels = m.encoding == "mono8" ? 1 : 3;
+  if (m.encoding != "bgr8" && m.encoding != "rgb8" && m.encoding != "mono8") {
+    return R::fail("Image.encoding '" + m.encoding + "': expected bgr8, rgb8 or mono8");
+  }
+  if (m.width == 0 || m.height == 0 || m.step < m.width * static_cast<std::uint32_t>(channels) ||
+      m.data.size() < static_cast<std::size_t>(m.step) * m.height) {
+    return R::fail("Image: " + std::to_string(m.width) + "x" + std::to_string(m.height) + ", step " +
+                   std::to_string(m.step) + ", " + std::to_string(m.data.size()) + " bytes: inconsistent");
+  }
+  const cv::Mat view(static_cast<int>(m.height), static_cast<int>(m.width), channels == 1 ? CV_8UC1 : CV_8UC3,
+                     const_cast<std::uint8_t*>(m.data.data()), m.step);
+  cv::Mat bgr;
+  if (m.encoding == "bgr8") bgr = view.clone();
+  else if (m.encoding == "rgb8") cv::cvtColor(view, bgr, cv::COLOR_RGB2BGR);
+  else cv::cvtColor(view, bgr, cv::COLOR_GRAY2BGR);
+  return R::ok(std::move(bgr));
+}
+/// An aligned depth image (16UC1 / mono16: units of depth_scale_m; 32FC1: metres) as an owned cv::Mat.
+inline common::Result<cv::Mat> toDepth(const sensor_msgs::Image& m) {
+  using R = common::Result<cv::Mat>;
+  int type = 0;
+  std::uint32_t bytes = 0;
+  if (m.encoding == "16UC1" || m.encoding == "mono16") {
+    type = CV_16UC1;
+    bytes = 2;
+  } else if (m.encoding == "32FC1") {
+    type = CV_32FC1;
+    bytes = 4;
+  } else {
+    return R::fail("depth Image.encoding '" + m.encoding + "': expected 16UC1, mono16 or 32FC1");
+  }
+  if (m.is_bigendian) return R::fail("depth Image: big-endian data not supported");
+  if (m.width == 0 || m.height == 0 || m.step < m.width * bytes ||
+      m.data.size() < static_cast<std::size_t>(m.step) * m.height) {
+    return R::fail("depth Image: " + std::to_string(m.width) + "x" + std::to_string(m.height) + ", step " +
+                   std::to_string(m.step) + ", " + std::to_string(m.data.size()) + " bytes: inconsistent");
+  }
+  const cv::Mat view(static_cast<int>(m.height), static_cast<int>(m.width), type, const_cast<std::uint8_t*>(m.data.data()),
+                     m.step);
+  return R::ok(view.clone());
+}
+/// CameraInfo (plumb_bob or no distortion) → intrinsics; fails naming what is unusable.
+inline common::Result<estimation::CameraIntrinsics> toIntrinsics(const sensor_msgs::CameraInfo& m) {
+  using R = common::Result<estimation::CameraIntrinsics>;
+  estimation::CameraIntrinsics k;
+  k.fx = m.K[0];
+  k.fy = m.K[4];
+  k.cx = m.K[2];
+  k.cy = m.K[5];
+  k.width_px = static_cast<int>(m.width);
+  k.height_px = static_cast<int>(m.height);
+  if (!m.D.empty()) {
+    if (m.distortion_model != "plumb_bob" || m.D.size() != 5) {
+      return R::fail("CameraInfo: distortion model '" + m.distortion_model + "' with " + std::to_string(m.D.size()) +
+                     " coefficients: expected plumb_bob with 5");
+    }
+    for (std::size_t i = 0; i < 5; ++i) k.distortion[i] = m.D[i];
+  }
+  const auto errors = k.validate();
+  if (!errors.empty()) return R::fail("CameraInfo: " + errors.front());
+  return R::ok(k);
 }
 
 }  // namespace gesture_formation::nodelets

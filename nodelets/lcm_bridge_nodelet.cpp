@@ -3,9 +3,12 @@
 // between UAVs and the ground station:
 //   ROS → LCM: worker_state_in (the leader's estimate), plan_in (this UAV's plan),
 //              formation_params_in (the leader's parameters), formation_command_in (operator),
+//              gesture_observation_in (this UAV's gesture vote, GestureObservation),
 //              and a heartbeat at ~heartbeat_rate_hz.
 //   LCM → ROS: worker_state_out, plans_out (other UAVs' plans), formation_params_out,
-//              formation_command_out.
+//              formation_command_out, gesture_observations_out (other UAVs' votes; refused
+//              and counted when the observing UAV is not the envelope's sender or the stamp
+//              is not a valid time).
 // A plan's fallback flag travels in a heartbeat sent just before the plan (status degraded,
 // last_plan_sequence = the plan's sequence); the receiver marks that plan `fallback`.
 // Stamps and freshness use ROS time (sim time in simulation: every process shares /clock).
@@ -95,6 +98,8 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     plan_sub_ = nh.subscribe("plan_in", 5, &LcmBridgeNodelet::onPlan, this);
     params_sub_ = nh.subscribe("formation_params_in", 5, &LcmBridgeNodelet::onParams, this);
     command_sub_ = nh.subscribe("formation_command_in", 20, &LcmBridgeNodelet::onCommand, this);
+    observations_pub_ = nh.advertise<gesture_formation::GestureObservation>("gesture_observations_out", 50);
+    observation_sub_ = nh.subscribe("gesture_observation_in", 20, &LcmBridgeNodelet::onObservation, this);
     drain_timer_ = nh.createWallTimer(ros::WallDuration(0.005), [this](const ros::WallTimerEvent&) {
       std::lock_guard<std::mutex> lock(mutex_);
       if (transport_) transport_->drain();
@@ -142,6 +147,16 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     send(*c, "command");
   }
 
+  void onObservation(const gesture_formation::GestureObservation::ConstPtr& msg) {
+    auto o = toWire(*msg);
+    if (!o) {
+      NODELET_WARN_STREAM_THROTTLE(1.0, "LcmBridge: gesture observation not sent: " << o.reason());
+      return;
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    send(*o, "gesture observation");
+  }
+
   // Called from drain() (mutex held).
   void onEnvelope(const comm::Envelope& e) {
     switch (e.type) {
@@ -187,6 +202,20 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
         command_pub_.publish(m);
         break;
       }
+      case comm::MessageType::kGestureObservation: {
+        comm::GestureObservationMessage o;
+        if (!decoder_.decode(e, o)) break;
+        // A UAV votes for its own camera only; the frame time must be a ROS time.
+        if (o.uav_index != e.sender_id || !(o.t_s >= 0.0 && o.t_s < 4.0e9)) {
+          ++observations_refused_;
+          NODELET_WARN_STREAM_THROTTLE(1.0, "LcmBridge: gesture observation refused (" << observations_refused_
+                                                << " so far): sender " << e.sender_id << ", uav_index " << o.uav_index
+                                                << ", t " << o.t_s << " s");
+          break;
+        }
+        observations_pub_.publish(fromWire(o));
+        break;
+      }
     }
     if (!decoder_.lastReason().empty()) {
       NODELET_WARN_STREAM_THROTTLE(1.0, "LcmBridge: payload refused: " << decoder_.lastReason());
@@ -200,8 +229,9 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
   comm::PayloadDecoder decoder_;
   comm::Heartbeat heartbeat_;
   std::map<std::uint16_t, comm::Heartbeat> peers_;
-  ros::Publisher worker_pub_, plans_pub_, params_pub_, command_pub_;
-  ros::Subscriber worker_sub_, plan_sub_, params_sub_, command_sub_;
+  std::uint64_t observations_refused_ = 0;  ///< decoded gesture observations with a bad sender / stamp
+  ros::Publisher worker_pub_, plans_pub_, params_pub_, command_pub_, observations_pub_;
+  ros::Subscriber worker_sub_, plan_sub_, params_sub_, command_sub_, observation_sub_;
   ros::WallTimer drain_timer_;
   ros::Timer heartbeat_timer_;
 };

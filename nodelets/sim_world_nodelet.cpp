@@ -2,12 +2,15 @@
 // sim time (/clock), the worker (sim::WorkerModel), the leader's camera (sim::LeaderCamera: box,
 // stereo and UWB from the leader's true pose with the mission's sensor faults, the skeleton from
 // the actual viewpoint through the gesture LSTM — the classifier output a Perception nodelet
-// would publish), the mission's scheduled operator requests, and the mission's metrics
+// would publish; with mission.gestures.view_fusion.min_agreeing_views > 1 also the followers'
+// cameras, each UAV's classification on its own topic, as `gfctl simulate` renders them),
+// the mission's scheduled operator requests, and the mission's metrics
 // (sim::MetricsAccumulator: the definitions of docs/simulation.md §4, fed from the UAVs' true
 // states, the worker's truth, the leader's parameters, the plans and the command outcomes).
 //
 // Publishes: /clock; worker_truth_out (nav_msgs/Odometry); detection_out (WorkerDetection in
-//   <leader>/camera_optical); uwb_out (sensor_msgs/Range); gesture_out (Gesture);
+//   <leader>/camera_optical); uwb_out (sensor_msgs/Range); uav<i>/gesture_out (Gesture: UAV i's
+//   classifier output; followers only while online, i.e. not in a mission follower dropout);
 //   operator_command_out (FormationCommand, sender/sequence assigned by the OperatorInterface);
 //   done_out (latched, at the end).
 // Subscribes: uav<i>/ground_truth (true states), uav<i>/plan, leader_params_in (FormationParams
@@ -89,7 +92,10 @@ class SimWorldNodelet : public nodelet::Nodelet {
     worker_pub_ = nh.advertise<nav_msgs::Odometry>("worker_truth_out", 10);
     detection_pub_ = nh.advertise<gesture_formation::WorkerDetection>("detection_out", 10);
     uwb_pub_ = nh.advertise<sensor_msgs::Range>("uwb_out", 10);
-    gesture_pub_ = nh.advertise<gesture_formation::Gesture>("gesture_out", 10);
+    follower_views_ = cfg_.view_fusion.min_agreeing_views > 1;  // as sim::runMission
+    for (int i = 0; i < (follower_views_ ? n_ : 1); ++i) {
+      gesture_pubs_.push_back(nh.advertise<gesture_formation::Gesture>("uav" + std::to_string(i) + "/gesture_out", 10));
+    }
     command_pub_ = nh.advertise<gesture_formation::FormationCommand>("operator_command_out", 20);
     done_pub_ = nh.advertise<std_msgs::Bool>("done_out", 1, true);
     for (int i = 0; i < n_; ++i) {
@@ -252,7 +258,9 @@ class SimWorldNodelet : public nodelet::Nodelet {
     }
     resolveOutcomes();
     const bool all = allTruths();
-    if (camera_frames_->due(k_) && truth_[0]) cameraFrame(ws);
+    // With the followers' cameras, a frame needs every UAV's truth (LeaderCamera wants the same
+    // number of followers at every call); SimWorld starts when every planner is up.
+    if (camera_frames_->due(k_) && (follower_views_ ? all : truth_[0].has_value())) cameraFrame(ws);
     if (all) {
       std::vector<Eigen::Vector3d> ps;
       for (const auto& s : truth_) ps.push_back(s->p_world);
@@ -268,8 +276,33 @@ class SimWorldNodelet : public nodelet::Nodelet {
     return toEigen(estimate_->position) + (t_s - estimate_->header.stamp.toSec()) * toEigen(estimate_->velocity);
   }
 
+  /// Whether follower i is in a mission follower dropout at t_s (its computer is down).
+  bool offline(int i, double t_s) const {
+    for (const auto& o : cfg_.faults.follower_dropouts) {
+      if (o.uav == i && t_s >= o.from_s && t_s < o.to_s) return true;
+    }
+    return false;
+  }
+
+  void publishGesture(int uav, const gesture::Classification& c, const ros::Time& stamp) {
+    gesture_formation::Gesture g;
+    g.header.stamp = stamp;
+    g.header.frame_id = "uav" + std::to_string(uav) + "/camera_optical";
+    g.gesture_id = c.gesture_id;
+    g.probabilities.assign(c.probabilities.begin(), c.probabilities.end());
+    gesture_pubs_[static_cast<std::size_t>(uav)].publish(g);
+  }
+
   void cameraFrame(const sim::WorkerState& ws) {
-    const sim::LeaderCameraFrame cf = camera_->frame(t_, *truth_[0], ws, *worker_, classifier_.get());
+    std::vector<sim::MultirotorState> followers;
+    std::vector<bool> online;
+    if (follower_views_) {
+      for (int i = 1; i < n_; ++i) {
+        followers.push_back(*truth_[static_cast<std::size_t>(i)]);
+        online.push_back(!offline(i, t_));
+      }
+    }
+    const sim::LeaderCameraFrame cf = camera_->frame(t_, *truth_[0], followers, online, ws, *worker_, classifier_.get());
     metrics_->counters().range_outliers += cf.range_outliers;
     const std::optional<Eigen::Vector3d> est = estimateAt(t_);
     metrics_->cameraFrame(cf.sensors.visible(), est ? &*est : nullptr, ws.p_world);
@@ -284,6 +317,11 @@ class SimWorldNodelet : public nodelet::Nodelet {
       r.range = static_cast<float>(cf.sensors.d_uwb_m);
       uwb_pub_.publish(r);
     }
+    // Each UAV's classifier output, as its Perception nodelet would publish it (the followers'
+    // first: the leader's closes the frame at the GestureCommander only when all have reported).
+    for (std::size_t i = 0; i < cf.followers.size(); ++i) {
+      if (cf.followers[i].classification) publishGesture(static_cast<int>(i) + 1, *cf.followers[i].classification, stamp);
+    }
     if (!cf.sensors.visible()) return;
     gesture_formation::WorkerDetection d;
     d.header.stamp = stamp;
@@ -296,14 +334,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
     d.confidence = 0.9f;
     d.stereo_distance_m = cf.sensors.d_stereo_m;
     detection_pub_.publish(d);
-    if (cf.classification) {
-      gesture_formation::Gesture g;
-      g.header.stamp = stamp;
-      g.header.frame_id = camera_frame_;
-      g.gesture_id = cf.classification->gesture_id;
-      g.probabilities.assign(cf.classification->probabilities.begin(), cf.classification->probabilities.end());
-      gesture_pub_.publish(g);
-    }
+    if (cf.classification) publishGesture(0, *cf.classification, stamp);
   }
 
   void sample(const sim::WorkerState& ws, bool all_truths) {
@@ -379,13 +410,14 @@ class SimWorldNodelet : public nodelet::Nodelet {
   double rtf_ = 1.0, clock_step_s_ = 0.01, duration_s_ = 0.0, t_ = 0.0, last_ratio_ = 0.0;
   long k_ = 0;
   int n_ = 0, last_class_ = -1;
-  bool finished_ = false, started_ = false;
+  bool finished_ = false, started_ = false, follower_views_ = false;
   std::size_t next_request_ = 0;
   std::vector<std::optional<sim::MultirotorState>> truth_;
   std::optional<gesture_formation::WorkerState> estimate_;
   std::vector<Outcome> outcomes_;
   ros::WallTime wall0_;
-  ros::Publisher clock_pub_, worker_pub_, detection_pub_, uwb_pub_, gesture_pub_, command_pub_, done_pub_;
+  ros::Publisher clock_pub_, worker_pub_, detection_pub_, uwb_pub_, command_pub_, done_pub_;
+  std::vector<ros::Publisher> gesture_pubs_;  ///< per UAV (only the leader's without follower views)
   std::vector<ros::Subscriber> truth_subs_, plan_subs_;
   ros::Subscriber params_sub_, estimate_sub_, status_sub_;
   ros::WallTimer clock_timer_;

@@ -14,6 +14,7 @@ const char* toString(MessageType type) {
     case MessageType::kPlannedTrajectory: return "planned_trajectory";
     case MessageType::kFormationParams: return "formation_params";
     case MessageType::kFormationCommand: return "formation_command";
+    case MessageType::kGestureObservation: return "gesture_observation";
   }
   return "unknown";
 }

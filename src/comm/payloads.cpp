@@ -393,4 +393,63 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, formation
   return d.report(reason);
 }
 
+// ---- gesture observation: u16 uav_index, f64 t_s, u8 gesture_id, u8 count, count × f64
+//      probability, u8 flags (bit0 geometry_known), f64 distance_m, f64 elevation_deg -------------
+
+EncodeResult encodePayload(const GestureObservationMessage& m) {
+  if (!validUavIndex(m.uav_index)) return EncodeResult::fail("gesture_observation.uav_index " + std::to_string(m.uav_index) + " outside [0, " + std::to_string(kMaxUavIndex) + "]");
+  if (!std::isfinite(m.t_s)) return EncodeResult::fail("gesture_observation.t_s not finite");
+  if (m.gesture_id > kMaxGestureId) return EncodeResult::fail("gesture_observation.gesture_id " + std::to_string(m.gesture_id) + " > " + std::to_string(kMaxGestureId));
+  if (m.probabilities.size() > kMaxGestureClasses) return EncodeResult::fail("gesture_observation.probabilities has " + std::to_string(m.probabilities.size()) + " entries, at most " + std::to_string(kMaxGestureClasses));
+  for (double p : m.probabilities) {
+    if (!(p >= 0.0 && p <= 1.0)) return EncodeResult::fail("gesture_observation.probabilities must be in [0, 1]");
+  }
+  if (!(m.distance_m >= 0.0 && m.distance_m <= kMaxObservationDistanceM)) return EncodeResult::fail("gesture_observation.distance_m outside [0, 1000]");
+  if (!(m.elevation_deg >= -90.0 && m.elevation_deg <= 90.0)) return EncodeResult::fail("gesture_observation.elevation_deg outside [-90, 90]");
+  ByteWriter w;
+  w.u16(m.uav_index);
+  w.f64(m.t_s);
+  w.u8(m.gesture_id);
+  w.u8(static_cast<std::uint8_t>(m.probabilities.size()));
+  for (double p : m.probabilities) w.f64(p);
+  w.u8(m.geometry_known ? 1 : 0);
+  w.f64(m.distance_m);
+  w.f64(m.elevation_deg);
+  return EncodeResult::ok(w.release());
+}
+
+PayloadError decodePayload(const std::uint8_t* data, std::size_t size, GestureObservationMessage& out, std::string* reason) {
+  Decoder d(data, size);
+  GestureObservationMessage m;
+  std::uint8_t count = 0, flags = 0;
+  if (d.u16(m.uav_index, "gesture_observation.uav_index") && !validUavIndex(m.uav_index)) {
+    d.fail(PayloadError::kOutOfRange, "gesture_observation.uav_index");
+  }
+  d.f64(m.t_s, "gesture_observation.t_s");
+  if (d.u8(m.gesture_id, "gesture_observation.gesture_id") && m.gesture_id > kMaxGestureId) {
+    d.fail(PayloadError::kOutOfRange, "gesture_observation.gesture_id");
+  }
+  if (d.u8(count, "gesture_observation.count") && count > kMaxGestureClasses) {
+    d.fail(PayloadError::kOversizeArray, "gesture_observation.probabilities");
+  }
+  for (std::size_t i = 0; d.ok() && i < count; ++i) {
+    const std::string field = "gesture_observation.probabilities[" + std::to_string(i) + "]";
+    double p = 0.0;
+    if (d.f64(p, field) && !(p >= 0.0 && p <= 1.0)) d.fail(PayloadError::kOutOfRange, field);
+    m.probabilities.push_back(p);
+  }
+  if (d.u8(flags, "gesture_observation.flags") && (flags & ~1u) != 0) d.fail(PayloadError::kOutOfRange, "gesture_observation.flags");
+  if (d.f64(m.distance_m, "gesture_observation.distance_m") && !(m.distance_m >= 0.0 && m.distance_m <= kMaxObservationDistanceM)) {
+    d.fail(PayloadError::kOutOfRange, "gesture_observation.distance_m");
+  }
+  if (d.f64(m.elevation_deg, "gesture_observation.elevation_deg") && !(m.elevation_deg >= -90.0 && m.elevation_deg <= 90.0)) {
+    d.fail(PayloadError::kOutOfRange, "gesture_observation.elevation_deg");
+  }
+  if (d.finish()) {
+    m.geometry_known = (flags & 1u) != 0;
+    out = std::move(m);
+  }
+  return d.report(reason);
+}
+
 }  // namespace gesture_formation::comm

@@ -20,6 +20,7 @@ constexpr ChannelSuffix kChannels[] = {
     {comm::MessageType::kPlannedTrajectory, "PLANNED_TRAJECTORY"},
     {comm::MessageType::kFormationParams, "FORMATION_PARAMS"},
     {comm::MessageType::kFormationCommand, "FORMATION_COMMAND"},
+    {comm::MessageType::kGestureObservation, "GESTURE_OBSERVATION"},
 };
 
 /// LCM's fixed part of gf_lcm::envelope_t: 8-byte fingerprint + int32 length.
@@ -98,7 +99,7 @@ common::Result<std::unique_ptr<LcmTransport>> LcmTransport::create(const std::st
   std::unique_ptr<LcmTransport> t(new LcmTransport(std::move(impl), channel_prefix));
   t->impl_->owner = t.get();
   // One regex subscription for our channels (LCM anchors it with ^...$).
-  t->impl_->lcm.subscribe(channel_prefix + "(HEARTBEAT|WORKER_STATE|PLANNED_TRAJECTORY|FORMATION_PARAMS|FORMATION_COMMAND)",
+  t->impl_->lcm.subscribe(channel_prefix + "(HEARTBEAT|WORKER_STATE|PLANNED_TRAJECTORY|FORMATION_PARAMS|FORMATION_COMMAND|GESTURE_OBSERVATION)",
                           &Impl::onMessage, t->impl_.get());
   return R::ok(std::move(t));
 }

@@ -1,7 +1,9 @@
 #!/bin/bash
 # Broken configs make the nodelets refuse to start, each problem named (parameter or YAML key),
 # and nothing is advertised: FormationPlanner (a formation.yaml missing a key + an out-of-range
-# ROS parameter + a missing one), GestureCommander (a gestures.yaml with an out-of-range ratio),
+# ROS parameter + a missing one), GestureCommander (a gestures.yaml with an out-of-range ratio; one
+# with an out-of-range view_fusion.min_agreeing_views and a missing view_fusion key), ViewObserver
+# (no parameters),
 # LcmBridge (a key file readable by others), SimWorld/SimUav (no mission).
 set -o pipefail
 source "$(dirname "$0")/common.bash"
@@ -9,6 +11,9 @@ start_master
 CFG=$SRC/config
 grep -v "distance_max_m" "$CFG/formation.yaml" > "$T/formation_broken.yaml"
 sed 's/^ratio_threshold: .*/ratio_threshold: 1.7/' "$CFG/gestures.yaml" > "$T/gestures_broken.yaml"
+sed -e 's/^\( *min_agreeing_views:\) .*/\1 0/' -e '/^ *elevation_max_deg:/d' "$CFG/gestures.yaml" > "$T/gestures_vf_broken.yaml"
+grep -q "min_agreeing_views: 0" "$T/gestures_vf_broken.yaml" && ! grep -q "elevation_max_deg" "$T/gestures_vf_broken.yaml" \
+  || fail "could not break view_fusion in a copy of gestures.yaml"
 runs=()
 run() {  # name, nodelet type, then ROS args (in the background; its pid in runs)
   local name=$1 type=$2; shift 2
@@ -19,23 +24,32 @@ run fp_bad FormationPlanner _uav_index:=0 _uav_count:=3 _world_frame:=world \
   _scenario_file:="$CFG/scenarios/power_towers.yaml" _formation_config:="$T/formation_broken.yaml" \
   _planner_config:="$CFG/planner.yaml" _replanning_period_s:=99.0 _horizon_dt_s:=0.2 _horizon_steps:=40 \
   _params_rate_hz:=2.0 plan_out:=fp_bad_plan
-run gc_bad GestureCommander _uav_count:=3 _sender_name:=gesture _gesture_config:="$T/gestures_broken.yaml"
+run gc_bad GestureCommander _uav_count:=3 _sender_name:=gesture _frame_wait_s:=0.1 _gesture_config:="$T/gestures_broken.yaml"
+run gc_vf GestureCommander _uav_count:=3 _sender_name:=gesture _frame_wait_s:=0.1 _gesture_config:="$T/gestures_vf_broken.yaml" \
+  gesture_status_out:=gc_vf_status
+run vo_bad ViewObserver observation_out:=vo_bad_observation
 make_key "$T/keys"; chmod 644 "$T/keys"
 run lb_bad LcmBridge _sender_id:=1 _known_senders:="[0,1,2]" _lcm_url:="memq://" _channel_prefix:=GF_ \
   _key_file:="$T/keys" _max_age_s:=1.0 _heartbeat_rate_hz:=5.0 _world_frame:=world
 run sw_bad SimWorld
 sleep 6
 rostopic list 2>/dev/null | grep -q fp_bad_plan && fail "FormationPlanner advertised its output although it refused to start"
+rostopic list 2>/dev/null | grep -q gc_vf_status && fail "GestureCommander advertised its output although it refused to start"
+rostopic list 2>/dev/null | grep -q vo_bad_observation && fail "ViewObserver advertised its output although it refused to start"
 wait "${runs[@]}"
 check() {  # log, pattern, what
   grep -q -- "$2" "$T/$1.log" || { fail "$1: $3 not reported"; sed 's/^/    /' "$T/$1.log" | head -20; }
 }
-for f in fp_bad gc_bad lb_bad sw_bad; do check $f "refuses to start" "refusal"; done
+for f in fp_bad gc_bad gc_vf vo_bad lb_bad sw_bad; do check $f "refuses to start" "refusal"; done
 check fp_bad "fp_bad/replanning_period_s: value 99 out of range" "out-of-range replanning_period_s"
 check fp_bad "fp_bad/max_share_age_s: missing" "missing max_share_age_s"
 check fp_bad "fp_bad/avoid_all_plans: missing" "missing avoid_all_plans (the avoidance rule without a mission)"
 check fp_bad "limits.distance_max_m" "the missing YAML key limits.distance_max_m"
 check gc_bad "ratio_threshold" "the out-of-range YAML key ratio_threshold"
+check gc_vf "view_fusion.min_agreeing_views" "the out-of-range YAML key view_fusion.min_agreeing_views"
+check gc_vf "view_fusion.elevation_max_deg" "the missing YAML key view_fusion.elevation_max_deg"
+check vo_bad "vo_bad/uav_index: missing" "missing uav_index"
+check vo_bad "vo_bad/max_state_age_s: missing" "missing max_state_age_s"
 check lb_bad "key_file: .*chmod 600" "the key file's permissions"
 for p in mission_file seed real_time_factor clock_step_s duration_s output_dir world_frame leader_camera_frame; do
   check sw_bad "sw_bad/$p: missing" "missing $p"

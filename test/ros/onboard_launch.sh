@@ -22,7 +22,7 @@ awk -v r="$rate" 'BEGIN { exit !(r > 2.0 && r < 3.0) }' && echo "PASS: /plan at 
 n=$(timeout 5 rostopic echo -n1 /flight/trajectory 2>/dev/null | grep -c "translation")
 [ "${n:-0}" -ge 2 ] && echo "PASS: MultiDOFJointTrajectory on the remapped /flight/trajectory ($n points)" || fail "no MultiDOFJointTrajectory on /flight/trajectory"
 grep -q "refuses to start" "$T/launch.log" && fail "a nodelet refused to start: $(grep -A3 'refuses' "$T/launch.log" | head -5)"
-for n in formation_planner lcm_bridge worker_estimator gesture_commander; do
+for n in formation_planner lcm_bridge worker_estimator gesture_commander view_observer perception; do
   grep -q "/$n" <(rosnode list 2>/dev/null) || fail "$n not running"
 done
 [ $fails -eq 0 ] || { echo "--- launch.log"; tail -30 "$T/launch.log"; }

@@ -1,13 +1,16 @@
 #!/usr/bin/env python3
 """Checks a running simulation.launch (test/ros/simulation_launch.sh): message rates over a
-sim-time window, then injects a gesture at the leader and checks that the followers' formation
-parameters (received over LCM) and their planned references change accordingly.
+sim-time window; then the formation's cameras vote (docs/gestures.md §4.1, 2 of 3): a gesture
+injected at the leader's classifier alone (1 of 3 UAVs) fires nothing and changes nothing; the
+same gesture injected at both followers' classifiers (2 of 3; their votes reach the leader over
+LCM) fires once, and the followers' formation parameters (received over LCM) and their planned
+references change accordingly.
 Prints one line per check; exit code = number of failures."""
 import math
 import sys
 
 import rospy
-from gesture_formation.msg import FormationParams, Gesture, PlannedTrajectory, WorkerState
+from gesture_formation.msg import FormationParams, Gesture, GestureStatus, PlannedTrajectory, WorkerState
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 from visualization_msgs.msg import MarkerArray
@@ -58,16 +61,47 @@ def main():
         x = [w[k] + (t0 - ts) * v[k] for k in range(3)]
         ref_dist.append(math.sqrt((r.x - x[0]) ** 2 + (r.y - x[1]) ** 2 + (r.z - x[2]) ** 2))
     rospy.Subscriber("/uav1/plan", PlannedTrajectory, on_plan)
-    gesture_pub = rospy.Publisher("/uav0/perception/gesture", Gesture, queue_size=50)
+    gesture_pubs = [rospy.Publisher("/uav%d/perception/gesture" % i, Gesture, queue_size=50) for i in range(3)]
+    statuses = []
+    rospy.Subscriber("/uav0/gesture_status", GestureStatus, lambda m: statuses.append(m), queue_size=200)
     fails = 0
     deadline = rospy.get_time() + 200  # wall guard below
     import time
+    def inject(uavs, frames=30):
+        # gesture 2 (power_towers mapping: all.distance_m +1) from the given UAVs' classifiers, one
+        # stamp per frame, 15 Hz for 2 s: 30 frames, dominant ratio 1 > 0.8 when they count
+        rate = rospy.Rate(15)
+        for _ in range(frames):
+            stamp = rospy.Time.now()
+            for i in uavs:
+                g = Gesture()
+                g.header.stamp = stamp
+                g.gesture_id = 2
+                g.probabilities = [0.0, 0.0, 1.0, 0.0, 0.0]
+                gesture_pubs[i].publish(g)
+            rate.sleep()
+
+    def wait_until(t_sim):
+        while not rospy.is_shutdown() and rospy.Time.now().to_sec() < t_sim:
+            if time.time() - wall0 > 45:
+                print("FAIL: sim time did not reach %.0f s within 45 s wall (now %.1f)" % (t_sim, rospy.Time.now().to_sec()))
+                return False
+            time.sleep(0.05)
+        return True
+
     wall0 = time.time()
-    while not rospy.is_shutdown() and rospy.Time.now().to_sec() < WINDOW[1]:
-        if time.time() - wall0 > 45:
-            print("FAIL: sim time did not reach %.0f s within 45 s wall (now %.1f)" % (WINDOW[1], rospy.Time.now().to_sec()))
-            return 1
-        time.sleep(0.05)
+    if not wait_until(WINDOW[0]):
+        return 1
+    # 1 of 3 (during the rate window: ~3 s wall, before the mission's first request at 20 s):
+    # the leader's camera alone sees the gesture: the vote refuses it.
+    d_before = state["params1"].uavs[1].distance_m if state["params1"] else float("nan")
+    del statuses[:]
+    inject([0])
+    time.sleep(1.0)
+    single = list(statuses)
+    d_now = state["params1"].uavs[1].distance_m if state["params1"] else float("nan")
+    if not wait_until(WINDOW[1]):
+        return 1
     dt = WINDOW[1] - WINDOW[0]
     for topic, (_, hz, tol) in RATES.items():
         rate = counts[topic] / dt
@@ -82,19 +116,19 @@ def main():
         last = sorted(ref_dist[-5:])
         return last[len(last) // 2] if last else float("nan")
 
-    d_before = state["params1"].uavs[1].distance_m if state["params1"] else float("nan")
+    fired = [m for m in single if m.fired]
+    agree = max([m.agreeing_views for m in single] or [0])
+    ok = len(single) >= 20 and not fired and agree == 1 and d_now == d_before
+    print("%s: gesture 2 at 1 of 3 UAVs (the leader): %d fused frames, at most %d agreeing view, %d fired, "
+          "follower 1 d %.2f -> %.2f m (expected: >= 20 frames, 1, 0 fired, unchanged)" % (
+              "PASS" if ok else "FAIL", len(single), agree, len(fired), d_before, d_now))
+    fails += 0 if ok else 1
+
     ref_before = follower_ref_distance()
-    # Inject gesture 2 (power_towers mapping: all.distance_m +1) at the leader's classifier output,
-    # 15 Hz for 2 s: 30 measurements, dominant ratio 1 > 0.8 → the GestureCommander fires once.
+    # 2 of 3: both followers' cameras see it (their votes travel over LCM to the leader).
+    del statuses[:]
     t_inject = rospy.Time.now().to_sec()
-    rate = rospy.Rate(15)
-    for _ in range(30):
-        g = Gesture()
-        g.header.stamp = rospy.Time.now()
-        g.gesture_id = 2
-        g.probabilities = [0.0, 0.0, 1.0, 0.0, 0.0]
-        gesture_pub.publish(g)
-        rate.sleep()
+    inject([1, 2])
     wall1 = time.time()
     changed_at = None
     while time.time() - wall1 < 15 and not rospy.is_shutdown():
@@ -105,6 +139,12 @@ def main():
             break
         time.sleep(0.05)
     ref_after = follower_ref_distance()
+    fired = [m for m in statuses if m.fired]
+    ok = len(fired) == 1 and fired[0].agreeing_views == 2 and fired[0].gesture_id == 2
+    print("%s: gesture 2 at 2 of 3 UAVs (both followers, over LCM): %d command(s) fired%s (expected 1, 2 agreeing)" % (
+        "PASS" if ok else "FAIL", len(fired),
+        ", %d of %d voting views agreed" % (fired[0].agreeing_views, fired[0].voting_views) if fired else ""))
+    fails += 0 if ok else 1
     ok = changed_at is not None
     print("%s: follower 1's formation parameters over LCM: d %.2f -> %s m after gesture 2 at t=%.1f s%s" % (
         "PASS" if ok else "FAIL", d_before, "%.2f" % state["params1"].uavs[1].distance_m if state["params1"] else "none",

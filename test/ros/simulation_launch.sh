@@ -1,7 +1,8 @@
 #!/bin/bash
 # simulation.launch end to end (3 UAV managers + world, LCM inside a private network namespace):
-# every stream publishes at its rate (sim time), and a gesture injected at the leader changes
-# the followers' formation parameters and planned references through LCM (test/ros/sim_check.py);
+# every stream publishes at its rate (sim time); a gesture injected at 1 of the 3 UAVs' classifiers
+# changes nothing, injected at 2 of 3 (the followers: votes over LCM) it changes the followers'
+# formation parameters and planned references through LCM (test/ros/sim_check.py);
 # at the end (40 s) SimWorld's metrics.json / events.csv / timeline.csv carry gfctl simulate's
 # metrics, with the requests followed to their adaptation (test/ros/check_sim_metrics.py).
 set -o pipefail
@@ -12,7 +13,7 @@ mkdir -p "$T/out"
 cat > "$T/inner.sh" <<INNER
 ip link set lo up && ip route add 224.0.0.0/4 dev lo || exit 1
 roslaunch -p $PORT gesture_formation simulation.launch key_file:=$T/keys output_dir:=$T/out duration:=40 \
-  real_time_factor:=1.5 gesture_topic:=/world/sim_gesture_unused > "$T/launch.log" 2>&1 &
+  real_time_factor:=1.5 gesture_prefix:=/world/unused > "$T/launch.log" 2>&1 &
 launch=\$!
 for _ in \$(seq 50); do rosparam get /use_sim_time > /dev/null 2>&1 && break; sleep 0.2; done
 timeout 80 python3 "$SRC/test/ros/sim_check.py"

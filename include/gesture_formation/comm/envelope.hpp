@@ -7,7 +7,7 @@
 /// offset size field
 ///      0    2 magic 'G' 'F' (0x47 0x46)
 ///      2    1 version (kEnvelopeVersion = 1)
-///      3    1 message type (MessageType, 1..5)
+///      3    1 message type (MessageType, 1..6)
 ///      4    2 sender id
 ///      6    1 key id (which pre-shared key made the tag)
 ///      7    1 flags (reserved, must be 0)
@@ -45,10 +45,12 @@ enum class MessageType : std::uint8_t {
   kPlannedTrajectory = 3,
   kFormationParams = 4,
   kFormationCommand = 5,
+  kGestureObservation = 6,
 };
 constexpr std::uint8_t kMinMessageType = 1;
-constexpr std::uint8_t kMaxMessageType = 5;
-/// \brief "heartbeat", "worker_state", "planned_trajectory", "formation_params", "formation_command".
+constexpr std::uint8_t kMaxMessageType = 6;
+/// \brief "heartbeat", "worker_state", "planned_trajectory", "formation_params", "formation_command",
+/// "gesture_observation".
 const char* toString(MessageType type);
 bool isKnownMessageType(std::uint8_t value);
 

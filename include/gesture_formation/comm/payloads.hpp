@@ -55,6 +55,24 @@ struct WorkerStateMessage {
   bool lost = false;  ///< estimator reports the worker lost (prediction only, timed out)
 };
 
+/// \brief One UAV's gesture classification of one camera frame with that camera's geometry to
+/// the worker estimate (the multi-view vote, gesture::ViewObservation; docs/gestures.md §4.1).
+/// The sender's id, sequence and send stamp are the envelope's.
+struct GestureObservationMessage {
+  std::uint16_t uav_index = 0;      ///< the observing UAV, ≤ kMaxUavIndex (0 = leader)
+  double t_s = 0.0;                 ///< the frame's time [s]
+  std::uint8_t gesture_id = 0;      ///< the classifier's argmax, ≤ kMaxGestureId
+  std::vector<double> probabilities;  ///< class probabilities, each in [0, 1], ≤ kMaxGestureClasses
+  bool geometry_known = false;      ///< false: no worker estimate / odometry (the view cannot vote)
+  double distance_m = 0.0;          ///< camera → worker estimate [m], [0, kMaxObservationDistanceM]
+  double elevation_deg = 0.0;       ///< camera above the worker estimate [deg], [−90, 90]
+};
+/// Largest gesture id and number of class probabilities on the wire.
+constexpr int kMaxGestureId = 15;
+constexpr std::size_t kMaxGestureClasses = 16;
+/// Largest camera → worker distance on the wire [m].
+constexpr double kMaxObservationDistanceM = 1000.0;
+
 /// \brief Why a payload was refused. Values index PayloadCounters.
 enum class PayloadError : std::uint8_t {
   kNone = 0,
@@ -74,6 +92,7 @@ common::Result<std::vector<std::uint8_t>> encodePayload(const WorkerStateMessage
 common::Result<std::vector<std::uint8_t>> encodePayload(const planning::PlannedTrajectory& m);
 common::Result<std::vector<std::uint8_t>> encodePayload(const formation::FormationParams& m);
 common::Result<std::vector<std::uint8_t>> encodePayload(const formation::FormationCommand& m);
+common::Result<std::vector<std::uint8_t>> encodePayload(const GestureObservationMessage& m);
 
 /// \brief The envelope type of each payload.
 inline MessageType messageTypeOf(const Heartbeat&) { return MessageType::kHeartbeat; }
@@ -81,6 +100,7 @@ inline MessageType messageTypeOf(const WorkerStateMessage&) { return MessageType
 inline MessageType messageTypeOf(const planning::PlannedTrajectory&) { return MessageType::kPlannedTrajectory; }
 inline MessageType messageTypeOf(const formation::FormationParams&) { return MessageType::kFormationParams; }
 inline MessageType messageTypeOf(const formation::FormationCommand&) { return MessageType::kFormationCommand; }
+inline MessageType messageTypeOf(const GestureObservationMessage&) { return MessageType::kGestureObservation; }
 
 // ---- decoders: `out` written only on kNone; `reason` (optional) names the field ---------
 PayloadError decodePayload(const std::uint8_t* data, std::size_t size, Heartbeat& out, std::string* reason = nullptr);
@@ -91,6 +111,8 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, planning:
 PayloadError decodePayload(const std::uint8_t* data, std::size_t size, formation::FormationParams& out,
                            std::string* reason = nullptr);
 PayloadError decodePayload(const std::uint8_t* data, std::size_t size, formation::FormationCommand& out,
+                           std::string* reason = nullptr);
+PayloadError decodePayload(const std::uint8_t* data, std::size_t size, GestureObservationMessage& out,
                            std::string* reason = nullptr);
 
 /// \brief One counter per PayloadError (kNone counts successful decodes).

@@ -113,7 +113,7 @@ TEST(CommEnvelopeTest, StructuralErrorsAreNamed) {
   b = good;
   b[3] = 0;
   check(b, EnvelopeError::kBadType);
-  b[3] = 6;
+  b[3] = kMaxMessageType + 1;
   check(b, EnvelopeError::kBadType);
   b = good;
   b[7] = 1;

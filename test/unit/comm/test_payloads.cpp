@@ -292,6 +292,78 @@ TEST(CommPayloadsTest, FormationCommandRefusals) {
   EXPECT_EQ(decode(bad, d), PayloadError::kTrailingBytes);
 }
 
+TEST(CommPayloadsTest, GestureObservationRoundTripAndRefusals) {
+  GestureObservationMessage m;
+  m.uav_index = 2;
+  m.t_s = 41.25;
+  m.gesture_id = 3;
+  m.probabilities = {0.05, 0.05, 0.1, 0.75, 0.05};
+  m.geometry_known = true;
+  m.distance_m = 8.5;
+  m.elevation_deg = 11.0;
+  const auto b = encoded(m);
+  // u16 + f64 + u8 + u8 + 5 × f64 + u8 + 2 × f64
+  ASSERT_EQ(b.size(), 2 + 8 + 1 + 1 + 5 * 8 + 1 + 2 * 8u);
+  GestureObservationMessage d;
+  ASSERT_EQ(decode(b, d), PayloadError::kNone);
+  EXPECT_EQ(d.uav_index, 2);
+  EXPECT_EQ(d.t_s, m.t_s);
+  EXPECT_EQ(d.gesture_id, 3);
+  EXPECT_EQ(d.probabilities, m.probabilities);
+  EXPECT_TRUE(d.geometry_known);
+  EXPECT_EQ(d.distance_m, 8.5);
+  EXPECT_EQ(d.elevation_deg, 11.0);
+  // Bad values on the wire: refused naming the field, the output untouched.
+  const std::size_t prob0 = 12, flags = 12 + 5 * 8, distance = flags + 1, elevation = distance + 8;
+  struct Case {
+    std::size_t offset;
+    int byte;       // ≥ 0: replace one byte
+    double value;   // else: replace a double
+    PayloadError error;
+    const char* field;
+  };
+  const Case cases[] = {
+      {1, kMaxUavIndex + 1, 0, PayloadError::kOutOfRange, "gesture_observation.uav_index"},
+      {10, kMaxGestureId + 1, 0, PayloadError::kOutOfRange, "gesture_observation.gesture_id"},
+      {11, static_cast<int>(kMaxGestureClasses) + 1, 0, PayloadError::kOversizeArray, "gesture_observation.probabilities"},
+      {prob0, -1, 1.5, PayloadError::kOutOfRange, "gesture_observation.probabilities[0]"},
+      {prob0, -1, -0.1, PayloadError::kOutOfRange, "gesture_observation.probabilities[0]"},
+      {prob0, -1, kNaN, PayloadError::kNonFinite, "gesture_observation.probabilities[0]"},
+      {flags, 2, 0, PayloadError::kOutOfRange, "gesture_observation.flags"},
+      {distance, -1, -1.0, PayloadError::kOutOfRange, "gesture_observation.distance_m"},
+      {distance, -1, 1e6, PayloadError::kOutOfRange, "gesture_observation.distance_m"},
+      {elevation, -1, 90.5, PayloadError::kOutOfRange, "gesture_observation.elevation_deg"},
+      {elevation, -1, kInf, PayloadError::kNonFinite, "gesture_observation.elevation_deg"},
+      {2, -1, kNaN, PayloadError::kNonFinite, "gesture_observation.t_s"},
+  };
+  for (const Case& c : cases) {
+    auto bad = b;
+    if (c.byte >= 0) bad[c.offset] = static_cast<std::uint8_t>(c.byte);
+    else putDouble(bad, c.offset, c.value);
+    GestureObservationMessage untouched = d;
+    std::string reason;
+    EXPECT_EQ(decode(bad, untouched, &reason), c.error) << c.field;
+    EXPECT_NE(reason.find(c.field), std::string::npos) << reason;
+    EXPECT_EQ(untouched.t_s, d.t_s);
+  }
+  auto longer = b;
+  longer.push_back(0);
+  EXPECT_EQ(decode(longer, d), PayloadError::kTrailingBytes);
+  // The encoder refuses what a decoder would.
+  auto e = m;
+  e.gesture_id = kMaxGestureId + 1;
+  EXPECT_FALSE(encodePayload(e));
+  e = m;
+  e.probabilities[1] = 1.2;
+  EXPECT_FALSE(encodePayload(e));
+  e = m;
+  e.elevation_deg = -91.0;
+  EXPECT_FALSE(encodePayload(e));
+  e = m;
+  e.uav_index = kMaxUavIndex + 1;
+  EXPECT_FALSE(encodePayload(e));
+}
+
 TEST(CommPayloadsTest, DecoderChecksTypeAndCountsEveryOutcome) {
   PayloadDecoder decoder;
   Envelope e;

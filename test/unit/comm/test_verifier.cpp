@@ -316,7 +316,7 @@ TEST(CommVerifierTest, HundredThousandHostilePacketsNoneAccepted) {
           b[2] = static_cast<std::uint8_t>(2 + rng() % 254);
           verdict = Verdict::kBadVersion;
         } else if (kind == 1) {
-          b[3] = static_cast<std::uint8_t>(6 + rng() % 250);
+          b[3] = static_cast<std::uint8_t>(kMaxMessageType + 1 + rng() % (255 - kMaxMessageType));
           verdict = Verdict::kBadType;
         } else if (kind == 2) {
           b[0] ^= static_cast<std::uint8_t>(1 + rng() % 255);

@@ -1,0 +1,156 @@
+// Perception nodelet (issue 8 item 2): one camera's RGB image (+ aligned depth, CameraInfo) →
+// the worker's box (perception::PerceptionPipeline: person detector ⇄ visual tracker), its
+// skeleton into the FIFO of N frames, the gesture LSTM (gesture::GestureClassifier) on a full
+// window, and the stereo range (estimation::stereoDistance: median depth in the box, along the
+// box-centre ray). A thin adapter: the core decides, this converts and publishes.
+//
+// Topics: image_in (sensor_msgs/Image: bgr8, rgb8 or mono8), depth_in (sensor_msgs/Image aligned
+//   to the colour image: 16UC1 in depth_scale_m units or 32FC1 in metres; optional),
+//   camera_info_in (sensor_msgs/CameraInfo of the colour camera; without it: no stereo range)
+//   → detection_out (WorkerDetection, one per image; frame_id = the image's),
+//   gesture_out (Gesture, one per image with a full skeleton window: this UAV's classifier output,
+//   the ViewObserver's input).
+// Parameters (required): ~models_root (third_party_models), ~gesture_model (the LSTM's .onnx),
+//   ~detector (movenet_multipose | blazepose), ~skeleton (movenet_lightning | blazepose_landmark),
+//   ~detect_every_k, ~min_depth_m, ~max_depth_m, ~depth_scale_m, ~max_depth_dt_s
+//   (a depth image further than this from the colour image's stamp is not used).
+#include <mutex>
+#include <optional>
+
+#include <nodelet/nodelet.h>
+#include <pluginlib/class_list_macros.hpp>
+#include <ros/ros.h>
+
+#include "conversions.hpp"
+#include "gesture_formation/Gesture.h"
+#include "gesture_formation/estimation/stereo_distance.hpp"
+#include "gesture_formation/gesture/gesture_classifier.hpp"
+#include "gesture_formation/perception/perception_pipeline.hpp"
+#include "param_loader.hpp"
+
+namespace gesture_formation::nodelets {
+
+class PerceptionNodelet : public nodelet::Nodelet {
+ private:
+  void onInit() override {
+    ros::NodeHandle& nh = getNodeHandle();
+    ParamLoader params(getPrivateNodeHandle());
+    perception::PerceptionConfig cfg;
+    std::string detector, skeleton, gesture_model;
+    params.load("models_root", cfg.models_root);
+    params.load("gesture_model", gesture_model);
+    params.load("detector", detector);
+    params.load("skeleton", skeleton);
+    params.load("detect_every_k", cfg.tracker.detect_every_k, 1, 1000);
+    params.load("min_depth_m", stereo_.min_depth_m, 0.0, 100.0);
+    params.load("max_depth_m", stereo_.max_depth_m, 0.01, 100.0);
+    params.load("depth_scale_m", stereo_.depth_scale_m, 1e-6, 1.0);
+    params.load("max_depth_dt_s", max_depth_dt_s_, 0.0, 1.0);
+    if (!detector.empty()) {
+      const auto k = perception::parseDetectorKind(detector);
+      if (k) cfg.detector = *k;
+      else params.addError("detector: " + k.reason());
+    }
+    if (!skeleton.empty()) {
+      const auto k = perception::parseSkeletonKind(skeleton);
+      if (k) cfg.skeleton = *k;
+      else params.addError("skeleton: " + k.reason());
+    }
+    if (!(stereo_.max_depth_m > stereo_.min_depth_m)) params.addError("max_depth_m: must exceed min_depth_m");
+    if (params.ok()) {
+      for (const auto& e : cfg.validate()) params.addError(e);
+    }
+    if (params.ok()) {
+      auto p = perception::PerceptionPipeline::create(cfg);
+      if (p) pipeline_ = std::move(*p);
+      else params.addError("models_root: " + p.reason());
+      auto c = gesture::GestureClassifier::load(gesture_model);
+      if (c) classifier_.emplace(std::move(*c));
+      else params.addError("gesture_model: " + c.reason());
+    }
+    if (!params.ok()) {
+      NODELET_ERROR_STREAM("Perception refuses to start; fix these parameters:\n" << params.report());
+      return;
+    }
+    NODELET_INFO_STREAM("Perception loaded:\n" << params.loaded());
+    detection_pub_ = nh.advertise<gesture_formation::WorkerDetection>("detection_out", 10);
+    gesture_pub_ = nh.advertise<gesture_formation::Gesture>("gesture_out", 10);
+    info_sub_ = nh.subscribe<sensor_msgs::CameraInfo>("camera_info_in", 2, [this](const sensor_msgs::CameraInfo::ConstPtr& m) {
+      auto k = toIntrinsics(*m);
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (k) camera_.emplace(*k);
+      else NODELET_WARN_STREAM_THROTTLE(5.0, "Perception: " << k.reason());
+    });
+    depth_sub_ = nh.subscribe<sensor_msgs::Image>("depth_in", 2, [this](const sensor_msgs::Image::ConstPtr& m) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      depth_ = m;
+    });
+    image_sub_ = nh.subscribe("image_in", 2, &PerceptionNodelet::onImage, this);
+  }
+
+  void onImage(const sensor_msgs::Image::ConstPtr& msg) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto bgr = toBgr(*msg);
+    if (!bgr) {
+      NODELET_WARN_STREAM_THROTTLE(5.0, "Perception: image refused: " << bgr.reason());
+      return;
+    }
+    auto frame = pipeline_->step(*bgr);
+    if (!frame) {
+      NODELET_WARN_STREAM_THROTTLE(5.0, "Perception: " << frame.reason());
+      return;
+    }
+    gesture_formation::WorkerDetection d;
+    d.header = msg->header;
+    d.detected = frame->track.found;
+    d.stereo_distance_m = std::nan("");
+    if (frame->track.found) {
+      const cv::Rect2f& b = frame->track.box_px;
+      d.u = b.x;
+      d.v = b.y;
+      d.w = b.width;
+      d.h = b.height;
+      // The detector's score of the worker's last detection (the tracker reports none).
+      const auto& t = frame->track;
+      if (t.identity_changed) last_score_ = 0.0f;
+      if (t.worker_detection >= 0) last_score_ = t.detections[static_cast<std::size_t>(t.worker_detection)].score;
+      d.confidence = last_score_;
+      if (depth_ && camera_ && std::abs((depth_->header.stamp - msg->header.stamp).toSec()) <= max_depth_dt_s_) {
+        auto depth = toDepth(*depth_);
+        const estimation::Box box{d.u, d.v, d.w, d.h};
+        auto range = depth ? estimation::stereoDistance(*depth, box, *camera_, stereo_)
+                           : common::Result<double>::fail(depth.reason());
+        if (range) d.stereo_distance_m = *range;
+        else NODELET_DEBUG_STREAM_THROTTLE(5.0, "Perception: no stereo range: " << range.reason());
+      }
+    }
+    detection_pub_.publish(d);
+    if (!frame->fifo_full) return;
+    const std::vector<float> window = pipeline_->classifierInput();
+    auto c = classifier_->classify(window.data());
+    if (!c) {
+      NODELET_WARN_STREAM_THROTTLE(5.0, "Perception: classifier: " << c.reason());
+      return;
+    }
+    gesture_formation::Gesture g;
+    g.header = msg->header;
+    g.gesture_id = c->gesture_id;
+    g.probabilities.assign(c->probabilities.begin(), c->probabilities.end());
+    gesture_pub_.publish(g);
+  }
+
+  std::mutex mutex_;
+  std::unique_ptr<perception::PerceptionPipeline> pipeline_;
+  std::optional<gesture::GestureClassifier> classifier_;
+  estimation::StereoDistanceConfig stereo_;
+  double max_depth_dt_s_ = 0.0;
+  float last_score_ = 0.0f;
+  std::optional<estimation::CameraModel> camera_;
+  sensor_msgs::Image::ConstPtr depth_;
+  ros::Publisher detection_pub_, gesture_pub_;
+  ros::Subscriber info_sub_, depth_sub_, image_sub_;
+};
+
+}  // namespace gesture_formation::nodelets
+
+PLUGINLIB_EXPORT_CLASS(gesture_formation::nodelets::PerceptionNodelet, nodelet::Nodelet)

@@ -1,0 +1,125 @@
+#!/usr/bin/env python3
+"""A tiny camera for the Perception nodelet (test/ros/perception_image.sh): publishes a PNG
+(decoded here with zlib + numpy: no OpenCV in Debian's python) as a bgr8 sensor_msgs/Image at
+10 Hz, an aligned 32FC1 depth image (constant DEPTH_M) and a CameraInfo, and checks what comes
+out: a WorkerDetection with the worker found, its box inside the image and a stereo range along
+the box-centre ray (>= DEPTH_M, within the ray's stretch), then a Gesture once the skeleton FIFO
+is full (the still astronaut: none, as GestureEndToEndTest.CommittedStillImageSkeletonClassifiesAsNone).
+Usage: perception_check.py IMAGE.png; exit code = number of failures."""
+import math
+import struct
+import sys
+import time
+import zlib
+
+import numpy as np
+import rospy
+from gesture_formation.msg import Gesture, WorkerDetection
+from sensor_msgs.msg import CameraInfo, Image
+
+DEPTH_M = 4.0
+F_PX = 500.0
+
+
+def read_png(path):
+    data = open(path, "rb").read()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n", "not a PNG"
+    pos, idat, w = 8, b"", None
+    while pos < len(data):
+        n, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        body = data[pos + 8:pos + 8 + n]
+        if kind == b"IHDR":
+            w, h, depth, ctype, _, _, interlace = struct.unpack(">IIBBBBB", body)
+            assert depth == 8 and ctype in (2, 6) and interlace == 0, "only 8-bit RGB(A), not interlaced"
+            bpp = 3 if ctype == 2 else 4
+        elif kind == b"IDAT":
+            idat += body
+        pos += 12 + n
+    raw = zlib.decompress(idat)
+    stride = w * bpp
+    out = np.zeros((h, stride), dtype=np.uint8)
+    prev = np.zeros(stride, dtype=np.int32)
+    for y in range(h):
+        f = raw[y * (stride + 1)]
+        line = np.frombuffer(raw, dtype=np.uint8, count=stride, offset=y * (stride + 1) + 1).astype(np.int32)
+        cur = np.zeros(stride, dtype=np.int32)
+        if f == 0:
+            cur = line
+        elif f == 2:
+            cur = (line + prev) & 255
+        else:  # Sub, Average, Paeth depend on the reconstructed left neighbour
+            for x in range(stride):
+                a = cur[x - bpp] if x >= bpp else 0
+                b = prev[x]
+                c = prev[x - bpp] if x >= bpp else 0
+                if f == 1:
+                    p = a
+                elif f == 3:
+                    p = (a + b) // 2
+                else:
+                    pa, pb, pc = abs(b - c), abs(a - c), abs(a + b - 2 * c)
+                    p = a if pa <= pb and pa <= pc else (b if pb <= pc else c)
+                cur[x] = (line[x] + p) & 255
+        out[y] = cur
+        prev = cur
+    rgb = out.reshape(h, w, bpp)[:, :, :3]
+    return np.ascontiguousarray(rgb[:, :, ::-1])  # BGR
+
+
+def main():
+    bgr = read_png(sys.argv[1])
+    h, w = bgr.shape[:2]
+    rospy.init_node("perception_check")
+    img_pub = rospy.Publisher("/cam/image", Image, queue_size=2)
+    depth_pub = rospy.Publisher("/cam/depth", Image, queue_size=2)
+    info_pub = rospy.Publisher("/cam/camera_info", CameraInfo, queue_size=2, latch=True)
+    detections, gestures = [], []
+    rospy.Subscriber("/perception/worker_detection", WorkerDetection, detections.append)
+    rospy.Subscriber("/perception/gesture", Gesture, gestures.append)
+    info = CameraInfo(width=w, height=h, distortion_model="plumb_bob", D=[0.0] * 5,
+                      K=[F_PX, 0, w / 2.0, 0, F_PX, h / 2.0, 0, 0, 1])
+    info.header.frame_id = "cam_optical"
+    info_pub.publish(info)
+    depth = np.full((h, w), DEPTH_M, dtype=np.float32)
+    wall0 = time.time()
+    while time.time() - wall0 < 50 and not rospy.is_shutdown():
+        stamp = rospy.Time.now()
+        m = Image(height=h, width=w, encoding="bgr8", step=3 * w, data=bgr.tobytes())
+        m.header.stamp, m.header.frame_id = stamp, "cam_optical"
+        d = Image(height=h, width=w, encoding="32FC1", step=4 * w, data=depth.tobytes())
+        d.header.stamp, d.header.frame_id = stamp, "cam_optical"
+        depth_pub.publish(d)
+        time.sleep(0.01)
+        img_pub.publish(m)
+        if gestures and len(detections) >= 10:
+            break
+        time.sleep(0.1)
+    fails = 0
+    found = [x for x in detections if x.detected]
+    ok = len(detections) >= 10 and len(found) >= 9
+    print("%s: %d WorkerDetection messages, %d with the worker found (expected >= 10, >= 9)" % (
+        "PASS" if ok else "FAIL", len(detections), len(found)))
+    fails += 0 if ok else 1
+    if found:
+        x = found[-1]
+        inside = x.w > 0.2 * w and x.h > 0.2 * h and x.u >= -1 and x.v >= -1 and x.u + x.w <= w + 1 and x.v + x.h <= h + 1 \
+            and 0.0 < x.confidence <= 1.0
+        cu, cv = x.u + x.w / 2 - w / 2.0, x.v + x.h / 2 - h / 2.0
+        expected = DEPTH_M * math.sqrt(1 + (cu / F_PX) ** 2 + (cv / F_PX) ** 2)  # depth → range along the ray
+        print("%s: box u %.0f v %.0f w %.0f h %.0f px in the %dx%d image, confidence %.2f (expected in (0, 1])" % (
+            "PASS" if inside else "FAIL", x.u, x.v, x.w, x.h, w, h, x.confidence))
+        fails += 0 if inside else 1
+        ok = abs(x.stereo_distance_m - expected) < 1e-3
+        print("%s: stereo range %.4f m (depth %.1f m along the box-centre ray: %.4f m)" % (
+            "PASS" if ok else "FAIL", x.stereo_distance_m, DEPTH_M, expected))
+        fails += 0 if ok else 1
+    ok = len(gestures) >= 1 and gestures[0].gesture_id == 0 and len(gestures[0].probabilities) == 5
+    print("%s: Gesture after a full skeleton window: %s (expected id 0, none: a still worker)" % (
+        "PASS" if ok else "FAIL", "id %d, p(none) %.3f" % (gestures[0].gesture_id, gestures[0].probabilities[0])
+        if gestures else "none published"))
+    fails += 0 if ok else 1
+    return fails
+
+
+if __name__ == "__main__":
+    sys.exit(main())
