@@ -1,0 +1,27 @@
+#!/bin/bash
+# The GestureCommander's vote (docs/gestures.md §4.1) on the shipped config/gestures.yaml
+# (min_agreeing_views 2) and on a copy with min_agreeing_views 1 (the paper's single camera),
+# fed GestureObservation messages directly (test/ros/gesture_commander_check.py): one camera fires
+# with 1 and never with 2; two cameras outside the classifier's envelope never fire; two inside
+# fire once with 2 agreeing views.
+set -o pipefail
+source "$(dirname "$0")/common.bash"
+start_master
+CFG=$SRC/config
+sed 's/^\( *min_agreeing_views:\) .*/\1 1/' "$CFG/gestures.yaml" > "$T/gestures_single.yaml"
+grep -q "min_agreeing_views: 1" "$T/gestures_single.yaml" || fail "could not set min_agreeing_views 1 in a copy"
+for v in single:$T/gestures_single.yaml voted:$CFG/gestures.yaml; do
+  name=${v%%:*} file=${v#*:}
+  timeout 60 rosrun nodelet nodelet standalone gesture_formation/GestureCommander __name:=gc_$name \
+    _uav_count:=3 _sender_name:=gesture _frame_wait_s:=0.1 _gesture_config:="$file" \
+    observation_in:=/$name/observation peer_observations_in:=/$name/peer_observations \
+    formation_command_out:=/$name/formation_command gesture_status_out:=/$name/gesture_status \
+    > "$T/gc_$name.log" 2>&1 & pids+=($!)
+done
+for _ in $(seq 100); do
+  [ "$(rostopic list 2>/dev/null | grep -c 'gesture_status$')" -ge 2 ] && break; sleep 0.3
+done
+timeout 60 python3 "$SRC/test/ros/gesture_commander_check.py" || fails=$((fails + $?))
+grep -q "refuses to start" "$T"/gc_*.log && fail "a GestureCommander refused to start: $(grep -h -A4 refuses "$T"/gc_*.log)"
+[ $fails -eq 0 ] && echo "PASS: the GestureCommander fires on 2 of 3 cameras inside the envelope, on 1 only with min_agreeing_views 1"
+exit $fails
