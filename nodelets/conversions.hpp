@@ -26,6 +26,7 @@
 #include "gesture_formation/formation/formation_commands.hpp"
 #include "gesture_formation/formation/formation_params.hpp"
 #include "gesture_formation/gesture/view_fusion.hpp"
+#include "gesture_formation/planning/polytope_edges.hpp"
 #include "gesture_formation/planning/uav_planner.hpp"
 #include "gesture_formation/sim/mission_config.hpp"
 #include "gesture_formation/sim/multirotor.hpp"
@@ -141,6 +142,12 @@ inline gesture_formation::PlannedTrajectory toMsg(const planning::PlanResult& r)
   m.reason = r.reason;
   m.planning_ms = r.timings.total_ms;
   for (const auto& p : r.path_world) m.path.push_back(toPoint(p));
+  for (const auto& c : r.corridors) {
+    for (const auto& [a, b] : planning::polytopeEdges(c.polytope)) {
+      m.corridor_edges.push_back(toPoint(a));
+      m.corridor_edges.push_back(toPoint(b));
+    }
+  }
   return m;
 }
 /// PlannedTrajectory.status → PlanStatus (fails naming the value).

@@ -187,6 +187,11 @@ class VisualizerNodelet : public nodelet::Nodelet {
         path.color = rgba(1.0f, 1.0f, 1.0f, 0.8f);
         path.points = p->path;
         if (path.points.size() >= 2) a.markers.push_back(path);
+        auto corridors = marker("corridors", i, visualization_msgs::Marker::LINE_LIST, now);
+        corridors.scale.x = 0.03;
+        corridors.color = color(i, 0.35f);
+        corridors.points = p->corridor_edges;
+        if (corridors.points.size() >= 2 && corridors.points.size() % 2 == 0) a.markers.push_back(corridors);
       }
     }
     geometry_msgs::Point text_at;

@@ -61,6 +61,9 @@ def main():
         x = [w[k] + (t0 - ts) * v[k] for k in range(3)]
         ref_dist.append(math.sqrt((r.x - x[0]) ** 2 + (r.y - x[1]) ** 2 + (r.z - x[2]) ** 2))
     rospy.Subscriber("/uav1/plan", PlannedTrajectory, on_plan)
+    corridor_points = []  # per "corridors" marker (the planners' stage-3 corridors, LINE_LIST)
+    rospy.Subscriber("/visualization/markers", MarkerArray, lambda a: corridor_points.extend(
+        len(m.points) for m in a.markers if m.ns == "corridors"), queue_size=50)
     gesture_pubs = [rospy.Publisher("/uav%d/perception/gesture" % i, Gesture, queue_size=50) for i in range(3)]
     statuses = []
     rospy.Subscriber("/uav0/gesture_status", GestureStatus, lambda m: statuses.append(m), queue_size=200)
@@ -156,6 +159,12 @@ def main():
     ok = abs(ref_after - (d_before + 1.0)) < 0.05 and ref_after - ref_before > 0.8
     print("%s: follower 1's planned reference distance to the worker %.2f -> %.2f m (expected %.2f, about +1)" % (
         "PASS" if ok else "FAIL", ref_before, ref_after, d_before + 1.0))
+    fails += 0 if ok else 1
+    # The stage-3 corridors reach rviz: LINE_LIST markers of whole polytopes (a corridor has
+    # at least the 12 edges of a box: 24 points).
+    ok = bool(corridor_points) and max(corridor_points) >= 24 and all(n % 2 == 0 for n in corridor_points)
+    print("%s: corridors drawn: %d markers, up to %d points (expected >= 24, pairs)" % (
+        "PASS" if ok else "FAIL", len(corridor_points), max(corridor_points or [0])))
     fails += 0 if ok else 1
     return fails
 
