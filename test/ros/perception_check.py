@@ -89,7 +89,7 @@ def main():
         d = Image(height=h, width=w, encoding="32FC1", step=4 * w, data=depth.tobytes())
         d.header.stamp, d.header.frame_id = stamp, "cam_optical"
         depth_pub.publish(d)
-        time.sleep(0.01)
+        time.sleep(0.03)  # depth first (a RealSense driver publishes both at once; order is not guaranteed)
         img_pub.publish(m)
         if gestures and len(detections) >= 10:
             break
@@ -109,9 +109,21 @@ def main():
         print("%s: box u %.0f v %.0f w %.0f h %.0f px in the %dx%d image, confidence %.2f (expected in (0, 1])" % (
             "PASS" if inside else "FAIL", x.u, x.v, x.w, x.h, w, h, x.confidence))
         fails += 0 if inside else 1
-        ok = abs(x.stereo_distance_m - expected) < 1e-3
-        print("%s: stereo range %.4f m (depth %.1f m along the box-centre ray: %.4f m)" % (
-            "PASS" if ok else "FAIL", x.stereo_distance_m, DEPTH_M, expected))
+        # Depth and colour are two topics: ROS 1 does not order their delivery, so a frame whose
+        # colour image is handled before its depth image has no range (the nodelet uses a depth
+        # image only within max_depth_dt_s of the colour stamp). Every range given must be the
+        # depth along the box-centre ray, and most frames must have one.
+        ranged = [y for y in found if math.isfinite(y.stereo_distance_m)]
+        wrong = []
+        for y in ranged:
+            cu, cv = y.u + y.w / 2 - w / 2.0, y.v + y.h / 2 - h / 2.0
+            exp_y = DEPTH_M * math.sqrt(1 + (cu / F_PX) ** 2 + (cv / F_PX) ** 2)
+            if abs(y.stereo_distance_m - exp_y) >= 1e-3:
+                wrong.append((y.stereo_distance_m, exp_y))
+        ok = len(ranged) * 2 >= len(found) and not wrong
+        print("%s: stereo range on %d of %d detections, e.g. %.4f m (depth %.1f m along the box-centre ray: %.4f m); "
+              "wrong: %s" % ("PASS" if ok else "FAIL", len(ranged), len(found),
+                             ranged[-1].stereo_distance_m if ranged else float("nan"), DEPTH_M, expected, wrong[:3]))
         fails += 0 if ok else 1
     ok = len(gestures) >= 1 and gestures[0].gesture_id == 0 and len(gestures[0].probabilities) == 5
     print("%s: Gesture after a full skeleton window: %s (expected id 0, none: a still worker)" % (
