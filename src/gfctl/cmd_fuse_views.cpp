@@ -69,16 +69,9 @@ int cmdFuseViews(const Args& args) {
       return kExitBadInput;
     }
   }
-  std::vector<std::string> paths;
-  {
-    const std::string list = args.get("in");
-    std::size_t pos = 0;
-    while (pos <= list.size()) {
-      const std::size_t comma = std::min(list.find(',', pos), list.size());
-      if (comma == pos) return badInput(args, "--in: empty file name in '" + list + "'");
-      paths.push_back(list.substr(pos, comma - pos));
-      pos = comma + 1;
-    }
+  const std::vector<std::string> paths = common::splitCsvLine(args.get("in"));
+  for (const std::string& path : paths) {
+    if (path.empty()) return badInput(args, "--in: empty file name in '" + args.get("in") + "'");
   }
   if (paths.size() > 16) return badInput(args, "--in: at most 16 views, got " + std::to_string(paths.size()));
   std::vector<ViewFile> files(paths.size());

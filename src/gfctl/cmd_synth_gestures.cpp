@@ -69,18 +69,14 @@ int cmdSynthGestures(const Args& args) {
   }
   std::vector<double> offsets;
   if (args.has("views")) {
-    std::string list = args.get("views");
-    std::size_t pos = 0;
-    while (pos <= list.size()) {
-      const std::size_t comma = std::min(list.find(',', pos), list.size());
-      const std::string item = list.substr(pos, comma - pos);
+    const std::string list = args.get("views");
+    for (const std::string& item : common::splitCsvLine(list)) {
       const auto v = common::parseDouble(item);
       if (!v || !std::isfinite(*v) || *v < -360.0 || *v > 360.0) {
         return badInput(args, "--views: expected comma-separated azimuth offsets in [-360, 360] deg, got '" + item + "' in '" +
                                   list + "'");
       }
       offsets.push_back(*v);
-      pos = comma + 1;
     }
     if (offsets.size() > 8) return badInput(args, "--views: at most 8 further views, got " + std::to_string(offsets.size()));
   }

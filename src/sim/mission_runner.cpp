@@ -414,6 +414,8 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
       // Each camera's classification → the vote (geometry from the leader's worker estimate
       // and each UAV's odometry: a view votes only inside the classifier's envelope) → filter.
       bool classified = false;
+      const std::optional<Eigen::Vector3d> worker_est =
+          kf.initialized() ? std::optional<Eigen::Vector3d>(kf.predicted(t).p_world) : std::nullopt;
       const auto observe = [&](int view, const gesture::Classification& c) {
         gesture::ViewObservation o;
         o.view = view;
@@ -421,8 +423,8 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
         o.gesture_id = c.gesture_id;
         o.distance_m = std::nan("");
         o.elevation_deg = std::nan("");
-        if (kf.initialized()) {
-          const Eigen::Vector3d rel = uavs[static_cast<std::size_t>(view)]->est.p_world - kf.predicted(t).p_world;
+        if (worker_est) {
+          const Eigen::Vector3d rel = uavs[static_cast<std::size_t>(view)]->est.p_world - *worker_est;
           o.distance_m = rel.norm();
           o.elevation_deg = common::radToDeg(std::asin(std::clamp(rel.z() / std::max(1e-9, rel.norm()), -1.0, 1.0)));
         }
