@@ -61,6 +61,8 @@ const char* toString(Motion m) {
     case Motion::kWalking: return "walking";
     case Motion::kClimbingLadder: return "climbing_ladder";
     case Motion::kIdle: return "idle";
+    case Motion::kHoldObjectAtChest: return "hold_object_at_chest";
+    case Motion::kBalanceLunge: return "balance_lunge";
     case Motion::kCount: break;
   }
   return "?";
@@ -255,6 +257,36 @@ Body3D SkeletonSynthesizer::pose(Motion motion, double s, double phase, bool lef
       p[kRightAnkle] += Vector3d(0.06 * H * liftR, 0, 0.12 * H * liftR);
       break;
     }
+    case Motion::kHoldObjectAtChest: {
+      // An object (box, ball, tool bag) held or caught in front of the chest, the wrists apart
+      // by its width (≥ 17 cm for a 1.75 m worker, wider than "palms together"), possibly
+      // off to one side so that at most one wrist crosses the midline (never the X of gesture 1).
+      const double x = (0.16 + 0.10 * va) * H, z = (0.66 + 0.16 * vb) * H;
+      const double half = (0.05 + 0.06 * vc) * H, shift = (vd - 0.5) * 0.20 * H;
+      pose_L = Vector3d(x, shift + half, z);
+      pose_R = Vector3d(x, shift - half, z);
+      ppole_L = Vector3d(-0.3, 1, -1);
+      ppole_R = Vector3d(-0.3, -1, -1);
+      break;
+    }
+    case Motion::kBalanceLunge: {
+      // Stepping across a gap or kicking something loose: the leading arm out and up 30–60°
+      // above the horizontal (between "extend" and "raise"), the other out, low and back; the
+      // torso leans and the stance is wide (applied after the arms, below).
+      const double up = degToRad(30 + 30 * va), fwd = degToRad(-30 + 60 * vb);
+      const Vector3d lead_dir(std::cos(up) * std::sin(fwd), std::cos(up) * std::cos(fwd), std::sin(up));
+      const Vector3d trail_dir = Vector3d(-0.3, 0.7, -0.6).normalized();
+      if (left_arm) {
+        pose_L = straight(lead_dir);
+        pose_R = sR + 0.97 * reach * mirror(trail_dir);
+      } else {
+        pose_R = mirror(straight(lead_dir));
+        pose_L = sL + 0.97 * reach * trail_dir;
+      }
+      ppole_L = Vector3d(-1, 0, -0.3);
+      ppole_R = Vector3d(-1, 0, -0.3);
+      break;
+    }
     case Motion::kIdle:
     case Motion::kCount: {
       if (va > 0.6) {  // hands on the hips
@@ -274,6 +306,32 @@ Body3D SkeletonSynthesizer::pose(Motion motion, double s, double phase, bool lef
   pole_R = (pole_R.normalized() + w * (ppole_R.normalized() - pole_R.normalized()));
   solveArm(sL, target_L, b.upper_arm, b.forearm, pole_L, p[kLeftElbow], p[kLeftWrist]);
   solveArm(sR, target_R, b.upper_arm, b.forearm, pole_R, p[kRightElbow], p[kRightWrist]);
+  if (motion == Motion::kBalanceLunge) {
+    // Wide stance: the leading side's foot forward, the other back; hips lowered; the upper
+    // body leans forward 15–40° and sideways ±15° about the hip centre.
+    const double step = s * (0.22 + 0.12 * va) * H, drop = s * 0.06 * H;
+    const double sign = left_arm ? 1.0 : -1.0;
+    const auto idx = [](int k) { return static_cast<std::size_t>(k); };
+    const std::size_t front_ankle = idx(left_arm ? kLeftAnkle : kRightAnkle), back_ankle = idx(left_arm ? kRightAnkle : kLeftAnkle);
+    const std::size_t front_knee = idx(left_arm ? kLeftKnee : kRightKnee), back_knee = idx(left_arm ? kRightKnee : kLeftKnee);
+    p[front_ankle] += Vector3d(step, 0, 0);
+    p[front_knee] += Vector3d(0.9 * step, 0, -0.3 * drop);
+    p[back_ankle] += Vector3d(-0.8 * step, 0, 0);
+    p[back_knee] += Vector3d(-0.4 * step, 0, -0.3 * drop);
+    const Vector3d hip_c = 0.5 * (p[kLeftHip] + p[kRightHip]);
+    const Eigen::Matrix3d R =
+        (Eigen::AngleAxisd(sign * s * degToRad(-15 + 30 * vd), Vector3d::UnitX()) *
+         Eigen::AngleAxisd(s * degToRad(15 + 25 * vc), Vector3d::UnitY()))
+            .toRotationMatrix();
+    for (const int k : {kNose, kLeftEye, kRightEye, kLeftEar, kRightEar, kLeftShoulder, kRightShoulder, kLeftElbow,
+                        kRightElbow, kLeftWrist, kRightWrist}) {
+      auto& q = p[static_cast<std::size_t>(k)];
+      q = hip_c + R * (q - hip_c) - Vector3d(0, 0, drop);
+    }
+    body.head_top = hip_c + R * (body.head_top - hip_c) - Vector3d(0, 0, drop);
+    p[kLeftHip].z() -= drop;
+    p[kRightHip].z() -= drop;
+  }
   return body;
 }
 

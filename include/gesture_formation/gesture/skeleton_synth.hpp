@@ -7,7 +7,8 @@
 /// motion per sequence: the four gestures (rest → raise into the pose → hold → lower) or a
 /// "none" motion — the near-misses of DESIGN §2 (reaching up to a bolt, arms folded low,
 /// a tool held at the waist, an arm raised part-way or pointing, walking, climbing a
-/// ladder, standing idle). Body frame: x forward, y left, z up, feet at z = 0. The body is
+/// ladder, standing idle; since v3 also an object held or caught in front of the chest and a
+/// balancing lunge with the torso leaning and the arms out). Body frame: x forward, y left, z up, feet at z = 0. The body is
 /// projected through a `CameraModel` from a viewpoint at distance d, elevation ε above the
 /// horizontal and azimuth ψ around the body (ψ = 0: in front), with keypoint noise,
 /// missing keypoints and box jitter. The simulator uses the same code with the leader's
@@ -30,6 +31,7 @@ enum class Motion : int {
   kCrossArms = 0, kExtendArmSide, kPalmsTogether, kRaiseArmUp,        // gestures 1..4
   kReachUpBolt, kArmsFoldedLow, kToolAtWaist, kArmPartwayOrPointing,   // near-misses (0)
   kWalking, kClimbingLadder, kIdle,                                    // work motions (0)
+  kHoldObjectAtChest, kBalanceLunge,                                   // work motions (0), v3
   kCount
 };
 const char* toString(Motion m);
