@@ -9,13 +9,21 @@
 //              formation_command_out, gesture_observations_out (other UAVs' votes; refused
 //              and counted when the observing UAV is not the envelope's sender or the stamp
 //              is not a valid time).
+// Operator / gesture commands are single events, not a stream: one lost datagram would lose the
+// request (found by the multi-host test, docs/reliability.md §5). The sender therefore sends each
+// command ~command_repeats times, ~command_repeat_period_s apart (new envelopes: new sequence and
+// stamp); the receiver forwards only the first copy of each command id (sender, sequence) to ROS
+// and counts the others. The leader's FormationState would apply a copy once anyway.
 // A plan's fallback flag travels in a heartbeat sent just before the plan (status degraded,
 // last_plan_sequence = the plan's sequence); the receiver marks that plan `fallback`.
 // Stamps and freshness use ROS time (sim time in simulation: every process shares /clock).
 // Parameters (required): ~sender_id, ~known_senders (int list: the fleet's ids, own id ignored), ~lcm_url, ~channel_prefix,
-//   ~key_file (owner-only permissions), ~max_age_s, ~heartbeat_rate_hz, ~world_frame.
+//   ~key_file (owner-only permissions), ~max_age_s, ~heartbeat_rate_hz, ~world_frame,
+//   ~command_repeats (1..20), ~command_repeat_period_s.
+#include <deque>
 #include <map>
 #include <mutex>
+#include <set>
 
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
@@ -52,6 +60,9 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     params.load("max_age_s", max_age_s, 0.01, 60.0);
     params.load("heartbeat_rate_hz", heartbeat_hz, 0.1, 50.0);
     params.load("world_frame", world_frame_);
+    double repeat_period_s = 0.0;
+    params.load("command_repeats", command_repeats_, 1, 20);
+    params.load("command_repeat_period_s", repeat_period_s, 0.01, 1.0);
     std::optional<comm::KeyRing> keys;
     if (!key_file.empty()) {
       auto k = comm::loadKeyFile(key_file);
@@ -104,6 +115,13 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
       std::lock_guard<std::mutex> lock(mutex_);
       if (transport_) transport_->drain();
     });
+    repeat_timer_ = nh.createTimer(ros::Duration(repeat_period_s), [this](const ros::TimerEvent&) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      for (auto it = repeating_.begin(); it != repeating_.end();) {
+        send(it->first, "command (repeat)");
+        it = --it->second == 0 ? repeating_.erase(it) : std::next(it);
+      }
+    });
     heartbeat_timer_ = nh.createTimer(ros::Duration(1.0 / heartbeat_hz), [this](const ros::TimerEvent&) {
       std::lock_guard<std::mutex> lock(mutex_);
       send(heartbeat_, "heartbeat");
@@ -145,6 +163,7 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     }
     std::lock_guard<std::mutex> lock(mutex_);
     send(*c, "command");
+    if (command_repeats_ > 1) repeating_.emplace_back(*c, command_repeats_ - 1);
   }
 
   void onObservation(const gesture_formation::GestureObservation::ConstPtr& msg) {
@@ -197,6 +216,18 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
       case comm::MessageType::kFormationCommand: {
         formation::FormationCommand c;
         if (!decoder_.decode(e, c)) break;
+        // The sender repeats each command: forward its first copy only (ids of the last 256).
+        const auto id = std::make_pair(c.id.sender, c.id.sequence);
+        if (commands_seen_.count(id) != 0) {
+          ++command_copies_dropped_;
+          break;
+        }
+        commands_seen_.insert(id);
+        commands_seen_order_.push_back(id);
+        if (commands_seen_order_.size() > 256) {
+          commands_seen_.erase(commands_seen_order_.front());
+          commands_seen_order_.pop_front();
+        }
         auto m = toMsg(c);
         m.header.stamp = ros::Time(e.stamp_s);
         command_pub_.publish(m);
@@ -229,11 +260,16 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
   comm::PayloadDecoder decoder_;
   comm::Heartbeat heartbeat_;
   std::map<std::uint16_t, comm::Heartbeat> peers_;
+  int command_repeats_ = 1;
+  std::deque<std::pair<formation::FormationCommand, int>> repeating_;  ///< commands still to repeat, copies left
+  std::set<std::pair<std::string, std::uint64_t>> commands_seen_;     ///< received command ids (bounded)
+  std::deque<std::pair<std::string, std::uint64_t>> commands_seen_order_;
+  std::uint64_t command_copies_dropped_ = 0;  ///< repeated copies of an already forwarded command
   std::uint64_t observations_refused_ = 0;  ///< decoded gesture observations with a bad sender / stamp
   ros::Publisher worker_pub_, plans_pub_, params_pub_, command_pub_, observations_pub_;
   ros::Subscriber worker_sub_, plan_sub_, params_sub_, command_sub_, observation_sub_;
   ros::WallTimer drain_timer_;
-  ros::Timer heartbeat_timer_;
+  ros::Timer heartbeat_timer_, repeat_timer_;
 };
 
 }  // namespace gesture_formation::nodelets

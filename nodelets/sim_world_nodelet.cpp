@@ -162,9 +162,11 @@ class SimWorldNodelet : public nodelet::Nodelet {
   /// at the command's stamp); an outcome whose request is not known yet (messages on different
   /// connections) waits. An operator command reaches the leader stamped by the ground LcmBridge
   /// when it sent it (the envelope stamp: the world process's clock, a tick or two after the
-  /// request); a gesture command keeps the classifier output's stamp (the fire time).
+  /// request) — by a repeated copy when the first ones were lost on the radio (LcmBridge
+  /// command_repeats × command_repeat_period_s: 0.4 s later with 5 × 0.1 s); a gesture command
+  /// keeps the classifier output's stamp (the fire time).
   void resolveOutcomes() {
-    constexpr double kStampToleranceS = 0.1;
+    constexpr double kStampToleranceS = 0.6;
     for (auto it = outcomes_.begin(); it != outcomes_.end();) {
       const auto index = metrics_->findPending(it->source, it->issued_s, kStampToleranceS);
       if (!index) {
