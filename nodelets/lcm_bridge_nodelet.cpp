@@ -10,7 +10,7 @@
 //              and counted when the observing UAV is not the envelope's sender or the stamp
 //              is not a valid time).
 // Operator / gesture commands are single events, not a stream: one lost datagram would lose the
-// request (found by the multi-host test, docs/reliability.md §5). The sender therefore sends each
+// request (found by the multi-host test, docs/safety.md §5). The sender therefore sends each
 // command ~command_repeats times, ~command_repeat_period_s apart (new envelopes: new sequence and
 // stamp); the receiver forwards only the first copy of each command id (sender, sequence) to ROS
 // and counts the others. The leader's FormationState would apply a copy once anyway.

@@ -3,7 +3,7 @@
 loss, delay, jitter (hence reordering) and duplication, from a seeded random generator.
 
 The kernel of this machine has no netem qdisc (`tc qdisc add dev lo root netem ...` answers
-"Specified qdisc kind is unknown"; docs/reliability.md §multi-host), so tools/run_multihost.sh
+"Specified qdisc kind is unknown"; docs/safety.md §5), so tools/run_multihost.sh
 puts this relay in the switch namespace that joins the UAVs' namespaces: each host sends its
 multicast (ttl=1) over its veth to the switch, where the kernel does not route multicast; this
 relay receives it, and for every other link independently drops it with probability --loss or

@@ -4,7 +4,7 @@
 # (launch/simulation.launch part:=uavN | world) against one ROS master, joined by veth pairs to a
 # switch namespace. Between the hosts LCM (the only inter-UAV channel) crosses a lossy radio:
 # tools/radio_relay.py drops, delays, jitters (reorders) and duplicates the multicast datagrams
-# (this kernel has no netem qdisc: docs/reliability.md §5). The ROS connections to the simulated
+# (this kernel has no netem qdisc: docs/safety.md §5). The ROS connections to the simulated
 # world (plant, sensors, /clock — the vehicle itself on real hardware) are routed by the kernel,
 # loss-free. Nothing leaves the machine: the namespaces have no link to the host's network.
 #   tools/run_multihost.sh [--out DIR] [--duration S] [--rtf X] [--seed N] [--mission FILE]

@@ -51,6 +51,7 @@ check gc_vf "view_fusion.elevation_max_deg" "the missing YAML key view_fusion.el
 check vo_bad "vo_bad/uav_index: missing" "missing uav_index"
 check vo_bad "vo_bad/max_state_age_s: missing" "missing max_state_age_s"
 check lb_bad "key_file: .*chmod 600" "the key file's permissions"
+check lb_bad "lb_bad/command_repeats: missing" "missing command_repeats (every problem at once)"
 for p in mission_file seed real_time_factor clock_step_s duration_s output_dir world_frame leader_camera_frame; do
   check sw_bad "sw_bad/$p: missing" "missing $p"
 done

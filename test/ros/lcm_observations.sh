@@ -13,7 +13,7 @@ roscore -p $PORT > "$T/roscore.log" 2>&1 &
 for _ in \$(seq 50); do rosparam list > /dev/null 2>&1 && break; sleep 0.2; done
 rosparam set /leader_bridge/known_senders "[0, 1, 2]"
 rosparam set /follower_bridge/known_senders "[0, 1, 2]"
-common="_lcm_url:=udpm://239.255.76.67:7667?ttl=0 _channel_prefix:=GFT_ _key_file:=$T/keys _max_age_s:=1.0 _heartbeat_rate_hz:=5.0 _world_frame:=world"
+common="_lcm_url:=udpm://239.255.76.67:7667?ttl=0 _channel_prefix:=GFT_ _key_file:=$T/keys _max_age_s:=1.0 _heartbeat_rate_hz:=5.0 _world_frame:=world _command_repeats:=5 _command_repeat_period_s:=0.1"
 rosrun nodelet nodelet standalone gesture_formation/LcmBridge __name:=leader_bridge _sender_id:=0 \$common \
   gesture_observations_out:=/leader/gesture_observations > "$T/leader.log" 2>&1 &
 rosrun nodelet nodelet standalone gesture_formation/LcmBridge __name:=follower_bridge _sender_id:=1 \$common \
