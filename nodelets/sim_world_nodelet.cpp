@@ -21,8 +21,6 @@
 // Parameters (required): ~mission_file, ~seed, ~real_time_factor, ~clock_step_s,
 //   ~duration_s, ~output_dir, ~world_frame, ~leader_camera_frame.
 #include <algorithm>
-#include <cstdio>
-#include <fstream>
 #include <mutex>
 #include <optional>
 
@@ -85,7 +83,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
     heading_.emplace(cfg_.formation.worker_heading);
     n_ = cfg_.formation.params.uavCount();
     params_ = cfg_.formation.params;
-    versions_.emplace_back(0, params_);
+    versions_.emplace(params_);
     truth_.resize(static_cast<std::size_t>(n_));
 
     clock_pub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
@@ -129,20 +127,12 @@ class SimWorldNodelet : public nodelet::Nodelet {
     clock_timer_ = nh.createWallTimer(ros::WallDuration(clock_step_s_ / rtf_), &SimWorldNodelet::onClock, this);
   }
 
-  /// What the leader's FormationState did with a command (FormationParams.last_command_*).
-  struct Outcome {
-    std::string source, status;
-    double issued_s = 0.0, t_s = 0.0;
-    std::uint64_t version = 0;
-    std::vector<int> uavs;
-  };
-
   void onParams(const gesture_formation::FormationParams::ConstPtr& m) {
     std::lock_guard<std::mutex> lock(mutex_);
     auto p = fromMsg(*m);
     if (p && p->uavCount() == n_) {
       params_ = *p;
-      if (m->version > versions_.back().first) versions_.emplace_back(m->version, *p);
+      versions_->published(m->version, *p);
     }
     if (finished_ || m->last_command.empty()) return;
     // Re-published parameters repeat the last command: one outcome per (command, status).
@@ -152,31 +142,19 @@ class SimWorldNodelet : public nodelet::Nodelet {
     if (m->last_command_status == formation::toString(formation::CommandStatus::kDuplicate)) {
       ++metrics_->counters().commands_duplicate;
     }
-    outcomes_.push_back(Outcome{m->last_command_source, m->last_command_status, m->last_command_stamp.toSec(),
-                                m->header.stamp.toSec(), m->version,
-                                std::vector<int>(m->last_command_uavs.begin(), m->last_command_uavs.end())});
-    resolveOutcomes();
+    metrics_->commandOutcome(sim::CommandOutcome{m->last_command_source, m->last_command_status,
+                                                 m->last_command_stamp.toSec(), m->header.stamp.toSec(), m->version,
+                                                 std::vector<int>(m->last_command_uavs.begin(), m->last_command_uavs.end())},
+                             kStampToleranceS);
   }
 
-  /// Gives each command outcome to its request (the earliest pending one of that source issued
-  /// at the command's stamp); an outcome whose request is not known yet (messages on different
-  /// connections) waits. An operator command reaches the leader stamped by the ground LcmBridge
-  /// when it sent it (the envelope stamp: the world process's clock, a tick or two after the
-  /// request) — by a repeated copy when the first ones were lost on the radio (LcmBridge
-  /// command_repeats × command_repeat_period_s: 0.4 s later with 5 × 0.1 s); a gesture command
-  /// keeps the classifier output's stamp (the fire time).
-  void resolveOutcomes() {
-    constexpr double kStampToleranceS = 0.6;
-    for (auto it = outcomes_.begin(); it != outcomes_.end();) {
-      const auto index = metrics_->findPending(it->source, it->issued_s, kStampToleranceS);
-      if (!index) {
-        ++it;
-        continue;
-      }
-      metrics_->requestOutcome(*index, it->status, it->t_s, it->version, it->uavs);
-      it = outcomes_.erase(it);
-    }
-  }
+  /// A command outcome goes to the earliest pending request of its source issued at the command's
+  /// stamp ± this. An operator command reaches the leader stamped by the ground LcmBridge when it
+  /// sent it (the envelope stamp: the world process's clock, a tick or two after the request) — by
+  /// a repeated copy when the first ones were lost on the radio (LcmBridge command_repeats ×
+  /// command_repeat_period_s: 0.4 s later with 5 × 0.1 s); a gesture command keeps the classifier
+  /// output's stamp (the fire time).
+  static constexpr double kStampToleranceS = 0.6;
 
   /// The parameter version a plan was made with: the leader's says it; a follower's parameters
   /// come over LCM without their version, so it is the latest version the leader published
@@ -185,17 +163,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
     if (m.uav_index == formation::kLeader || m.params_version > 0 || m.formation.empty()) return m.params_version;
     const auto used = fromMsg(m.formation);
     if (!used || used->uavCount() != n_) return m.params_version;
-    for (auto it = versions_.rbegin(); it != versions_.rend(); ++it) {
-      if (sameParams(it->second, *used)) return it->first;
-    }
-    return m.params_version;
-  }
-  static bool sameParams(const formation::FormationParams& a, const formation::FormationParams& b) {
-    for (int i = 0; i < a.uavCount(); ++i) {
-      const auto &x = a.uav(i), &y = b.uav(i);
-      if (x.beta_deg != y.beta_deg || x.gamma_deg != y.gamma_deg || x.distance_m != y.distance_m) return false;
-    }
-    return true;
+    return versions_->versionOf(*used).value_or(m.params_version);
   }
 
   void onGestureStatus(const gesture_formation::GestureStatus::ConstPtr& m) {
@@ -204,7 +172,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
     last_ratio_ = m->dominant_ratio;
     if (finished_ || !m->fired) return;
     metrics_->addRequest(sim::firedGestureRecord(m->header.stamp.toSec(), m->dominant_id, cfg_.gesture_mapping));
-    resolveOutcomes();
+    metrics_->resolveOutcomes(kStampToleranceS);
   }
 
   void publishClock() {
@@ -258,7 +226,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
       rec.status = "lost";  // until the leader says what it did with it
       metrics_->addRequest(rec);
     }
-    resolveOutcomes();
+    metrics_->resolveOutcomes(kStampToleranceS);
     const bool all = allTruths();
     // With the followers' cameras, a frame needs every UAV's truth (LeaderCamera wants the same
     // number of followers at every call); SimWorld starts when every planner is up.
@@ -372,22 +340,12 @@ class SimWorldNodelet : public nodelet::Nodelet {
                                          "messages_sent", "messages_lost",       "messages_duplicated",
                                          "messages_reordered"};
     const sim::MissionOutput out = metrics_->finish(worker_->episodes(), t_, wall);
-    std::string err;
-    if (!sim::writeTimelineCsv(output_dir_ + "/timeline.csv", out, n_, &err) ||
-        !sim::writeEventsCsv(output_dir_ + "/events.csv", out, &err)) {
-      NODELET_ERROR_STREAM("SimWorld: " << err);
-    }
     // metrics.json last: its appearance tells tools/run_ros_mission.sh that the files are complete.
-    {
-      const std::string tmp = output_dir_ + "/metrics.json.tmp";
-      std::ofstream(tmp) << sim::metricsJson(out.metrics);
-      if (std::rename(tmp.c_str(), (output_dir_ + "/metrics.json").c_str()) != 0) {
-        NODELET_ERROR_STREAM("SimWorld: cannot write " << output_dir_ << "/metrics.json");
-      }
-    }
-    if (!outcomes_.empty()) {
-      NODELET_WARN_STREAM("SimWorld: " << outcomes_.size() << " command outcome(s) matched no request (e.g. "
-                                       << outcomes_.front().source << " at " << outcomes_.front().issued_s << " s)");
+    std::string err;
+    if (!sim::writeMissionFiles(output_dir_, out, n_, false, &err)) NODELET_ERROR_STREAM("SimWorld: " << err);
+    if (const auto& left = metrics_->unmatchedOutcomes(); !left.empty()) {
+      NODELET_WARN_STREAM("SimWorld: " << left.size() << " command outcome(s) matched no request (e.g. "
+                                       << left.front().source << " at " << left.front().issued_s << " s)");
     }
     NODELET_INFO_STREAM("SimWorld: mission done at t = " << t_ << " s (" << wall << " s wall); wrote " << output_dir_
                                                          << "/metrics.json");
@@ -407,7 +365,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
   std::optional<formation::WorkerHeading> heading_;
   formation::FormationParams params_;
   /// Every parameter version the leader published (0: the mission's), for planVersion().
-  std::vector<std::pair<std::uint64_t, formation::FormationParams>> versions_;
+  std::optional<sim::ParamsVersions> versions_;
   std::string output_dir_, world_frame_, camera_frame_, last_outcome_key_;
   double rtf_ = 1.0, clock_step_s_ = 0.01, duration_s_ = 0.0, t_ = 0.0, last_ratio_ = 0.0;
   long k_ = 0;
@@ -416,7 +374,6 @@ class SimWorldNodelet : public nodelet::Nodelet {
   std::size_t next_request_ = 0;
   std::vector<std::optional<sim::MultirotorState>> truth_;
   std::optional<gesture_formation::WorkerState> estimate_;
-  std::vector<Outcome> outcomes_;
   ros::WallTime wall0_;
   ros::Publisher clock_pub_, worker_pub_, detection_pub_, uwb_pub_, command_pub_, done_pub_;
   std::vector<ros::Publisher> gesture_pubs_;  ///< per UAV (only the leader's without follower views)

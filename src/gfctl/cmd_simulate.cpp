@@ -146,11 +146,7 @@ int runOne(const Args& args, Loaded& L, std::uint64_t seed, double duration, con
   if (!out) return badInput(args, out.reason());
   const auto& m = out->metrics;
   std::string err;
-  if (!writeText(dir + "/metrics.json", sim::metricsJson(m))) return badInput(args, dir + "/metrics.json: write failed");
-  if (!sim::writeTimelineCsv(dir + "/timeline.csv", *out, L.mission.formation.params.uavCount(), &err) ||
-      !sim::writeEventsCsv(dir + "/events.csv", *out, &err) || !sim::writeModesCsv(dir + "/modes.csv", *out, &err)) {
-    return badInput(args, err);
-  }
+  if (!sim::writeMissionFiles(dir, *out, L.mission.formation.params.uavCount(), true, &err)) return badInput(args, err);
   if (!writeText(dir + "/scene.json", sceneJson(L.scenario))) return badInput(args, dir + "/scene.json: write failed");
   std::cout << std::fixed << std::setprecision(2) << "seed " << seed << ": " << m.sim_time_s << " s simulated in "
             << m.wall_time_s << " s wall: real-time factor " << m.real_time_factor << "x\n"

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <regex>
 #include <sstream>
@@ -227,6 +228,41 @@ void MetricsAccumulator::requestOutcome(std::size_t index, const std::string& st
   }
 }
 
+void MetricsAccumulator::commandOutcome(const CommandOutcome& outcome, double tolerance_s) {
+  unmatched_.push_back(outcome);
+  resolveOutcomes(tolerance_s);
+}
+
+void MetricsAccumulator::resolveOutcomes(double tolerance_s) {
+  for (auto it = unmatched_.begin(); it != unmatched_.end();) {
+    const auto index = findPending(it->source, it->issued_s, tolerance_s);
+    if (!index) {
+      ++it;
+      continue;
+    }
+    requestOutcome(*index, it->status, it->t_s, it->version, it->uavs);
+    it = unmatched_.erase(it);
+  }
+}
+
+void ParamsVersions::published(std::uint64_t version, const formation::FormationParams& params) {
+  if (version > versions_.back().first) versions_.emplace_back(version, params);
+}
+
+std::optional<std::uint64_t> ParamsVersions::versionOf(const formation::FormationParams& used) const {
+  for (auto it = versions_.rbegin(); it != versions_.rend(); ++it) {
+    const formation::FormationParams& p = it->second;
+    if (p.uavCount() != used.uavCount()) continue;
+    bool same = true;
+    for (int i = 0; i < p.uavCount() && same; ++i) {
+      const auto &x = p.uav(i), &y = used.uav(i);
+      same = x.beta_deg == y.beta_deg && x.gamma_deg == y.gamma_deg && x.distance_m == y.distance_m;
+    }
+    if (same) return it->first;
+  }
+  return std::nullopt;
+}
+
 MissionOutput MetricsAccumulator::finish(const std::vector<GestureEpisode>& gestures, double sim_time_s,
                                          double wall_time_s) {
   MissionOutput out;
@@ -447,6 +483,28 @@ bool writeModesCsv(const std::string& path, const MissionOutput& out, std::strin
   f.flush();
   if (!f) {
     if (error) *error = path + ": write failed";
+    return false;
+  }
+  return true;
+}
+
+bool writeMissionFiles(const std::string& dir, const MissionOutput& out, int uav_count, bool with_modes,
+                       std::string* error) {
+  if (!writeTimelineCsv(dir + "/timeline.csv", out, uav_count, error) || !writeEventsCsv(dir + "/events.csv", out, error) ||
+      (with_modes && !writeModesCsv(dir + "/modes.csv", out, error))) {
+    return false;
+  }
+  const std::string tmp = dir + "/metrics.json.tmp", path = dir + "/metrics.json";
+  {
+    std::ofstream f(tmp);
+    f << metricsJson(out.metrics);
+    if (!f.good()) {
+      if (error) *error = tmp + ": write failed";
+      return false;
+    }
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    if (error) *error = path + ": rename from " + tmp + " failed";
     return false;
   }
   return true;

@@ -27,6 +27,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -184,6 +185,32 @@ std::string describeCommand(const formation::FormationCommand& command, const st
 /// "lost" until requestOutcome() says what the FormationState did with its command.
 RequestRecord firedGestureRecord(double t_s, int gesture_id, const gesture::GestureMapping& mapping);
 
+/// \brief What the leader's FormationState did with a command, as a distributed system reports
+/// it: by the command's stamp rather than by request index (MetricsAccumulator::commandOutcome).
+struct CommandOutcome {
+  std::string source;         ///< operator | gesture
+  std::string status;         ///< formation::toString(CommandStatus)
+  double issued_s = 0.0;      ///< the command's stamp (operator: sent by the ground; gesture: fired)
+  double t_s = 0.0;           ///< when the leader handled it
+  std::uint64_t version = 0;  ///< applied: the parameter version it created
+  std::vector<int> uavs;      ///< applied: the UAVs it addressed (0 = leader)
+};
+
+/// \brief The parameter versions the leader published, to tell which one a follower planned
+/// with when only the parameters travel with its plan (over LCM, without a version).
+class ParamsVersions {
+ public:
+  explicit ParamsVersions(const formation::FormationParams& initial) { versions_.emplace_back(0, initial); }
+  /// \brief Records `params` as `version` if it is newer than every recorded one.
+  void published(std::uint64_t version, const formation::FormationParams& params);
+  /// \brief The latest version published with exactly `used` (β, γ, d of every UAV); nullopt
+  /// if none (or another UAV count).
+  std::optional<std::uint64_t> versionOf(const formation::FormationParams& used) const;
+
+ private:
+  std::vector<std::pair<std::uint64_t, formation::FormationParams>> versions_;
+};
+
 /// \brief The accumulator (see the file comment).
 class MetricsAccumulator {
  public:
@@ -218,6 +245,15 @@ class MetricsAccumulator {
   /// UAVs it addressed. A copy of an already applied command changes nothing.
   void requestOutcome(std::size_t index, const std::string& status, double t_s, std::uint64_t params_version,
                       const std::vector<int>& uavs);
+  /// \brief An outcome reported by the leader with the command's stamp, not the request's index
+  /// (the ROS system: FormationParams.last_command_*). It goes to the earliest pending request
+  /// of its source issued within `tolerance_s` of the stamp; one whose request is not known yet
+  /// (the messages travel on different connections) waits, and every later call retries it.
+  void commandOutcome(const CommandOutcome& outcome, double tolerance_s);
+  /// \brief Retries the waiting outcomes (after addRequest()).
+  void resolveOutcomes(double tolerance_s);
+  /// \brief Outcomes that matched no request so far.
+  const std::vector<CommandOutcome>& unmatchedOutcomes() const { return unmatched_; }
 
   /// \brief Diagnostic counters the caller counts itself: plans_skipped, plans_hold,
   /// commands_stale, commands_duplicate, range_outliers, messages_*.
@@ -239,6 +275,7 @@ class MetricsAccumulator {
   MissionMetrics m_;
   std::vector<TimelineRow> timeline_;
   std::vector<RequestRecord> requests_;
+  std::vector<CommandOutcome> unmatched_;
   std::vector<PlanEvent> plan_events_;
   std::vector<double> plan_ms_;
   std::vector<int> last_status_;
@@ -256,5 +293,10 @@ bool writeTimelineCsv(const std::string& path, const MissionOutput& out, int uav
 bool writeEventsCsv(const std::string& path, const MissionOutput& out, std::string* error);
 /// \brief Writes modes.csv: `t,uav,mode,reason`, one row per ModeChange.
 bool writeModesCsv(const std::string& path, const MissionOutput& out, std::string* error);
+/// \brief Writes a mission's files into `dir`: timeline.csv, events.csv, modes.csv (if
+/// `with_modes`) and metrics.json last, atomically (written to a temporary name, then renamed:
+/// its appearance tells a watching script that the files are complete).
+bool writeMissionFiles(const std::string& dir, const MissionOutput& out, int uav_count, bool with_modes,
+                       std::string* error);
 
 }  // namespace gesture_formation::sim

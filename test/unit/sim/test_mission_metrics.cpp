@@ -15,7 +15,10 @@
 #include "gesture_formation/sim/random.hpp"
 
 namespace gf = gesture_formation;
+using gf::sim::CommandOutcome;
 using gf::sim::MetricsAccumulator;
+using gf::sim::ParamsVersions;
+using gf::sim::RequestRecord;
 
 namespace {
 
@@ -193,6 +196,50 @@ TEST(MetricsAccumulatorTest, OutcomesFindTheirPendingRequestAndAnAppliedOneStays
   const auto out = acc.finish({}, 10.0, 1.0);
   EXPECT_EQ(out.metrics.requests_applied, 1);
   EXPECT_EQ(out.requests[1].status, "rejected");
+}
+
+TEST(MetricsAccumulatorTest, StampedOutcomesWaitForTheirRequestAndMatchWithinTheTolerance) {
+  const BoxWorld w;
+  const auto cfg = openField();
+  MetricsAccumulator acc(cfg, w.exact(), 1);
+  const std::size_t a = acc.addRequest(operatorRecord(5.0));
+  // A repeated copy stamped 0.4 s after the request (the first copies lost on the radio).
+  acc.commandOutcome(CommandOutcome{"operator", "applied", 5.4, 5.45, 1, {0, 1, 2}}, 0.6);
+  EXPECT_TRUE(acc.unmatchedOutcomes().empty());
+  EXPECT_EQ(acc.request(a).status, "applied");
+  EXPECT_DOUBLE_EQ(acc.request(a).applied_s, 5.45);
+  // An outcome outside the tolerance, and one that arrives before its request, wait.
+  acc.commandOutcome(CommandOutcome{"operator", "applied", 9.0, 9.05, 2, {0}}, 0.6);
+  acc.commandOutcome(CommandOutcome{"gesture", "applied", 12.0, 12.01, 3, {0, 1, 2}}, 0.6);
+  ASSERT_EQ(acc.unmatchedOutcomes().size(), 2u);
+  const std::size_t g = acc.addRequest(operatorRecord(12.0));  // an operator request at 12 s: not the gesture's
+  acc.resolveOutcomes(0.6);
+  EXPECT_EQ(acc.unmatchedOutcomes().size(), 2u);
+  EXPECT_EQ(acc.request(g).status, "lost");
+  RequestRecord fired = operatorRecord(12.0);
+  fired.source = "gesture";
+  const std::size_t h = acc.addRequest(fired);
+  acc.resolveOutcomes(0.6);
+  ASSERT_EQ(acc.unmatchedOutcomes().size(), 1u);
+  EXPECT_DOUBLE_EQ(acc.unmatchedOutcomes().front().issued_s, 9.0);
+  EXPECT_EQ(acc.request(h).status, "applied");
+  EXPECT_EQ(acc.request(h).params_version, 3u);
+}
+
+TEST(ParamsVersionsTest, LatestVersionWithExactlyTheseParameters) {
+  const auto cfg = openField();
+  const gf::formation::FormationParams p0 = cfg.formation.params;
+  ParamsVersions v(p0);
+  EXPECT_EQ(v.versionOf(p0), std::optional<std::uint64_t>(0));
+  gf::formation::FormationParams p1 = p0;
+  p1.uav(1).distance_m += 1.0;
+  EXPECT_FALSE(v.versionOf(p1));
+  v.published(1, p1);
+  v.published(1, p0);  // not newer: ignored
+  EXPECT_EQ(v.versionOf(p1), std::optional<std::uint64_t>(1));
+  EXPECT_EQ(v.versionOf(p0), std::optional<std::uint64_t>(0));
+  v.published(2, p0);  // back to the first parameters: the latest version wins
+  EXPECT_EQ(v.versionOf(p0), std::optional<std::uint64_t>(2));
 }
 
 TEST(MetricsAccumulatorTest, GestureMatchingSuccessLatencyAndFalseAdaptations) {
