@@ -6,7 +6,7 @@
 // The leader's instance also owns the formation's parameters (formation::FormationState):
 // commands arrive on formation_command_in (gestures, operator over LCM) and the parameters go
 // out on formation_params_out. The request (reference + the other UAVs' plans to avoid) is
-// sim::buildPlanRequest, the same as gfctl simulate's: with avoid_all_plans every UAV plans
+// planning::buildPlanRequest, the same as gfctl simulate's: with avoid_all_plans every UAV plans
 // around every other UAV's received plan.
 //
 // Topics: odometry_in (nav_msgs/Odometry, orientation = camera axis, docs/ros.md),
@@ -32,7 +32,7 @@
 #include "conversions.hpp"
 #include "gesture_formation/formation/formation_geometry.hpp"
 #include "gesture_formation/formation/worker_heading.hpp"
-#include "gesture_formation/sim/plan_request_builder.hpp"
+#include "gesture_formation/planning/plan_request_builder.hpp"
 #include "param_loader.hpp"
 
 namespace gesture_formation::nodelets {
@@ -61,7 +61,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
       if (loadMission(mission_file, params, mission)) {
         fcfg = mission.formation;
         pcfg = mission.planner;
-        rule_ = sim::AvoidanceRule{mission.faults.avoid_all_plans, mission.faults.max_plan_age_s};
+        rule_ = planning::AvoidanceRule{mission.faults.avoid_all_plans, mission.faults.max_plan_age_s};
       }
     } else {
       params.load("formation_config", formation_file);
@@ -129,7 +129,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     }
     std::lock_guard<std::mutex> lock(mutex_);
     auto& slot = received_[static_cast<std::size_t>(msg->uav_index)];
-    if (!slot || plan->t0_s >= slot->plan.t0_s) slot = sim::ReceivedPlan{std::move(*plan), msg->fallback != 0};
+    if (!slot || plan->t0_s >= slot->plan.t0_s) slot = planning::ReceivedPlan{std::move(*plan), msg->fallback != 0};
   }
   void onParams(const gesture_formation::FormationParams::ConstPtr& msg) {
     auto p = fromMsg(*msg);
@@ -203,7 +203,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     const Eigen::Vector3d v0 = worker_->lost ? Eigen::Vector3d::Zero() : toEigen(worker_->velocity);
     const Eigen::Vector3d p0 = toEigen(worker_->position) + std::max(0.0, age) * v0;
     const double hphi = heading_->update(v0);
-    sim::PlanRequestInputs in;
+    planning::PlanRequestInputs in;
     in.uav_index = uav_index_;
     in.t_s = t;
     in.dt_s = horizon_dt_s_;
@@ -216,7 +216,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     if (leader && t - leader->plan.t0_s <= max_share_age_s_) in.leader_plan = &leader->plan;
     in.received = &received_;
     in.rule = rule_;
-    const planning::PlanRequest req = sim::buildPlanRequest(in);
+    const planning::PlanRequest req = planning::buildPlanRequest(in);
     const planning::PlanResult res = planner_->plan(req);
     if (res.status != planning::PlanStatus::kOptimized) {
       NODELET_WARN_STREAM_THROTTLE(2.0, "FormationPlanner UAV " << uav_index_ << ": " << planning::toString(res.status)
@@ -242,14 +242,14 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   std::optional<formation::FormationState> state_;
   std::uint64_t version_ = 0;           ///< leader: the parameters' version
   std::uint64_t received_version_ = 0;  ///< followers: the version received (0 over LCM: not carried)
-  sim::AvoidanceRule rule_;
+  planning::AvoidanceRule rule_;
   std::string last_command_, last_outcome_, last_source_, last_status_;
   ros::Time last_stamp_;
   std::vector<int> last_uavs_;
   std::unique_ptr<planning::UavPlanner> planner_;
   std::optional<planning::UavKinematicState> odom_;
   std::optional<gesture_formation::WorkerState> worker_;
-  std::vector<std::optional<sim::ReceivedPlan>> received_;  ///< by sender; [0] the leader's plan
+  std::vector<std::optional<planning::ReceivedPlan>> received_;  ///< by sender; [0] the leader's plan
   ros::Publisher plan_pub_, traj_pub_, params_pub_;
   ros::Subscriber odom_sub_, worker_sub_, plans_sub_, params_sub_, command_sub_;
   ros::Timer timer_, params_timer_;

@@ -13,7 +13,7 @@
 #include "gesture_formation/formation/worker_heading.hpp"
 #include "gesture_formation/planning/distance_field.hpp"
 #include "gesture_formation/planning/occupancy_map.hpp"
-#include "gesture_formation/sim/plan_request_builder.hpp"
+#include "gesture_formation/planning/plan_request_builder.hpp"
 #include "gesture_formation/sim/random.hpp"
 
 namespace gesture_formation::sim {
@@ -60,7 +60,7 @@ struct LeaderShare {
 
 /// A follower's plan with its planner status: a UAV that could not plan (braking or on its
 /// previous plan) is avoided by every other UAV, also higher-priority ones (right of way).
-using PlanMessage = ReceivedPlan;
+using PlanMessage = planning::ReceivedPlan;
 
 struct OperatorMessage {
   std::size_t record = 0;
@@ -278,7 +278,7 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
     } else {
       u.hold_p.reset();
     }
-    PlanRequestInputs in;
+    planning::PlanRequestInputs in;
     in.uav_index = i;
     in.t_s = t;
     in.dt_s = hdt;
@@ -292,8 +292,8 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
     in.leader_plan = share != nullptr ? &share->plan : nullptr;
     in.received = &u.received;
     in.hold_reference = hold.empty() ? nullptr : &hold_reference;
-    in.rule = AvoidanceRule{cfg.faults.avoid_all_plans, cfg.faults.max_plan_age_s};
-    const planning::PlanRequest req = buildPlanRequest(in);
+    in.rule = planning::AvoidanceRule{cfg.faults.avoid_all_plans, cfg.faults.max_plan_age_s};
+    const planning::PlanRequest req = planning::buildPlanRequest(in);
     const planning::PlanResult res = u.planner->plan(req);
     metrics.plan(i, t, version, res.status, res.timings.total_ms, res.reason);
     if (res.trajectory.empty()) {

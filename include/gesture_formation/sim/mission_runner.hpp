@@ -19,7 +19,7 @@
 ///
 /// The parts the ROS simulation (SimWorld, FormationPlanner nodelets) runs too: the metrics
 /// (MetricsAccumulator, mission_metrics.hpp), the leader's camera (LeaderCamera,
-/// leader_camera.hpp) and the planning request (buildPlanRequest, plan_request_builder.hpp).
+/// leader_camera.hpp) and the planning request (buildPlanRequest, planning/plan_request_builder.hpp).
 ///
 /// Determinism: every random draw comes from a stream seeded by (seed, component); the
 /// metrics that measure wall-clock time (planning_ms_*, real_time_factor) are the only ones

@@ -11,7 +11,7 @@
 #include "gesture_formation/planning/occupancy_map.hpp"
 #include "gesture_formation/sim/leader_camera.hpp"
 #include "gesture_formation/sim/mission_metrics.hpp"
-#include "gesture_formation/sim/plan_request_builder.hpp"
+#include "gesture_formation/planning/plan_request_builder.hpp"
 #include "gesture_formation/sim/random.hpp"
 
 namespace gf = gesture_formation;
@@ -360,14 +360,14 @@ std::vector<int> senders(const gf::planning::PlanRequest& r) {
 struct RequestFixture {
   gf::formation::FormationParams params;
   gf::planning::PlannedTrajectory leader = planOf(0, 10.0, 0.7);
-  std::vector<std::optional<gf::sim::ReceivedPlan>> received;
+  std::vector<std::optional<gf::planning::ReceivedPlan>> received;
   RequestFixture() {
     received.resize(3);
-    received[1] = gf::sim::ReceivedPlan{planOf(1, 9.9, 0.0), false};
-    received[2] = gf::sim::ReceivedPlan{planOf(2, 9.95, 0.0), false};
+    received[1] = gf::planning::ReceivedPlan{planOf(1, 9.9, 0.0), false};
+    received[2] = gf::planning::ReceivedPlan{planOf(2, 9.95, 0.0), false};
   }
-  gf::sim::PlanRequestInputs inputs(int uav, bool avoid_all) const {
-    gf::sim::PlanRequestInputs in;
+  gf::planning::PlanRequestInputs inputs(int uav, bool avoid_all) const {
+    gf::planning::PlanRequestInputs in;
     in.uav_index = uav;
     in.t_s = 10.0;
     in.dt_s = 0.2;
@@ -375,7 +375,7 @@ struct RequestFixture {
     in.params = &params;
     in.leader_plan = uav == 0 ? nullptr : &leader;
     in.received = &received;
-    in.rule = gf::sim::AvoidanceRule{avoid_all, 1.0};
+    in.rule = gf::planning::AvoidanceRule{avoid_all, 1.0};
     return in;
   }
 };
@@ -385,24 +385,24 @@ struct RequestFixture {
 TEST(PlanRequestBuilderTest, AvoidAllPlansVersusThePriorityRule) {
   RequestFixture f;
   ASSERT_EQ(f.params.uavCount(), 3);
-  EXPECT_EQ(senders(gf::sim::buildPlanRequest(f.inputs(1, true))), std::vector<int>({0, 2}));
-  EXPECT_EQ(senders(gf::sim::buildPlanRequest(f.inputs(1, false))), std::vector<int>({0}));
-  EXPECT_EQ(senders(gf::sim::buildPlanRequest(f.inputs(2, false))), std::vector<int>({0, 1}));
-  EXPECT_EQ(senders(gf::sim::buildPlanRequest(f.inputs(0, true))), std::vector<int>({1, 2}));
-  EXPECT_TRUE(senders(gf::sim::buildPlanRequest(f.inputs(0, false))).empty());
+  EXPECT_EQ(senders(gf::planning::buildPlanRequest(f.inputs(1, true))), std::vector<int>({0, 2}));
+  EXPECT_EQ(senders(gf::planning::buildPlanRequest(f.inputs(1, false))), std::vector<int>({0}));
+  EXPECT_EQ(senders(gf::planning::buildPlanRequest(f.inputs(2, false))), std::vector<int>({0, 1}));
+  EXPECT_EQ(senders(gf::planning::buildPlanRequest(f.inputs(0, true))), std::vector<int>({1, 2}));
+  EXPECT_TRUE(senders(gf::planning::buildPlanRequest(f.inputs(0, false))).empty());
   // Right of way under the priority rule: a fallback plan, or a silent UAV.
   f.received[2]->fallback = true;
-  EXPECT_EQ(senders(gf::sim::buildPlanRequest(f.inputs(1, false))), std::vector<int>({0, 2}));
+  EXPECT_EQ(senders(gf::planning::buildPlanRequest(f.inputs(1, false))), std::vector<int>({0, 2}));
   f.received[2]->fallback = false;
   f.received[2]->plan.t0_s = 8.5;  // 1.5 s > max_plan_age_s
-  EXPECT_EQ(senders(gf::sim::buildPlanRequest(f.inputs(0, false))), std::vector<int>({2}));
+  EXPECT_EQ(senders(gf::planning::buildPlanRequest(f.inputs(0, false))), std::vector<int>({2}));
 }
 
 TEST(PlanRequestBuilderTest, ReferencesAndHold) {
   const RequestFixture f;
   // Follower: eq. follower_ref on the leader's planned heading and pitch.
   const auto in = f.inputs(1, true);
-  const auto req = gf::sim::buildPlanRequest(in);
+  const auto req = gf::planning::buildPlanRequest(in);
   gf::formation::LeaderPlan lp;
   lp.heading_rad.resize(1, 10);
   lp.pitch_rad.resize(1, 10);
@@ -419,7 +419,7 @@ TEST(PlanRequestBuilderTest, ReferencesAndHold) {
   // Without the leader's plan: the leader's desired heading (a different reference).
   auto no_plan = f.inputs(1, true);
   no_plan.leader_plan = nullptr;
-  const auto req2 = gf::sim::buildPlanRequest(no_plan);
+  const auto req2 = gf::planning::buildPlanRequest(no_plan);
   EXPECT_FALSE(req2.reference.p_world.isApprox(expected.p_world, 1e-6));
   EXPECT_EQ(senders(req2), std::vector<int>({2}));
   // Hold: the given reference, and every received plan even under the priority rule.
@@ -430,7 +430,7 @@ TEST(PlanRequestBuilderTest, ReferencesAndHold) {
   hold.pitch_rad.setZero();
   auto h = f.inputs(1, false);
   h.hold_reference = &hold;
-  const auto req3 = gf::sim::buildPlanRequest(h);
+  const auto req3 = gf::planning::buildPlanRequest(h);
   EXPECT_TRUE(req3.reference.p_world.isApprox(hold.p_world));
   EXPECT_EQ(senders(req3), std::vector<int>({0, 2}));
 }

@@ -1,9 +1,9 @@
-#include "gesture_formation/sim/plan_request_builder.hpp"
+#include "gesture_formation/planning/plan_request_builder.hpp"
 
-namespace gesture_formation::sim {
+namespace gesture_formation::planning {
 
-planning::PlanRequest buildPlanRequest(const PlanRequestInputs& in) {
-  planning::PlanRequest req;
+PlanRequest buildPlanRequest(const PlanRequestInputs& in) {
+  PlanRequest req;
   const int i = in.uav_index;
   const int steps = in.worker.steps();
   req.uav_index = i;
@@ -46,4 +46,4 @@ planning::PlanRequest buildPlanRequest(const PlanRequestInputs& in) {
   return req;
 }
 
-}  // namespace gesture_formation::sim
+}  // namespace gesture_formation::planning

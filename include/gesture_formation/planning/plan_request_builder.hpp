@@ -22,12 +22,12 @@
 #include "gesture_formation/formation/formation_params.hpp"
 #include "gesture_formation/planning/uav_planner.hpp"
 
-namespace gesture_formation::sim {
+namespace gesture_formation::planning {
 
 /// \brief A plan received from another UAV with its sender's fallback flag (the sender's
 /// planner returned its previous plan / braking, or it holds).
 struct ReceivedPlan {
-  planning::PlannedTrajectory plan;
+  PlannedTrajectory plan;
   bool fallback = false;
 };
 
@@ -42,12 +42,12 @@ struct PlanRequestInputs {
   int uav_index = 0;                 ///< 0 = leader, i = follower i (priority order)
   double t_s = 0.0;                  ///< now; sample 0 of the reference
   double dt_s = 0.2;                 ///< horizon step [s]
-  planning::UavKinematicState state;  ///< the UAV's current (estimated) state
+  UavKinematicState state;  ///< the UAV's current (estimated) state
   formation::WorkerHorizon worker;    ///< the worker's predicted trajectory (its steps = the horizon's)
   const formation::FormationParams* params = nullptr;  ///< required: the formation's parameters
   /// Followers: the leader's last received plan (null or empty: none; the reference then
   /// uses the leader's desired heading and pitch).
-  const planning::PlannedTrajectory* leader_plan = nullptr;
+  const PlannedTrajectory* leader_plan = nullptr;
   /// The plans received from the followers, indexed by sender (entries 0 and uav_index are
   /// ignored); may be null.
   const std::vector<std::optional<ReceivedPlan>>* received = nullptr;
@@ -59,6 +59,6 @@ struct PlanRequestInputs {
 
 /// \brief The request (see the file comment). Preconditions: params non-null with a
 /// follower entry for uav_index; worker.steps() ≥ 1.
-planning::PlanRequest buildPlanRequest(const PlanRequestInputs& in);
+PlanRequest buildPlanRequest(const PlanRequestInputs& in);
 
-}  // namespace gesture_formation::sim
+}  // namespace gesture_formation::planning
