@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <optional>
 #include <random>
@@ -135,33 +136,46 @@ std::vector<std::pair<double, int>> firedCommands(GestureClassifier& classifier,
   return fired;
 }
 
-TEST(GestureEndToEndTest, GestureHeldThreeSecondsFiresOnce) {
-  GestureClassifier classifier = loadModel();
+/// What fired for one performance, and when the worker performed the gesture.
+struct Performance {
+  std::vector<std::pair<double, int>> fired;
+  double start_s = 0.0, end_s = 0.0;
+};
+
+/// Six performances of each gesture, held 3 s, from random viewpoints: `perform` draws its
+/// camera(s) from `rng` and returns what fired. Every command must be the performed gesture,
+/// at most one per performance, fired while the worker still performs it; at least all but one
+/// of the 24 performances fire exactly once.
+void expectThreeSecondGesturesFireOnce(const std::function<Performance(SkeletonSynthesizer&, Motion, std::mt19937_64&)>& perform) {
   SynthConfig config;
   config.hold_min_s = config.hold_max_s = 3.0;
   SkeletonSynthesizer synth(config, 4242);
   std::mt19937_64 rng(99);
-  std::uniform_real_distribution<double> dist(6.0, 18.0), elev(5.0, 40.0), azim(-180.0, 180.0);
   int cases = 0, exactly_once = 0;
   for (Motion m : {Motion::kCrossArms, Motion::kExtendArmSide, Motion::kPalmsTogether, Motion::kRaiseArmUp}) {
     for (int i = 0; i < 6; ++i) {
-      const SynthSequence seq = synth.generateFrom(m, dist(rng), elev(rng), azim(rng));
-      const auto fired = firedCommands(classifier, seq);
+      const Performance p = perform(synth, m, rng);
       ++cases;
-      for (const auto& [t, id] : fired) {
-        EXPECT_EQ(id, gestureIdOf(m)) << toString(m) << " fired gesture " << id << " at " << t << " s (azimuth "
-                                      << seq.azimuth_deg << ")";
-      }
-      EXPECT_LE(fired.size(), 1u) << toString(m) << ": a 3 s gesture fired " << fired.size() << " commands";
-      if (fired.size() == 1 && fired[0].second == gestureIdOf(m)) {
+      for (const auto& [t, id] : p.fired) EXPECT_EQ(id, gestureIdOf(m)) << toString(m) << " fired gesture " << id << " at " << t << " s";
+      EXPECT_LE(p.fired.size(), 1u) << toString(m) << ": a 3 s gesture fired " << p.fired.size() << " commands";
+      if (p.fired.size() == 1 && p.fired[0].second == gestureIdOf(m)) {
         ++exactly_once;
-        EXPECT_GE(fired[0].first, seq.motion_start_s);
-        EXPECT_LE(fired[0].first, seq.motion_end_s) << "fired after the worker stopped the gesture";
+        EXPECT_GE(p.fired[0].first, p.start_s);
+        EXPECT_LE(p.fired[0].first, p.end_s) << "fired after the worker stopped the gesture";
       }
     }
   }
-  // 24 random viewpoints (front, side and back): at least 23 fire exactly once.
   EXPECT_GE(exactly_once, cases - 1) << exactly_once << " of " << cases;
+}
+
+TEST(GestureEndToEndTest, GestureHeldThreeSecondsFiresOnce) {
+  GestureClassifier classifier = loadModel();
+  std::uniform_real_distribution<double> dist(6.0, 18.0), elev(5.0, 40.0), azim(-180.0, 180.0);
+  expectThreeSecondGesturesFireOnce([&](SkeletonSynthesizer& synth, Motion m, std::mt19937_64& rng) {
+    const double d = dist(rng), e = elev(rng), a = azim(rng);
+    const SynthSequence seq = synth.generateFrom(m, d, e, a);
+    return Performance{firedCommands(classifier, seq), seq.motion_start_s, seq.motion_end_s};
+  });
 }
 
 // KNOWN LIMIT of ONE camera (docs/gestures.md §6): 1 of these 56 sequences (arm pointing
@@ -257,29 +271,14 @@ TEST(GestureEndToEndTest, WorkMotionsSeenByTheFormationsThreeCamerasFireNothing)
 
 TEST(GestureEndToEndTest, GestureHeldThreeSecondsSeenByThreeCamerasFiresOnce) {
   GestureClassifier classifier = loadModel();
-  SynthConfig config;
-  config.hold_min_s = config.hold_max_s = 3.0;
-  SkeletonSynthesizer synth(config, 4242);
-  std::mt19937_64 rng(99);
   std::uniform_real_distribution<double> dist(6.0, 18.0), elev(5.0, 40.0), azim(-180.0, 180.0);
-  int cases = 0, exactly_once = 0;
-  for (Motion m : {Motion::kCrossArms, Motion::kExtendArmSide, Motion::kPalmsTogether, Motion::kRaiseArmUp}) {
-    for (int i = 0; i < 6; ++i) {
-      const double e = elev(rng), a = azim(rng);
-      std::vector<SkeletonSynthesizer::View> cams{{dist(rng), e, a}, {dist(rng), e, a + 60.0}, {dist(rng), e, a - 60.0}};
-      const auto views = synth.generateViewsFrom(m, cams);
-      const auto fired = firedCommandsFused(classifier, views);
-      ++cases;
-      for (const auto& [t, id] : fired) EXPECT_EQ(id, gestureIdOf(m)) << toString(m) << " fired " << id << " at " << t;
-      EXPECT_LE(fired.size(), 1u);
-      if (fired.size() == 1 && fired[0].second == gestureIdOf(m)) {
-        ++exactly_once;
-        EXPECT_GE(fired[0].first, views[0].motion_start_s);
-        EXPECT_LE(fired[0].first, views[0].motion_end_s) << "fired after the worker stopped the gesture";
-      }
-    }
-  }
-  EXPECT_GE(exactly_once, cases - 1) << exactly_once << " of " << cases;
+  expectThreeSecondGesturesFireOnce([&](SkeletonSynthesizer& synth, Motion m, std::mt19937_64& rng) {
+    const double e = elev(rng), a = azim(rng);
+    const double d0 = dist(rng), d1 = dist(rng), d2 = dist(rng);
+    std::vector<SkeletonSynthesizer::View> cams{{d0, e, a}, {d1, e, a + 60.0}, {d2, e, a - 60.0}};
+    const auto views = synth.generateViewsFrom(m, cams);
+    return Performance{firedCommandsFused(classifier, views), views[0].motion_start_s, views[0].motion_end_s};
+  });
 }
 
 TEST(SkeletonSynthTest, FurtherViewsLeaveThePrimaryViewAsTheSingleViewOutput) {

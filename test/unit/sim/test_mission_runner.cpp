@@ -4,9 +4,8 @@
 
 #include <fstream>
 
-#include "gesture_formation/planning/distance_field.hpp"
-#include "gesture_formation/planning/occupancy_map.hpp"
 #include "gesture_formation/sim/mission_runner.hpp"
+#include "sim_test_support.hpp"
 
 namespace gf = gesture_formation;
 
@@ -22,43 +21,17 @@ class ReferencePlanner : public gf::sim::MissionPlanner {
       res.status = gf::planning::PlanStatus::kFallbackBrake;
       return res;  // empty trajectory: the controller must brake to hover
     }
-    res.status = gf::planning::PlanStatus::kOptimized;
-    res.trajectory.uav_index = r.uav_index;
-    res.trajectory.t0_s = r.t_now_s;
-    res.trajectory.dt_s = r.dt_s;
-    for (int k = 0; k < r.reference.steps(); ++k) {
-      gf::planning::TrajectorySample s;
-      s.p_world = r.reference.p_world.col(k);
-      const int k1 = std::min(k + 1, r.reference.steps() - 1), k0 = k1 - 1;
-      s.v_world = (r.reference.p_world.col(k1) - r.reference.p_world.col(k0)) / r.dt_s;
-      s.heading_rad = r.reference.heading_rad(k);
-      s.pitch_rad = r.reference.pitch_rad(k);
-      res.trajectory.samples.push_back(s);
-    }
-    return res;
+    return gf::sim::test::referenceAsPlan(r);
   }
 
  private:
   bool fail_;
 };
 
-struct World {
-  gf::planning::OccupancyMap map;
-  gf::planning::DistanceField field;
-  World() : map(makeMap()), field(map) {}
-  static gf::planning::OccupancyMap makeMap() {
-    gf::planning::MapConfig mc;
-    mc.resolution_m = 0.4;
-    mc.bounds = gf::planning::Aabb{Eigen::Vector3d(-30, -30, 0), Eigen::Vector3d(30, 30, 20)};
-    return gf::planning::OccupancyMap::fromPrimitives(mc, gf::planning::PrimitiveSet{}, gf::planning::GroundSpec{true, 0.0});
-  }
-};
+using World = gf::sim::test::EmptyWorld;
 
 gf::sim::MissionConfig openFieldMission() {
-  const auto m = gf::sim::loadMissionConfig(std::string(GF_SOURCE_DIR) + "/config/scenarios/open_field.yaml");
-  EXPECT_TRUE(m) << m.reason();
-  gf::sim::MissionConfig c = *m;
-  c.requests.clear();
+  gf::sim::MissionConfig c = gf::sim::test::openFieldWithoutRequests();
   gf::sim::OperatorRequest q;
   q.t_s = 5.0;
   q.target_text = "[2]";
