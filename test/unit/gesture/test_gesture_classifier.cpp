@@ -338,21 +338,28 @@ TEST(GestureEndToEndTest, CommittedStillImageSkeletonClassifiesAsNone) {
   EXPECT_EQ(c->gesture_id, kNone) << "p(none) = " << c->probabilities[0];
 }
 
-// KNOWN FAILURE, issue 6 open (docs/gestures.md §6): the lunging footballer (messi5) reads as
-// "raise arm up" and the man holding a ball crossed at his chest (basketball1) as "cross arms",
-// both with p(none) < 1e-6 — postures outside the synthetic training distribution. Disabled,
-// not loosened: enable it when the classifier meets it (--gtest_also_run_disabled_tests runs it).
-TEST(GestureEndToEndTest, DISABLED_OpenCvDocStillImageSkeletonsClassifyAsNone) {
+// The man holding a ball at his chest (opencv-doc's basketball1) read as "cross arms" until the
+// v3 model (trained with objects held at the chest among the work motions).
+TEST(GestureEndToEndTest, OpenCvDocBasketballStillImageClassifiesAsNone) {
   GestureClassifier classifier = loadModel();
-  int classified = 0;
-  for (const std::string path : {"/usr/share/doc/opencv-doc/examples/data/messi5.jpg",
-                                  "/usr/share/doc/opencv-doc/examples/data/basketball1.png"}) {
-    const auto c = classifyStill(classifier, path);
-    if (!c) continue;  // opencv-doc absent
-    EXPECT_EQ(c->gesture_id, kNone) << path << ": p(none) = " << c->probabilities[0];
-    ++classified;
-  }
-  EXPECT_GE(classified, 1) << "opencv-doc images missing (tools/setup.sh installs opencv-doc)";
+  const std::string path = "/usr/share/doc/opencv-doc/examples/data/basketball1.png";
+  ASSERT_TRUE(std::ifstream(path).good()) << path << " missing (tools/setup.sh installs opencv-doc)";
+  const auto c = classifyStill(classifier, path);
+  ASSERT_TRUE(c.has_value());
+  EXPECT_EQ(c->gesture_id, kNone) << path << ": p(none) = " << c->probabilities[0];
+}
+
+// KNOWN FAILURE, issue 6 open (docs/gestures.md §6): the footballer kicking with one arm out
+// (opencv-doc's messi5) reads as "raise arm up" with p(none) ~ 1e-5 — still with the v3 model
+// (balancing lunges in training) and with a trial model that also had kicks (v4, not kept).
+// Disabled, not loosened: enable it when the classifier meets it (--gtest_also_run_disabled_tests).
+TEST(GestureEndToEndTest, DISABLED_OpenCvDocFootballerStillImageClassifiesAsNone) {
+  GestureClassifier classifier = loadModel();
+  const std::string path = "/usr/share/doc/opencv-doc/examples/data/messi5.jpg";
+  ASSERT_TRUE(std::ifstream(path).good()) << path << " missing (tools/setup.sh installs opencv-doc)";
+  const auto c = classifyStill(classifier, path);
+  ASSERT_TRUE(c.has_value());
+  EXPECT_EQ(c->gesture_id, kNone) << path << ": p(none) = " << c->probabilities[0];
 }
 
 }  // namespace
