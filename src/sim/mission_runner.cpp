@@ -166,6 +166,14 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
           std::make_unique<Link<PlanMessage>>(cfg.link, makeRng(seed, Stream::kLink, link_index++));
     }
   }
+  // [i]: follower i's gesture votes → the leader over the same lossy link (the ROS system:
+  // ViewObserver → LcmBridge → the leader's GestureCommander). Created after the other links:
+  // their random streams are unchanged.
+  std::vector<std::unique_ptr<Link<gesture::ViewObservation>>> vote_links(static_cast<std::size_t>(n));
+  for (int i = 1; follower_views && i < n; ++i) {
+    vote_links[static_cast<std::size_t>(i)] =
+        std::make_unique<Link<gesture::ViewObservation>>(cfg.link, makeRng(seed, Stream::kLink, link_index++));
+  }
 
   MetricsAccumulator metrics(cfg, ObstacleDistance{world.field, world.solids, world.ground_height_m}, seed);
   MissionMetrics& M = metrics.counters();
@@ -416,7 +424,7 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
       bool classified = false;
       const std::optional<Eigen::Vector3d> worker_est =
           kf.initialized() ? std::optional<Eigen::Vector3d>(kf.predicted(t).p_world) : std::nullopt;
-      const auto observe = [&](int view, const gesture::Classification& c) {
+      const auto observation = [&](int view, const gesture::Classification& c) {
         gesture::ViewObservation o;
         o.view = view;
         o.t_s = t;
@@ -428,11 +436,18 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
           o.distance_m = rel.norm();
           o.elevation_deg = common::radToDeg(std::asin(std::clamp(rel.z() / std::max(1e-9, rel.norm()), -1.0, 1.0)));
         }
-        classified = fusion.observe(o) || classified;
+        return o;
       };
-      if (cf.classification) observe(0, *cf.classification);
+      if (cf.classification) classified = fusion.observe(observation(0, *cf.classification));
+      // The followers' votes travel the link; those that arrived by now are counted (older ones
+      // age out of the vote: view_fusion.max_age_s).
       for (std::size_t i = 0; i < cf.followers.size(); ++i) {
-        if (cf.followers[i].classification) observe(static_cast<int>(i) + 1, *cf.followers[i].classification);
+        if (cf.followers[i].classification) {
+          vote_links[i + 1]->send(t, observation(static_cast<int>(i) + 1, *cf.followers[i].classification));
+        }
+      }
+      for (int i = 1; follower_views && i < n; ++i) {
+        for (const auto& o : vote_links[static_cast<std::size_t>(i)]->receive(t)) classified = fusion.observe(o) || classified;
       }
       if (classified) {
         const int fused = follower_views ? fusion.fuse(t).gesture_id : cf.classification->gesture_id;
@@ -492,6 +507,9 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
   }
 
   for (const auto& l : share_links) addCounters(M, l->counters());
+  for (const auto& l : vote_links) {
+    if (l) addCounters(M, l->counters());
+  }
   for (const auto& row : plan_links) {
     for (const auto& l : row) {
       if (l) addCounters(M, l->counters());

@@ -98,3 +98,43 @@ TEST(MissionRunnerTest, InitialPositionInsideObstacleIsRefused) {
   ASSERT_FALSE(out);
   EXPECT_NE(out.reason().find("mission.uavs[1].initial_position"), std::string::npos) << out.reason();
 }
+
+namespace {
+
+/// Test-only classifier: every camera reads "extend arm" (gesture 2) in every frame.
+class AlwaysExtendArm : public gf::sim::MissionClassifier {
+ public:
+  gf::common::Result<gf::gesture::Classification> classify(const gf::gesture::SkeletonWindow&) override {
+    gf::gesture::Classification c;
+    c.gesture_id = 2;
+    return gf::common::Result<gf::gesture::Classification>::ok(c);
+  }
+};
+
+}  // namespace
+
+// The followers' gesture votes reach the leader over the inter-UAV link (as over LCM in the ROS
+// system), so they share its faults: with every message lost, the leader's own view is 1 of the
+// 2 agreeing views the vote needs and nothing fires; with a working link the same readings fire.
+TEST(MissionRunnerTest, FollowerGestureVotesTravelTheLossyLink) {
+  World w;
+  auto cfg = gf::sim::test::openFieldWithoutRequests();
+  ASSERT_EQ(cfg.view_fusion.min_agreeing_views, 2);
+  gf::sim::MissionWorld world{&w.map, &w.field, 0.0};
+  const gf::sim::PlannerFactory factory = [](int) { return std::make_unique<ReferencePlanner>(false); };
+  AlwaysExtendArm classifier;
+  const auto fired = [&](double loss) {
+    cfg.link.loss = loss;
+    const auto out = gf::sim::runMission(cfg, world, factory, &classifier, 3, 20.0);
+    EXPECT_TRUE(out) << out.reason();
+    int n = 0;
+    for (const auto& r : out->requests) n += r.source == "gesture" ? 1 : 0;
+    return std::make_pair(n, out->metrics.messages_lost);
+  };
+  const auto [fired_ok, lost_ok] = fired(0.0);
+  EXPECT_GE(fired_ok, 1);
+  EXPECT_EQ(lost_ok, 0);
+  const auto [fired_lost, lost_all] = fired(1.0);
+  EXPECT_EQ(fired_lost, 0);
+  EXPECT_GT(lost_all, 0);
+}
