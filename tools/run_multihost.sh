@@ -11,8 +11,8 @@
 #                          [--loss P] [--delay-ms D] [--jitter-ms J] [--duplicate P]
 # Defaults: --out results/multihost, --duration 120 (simulated s; -1: the whole mission),
 # --rtf 1.5, --seed 1, --loss 0.2, --delay-ms 30, --jitter-ms 20, --duplicate 0.01.
-# Writes OUT/metrics.json, events.csv, timeline.csv (SimWorld, as gfctl simulate), radio.json
-# (relay counters), logs/. Needs root (network namespaces). Exit code: 0 when the mission finished
+# Writes OUT/metrics.json, events.csv, timeline.csv (SimWorld, as gfctl simulate), timeline.png,
+# radio.json (relay counters), logs/. Needs root (network namespaces). Exit code: 0 when the mission finished
 # without a collision; 1 when it did not finish or a UAV collided; 2 for bad arguments.
 set -eo pipefail  # not -u: devel/setup.bash reads unset variables
 cd "$(dirname "$0")/.."
@@ -128,6 +128,14 @@ sleep 1
 kill -INT $relay 2>/dev/null || true
 wait $relay 2>/dev/null || true
 [ -f "$OUT/metrics.json" ] || { echo "$0: the mission did not finish; see $OUT/logs/world.log" >&2; tail -20 "$OUT/logs/world.log" >&2; exit 1; }
+# scene.json (the scenario's solids) and timeline.png, as tools/run_ros_mission.sh draws them.
+GFCTL=$BUILD/devel/lib/gesture_formation/gfctl
+if [ -x "$GFCTL" ] && "$GFCTL" simulate --scenario "$MISSION" --out "$T/scene" --duration 0.1 --no-plot > /dev/null 2>&1; then
+  cp "$T/scene/scene.json" "$OUT/scene.json"
+fi
+PY=/opt/gesture_formation/venv/bin/python
+[ -x "$PY" ] || PY=python3
+"$PY" tools/plot_timeline.py "$OUT" > /dev/null 2>&1 && echo "wrote $OUT/timeline.png" || echo "timeline.png not drawn (needs matplotlib)"
 python3 - "$OUT" "$(( $(date +%s) - start ))" <<'PY'
 import json, sys
 out = sys.argv[1]
