@@ -108,7 +108,7 @@ for p in profiles:
         if m["min_mutual_distance_m"] < 2.5 or m["min_obstacle_distance_m"] < 0.5 or m["collisions"] != 0:
             violations.append(f"{p} seed {m['seed']:.0f}: mutual {m['min_mutual_distance_m']:.2f} m, obstacle "
                               f"{m['min_obstacle_distance_m']:.2f} m (UAV {m['min_obstacle_uav']:.0f} at {m['min_obstacle_t_s']:.1f} s), "
-                              f"collisions {m['collisions']}")
+                              f"collisions {m['collisions']:.0f}")
     runs[p] = len(ms)
     get = lambda k: [float(m[k]) for m in ms if m.get(k) is not None]
     rows.append(f"| `{p}` | {len(ms)} | " + " | ".join(cell(get(k), fmt) for k, _, fmt in cols) + " |")
@@ -147,9 +147,15 @@ with open(report, "w") as f:
             "52 missions**: `harsh` seed 3 (1.81 m) and `delay_jitter` seed 3 (2.25 m) — a follower braked, and the "
             "leader learned it too late over the delayed link. Cause and fix (every UAV avoids every plan, now the "
             "default): [safety.md](safety.md) §4. The tables above are with the fix.\n\n")
+    top = int(max((r["seed"] for r in all_rows), default=0))
+    missing = [f"`{p}` seed {k}" for p in profiles for k in range(1, top + 1)
+               if not any(r["profile"] == p and int(r["seed"]) == k for r in all_rows)]
+    if missing:
+        f.write(f"**Missions without a row** (seeds 1–{top}: did not finish, or not run yet): " + ", ".join(missing)
+                + ". See [safety.md](safety.md) §4.5 for missions that hung.\n\n")
     if violations:
         f.write(f"**Safety violations ({len(violations)} of {total} missions):**\n\n" + "\n".join(f"- {v}" for v in violations)
-                + "\n\nCauses and reproduction: [safety.md](safety.md) §4.\n")
+                + "\n\nCauses and reproduction: [safety.md](safety.md) §4.4.\n")
     else:
         f.write(f"**No safety violation in the {total} missions** (no min mutual < 2.5 m, no obstacle distance < 0.5 m, "
                 "no collision).\n")
