@@ -128,14 +128,7 @@ sleep 1
 kill -INT $relay 2>/dev/null || true
 wait $relay 2>/dev/null || true
 [ -f "$OUT/metrics.json" ] || { echo "$0: the mission did not finish; see $OUT/logs/world.log" >&2; tail -20 "$OUT/logs/world.log" >&2; exit 1; }
-# scene.json (the scenario's solids) and timeline.png, as tools/run_ros_mission.sh draws them.
-GFCTL=$BUILD/devel/lib/gesture_formation/gfctl
-if [ -x "$GFCTL" ] && "$GFCTL" simulate --scenario "$MISSION" --out "$T/scene" --duration 0.1 --no-plot > /dev/null 2>&1; then
-  cp "$T/scene/scene.json" "$OUT/scene.json"
-fi
-PY=/opt/gesture_formation/venv/bin/python
-[ -x "$PY" ] || PY=python3
-"$PY" tools/plot_timeline.py "$OUT" > /dev/null 2>&1 && echo "wrote $OUT/timeline.png" || echo "timeline.png not drawn (needs matplotlib)"
+tools/plot_mission.sh "$OUT" "$MISSION" "$BUILD"
 python3 - "$OUT" "$(( $(date +%s) - start ))" <<'PY'
 import json, sys
 out = sys.argv[1]

@@ -81,14 +81,7 @@ echo "running the mission through simulation.launch (real-time factor $RTF; log:
 "${NETNS[@]}" bash "$T/netns.sh"
 cp "$T/launch.log" "$OUT/launch.log"
 [ -f "$OUT/metrics.json" ] || { echo "$0: the mission did not finish; see $OUT/launch.log" >&2; tail -30 "$OUT/launch.log" >&2; exit 1; }
-# scene.json for the plot's side views: the scenario's solids, as gfctl simulate writes them.
-GFCTL=$BUILD/devel/lib/gesture_formation/gfctl
-if [ -x "$GFCTL" ] && "$GFCTL" simulate --scenario "$MISSION" --out "$T/scene" --duration 0.1 --no-plot > /dev/null 2>&1; then
-  cp "$T/scene/scene.json" "$OUT/scene.json"
-fi
-PY=/opt/gesture_formation/venv/bin/python
-[ -x "$PY" ] || PY=python3
-"$PY" tools/plot_timeline.py "$OUT" > /dev/null 2>&1 && echo "wrote $OUT/timeline.png" || echo "timeline.png not drawn (needs matplotlib: $PY tools/plot_timeline.py $OUT)"
+tools/plot_mission.sh "$OUT" "$MISSION" "$BUILD"
 # The summary, in the words of gfctl simulate's (same metric definitions: docs/simulation.md §4).
 python3 - "$OUT/metrics.json" "$(( $(date +%s) - start ))" "$SEED" <<'PY'
 import json, sys

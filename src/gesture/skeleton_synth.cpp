@@ -336,14 +336,7 @@ Body3D SkeletonSynthesizer::pose(Motion motion, double s, double phase, bool lef
 }
 
 SynthSequence SkeletonSynthesizer::next() {
-  std::uniform_real_distribution<double> u01(0.0, 1.0);
-  Motion m;
-  if (u01(rng_) < config_.gesture_fraction) {
-    m = static_cast<Motion>(std::uniform_int_distribution<int>(0, 3)(rng_));
-  } else {
-    m = static_cast<Motion>(std::uniform_int_distribution<int>(4, static_cast<int>(Motion::kCount) - 1)(rng_));
-  }
-  return generate(m);
+  return nextViews({}).front();  // the same draws, one view
 }
 
 SynthSequence SkeletonSynthesizer::generate(Motion motion) {
@@ -365,7 +358,8 @@ std::vector<SynthSequence> SkeletonSynthesizer::generateViewsFrom(Motion motion,
 }
 
 std::vector<SynthSequence> SkeletonSynthesizer::nextViews(const std::vector<double>& azimuth_offsets_deg) {
-  // The same draws as next() → generate(), in the same order.
+  // Motion, then distance, elevation, azimuth from the main stream (generate() draws the last three
+  // the same way): a sequence with further views has the primary view of the one without.
   std::uniform_real_distribution<double> u01(0.0, 1.0);
   Motion m;
   if (u01(rng_) < config_.gesture_fraction) {
