@@ -33,6 +33,7 @@
 #include "gesture_formation/formation/formation_geometry.hpp"
 #include "gesture_formation/formation/worker_heading.hpp"
 #include "gesture_formation/planning/plan_request_builder.hpp"
+#include "gesture_formation/planning/trajectory_qp.hpp"
 #include "param_loader.hpp"
 
 namespace gesture_formation::nodelets {
@@ -221,6 +222,12 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     if (res.status != planning::PlanStatus::kOptimized) {
       NODELET_WARN_STREAM_THROTTLE(2.0, "FormationPlanner UAV " << uav_index_ << ": " << planning::toString(res.status)
                                                                 << ": " << res.reason);
+    }
+    if (res.qp_sparse_timeouts > 0) {
+      NODELET_ERROR_STREAM("FormationPlanner UAV " << uav_index_ << ": " << res.qp_sparse_timeouts
+                                                   << " sparse QP solve(s) abandoned after qp.solve_timeout_s (dense backend used; "
+                                                   << planning::TrajectoryQp::abandonedSolves()
+                                                   << " abandoned in this process, docs/safety.md 4.5)");
     }
     auto msg = toMsg(res);
     msg.header.frame_id = world_frame_;

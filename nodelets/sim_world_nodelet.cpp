@@ -335,10 +335,10 @@ class SimWorldNodelet : public nodelet::Nodelet {
     finished_ = true;
     const double wall = (ros::WallTime::now() - wall0_).toSec();
     // What the ROS system does not report (docs/ros.md): the planners' skipped and hold
-    // replannings, command ages, and the LCM links' counters.
+    // replannings, command ages, the LCM links' counters, QP sparse timeouts (logged by the planner).
     metrics_->counters().not_measured = {"plans_skipped",  "plans_hold",          "commands_stale",
                                          "messages_sent", "messages_lost",       "messages_duplicated",
-                                         "messages_reordered"};
+                                         "messages_reordered", "qp_sparse_timeouts"};
     const sim::MissionOutput out = metrics_->finish(worker_->episodes(), t_, wall);
     // metrics.json last: its appearance tells tools/run_ros_mission.sh that the files are complete.
     std::string err;

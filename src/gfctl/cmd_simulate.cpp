@@ -160,7 +160,8 @@ int runOne(const Args& args, Loaded& L, std::uint64_t seed, double duration, con
             << "  distance error rms " << m.distance_error_rms_m << " m, angle error rms " << m.angle_error_rms_deg
             << " deg, estimate error rms " << m.human_estimate_error_rms_m << " m, planning median "
             << m.planning_ms_median << " ms p99 " << m.planning_ms_p99 << " ms (fallback previous "
-            << m.plans_fallback_previous << ", brake " << m.plans_fallback_brake << " of " << m.plans << ")\n"
+            << m.plans_fallback_previous << ", brake " << m.plans_fallback_brake << " of " << m.plans
+            << ", QP sparse timeouts " << m.qp_sparse_timeouts << ")\n"
             << "  faults: hold plans " << m.plans_hold << ", skipped " << m.plans_skipped << ", stale commands "
             << m.commands_stale << ", duplicate commands " << m.commands_duplicate << ", range outliers "
             << m.range_outliers << ", inter-UAV messages " << m.messages_sent << " (lost " << m.messages_lost

@@ -69,6 +69,7 @@ std::vector<std::string> PlannerConfig::validate() const {
   require(e, nonneg(qp_distance_buffer_m), "qp.distance_buffer_m", qp_distance_buffer_m, "must be >= 0");
   require(e, pos(qp_eps_abs) && qp_eps_abs <= 1e-3, "qp.eps_abs", qp_eps_abs, "must be in (0, 1e-3]");
   require(e, qp_max_iterations >= 10, "qp.max_iterations", qp_max_iterations, "must be >= 10");
+  require(e, pos(qp_solve_timeout_s), "qp.solve_timeout_s", qp_solve_timeout_s, "must be > 0");
 
   require(e, pos(heading_weight), "camera.heading_weight", heading_weight, "must be > 0");
   require(e, nonneg(heading_smoothness_weight), "camera.smoothness_weight", heading_smoothness_weight, "must be >= 0");
@@ -122,6 +123,7 @@ PlannerConfig readPlannerConfig(ConfigReader& r, const std::string& prefix) {
   r.readDouble(key("qp.distance_buffer_m"), c.qp_distance_buffer_m, Range::nonNegative());
   r.readDouble(key("qp.eps_abs"), c.qp_eps_abs, Range::openClosed(0.0, 1e-3));
   r.readInt(key("qp.max_iterations"), c.qp_max_iterations, Range::atLeast(10));
+  r.readDouble(key("qp.solve_timeout_s"), c.qp_solve_timeout_s, Range::positive());
 
   std::string solver = c.camera_solver == PlannerConfig::CameraSolver::kCeres ? "ceres" : "filter";
   r.readString(key("camera.solver"), solver, {"filter", "ceres"});

@@ -1,10 +1,16 @@
 #include "gesture_formation/planning/trajectory_qp.hpp"
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
+#include <condition_variable>
+#include <mutex>
 #include <sstream>
+#include <thread>
 
 #include <Eigen/Sparse>
+#include <proxsuite/proxqp/dense/dense.hpp>
 #include <proxsuite/proxqp/sparse/sparse.hpp>
 
 namespace gesture_formation::planning {
@@ -66,6 +72,9 @@ std::string checkProblem(const TrajectoryQpProblem& pr) {
       e << "constraint " << i << " (sample " << c.sample << ") is invalid; ";
       break;
     }
+  }
+  if (!(pr.solve_timeout_s > 0.0) || !std::isfinite(pr.solve_timeout_s)) {
+    e << "solve_timeout_s must be > 0, got " << pr.solve_timeout_s << "; ";
   }
   if (!(pr.w_reference > 0.0) || pr.w_acceleration < 0.0 || pr.w_jerk < 0.0 || pr.w_terminal_velocity < 0.0) {
     e << "weights must be >= 0 (reference > 0); ";
@@ -241,6 +250,125 @@ QpMatrices TrajectoryQp::assemble(const TrajectoryQpProblem& pr) {
   return m;
 }
 
+namespace {
+
+namespace pq = proxsuite::proxqp;
+using Status = TrajectoryQpSolution::Status;
+
+std::atomic<int> g_abandoned_solves{0};
+
+Status statusOf(pq::QPSolverOutput s) {
+  switch (s) {
+    case pq::QPSolverOutput::PROXQP_SOLVED:
+      return Status::kSolved;
+    case pq::QPSolverOutput::PROXQP_PRIMAL_INFEASIBLE:
+    case pq::QPSolverOutput::PROXQP_SOLVED_CLOSEST_PRIMAL_FEASIBLE:
+      return Status::kInfeasible;
+    case pq::QPSolverOutput::PROXQP_MAX_ITER_REACHED:
+      return Status::kMaxIterations;
+    default:
+      return Status::kNumerical;
+  }
+}
+
+template <class Qp>
+void runSolver(Qp& qp, const Eigen::VectorXd* x0, double eps_abs, int max_iterations, QpMatricesSolution& out) {
+  qp.settings.eps_abs = eps_abs;
+  qp.settings.eps_rel = 0.0;
+  qp.settings.max_iter = max_iterations;
+  qp.settings.verbose = false;
+  qp.settings.compute_timings = false;
+  if (x0 != nullptr) {
+    qp.solve(*x0, proxsuite::nullopt, proxsuite::nullopt);
+  } else {
+    qp.solve();
+  }
+  out.status = statusOf(qp.results.info.status);
+  out.iterations = static_cast<int>(qp.results.info.iter);
+  out.x = qp.results.x;
+}
+
+QpMatricesSolution solveSparse(const QpMatrices& m, const Eigen::VectorXd* x0, double eps_abs, int max_iterations) {
+  QpMatricesSolution out;
+  pq::sparse::QP<double, int> qp(static_cast<int>(m.H.rows()), static_cast<int>(m.A.rows()), static_cast<int>(m.C.rows()));
+  qp.init(m.H, m.g, m.A, m.b, m.C, m.l, m.u);
+  runSolver(qp, x0, eps_abs, max_iterations, out);
+  return out;
+}
+
+QpMatricesSolution solveDense(const QpMatrices& m, const Eigen::VectorXd* x0, double eps_abs, int max_iterations) {
+  QpMatricesSolution out;
+  out.dense_backend = true;
+  pq::dense::QP<double> qp(m.H.rows(), m.A.rows(), m.C.rows());
+  const Eigen::MatrixXd H(m.H), A(m.A), C(m.C);
+  qp.init(H, m.g, A, m.b, C, m.l, m.u);
+  runSolver(qp, x0, eps_abs, max_iterations, out);
+  return out;
+}
+
+/// The sparse solve's state, shared by the waiting caller and the worker thread (which may
+/// outlive the caller when abandoned).
+struct SparseJob {
+  std::shared_ptr<const QpMatrices> m;
+  Eigen::VectorXd x0;
+  bool warm = false;
+  double eps_abs = 0.0;
+  int max_iterations = 0;
+  std::mutex mutex;
+  std::condition_variable cv;
+  bool done = false;
+  QpMatricesSolution result;
+};
+
+}  // namespace
+
+int TrajectoryQp::abandonedSolves() { return g_abandoned_solves.load(); }
+
+QpMatricesSolution TrajectoryQp::solveMatrices(std::shared_ptr<const QpMatrices> m, const Eigen::VectorXd* x0,
+                                               double eps_abs, int max_iterations, double timeout_s) {
+  const auto guarded = [](auto&& f) {
+    try {
+      return f();
+    } catch (const std::exception&) {  // ProxQP throws on inconsistent dimensions / allocation
+      return QpMatricesSolution{};
+    }
+  };
+  if (g_abandoned_solves.load() >= kMaxAbandonedSolves) {
+    return guarded([&] { return solveDense(*m, x0, eps_abs, max_iterations); });
+  }
+  auto job = std::make_shared<SparseJob>();
+  job->m = m;
+  job->warm = x0 != nullptr;
+  if (x0 != nullptr) job->x0 = *x0;
+  job->eps_abs = eps_abs;
+  job->max_iterations = max_iterations;
+  try {
+    std::thread([job, guarded] {
+      QpMatricesSolution r =
+          guarded([&] { return solveSparse(*job->m, job->warm ? &job->x0 : nullptr, job->eps_abs, job->max_iterations); });
+      {
+        std::lock_guard<std::mutex> lock(job->mutex);
+        job->result = std::move(r);
+        job->done = true;
+      }
+      job->cv.notify_all();
+    }).detach();
+  } catch (const std::system_error&) {  // no thread available: the bounded backend, inline
+    return guarded([&] { return solveDense(*m, x0, eps_abs, max_iterations); });
+  }
+  {
+    std::unique_lock<std::mutex> lock(job->mutex);
+    if (job->cv.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return job->done; })) {
+      return std::move(job->result);
+    }
+  }
+  g_abandoned_solves.fetch_add(1);
+  QpMatricesSolution out = guarded([&] { return solveDense(*m, x0, eps_abs, max_iterations); });
+  out.sparse_timed_out = true;
+  out.dense_backend = true;
+  return out;
+}
+
 TrajectoryQpSolution TrajectoryQp::solve(const TrajectoryQpProblem& pr, const TrajectoryQpSolution* warm) const {
   TrajectoryQpSolution out;
   const std::string bad = checkProblem(pr);
@@ -251,52 +379,37 @@ TrajectoryQpSolution TrajectoryQp::solve(const TrajectoryQpProblem& pr, const Tr
   }
   const int N = pr.intervals;
   const int n = 9 * N;
-  const QpMatrices m = assemble(pr);
-  const int n_eq = static_cast<int>(m.b.size());
-  const int n_in = static_cast<int>(m.l.size());
+  auto m = std::make_shared<QpMatrices>(assemble(pr));
   out.variables = n;
-  out.equalities = n_eq;
-  out.inequalities = n_in;
-  const auto& H = m.H;
-  const auto& g = m.g;
-  const auto& A = m.A;
-  const auto& b = m.b;
-  const auto& C = m.C;
-  const auto& l = m.l;
-  const auto& u = m.u;
+  out.equalities = static_cast<int>(m->b.size());
+  out.inequalities = static_cast<int>(m->l.size());
 
-  namespace pq = proxsuite::proxqp;
-  pq::sparse::QP<double, int> qp(n, n_eq, n_in);
-  qp.settings.eps_abs = pr.eps_abs;
-  qp.settings.eps_rel = 0.0;
-  qp.settings.max_iter = pr.max_iterations;
-  qp.settings.verbose = false;
-  qp.settings.compute_timings = false;
-  qp.init(H, g, A, b, C, l, u);
+  Eigen::VectorXd x0;
   if (warm != nullptr && static_cast<int>(warm->p.size()) == N + 1 && static_cast<int>(warm->v.size()) == N + 1 &&
       static_cast<int>(warm->a.size()) == N + 1) {
-    Eigen::VectorXd x0(n);
-    bool finite = true;
+    x0.resize(n);
     for (int k = 1; k <= N; ++k) {
       x0.segment<3>(var(k, 0, 0)) = warm->p[k];
       x0.segment<3>(var(k, 1, 0)) = warm->v[k];
       x0.segment<3>(var(k, 2, 0)) = warm->a[k];
     }
-    finite = x0.allFinite();
-    if (finite) {
-      qp.solve(x0, proxsuite::nullopt, proxsuite::nullopt);
-      out.warm_started = true;
-    } else {
-      qp.solve();
-    }
-  } else {
-    qp.solve();
+    if (!x0.allFinite()) x0.resize(0);
   }
-  out.iterations = static_cast<int>(qp.results.info.iter);
-  const Eigen::VectorXd& x = qp.results.x;
+  out.warm_started = x0.size() == n;
+  const QpMatricesSolution r =
+      solveMatrices(m, out.warm_started ? &x0 : nullptr, pr.eps_abs, pr.max_iterations, pr.solve_timeout_s);
+  out.sparse_timed_out = r.sparse_timed_out;
+  out.dense_backend = r.dense_backend;
+  out.iterations = r.iterations;
   out.p.assign(N + 1, pr.p0);
   out.v.assign(N + 1, pr.v0);
   out.a.assign(N + 1, pr.a0);
+  if (r.x.size() != n) {
+    out.status = TrajectoryQpSolution::Status::kNumerical;
+    out.reason = "QP solver failed (threw)";
+    return out;
+  }
+  const Eigen::VectorXd& x = r.x;
   for (int k = 1; k <= N; ++k) {
     out.p[k] = x.segment<3>(var(k, 0, 0));
     out.v[k] = x.segment<3>(var(k, 1, 0));
@@ -304,23 +417,24 @@ TrajectoryQpSolution TrajectoryQp::solve(const TrajectoryQpProblem& pr, const Tr
   }
   out.primal_residual = maxViolation(pr, out.p, out.v, out.a);
   out.objective = cost(pr, out.p, out.v, out.a);
-  switch (qp.results.info.status) {
-    case pq::QPSolverOutput::PROXQP_SOLVED:
-      out.status = TrajectoryQpSolution::Status::kSolved;
+  out.status = r.status;
+  switch (r.status) {
+    case Status::kSolved:
       break;
-    case pq::QPSolverOutput::PROXQP_PRIMAL_INFEASIBLE:
-    case pq::QPSolverOutput::PROXQP_SOLVED_CLOSEST_PRIMAL_FEASIBLE:
-      out.status = TrajectoryQpSolution::Status::kInfeasible;
+    case Status::kInfeasible:
       out.reason = "QP primal infeasible";
       break;
-    case pq::QPSolverOutput::PROXQP_MAX_ITER_REACHED:
-      out.status = TrajectoryQpSolution::Status::kMaxIterations;
+    case Status::kMaxIterations:
       out.reason = "QP reached " + std::to_string(pr.max_iterations) + " iterations";
       break;
     default:
-      out.status = TrajectoryQpSolution::Status::kNumerical;
       out.reason = "QP solver failed";
       break;
+  }
+  if (out.sparse_timed_out) {
+    std::ostringstream os;
+    os << " (sparse solve abandoned after " << pr.solve_timeout_s << " s, dense backend)";
+    if (!out.reason.empty()) out.reason += os.str();
   }
   if (out.solved() && !x.allFinite()) {
     out.status = TrajectoryQpSolution::Status::kNumerical;

@@ -477,6 +477,7 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
   qp.w_terminal_velocity = config_.weights.terminal_velocity;
   qp.eps_abs = config_.qp_eps_abs;
   qp.max_iterations = config_.qp_max_iterations;
+  qp.solve_timeout_s = config_.qp_solve_timeout_s;
 
   // Assignment of samples to corridors: a guide point moves along the path no faster than the
   // inner speed/acceleration sets allow (70 %), towards the projection of r_k, stopping on
@@ -642,6 +643,7 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
   result.qp_variables = sol.variables;
   result.qp_constraints = sol.equalities + sol.inequalities;
   result.qp_iterations = sol.iterations;
+  result.qp_sparse_timeouts += sol.sparse_timed_out ? 1 : 0;
   result.timings.qp_ms = msSince(t_stage);
   if (!sol.solved()) {
     // Name the constraint family that makes it infeasible (users and the simulator's failure
@@ -656,7 +658,9 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
                                                [kind = kind](const PositionConstraint& c) { return c.kind == kind; }),
                                 relaxed.constraints.end());
       if (relaxed.constraints.size() == before) continue;
-      if (qp_->solve(relaxed, nullptr).solved()) {
+      const TrajectoryQpSolution relaxed_sol = qp_->solve(relaxed, nullptr);
+      result.qp_sparse_timeouts += relaxed_sol.sparse_timed_out ? 1 : 0;
+      if (relaxed_sol.solved()) {
         cause = std::string(" (feasible without the ") + name + " constraints)";
         break;
       }

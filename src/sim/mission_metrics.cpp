@@ -186,8 +186,9 @@ void MetricsAccumulator::cameraFrame(bool visible, const Eigen::Vector3d* estima
 }
 
 void MetricsAccumulator::plan(int uav, double t_s, std::uint64_t params_version, planning::PlanStatus status,
-                              double total_ms, const std::string& reason) {
+                              double total_ms, const std::string& reason, int qp_sparse_timeouts) {
   ++m_.plans;
+  m_.qp_sparse_timeouts += qp_sparse_timeouts;
   if (status == planning::PlanStatus::kFallbackPrevious) ++m_.plans_fallback_previous;
   if (status == planning::PlanStatus::kFallbackBrake) ++m_.plans_fallback_brake;
   if (status != planning::PlanStatus::kOptimized) ++m_.plan_failure_reasons[reasonKey(reason)];
@@ -364,6 +365,7 @@ std::string metricsJson(const MissionMetrics& m) {
   os << "  \"plans_fallback_previous\": " << m.plans_fallback_previous << ",\n";
   os << "  \"plans_fallback_brake\": " << m.plans_fallback_brake << ",\n";
   os << "  \"plans_skipped\": " << count("plans_skipped", m.plans_skipped) << ",\n";
+  os << "  \"qp_sparse_timeouts\": " << count("qp_sparse_timeouts", m.qp_sparse_timeouts) << ",\n";
   os << "  \"plans_hold\": " << count("plans_hold", m.plans_hold) << ",\n";
   os << "  \"commands_stale\": " << count("commands_stale", m.commands_stale) << ",\n";
   os << "  \"commands_duplicate\": " << count("commands_duplicate", m.commands_duplicate) << ",\n";

@@ -303,7 +303,7 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
     in.rule = planning::AvoidanceRule{cfg.faults.avoid_all_plans, cfg.faults.max_plan_age_s};
     const planning::PlanRequest req = planning::buildPlanRequest(in);
     const planning::PlanResult res = u.planner->plan(req);
-    metrics.plan(i, t, version, res.status, res.timings.total_ms, res.reason);
+    metrics.plan(i, t, version, res.status, res.timings.total_ms, res.reason, res.qp_sparse_timeouts);
     if (res.trajectory.empty()) {
       u.ctl.clearPlan();
     } else {

@@ -105,6 +105,9 @@ struct PlannerConfig {
   /// ProxQP absolute accuracy and iteration limit.
   double qp_eps_abs = 1e-6;
   int qp_max_iterations = 4000;
+  /// Wall-clock bound (s) of ProxQP's sparse solve; past it the QP is re-solved by the dense
+  /// backend (trajectory_qp.hpp, docs/safety.md §4.5), > 0.
+  double qp_solve_timeout_s = 0.5;
 
   // --- camera heading / pitch -------------------------------------------------------------
   /// Solver of the camera angles (camera_tracking.hpp): the closed-form rate-limited filter

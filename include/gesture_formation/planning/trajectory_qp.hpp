@@ -15,8 +15,16 @@
 ///     middle Bézier control point v_k + a_k dt/2 of every interval — v(t) is a quadratic
 ///     Bézier on each interval, so it stays in V between samples too;
 ///   - acceleration in the inner polyhedron A at every sample (a(t) is linear in between).
-/// Thread safety: not thread-safe (keeps the warm start).
+///
+/// Time bound: ProxQP's sparse solver can loop forever (0.7.2–0.8.0: its LDLᵀ row update corrupts
+/// the elimination tree; `max_iter` does not bound it; docs/safety.md §4.5). So the sparse solve
+/// runs on its own thread and is waited for at most `solve_timeout_s`; past that it is abandoned
+/// (the thread cannot be stopped, it keeps one core until the process exits) and the same QP is
+/// solved by ProxQP's dense backend (no elimination tree; ~7× slower, bounded by max_iter). After
+/// kMaxAbandonedSolves abandoned threads every later QP of the process goes to the dense backend.
+/// Thread safety: solve() may be called from several threads (each call has its own solver).
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -59,6 +67,8 @@ struct TrajectoryQpProblem {
   double w_reference = 1.0, w_acceleration = 0.05, w_jerk = 0.01, w_terminal_velocity = 1.0;
   double eps_abs = 1e-6;
   int max_iterations = 4000;
+  /// Wall-clock bound (s) of the sparse solve before the dense fallback, > 0.
+  double solve_timeout_s = 0.5;
 };
 
 struct TrajectoryQpSolution {
@@ -70,6 +80,10 @@ struct TrajectoryQpSolution {
   double primal_residual = 0.0;  ///< max constraint violation of the returned x (ProxQP's scale)
   double objective = 0.0;
   bool warm_started = false;
+  /// The sparse solve did not return within solve_timeout_s (abandoned) / the dense backend
+  /// produced this solution (after a timeout, or because sparse solves are disabled).
+  bool sparse_timed_out = false;
+  bool dense_backend = false;
   bool solved() const { return status == Status::kSolved; }
 };
 
@@ -82,6 +96,15 @@ struct QpMatrices {
   double cost_constant = 0.0;
 };
 
+/// \brief What ProxQP returned for assembled matrices (TrajectoryQp::solveMatrices).
+struct QpMatricesSolution {
+  TrajectoryQpSolution::Status status = TrajectoryQpSolution::Status::kNumerical;
+  Eigen::VectorXd x;  ///< the primal solution (size of H), empty if the solver threw
+  int iterations = 0;
+  bool sparse_timed_out = false;
+  bool dense_backend = false;
+};
+
 /// \brief Assembles and solves the QP. `warm` (optional): a guess of p, v, a for k = 0..N
 /// (e.g. the previous plan re-timed), used as ProxQP's primal warm start.
 class TrajectoryQp {
@@ -89,6 +112,14 @@ class TrajectoryQp {
   TrajectoryQpSolution solve(const TrajectoryQpProblem& problem, const TrajectoryQpSolution* warm = nullptr) const;
   /// \brief The matrices solve() hands to ProxQP (problem must be valid: see solve()).
   static QpMatrices assemble(const TrajectoryQpProblem& problem);
+  /// \brief ProxQP on assembled matrices with the time bound above: sparse on a worker thread,
+  /// waited for `timeout_s`, then dense. `x0` (optional, size of H): primal warm start.
+  static QpMatricesSolution solveMatrices(std::shared_ptr<const QpMatrices> matrices, const Eigen::VectorXd* x0,
+                                          double eps_abs, int max_iterations, double timeout_s);
+  /// \brief Sparse solves abandoned by this process so far; from kMaxAbandonedSolves on, only
+  /// the dense backend is used.
+  static int abandonedSolves();
+  static constexpr int kMaxAbandonedSolves = 2;
 
   /// \brief Worst violation of every constraint of `problem` (dynamics equalities, rows,
   /// velocity/acceleration polyhedra incl. the Bézier points) by p, v, a: ≤ 0 when all hold.

@@ -71,6 +71,7 @@ struct MissionMetrics {
   int gestures_performed = 0;
   int gestures_successful = 0;
   int plans = 0, plans_fallback_previous = 0, plans_fallback_brake = 0, plans_skipped = 0;
+  int qp_sparse_timeouts = 0;  ///< sparse QP solves abandoned (dense fallback), docs/safety.md §4.5
   int plans_hold = 0;          ///< replannings in hold mode (stale data, docs/safety.md)
   int commands_stale = 0;      ///< operator commands older than faults.max_command_age_s on arrival (rejected)
   int commands_duplicate = 0;  ///< duplicate command copies (ignored by the FormationState)
@@ -228,7 +229,7 @@ class MetricsAccumulator {
   void cameraFrame(bool visible, const Eigen::Vector3d* estimate_world, const Eigen::Vector3d& worker_world);
   /// \brief UAV `uav` replanned at `t_s` with formation parameters `params_version`.
   void plan(int uav, double t_s, std::uint64_t params_version, planning::PlanStatus status, double total_ms,
-            const std::string& reason);
+            const std::string& reason, int qp_sparse_timeouts = 0);
   /// \brief The last plan status of `uav` (PlanStatus as int; −1 none).
   int lastPlanStatus(int uav) const;
 
