@@ -178,6 +178,70 @@ PlannedTrajectory UavPlanner::brakePlan(const PlanRequest& req) const {
   return tr;
 }
 
+std::optional<PlannedTrajectory> UavPlanner::separateHoldPoint(const PlanRequest& req, const PlannedTrajectory& hold,
+                                                               std::string& why) const {
+  const int n = static_cast<int>(hold.samples.size());
+  if (n < 2 || !verifier_ || req.higher_priority_plans.empty()) return std::nullopt;
+  // First sample from which the plan stands still (the stop point).
+  int k_stop = n - 1;
+  while (k_stop > 0 && hold.samples[static_cast<std::size_t>(k_stop) - 1].v_world.norm() < 1e-9 &&
+         (hold.samples[static_cast<std::size_t>(k_stop) - 1].p_world - hold.samples.back().p_world).norm() < 1e-9) {
+    --k_stop;
+  }
+  const Eigen::Vector3d p_hold = hold.samples.back().p_world;
+  const double need = config_.mutual_distance_m + config_.qp_distance_buffer_m;
+  Eigen::Vector3d away = Eigen::Vector3d::Zero();
+  double deficit = 0.0;
+  int closest_uav = -1;
+  for (const auto& other : req.higher_priority_plans) {
+    if (other.empty()) continue;
+    double d_min = std::numeric_limits<double>::infinity();
+    Eigen::Vector3d q_min = Eigen::Vector3d::Zero();
+    for (int k = k_stop; k < n; ++k) {
+      const Eigen::Vector3d q = evaluateTrajectory(other, hold.t0_s + k * hold.dt_s).p;
+      const double d = (p_hold - q).norm();
+      if (d < d_min) d_min = d, q_min = q;
+    }
+    if (!(d_min < need) || !(d_min > 1e-6)) continue;
+    away += (p_hold - q_min) / d_min * (need - d_min);
+    if (need - d_min > deficit) deficit = need - d_min, closest_uav = other.uav_index;
+  }
+  if (!(away.norm() > 1e-6) || !(deficit > 1e-3)) return std::nullopt;
+  const Eigen::Vector3d dir = away.normalized();
+  const double D = std::min(deficit, config_.fallback_max_deviation_m);
+  // s(τ) = D (1 − cos(πτ/T)) / 2: peak speed Dπ/2T and acceleration Dπ²/2T² within the recovery pace.
+  // T a whole number of samples, so that the move ends on a sample (no overshoot in between).
+  const double T = hold.dt_s * std::ceil(std::max(D * M_PI / (2.0 * config_.recovery_speed_mps),
+                                                  M_PI * std::sqrt(D / (2.0 * config_.recovery_acceleration_mps2))) /
+                                         hold.dt_s - 1e-9);
+  PlannedTrajectory moved = hold;
+  for (int k = k_stop; k < n; ++k) {
+    const double tau = (k - k_stop) * hold.dt_s;
+    const double ph = tau < T ? M_PI * tau / T : M_PI;
+    TrajectorySample& s = moved.samples[static_cast<std::size_t>(k)];
+    s.p_world = p_hold + dir * (D * 0.5 * (1.0 - std::cos(ph)));
+    s.v_world = tau < T ? Eigen::Vector3d(dir * (D * M_PI / (2.0 * T) * std::sin(ph))) : Eigen::Vector3d::Zero();
+    s.a_world = tau < T ? Eigen::Vector3d(dir * (D * M_PI * M_PI / (2.0 * T * T) * std::cos(ph))) : Eigen::Vector3d::Zero();
+  }
+  if (static_cast<double>(n - 1 - k_stop) * hold.dt_s < T) return std::nullopt;  // the move must end inside the plan
+  aimCamera(req, moved);
+  // Obstacles, worker, limits: the verifier without the other UAVs; the other UAVs: never closer than the hold.
+  const VerificationReport rep = verifier_->verify(moved, req.t_now_s, {}, req.worker, req.t_now_s, hold.dt_s);
+  if (!rep.ok) return std::nullopt;
+  for (const auto& other : req.higher_priority_plans) {
+    if (other.empty()) continue;
+    for (double t = hold.t0_s; t <= hold.tEnd() + 1e-9; t += hold.dt_s / 4.0) {
+      const Eigen::Vector3d q = evaluateTrajectory(other, t).p;
+      if ((evaluateTrajectory(moved, t).p - q).norm() < (evaluateTrajectory(hold, t).p - q).norm() - 1e-6) return std::nullopt;
+    }
+  }
+  std::ostringstream os;
+  os.precision(3);
+  os << "; moving the brake point " << D << " m away from UAV " << closest_uav << " (Γ_dis + buffer " << need << " m)";
+  why = os.str();
+  return moved;
+}
+
 void UavPlanner::aimCamera(const PlanRequest& req, PlannedTrajectory& tr) const {
   // Keep looking at the worker within the rate limits (closed-form filter: no failure modes),
   // else hold the current angles.
@@ -301,6 +365,13 @@ PlanResult UavPlanner::fallback(const PlanRequest& req, PlanResult result, const
   }
   if (brake_.empty()) result.trajectory = brakePlan(req);
   result.reason += held;
+  // Brake points are not chosen against each other, and a hovering UAV drifts: a stop point
+  // closer than Γ_dis + buffer to another UAV's plan is moved away (docs/safety.md §4.4).
+  std::string separated;
+  if (auto moved = separateHoldPoint(req, result.trajectory, separated)) {
+    result.trajectory = std::move(*moved);
+    result.reason += separated;
+  }
   result.trajectory.sequence = ++sequence_;
   brake_ = result.trajectory;  // held: the same curve (re-timed), now under this sequence number
   if (verifier_) {

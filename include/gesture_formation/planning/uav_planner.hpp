@@ -21,6 +21,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -178,6 +179,12 @@ class UavPlanner {
   struct Stage2;
   PlanResult fallback(const PlanRequest& request, PlanResult result, const std::string& reason);
   PlannedTrajectory brakePlan(const PlanRequest& request) const;
+  /// The brake plan `hold` with its stop point moved away from the other UAVs' plans it is
+  /// closer to than Γ_dis + qp.distance_buffer_m (after the stop, at the recovery pace), if
+  /// that move keeps the obstacle and worker checks and comes no closer to any other plan than
+  /// `hold` at any time; `why` names the move. Empty: keep `hold`.
+  std::optional<PlannedTrajectory> separateHoldPoint(const PlanRequest& request, const PlannedTrajectory& hold,
+                                                     std::string& why) const;
   void aimCamera(const PlanRequest& request, PlannedTrajectory& trajectory) const;
   void updateTrackingAllowance(const PlanRequest& request);
 

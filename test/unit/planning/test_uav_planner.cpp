@@ -540,7 +540,10 @@ TEST(UavPlannerTest, RepeatedBrakeFallbacksHoldTheBrakePoint) {
   const World& w = towers();
   PlannerConfig cfg = testConfig();
   UavPlanner planner(cfg, w.map, w.field);
-  const Eigen::Vector3d start(-8, -12, 10), other_p(-8, -9.8, 10), push(0, 0.1, 0);  // 2.2 m apart
+  // 3 m apart (more than Γ_dis + buffer: the stop point is not moved away, see
+  // BrakePointCloserThanGammaDisMovesAwayThenHolds), the other plan 0.4 s old (age margin 2 m:
+  // the brake plan does not verify).
+  const Eigen::Vector3d start(-8, -12, 10), other_p(-8, -9.0, 10), push(0, 0.1, 0);
   PlannedTrajectory other;
   other.uav_index = 0;
   other.dt_s = 0.2;
@@ -556,7 +559,7 @@ TEST(UavPlannerTest, RepeatedBrakeFallbacksHoldTheBrakePoint) {
   for (int cycle = 0; cycle < 12; ++cycle) {
     PlanRequest req = straightRequest(1, t, s, start, start, 0.0, Eigen::Vector3d(-5, -3, 1));
     req.reference.p_world(0, 5) = std::numeric_limits<double>::quiet_NaN();  // every replanning fails
-    other.t0_s = t;                                                          // fresh every time
+    other.t0_s = t - 0.4;                                                    // 0.4 s old every time
     req.higher_priority_plans = {other};
     const PlanResult r = planner.plan(req);
     ASSERT_EQ(r.status, PlanStatus::kFallbackBrake) << "cycle " << cycle << ": " << r.reason;
@@ -582,6 +585,87 @@ TEST(UavPlannerTest, RepeatedBrakeFallbacksHoldTheBrakePoint) {
   const PlanResult r = planner.plan(far);
   EXPECT_LT((r.trajectory.samples.back().p_world - far.state.p_world).norm(), 1e-9);
   EXPECT_NE(r.reason.find("braking anew"), std::string::npos) << r.reason;
+}
+
+namespace {
+
+PlannedTrajectory standingPlan(int uav, const Eigen::Vector3d& p, double t0) {
+  PlannedTrajectory tr;
+  tr.uav_index = uav;
+  tr.dt_s = 0.2;
+  tr.t0_s = t0;
+  for (int k = 0; k < 41; ++k) {
+    TrajectorySample s;
+    s.p_world = p;
+    tr.samples.push_back(s);
+  }
+  return tr;
+}
+
+}  // namespace
+
+// loss30 seed 21 (docs/safety.md §4.4): two braked UAVs 2.506 m apart drifted to 2.488 m. A
+// stop point closer than Γ_dis + qp.distance_buffer_m to another UAV's plan is moved away at the
+// recovery pace, then held.
+TEST(UavPlannerTest, BrakePointCloserThanGammaDisMovesAwayThenHolds) {
+  const World& w = towers();
+  PlannerConfig cfg = testConfig();
+  UavPlanner planner(cfg, w.map, w.field);
+  const Eigen::Vector3d start(-8, -12, 10), other_p(-8, -9.8, 10);  // 2.2 m apart
+  const double need = cfg.mutual_distance_m + cfg.qp_distance_buffer_m;
+  UavKinematicState s = stateAt(start, 10.0);
+  s.v_world = Eigen::Vector3d(1.0, 0, 0);
+  double t = 10.0;
+  Eigen::Vector3d held = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  for (int cycle = 0; cycle < 10; ++cycle) {
+    PlanRequest req = straightRequest(1, t, s, start, start, 0.0, Eigen::Vector3d(-5, -3, 1));
+    req.reference.p_world(0, 5) = std::numeric_limits<double>::quiet_NaN();  // every replanning fails
+    req.higher_priority_plans = {standingPlan(0, other_p, t)};
+    const PlanResult r = planner.plan(req);
+    // The moved brake plan verifies, so later cycles may reuse it as the previous verified plan.
+    ASSERT_TRUE(r.status == PlanStatus::kFallbackBrake || (cycle > 0 && r.status == PlanStatus::kFallbackPrevious))
+        << "cycle " << cycle << ": " << r.reason;
+    const Eigen::Vector3d stop = r.trajectory.samples.back().p_world;
+    EXPECT_GE((stop - other_p).norm(), need - 1e-6) << "cycle " << cycle << ": " << r.reason;
+    if (cycle == 0) {
+      EXPECT_NE(r.reason.find("moving the brake point"), std::string::npos) << r.reason;
+      held = stop;
+    } else {
+      EXPECT_LT((stop - held).norm(), 1e-9) << "cycle " << cycle << ": the held point moved again";
+    }
+    // The move: within the recovery pace, never closer to the other UAV than where it stopped.
+    double d_prev = 0.0;
+    for (double tt = t; tt <= r.trajectory.tEnd(); tt += 0.05) {
+      const TrajectoryPoint x = evaluateTrajectory(r.trajectory, tt);
+      if (tt > t + 1.0) {  // after the brake from 1 m/s (0.33 s)
+        EXPECT_LE(x.v.norm(), std::max(cfg.recovery_speed_mps, 0.0) + 1e-6) << "t=" << tt;
+        EXPECT_GE((x.p - other_p).norm(), d_prev - 1e-6) << "t=" << tt << ": came closer";
+      }
+      d_prev = (x.p - other_p).norm();
+    }
+    expectSafe(r.trajectory, *w.map, cfg);
+    t += 0.4;
+    s = advance(r.trajectory, t);
+  }
+}
+
+TEST(UavPlannerTest, BoxedInBrakePointIsNotMoved) {
+  const World& w = towers();
+  PlannerConfig cfg = testConfig();
+  UavPlanner planner(cfg, w.map, w.field);
+  // Others 2.2 m away on both sides along y, a third 2.2 m along +x beyond the stop point and
+  // one along −x: every direction of the sum of the away vectors comes closer to one of them.
+  const Eigen::Vector3d start(-8, -12, 10);
+  PlanRequest req = straightRequest(1, 10.0, stateAt(start, 10.0), start, start, 0.0, Eigen::Vector3d(-5, -3, 1));
+  req.reference.p_world(0, 5) = std::numeric_limits<double>::quiet_NaN();
+  req.higher_priority_plans = {standingPlan(0, start + Eigen::Vector3d(0, 2.2, 0), 10.0),
+                               standingPlan(2, start + Eigen::Vector3d(0, -2.3, 0), 10.0)};
+  const PlanResult r = planner.plan(req);
+  ASSERT_EQ(r.status, PlanStatus::kFallbackBrake) << r.reason;
+  // The away vectors nearly cancel (0.45 vs 0.35 m deficits): moving along +y by the larger deficit
+  // comes closer to the UAV at −y, so the point is held.
+  EXPECT_EQ(r.reason.find("moving the brake point"), std::string::npos) << r.reason;
+  EXPECT_LT((r.trajectory.samples.back().p_world - start).norm(), 1e-9);
 }
 
 TEST(UavPlannerTest, TrackingAllowanceKeysAreValidated) {
