@@ -79,6 +79,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
     camera_.emplace(cfg_, world_.map.get(), s);
     camera_frames_.emplace(1.0 / cfg_.camera.rate_hz, clock_step_s_);
     timeline_samples_.emplace(1.0 / cfg_.timeline_rate_hz, clock_step_s_);
+    schedule_.emplace(cfg_.requests, "mission");
     metrics_.emplace(cfg_, sim::ObstacleDistance{world_.field.get(), world_.solids.get(), world_.ground_height_m}, s);
     heading_.emplace(cfg_.formation.worker_heading);
     n_ = cfg_.formation.params.uavCount();
@@ -208,23 +209,11 @@ class SimWorldNodelet : public nodelet::Nodelet {
     publishClock();
     const sim::WorkerState ws = worker_->stateAt(t_);
     // Operator requests (the OperatorInterface numbers them and sends them over LCM).
-    while (next_request_ < cfg_.requests.size() && cfg_.requests[next_request_].t_s <= t_ + 1e-9) {
-      const sim::OperatorRequest& q = cfg_.requests[next_request_++];
-      formation::FormationCommand c;
-      c.id = {"mission", next_request_};
-      c.target = q.target;
-      c.parameter = q.parameter;
-      c.kind = q.kind;
-      c.amount = q.amount;
-      auto m = toMsg(c);
+    for (const auto& d : schedule_->due(t_)) {
+      auto m = toMsg(d.command);
       m.header.stamp = ros::Time(t_);
       command_pub_.publish(m);
-      sim::RequestRecord rec;
-      rec.t_s = t_;
-      rec.source = "operator";
-      rec.description = sim::describeCommand(c, q.target_text);
-      rec.status = "lost";  // until the leader says what it did with it
-      metrics_->addRequest(rec);
+      metrics_->addRequest(d.record);  // "lost" until the leader says what it did with it
     }
     metrics_->resolveOutcomes(kStampToleranceS);
     const bool all = allTruths();
@@ -247,12 +236,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
   }
 
   /// Whether follower i is in a mission follower dropout at t_s (its computer is down).
-  bool offline(int i, double t_s) const {
-    for (const auto& o : cfg_.faults.follower_dropouts) {
-      if (o.uav == i && t_s >= o.from_s && t_s < o.to_s) return true;
-    }
-    return false;
-  }
+  bool offline(int i, double t_s) const { return cfg_.faults.followerOffline(i, t_s); }
 
   void publishGesture(int uav, const gesture::Classification& c, const ros::Time& stamp) {
     gesture_formation::Gesture g;
@@ -371,7 +355,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
   long k_ = 0;
   int n_ = 0, last_class_ = -1;
   bool finished_ = false, started_ = false, follower_views_ = false;
-  std::size_t next_request_ = 0;
+  std::optional<sim::OperatorSchedule> schedule_;
   std::vector<std::optional<sim::MultirotorState>> truth_;
   std::optional<gesture_formation::WorkerState> estimate_;
   ros::WallTime wall0_;

@@ -63,6 +63,13 @@ std::vector<std::string> FaultConfig::validate(const std::string& prefix) const 
   return e;
 }
 
+bool FaultConfig::followerOffline(int uav, double t_s) const {
+  for (const auto& o : follower_dropouts) {
+    if (o.uav == uav && t_s >= o.from_s && t_s < o.to_s) return true;
+  }
+  return false;
+}
+
 bool inWindow(const std::vector<std::pair<double, double>>& windows, double t_s) {
   for (const auto& [a, b] : windows) {
     if (t_s >= a && t_s < b) return true;

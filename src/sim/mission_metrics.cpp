@@ -512,4 +512,24 @@ bool writeMissionFiles(const std::string& dir, const MissionOutput& out, int uav
   return true;
 }
 
+std::vector<OperatorSchedule::Due> OperatorSchedule::due(double t_s) {
+  std::vector<Due> out;
+  while (next_ < requests_.size() && requests_[next_].t_s <= t_s + 1e-9) {
+    const OperatorRequest& q = requests_[next_++];
+    Due d;
+    d.command.id = {id_source_, next_};
+    d.command.source = formation::CommandSource::kOperator;
+    d.command.target = q.target;
+    d.command.parameter = q.parameter;
+    d.command.kind = q.kind;
+    d.command.amount = q.amount;
+    d.record.t_s = t_s;
+    d.record.source = "operator";
+    d.record.description = describeCommand(d.command, q.target_text);
+    d.record.status = "lost";  // until an outcome
+    out.push_back(std::move(d));
+  }
+  return out;
+}
+
 }  // namespace gesture_formation::sim

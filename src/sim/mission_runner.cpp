@@ -178,8 +178,8 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
   MetricsAccumulator metrics(cfg, ObstacleDistance{world.field, world.solids, world.ground_height_m}, seed);
   MissionMetrics& M = metrics.counters();
   std::vector<ModeChange> modes;
-  std::uint64_t operator_seq = 0, gesture_seq = 0;
-  std::size_t next_request = 0;
+  std::uint64_t gesture_seq = 0;
+  OperatorSchedule schedule(cfg.requests, "operator");
   int last_class = -1;
   double last_ratio = 0.0;
   double last_fused_s = -std::numeric_limits<double>::infinity();  // the leader's last fused worker measurement
@@ -333,22 +333,7 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
     const WorkerState ws = worker.stateAt(t);
 
     // Operator requests → operator link → the leader's FormationState.
-    while (next_request < cfg.requests.size() && cfg.requests[next_request].t_s <= t + 1e-9) {
-      const OperatorRequest& q = cfg.requests[next_request++];
-      formation::FormationCommand cmd;
-      cmd.id = {"operator", ++operator_seq};
-      cmd.source = formation::CommandSource::kOperator;
-      cmd.target = q.target;
-      cmd.parameter = q.parameter;
-      cmd.kind = q.kind;
-      cmd.amount = q.amount;
-      RequestRecord rec;
-      rec.t_s = t;
-      rec.source = "operator";
-      rec.description = describeCommand(cmd, q.target_text);
-      rec.status = "lost";
-      operator_link.send(t, OperatorMessage{metrics.addRequest(rec), t, cmd});
-    }
+    for (const auto& d : schedule.due(t)) operator_link.send(t, OperatorMessage{metrics.addRequest(d.record), t, d.command});
     for (const auto& msg : operator_link.receive(t)) {
       RequestRecord& rec = metrics.request(msg.record);
       if (t - msg.sent_s > cfg.faults.max_command_age_s) {  // never act on a command older than its age
@@ -362,8 +347,7 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
     // Follower dropouts: offline → nothing runs; back online → a rebooted computer with no memory.
     for (int i = 1; i < n; ++i) {
       UavRuntime& u = *uavs[static_cast<std::size_t>(i)];
-      bool off = false;
-      for (const auto& o : cfg.faults.follower_dropouts) off = off || (o.uav == i && t >= o.from_s && t < o.to_s);
+      const bool off = cfg.faults.followerOffline(i, t);
       if (off && !u.offline) {
         setMode(i, t, "offline", "follower dropout: the loaded plan is flown to its end and held");
       } else if (!off && u.offline) {

@@ -97,6 +97,8 @@ struct FaultConfig {
   /// late or lost fallback flag makes unsafe (docs/safety.md §2.1).
   bool avoid_all_plans = true;
   std::vector<std::string> validate(const std::string& prefix = "") const;
+  /// \brief Whether follower `uav`'s computer is down at `t_s` (a follower_dropouts window).
+  bool followerOffline(int uav, double t_s) const;
 };
 
 /// \brief True when t_s lies in one of the [from, to) windows.

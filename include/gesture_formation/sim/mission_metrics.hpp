@@ -181,6 +181,26 @@ struct TimelineInput {
 /// \brief "all.beta_deg +30" / "followers.distance_m = 8": a command as events.csv shows it.
 std::string describeCommand(const formation::FormationCommand& command, const std::string& target_text);
 
+/// \brief The mission's operator requests as they fall due: each becomes a FormationCommand
+/// (id {id_source, 1, 2, …} in schedule order) and the request record the metrics track
+/// (status "lost" until an outcome). Used by gfctl simulate and the ROS SimWorld.
+class OperatorSchedule {
+ public:
+  struct Due {
+    formation::FormationCommand command;
+    RequestRecord record;
+  };
+  OperatorSchedule(std::vector<OperatorRequest> requests, std::string id_source)
+      : requests_(std::move(requests)), id_source_(std::move(id_source)) {}
+  /// \brief The requests with t_s ≤ `t_s` not returned before, in order.
+  std::vector<Due> due(double t_s);
+
+ private:
+  std::vector<OperatorRequest> requests_;
+  std::string id_source_;
+  std::size_t next_ = 0;
+};
+
 /// \brief The record of a gesture fired at `t_s` with dominant id `gesture_id`, described and
 /// with its status from `mapping`: "unmapped" (no action), "event" (an event action), else
 /// "lost" until requestOutcome() says what the FormationState did with its command.
