@@ -227,7 +227,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
       NODELET_ERROR_STREAM("FormationPlanner UAV " << uav_index_ << ": " << res.qp_sparse_timeouts
                                                    << " sparse QP solve(s) abandoned after qp.solve_timeout_s (dense backend used; "
                                                    << planning::TrajectoryQp::abandonedSolves()
-                                                   << " abandoned in this process, docs/safety.md 4.5)");
+                                                   << " abandoned solve(s) still running in this process, docs/safety.md 4.5)");
     }
     auto msg = toMsg(res);
     msg.header.frame_id = world_frame_;

@@ -317,6 +317,7 @@ struct SparseJob {
   std::mutex mutex;
   std::condition_variable cv;
   bool done = false;
+  bool abandoned = false;  ///< the caller stopped waiting (counted in g_abandoned_solves until done)
   QpMatricesSolution result;
 };
 
@@ -350,6 +351,7 @@ QpMatricesSolution TrajectoryQp::solveMatrices(std::shared_ptr<const QpMatrices>
         std::lock_guard<std::mutex> lock(job->mutex);
         job->result = std::move(r);
         job->done = true;
+        if (job->abandoned) g_abandoned_solves.fetch_sub(1);  // it was only slow (a loaded machine)
       }
       job->cv.notify_all();
     }).detach();
@@ -361,8 +363,9 @@ QpMatricesSolution TrajectoryQp::solveMatrices(std::shared_ptr<const QpMatrices>
     if (job->cv.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return job->done; })) {
       return std::move(job->result);
     }
+    job->abandoned = true;
+    g_abandoned_solves.fetch_add(1);
   }
-  g_abandoned_solves.fetch_add(1);
   QpMatricesSolution out = guarded([&] { return solveDense(*m, x0, eps_abs, max_iterations); });
   out.sparse_timed_out = true;
   out.dense_backend = true;

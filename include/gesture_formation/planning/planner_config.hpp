@@ -107,7 +107,7 @@ struct PlannerConfig {
   int qp_max_iterations = 4000;
   /// Wall-clock bound (s) of ProxQP's sparse solve; past it the QP is re-solved by the dense
   /// backend (trajectory_qp.hpp, docs/safety.md §4.5), > 0.
-  double qp_solve_timeout_s = 0.5;
+  double qp_solve_timeout_s = 2.0;
 
   // --- camera heading / pitch -------------------------------------------------------------
   /// Solver of the camera angles (camera_tracking.hpp): the closed-form rate-limited filter

@@ -19,9 +19,9 @@
 /// Time bound: ProxQP's sparse solver can loop forever (0.7.2–0.8.0: its LDLᵀ row update corrupts
 /// the elimination tree; `max_iter` does not bound it; docs/safety.md §4.5). So the sparse solve
 /// runs on its own thread and is waited for at most `solve_timeout_s`; past that it is abandoned
-/// (the thread cannot be stopped, it keeps one core until the process exits) and the same QP is
-/// solved by ProxQP's dense backend (no elimination tree; ~7× slower, bounded by max_iter). After
-/// kMaxAbandonedSolves abandoned threads every later QP of the process goes to the dense backend.
+/// (the thread cannot be stopped: a looping one keeps a core until the process exits) and the same
+/// QP is solved by ProxQP's dense backend (no elimination tree; ~7× slower, bounded by max_iter).
+/// While kMaxAbandonedSolves abandoned threads are still running, every QP goes to the dense backend.
 /// Thread safety: solve() may be called from several threads (each call has its own solver).
 
 #include <memory>
@@ -68,7 +68,7 @@ struct TrajectoryQpProblem {
   double eps_abs = 1e-6;
   int max_iterations = 4000;
   /// Wall-clock bound (s) of the sparse solve before the dense fallback, > 0.
-  double solve_timeout_s = 0.5;
+  double solve_timeout_s = 2.0;
 };
 
 struct TrajectoryQpSolution {
@@ -116,8 +116,8 @@ class TrajectoryQp {
   /// waited for `timeout_s`, then dense. `x0` (optional, size of H): primal warm start.
   static QpMatricesSolution solveMatrices(std::shared_ptr<const QpMatrices> matrices, const Eigen::VectorXd* x0,
                                           double eps_abs, int max_iterations, double timeout_s);
-  /// \brief Sparse solves abandoned by this process so far; from kMaxAbandonedSolves on, only
-  /// the dense backend is used.
+  /// \brief Abandoned sparse solves still running (one that finishes late — a loaded machine —
+  /// is no longer counted); from kMaxAbandonedSolves on, only the dense backend is used.
   static int abandonedSolves();
   static constexpr int kMaxAbandonedSolves = 2;
 

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "gesture_formation/planning/trajectory_qp.hpp"
@@ -108,6 +109,29 @@ TEST(QpTimeBound, SparseSolveThatNeverReturnsFallsBackToTheDenseBackend) {
   // Returned after the timeout plus one dense solve, not never (ctest's limit would catch that;
   // this bound documents the order of magnitude on a loaded 2-core machine).
   EXPECT_LT(wall_s, 0.5 + 10.0);
+}
+
+TEST(QpTimeBound, ASolveAbandonedOnlyForSlownessStopsCountingWhenItFinishes) {
+  const RecordedQp q = readRecordedQp(std::string(GF_SOURCE_DIR) + "/test/data/planning/proxqp_sparse_hang.txt");
+  auto m = std::make_shared<const QpMatrices>(q.m);
+  const int before = TrajectoryQp::abandonedSolves();
+  // Cold start: the sparse solve returns after ~25 ms, far beyond a 1 µs wait (a thread does not
+  // even start that fast), so it is abandoned and the dense backend answers.
+  const QpMatricesSolution r = TrajectoryQp::solveMatrices(m, nullptr, q.eps_abs, q.max_iterations, 1e-6);
+  EXPECT_TRUE(r.sparse_timed_out);
+  EXPECT_TRUE(r.dense_backend);
+  ASSERT_EQ(r.status, TrajectoryQpSolution::Status::kSolved);
+  EXPECT_LT(violation(q.m, r.x), 1e-5);
+  // The late sparse thread finishes and is no longer counted: later QPs stay on the sparse backend.
+  const auto t0 = std::chrono::steady_clock::now();
+  while (TrajectoryQp::abandonedSolves() != before &&
+         std::chrono::steady_clock::now() - t0 < std::chrono::seconds(20)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  EXPECT_EQ(TrajectoryQp::abandonedSolves(), before);
+  const QpMatricesSolution next = TrajectoryQp::solveMatrices(m, nullptr, q.eps_abs, q.max_iterations, 5.0);
+  EXPECT_FALSE(next.dense_backend);
+  EXPECT_EQ(next.status, TrajectoryQpSolution::Status::kSolved);
 }
 
 TEST(QpTimeBound, ANonPositiveTimeoutIsRejected) {
