@@ -147,6 +147,11 @@ with open(report, "w") as f:
             "52 missions**: `harsh` seed 3 (1.81 m) and `delay_jitter` seed 3 (2.25 m) — a follower braked, and the "
             "leader learned it too late over the delayed link. Cause and fix (every UAV avoids every plan, now the "
             "default): [safety.md](safety.md) §4. The tables above are with the fix.\n\n")
+    import glob
+    archived = sorted(glob.glob(os.path.join(os.path.dirname(runs_file) or ".", "fault_matrix_runs_*.csv")))
+    if archived:
+        f.write("Runs of earlier commits (kept, not in the tables): " + ", ".join(
+            f"`{os.path.relpath(a)}` ({sum(1 for _ in open(a)) - 1} missions)" for a in archived) + ".\n\n")
     top = int(max((r["seed"] for r in all_rows), default=0))
     missing = [f"`{p}` seed {k}" for p in profiles for k in range(1, top + 1)
                if not any(r["profile"] == p and int(r["seed"]) == k for r in all_rows)]
