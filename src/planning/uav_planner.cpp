@@ -3,6 +3,7 @@
 #include "gesture_formation/planning/uav_planner.hpp"
 
 #include <algorithm>
+#include <functional>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -181,7 +182,25 @@ PlannedTrajectory UavPlanner::brakePlan(const PlanRequest& req) const {
 std::optional<PlannedTrajectory> UavPlanner::separateHoldPoint(const PlanRequest& req, const PlannedTrajectory& hold,
                                                                std::string& why) const {
   const int n = static_cast<int>(hold.samples.size());
-  if (n < 2 || !verifier_ || req.higher_priority_plans.empty()) return std::nullopt;
+  if (n < 2 || !verifier_) return std::nullopt;
+  // What the stop point keeps away from: the other UAVs' plans (Γ_dis) and the worker's
+  // predicted positions (worker_safety_distance_m), each plus the QP's buffer.
+  struct Keep {
+    std::function<Eigen::Vector3d(double)> at;
+    double distance;
+    std::string name;
+  };
+  std::vector<Keep> keep;
+  for (const auto& other : req.higher_priority_plans) {
+    if (other.empty()) continue;
+    keep.push_back({[&other](double t) { return evaluateTrajectory(other, t).p; },
+                    config_.mutual_distance_m + config_.qp_distance_buffer_m, "UAV " + std::to_string(other.uav_index)});
+  }
+  if (req.worker.steps() > 0 && req.worker.p_world.allFinite()) {
+    keep.push_back({[&req](double t) { return workerPositionAt(req.worker, req.t_now_s, req.dt_s, t); },
+                    config_.worker_safety_distance_m + config_.qp_distance_buffer_m, "the worker"});
+  }
+  if (keep.empty()) return std::nullopt;
   // First sample from which the plan stands still (the stop point).
   int k_stop = n - 1;
   while (k_stop > 0 && hold.samples[static_cast<std::size_t>(k_stop) - 1].v_world.norm() < 1e-9 &&
@@ -189,31 +208,30 @@ std::optional<PlannedTrajectory> UavPlanner::separateHoldPoint(const PlanRequest
     --k_stop;
   }
   const Eigen::Vector3d p_hold = hold.samples.back().p_world;
-  const double need = config_.mutual_distance_m + config_.qp_distance_buffer_m;
   Eigen::Vector3d away = Eigen::Vector3d::Zero();
   double deficit = 0.0;
-  int closest_uav = -1;
-  for (const auto& other : req.higher_priority_plans) {
-    if (other.empty()) continue;
+  std::string closest;
+  for (const auto& kp : keep) {
     double d_min = std::numeric_limits<double>::infinity();
     Eigen::Vector3d q_min = Eigen::Vector3d::Zero();
     for (int k = k_stop; k < n; ++k) {
-      const Eigen::Vector3d q = evaluateTrajectory(other, hold.t0_s + k * hold.dt_s).p;
+      const Eigen::Vector3d q = kp.at(hold.t0_s + k * hold.dt_s);
       const double d = (p_hold - q).norm();
       if (d < d_min) d_min = d, q_min = q;
     }
-    if (!(d_min < need) || !(d_min > 1e-6)) continue;
-    away += (p_hold - q_min) / d_min * (need - d_min);
-    if (need - d_min > deficit) deficit = need - d_min, closest_uav = other.uav_index;
+    if (!(d_min < kp.distance) || !(d_min > 1e-6)) continue;
+    away += (p_hold - q_min) / d_min * (kp.distance - d_min);
+    if (kp.distance - d_min > deficit) deficit = kp.distance - d_min, closest = kp.name;
   }
   if (!(away.norm() > 1e-6) || !(deficit > 1e-3)) return std::nullopt;
   const Eigen::Vector3d dir = away.normalized();
   const double D = std::min(deficit, config_.fallback_max_deviation_m);
-  // s(τ) = D (1 − cos(πτ/T)) / 2: peak speed Dπ/2T and acceleration Dπ²/2T² within the recovery pace.
-  // T a whole number of samples, so that the move ends on a sample (no overshoot in between).
+  // s(τ) = D (1 − cos(πτ/T)) / 2: peak speed Dπ/2T and acceleration Dπ²/2T² within the recovery
+  // pace; T a whole number of samples, so that the move ends on a sample (no overshoot in between).
   const double T = hold.dt_s * std::ceil(std::max(D * M_PI / (2.0 * config_.recovery_speed_mps),
                                                   M_PI * std::sqrt(D / (2.0 * config_.recovery_acceleration_mps2))) /
                                          hold.dt_s - 1e-9);
+  if (static_cast<double>(n - 1 - k_stop) * hold.dt_s < T) return std::nullopt;  // the move must end inside the plan
   PlannedTrajectory moved = hold;
   for (int k = k_stop; k < n; ++k) {
     const double tau = (k - k_stop) * hold.dt_s;
@@ -223,21 +241,19 @@ std::optional<PlannedTrajectory> UavPlanner::separateHoldPoint(const PlanRequest
     s.v_world = tau < T ? Eigen::Vector3d(dir * (D * M_PI / (2.0 * T) * std::sin(ph))) : Eigen::Vector3d::Zero();
     s.a_world = tau < T ? Eigen::Vector3d(dir * (D * M_PI * M_PI / (2.0 * T * T) * std::cos(ph))) : Eigen::Vector3d::Zero();
   }
-  if (static_cast<double>(n - 1 - k_stop) * hold.dt_s < T) return std::nullopt;  // the move must end inside the plan
   aimCamera(req, moved);
-  // Obstacles, worker, limits: the verifier without the other UAVs; the other UAVs: never closer than the hold.
-  const VerificationReport rep = verifier_->verify(moved, req.t_now_s, {}, req.worker, req.t_now_s, hold.dt_s);
+  // Obstacles and limits: the verifier alone; the UAVs and the worker: never closer than the hold.
+  const VerificationReport rep = verifier_->verify(moved, req.t_now_s, {}, formation::WorkerHorizon{}, req.t_now_s, hold.dt_s);
   if (!rep.ok) return std::nullopt;
-  for (const auto& other : req.higher_priority_plans) {
-    if (other.empty()) continue;
+  for (const auto& kp : keep) {
     for (double t = hold.t0_s; t <= hold.tEnd() + 1e-9; t += hold.dt_s / 4.0) {
-      const Eigen::Vector3d q = evaluateTrajectory(other, t).p;
+      const Eigen::Vector3d q = kp.at(t);
       if ((evaluateTrajectory(moved, t).p - q).norm() < (evaluateTrajectory(hold, t).p - q).norm() - 1e-6) return std::nullopt;
     }
   }
   std::ostringstream os;
   os.precision(3);
-  os << "; moving the brake point " << D << " m away from UAV " << closest_uav << " (Γ_dis + buffer " << need << " m)";
+  os << "; moving the brake point " << D << " m away from " << closest;
   why = os.str();
   return moved;
 }

@@ -179,10 +179,11 @@ class UavPlanner {
   struct Stage2;
   PlanResult fallback(const PlanRequest& request, PlanResult result, const std::string& reason);
   PlannedTrajectory brakePlan(const PlanRequest& request) const;
-  /// The brake plan `hold` with its stop point moved away from the other UAVs' plans it is
-  /// closer to than Γ_dis + qp.distance_buffer_m (after the stop, at the recovery pace), if
-  /// that move keeps the obstacle and worker checks and comes no closer to any other plan than
-  /// `hold` at any time; `why` names the move. Empty: keep `hold`.
+  /// The brake plan `hold` with its stop point moved away from the other UAVs' plans and the
+  /// worker's prediction it is closer to than Γ_dis / worker_safety_distance_m (+ qp buffer),
+  /// after the stop at the recovery pace, if the move passes the verifier's obstacle and limit
+  /// checks and comes no closer to any of them than `hold` at any time; `why` names the move.
+  /// Empty: keep `hold`.
   std::optional<PlannedTrajectory> separateHoldPoint(const PlanRequest& request, const PlannedTrajectory& hold,
                                                      std::string& why) const;
   void aimCamera(const PlanRequest& request, PlannedTrajectory& trajectory) const;

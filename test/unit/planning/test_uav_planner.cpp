@@ -649,6 +649,30 @@ TEST(UavPlannerTest, BrakePointCloserThanGammaDisMovesAwayThenHolds) {
   }
 }
 
+// delay_jitter seed 26: a braked follower hovered 3.2 m up while the worker walked under it
+// (2.56 m; worker_safety_distance_m 3). The stop point also keeps away from the worker's prediction.
+TEST(UavPlannerTest, BrakePointCloseToTheWorkerMovesAway) {
+  const World& w = towers();
+  PlannerConfig cfg = testConfig();
+  UavPlanner planner(cfg, w.map, w.field);
+  const Eigen::Vector3d start(-8, -12, 10), worker(-8, -10, 9);  // 2.24 m from the stop point
+  PlanRequest req = straightRequest(1, 10.0, stateAt(start, 10.0), start, start, 0.0, worker);
+  req.reference.p_world(0, 5) = std::numeric_limits<double>::quiet_NaN();  // the replanning fails
+  const PlanResult r = planner.plan(req);
+  ASSERT_EQ(r.status, PlanStatus::kFallbackBrake) << r.reason;
+  EXPECT_NE(r.reason.find("away from the worker"), std::string::npos) << r.reason;
+  const double need = cfg.worker_safety_distance_m + cfg.qp_distance_buffer_m;
+  EXPECT_GE((r.trajectory.samples.back().p_world - worker).norm(), need - 1e-6);
+  double d_prev = 0.0;
+  for (double t = 10.0; t <= r.trajectory.tEnd(); t += 0.05) {
+    const TrajectoryPoint x = evaluateTrajectory(r.trajectory, t);
+    EXPECT_LE(x.v.norm(), cfg.recovery_speed_mps + 1e-6) << "t=" << t;
+    EXPECT_GE((x.p - worker).norm(), d_prev - 1e-6) << "t=" << t << ": came closer to the worker";
+    d_prev = (x.p - worker).norm();
+  }
+  expectSafe(r.trajectory, *w.map, cfg);
+}
+
 TEST(UavPlannerTest, BoxedInBrakePointIsNotMoved) {
   const World& w = towers();
   PlannerConfig cfg = testConfig();
