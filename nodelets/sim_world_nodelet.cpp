@@ -235,9 +235,6 @@ class SimWorldNodelet : public nodelet::Nodelet {
     return toEigen(estimate_->position) + (t_s - estimate_->header.stamp.toSec()) * toEigen(estimate_->velocity);
   }
 
-  /// Whether follower i is in a mission follower dropout at t_s (its computer is down).
-  bool offline(int i, double t_s) const { return cfg_.faults.followerOffline(i, t_s); }
-
   void publishGesture(int uav, const gesture::Classification& c, const ros::Time& stamp) {
     gesture_formation::Gesture g;
     g.header.stamp = stamp;
@@ -253,7 +250,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
     if (follower_views_) {
       for (int i = 1; i < n_; ++i) {
         followers.push_back(*truth_[static_cast<std::size_t>(i)]);
-        online.push_back(!offline(i, t_));
+        online.push_back(!cfg_.faults.followerOffline(i, t_));
       }
     }
     const sim::LeaderCameraFrame cf = camera_->frame(t_, *truth_[0], followers, online, ws, *worker_, classifier_.get());

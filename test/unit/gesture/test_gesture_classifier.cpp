@@ -168,13 +168,25 @@ void expectThreeSecondGesturesFireOnce(const std::function<Performance(SkeletonS
   EXPECT_GE(exactly_once, cases - 1) << exactly_once << " of " << cases;
 }
 
+/// One camera's viewpoint drawn from `rng`: azimuth first, then elevation, then distance — the
+/// order in which GCC evaluated the former call's arguments (so the same viewpoints).
+struct SingleView {
+  double d, e, a;
+};
+SingleView drawSingleView(std::mt19937_64& rng, double d_min, double d_max, double e_min, double e_max) {
+  std::uniform_real_distribution<double> dist(d_min, d_max), elev(e_min, e_max), azim(-180.0, 180.0);
+  SingleView v{};
+  v.a = azim(rng);
+  v.e = elev(rng);
+  v.d = dist(rng);
+  return v;
+}
+
 TEST(GestureEndToEndTest, GestureHeldThreeSecondsFiresOnce) {
   GestureClassifier classifier = loadModel();
-  std::uniform_real_distribution<double> dist(6.0, 18.0), elev(5.0, 40.0), azim(-180.0, 180.0);
   expectThreeSecondGesturesFireOnce([&](SkeletonSynthesizer& synth, Motion m, std::mt19937_64& rng) {
-    // Azimuth first: the order in which GCC evaluated the former call's arguments (same viewpoints).
-    const double a = azim(rng), e = elev(rng), d = dist(rng);
-    const SynthSequence seq = synth.generateFrom(m, d, e, a);
+    const SingleView v = drawSingleView(rng, 6.0, 18.0, 5.0, 40.0);
+    const SynthSequence seq = synth.generateFrom(m, v.d, v.e, v.a);
     return Performance{firedCommands(classifier, seq), seq.motion_start_s, seq.motion_end_s};
   });
 }
@@ -209,13 +221,11 @@ void expectWorkMotionsFireNothing(
 // --gtest_also_run_disabled_tests.
 TEST(GestureEndToEndTest, DISABLED_WorkMotionsFireNothing) {
   GestureClassifier classifier = loadModel();
-  std::uniform_real_distribution<double> dist(5.0, 20.0), elev(0.0, 45.0), azim(-180.0, 180.0);
   expectWorkMotionsFireNothing([&](SkeletonSynthesizer& synth, Motion m, std::mt19937_64& rng) {
-    // Azimuth first: the order in which GCC evaluated the former call's arguments (same viewpoints).
-    const double a = azim(rng), e = elev(rng), d = dist(rng);
-    const SynthSequence seq = synth.generateFrom(m, d, e, a);
-    return std::make_pair(firedCommands(classifier, seq), "d " + std::to_string(d) + ", elevation " + std::to_string(e) +
-                                                              ", azimuth " + std::to_string(a));
+    const SingleView v = drawSingleView(rng, 5.0, 20.0, 0.0, 45.0);
+    const SynthSequence seq = synth.generateFrom(m, v.d, v.e, v.a);
+    return std::make_pair(firedCommands(classifier, seq), "d " + std::to_string(v.d) + ", elevation " +
+                                                              std::to_string(v.e) + ", azimuth " + std::to_string(v.a));
   });
 }
 
