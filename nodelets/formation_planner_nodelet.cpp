@@ -12,12 +12,14 @@
 // Topics: odometry_in (nav_msgs/Odometry, orientation = camera axis, docs/ros.md),
 //   worker_state_in (WorkerState: the leader's estimator, or the leader's share over LCM),
 //   plans_in (PlannedTrajectory of other UAVs), formation_params_in (followers),
-//   formation_command_in (leader) → plan_out (PlannedTrajectory), trajectory_out
+//   formation_command_in (leader), wind_estimate_in (geometry_msgs/TwistWithCovarianceStamped in
+//   world_frame, twist.linear = the wind: mavros `wind_estimation`; optional — without it no
+//   wind allowance, docs/safety.md §4.7) → plan_out (PlannedTrajectory), trajectory_out
 //   (trajectory_msgs/MultiDOFJointTrajectory), formation_params_out (leader, latched).
 // Parameters (all required unless noted): ~uav_index, ~uav_count, ~world_frame,
 //   ~scenario_file (the map), ~mission_file (optional: take formation + planner from a
 //   scenario's mission) or ~formation_config + ~planner_config, ~replanning_period_s,
-//   ~horizon_dt_s, ~horizon_steps, ~max_share_age_s, ~params_rate_hz; without ~mission_file
+//   ~horizon_dt_s, ~horizon_steps, ~max_share_age_s, ~params_rate_hz, ~max_wind_estimate_age_s; without ~mission_file
 //   also ~avoid_all_plans, ~max_plan_age_s (with it: the mission's faults.avoid_all_plans and
 //   faults.max_plan_age_s, as gfctl simulate).
 #include <map>
@@ -26,6 +28,7 @@
 
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
+#include <geometry_msgs/TwistWithCovarianceStamped.h>
 #include <ros/ros.h>
 
 #include "config_sources.hpp"
@@ -53,6 +56,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     params.load("horizon_dt_s", horizon_dt_s_, 0.02, 1.0);
     params.load("horizon_steps", horizon_steps_, 2, formation::kMaxHorizonSteps);
     params.load("max_share_age_s", max_share_age_s_, 0.1, 10.0);
+    params.load("max_wind_estimate_age_s", max_wind_age_s_, 0.1, 60.0);
     double params_rate_hz = 0.0;
     params.load("params_rate_hz", params_rate_hz, 0.1, 50.0);
     formation::FormationConfig fcfg;
@@ -98,6 +102,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     odom_sub_ = nh.subscribe("odometry_in", 5, &FormationPlannerNodelet::onOdometry, this);
     worker_sub_ = nh.subscribe("worker_state_in", 5, &FormationPlannerNodelet::onWorker, this);
     plans_sub_ = nh.subscribe("plans_in", 20, &FormationPlannerNodelet::onPlan, this);
+    wind_sub_ = nh.subscribe("wind_estimate_in", 5, &FormationPlannerNodelet::onWind, this);
     if (uav_index_ == formation::kLeader) {
       params_pub_ = nh.advertise<gesture_formation::FormationParams>("formation_params_out", 5, true);
       command_sub_ = nh.subscribe("formation_command_in", 20, &FormationPlannerNodelet::onCommand, this);
@@ -116,6 +121,20 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   void onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
     odom_ = toKinematicState(*msg);
+  }
+  void onWind(const geometry_msgs::TwistWithCovarianceStamped::ConstPtr& msg) {
+    const Eigen::Vector3d w = toEigen(msg->twist.twist.linear);
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (msg->header.frame_id != world_frame_ || !w.allFinite() || w.norm() > kMaxWindMps) {
+      ++wind_rejected_;
+      NODELET_WARN_STREAM_THROTTLE(2.0, "FormationPlanner: wind estimate rejected (frame_id '"
+                                            << msg->header.frame_id << "', expected '" << world_frame_
+                                            << "'; wind " << w.transpose() << " m/s, at most " << kMaxWindMps
+                                            << "); " << wind_rejected_ << " rejected so far");
+      return;
+    }
+    wind_ = w;
+    wind_stamp_s_ = msg->header.stamp.toSec();
   }
   void onWorker(const gesture_formation::WorkerState::ConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -209,6 +228,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     in.t_s = t;
     in.dt_s = horizon_dt_s_;
     in.state = *odom_;
+    if (wind_ && t - wind_stamp_s_ <= max_wind_age_s_) in.wind_estimate_mps = *wind_;
     const auto& last = planner_->lastVerifiedPlan();
     if (!last.empty()) in.state.a_world = last.sampleAt(t).a_world;
     in.worker = formation::constantVelocityHorizon(p0, v0, hphi, horizon_steps_, horizon_dt_s_);
@@ -244,6 +264,10 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   int uav_index_ = 0, uav_count_ = 0, horizon_steps_ = 0;
   std::string world_frame_;
   double period_s_ = 0.0, horizon_dt_s_ = 0.0, max_share_age_s_ = 0.0, offset_s_ = 0.0, next_plan_s_ = -1.0;
+  static constexpr double kMaxWindMps = 60.0;  ///< a larger wind estimate is garbage
+  double max_wind_age_s_ = 0.0, wind_stamp_s_ = 0.0;
+  std::optional<Eigen::Vector3d> wind_;
+  std::uint64_t wind_rejected_ = 0;
   formation::FormationParams params_;
   std::optional<formation::WorkerHeading> heading_;
   std::optional<formation::FormationState> state_;
@@ -258,7 +282,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   std::optional<gesture_formation::WorkerState> worker_;
   std::vector<std::optional<planning::ReceivedPlan>> received_;  ///< by sender; [0] the leader's plan
   ros::Publisher plan_pub_, traj_pub_, params_pub_;
-  ros::Subscriber odom_sub_, worker_sub_, plans_sub_, params_sub_, command_sub_;
+  ros::Subscriber odom_sub_, worker_sub_, plans_sub_, params_sub_, command_sub_, wind_sub_;
   ros::Timer timer_, params_timer_;
 };
 

@@ -5,7 +5,9 @@
 //
 // Topics: plan_in (PlannedTrajectory) → odometry_out (nav_msgs/Odometry, the noisy estimate the
 //   planner and estimator use; orientation = camera axis, docs/ros.md), ground_truth_out (the
-//   true state, for the world's sensors and metrics), tf world → <tf_prefix>/camera_axis and
+//   true state, for the world's sensors and metrics), wind_estimate_out
+//   (geometry_msgs/TwistWithCovarianceStamped, twist.linear = the wind, as mavros
+//   `wind_estimation`: sim::WindEstimate, for the planner's wind allowance), tf world → <tf_prefix>/camera_axis and
 //   <tf_prefix>/camera_optical (from the estimate, as the onboard camera pose would be).
 // Parameters (required): ~mission_file, ~uav_index, ~seed, ~world_frame, ~tf_prefix,
 //   ~publish_rate_hz.
@@ -14,6 +16,7 @@
 
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
+#include <geometry_msgs/TwistWithCovarianceStamped.h>
 #include <ros/ros.h>
 #include <tf2_ros/transform_broadcaster.h>
 
@@ -84,6 +87,7 @@ class SimUavNodelet : public nodelet::Nodelet {
 
     odom_pub_ = nh.advertise<nav_msgs::Odometry>("odometry_out", 10);
     truth_pub_ = nh.advertise<nav_msgs::Odometry>("ground_truth_out", 10);
+    wind_pub_ = nh.advertise<geometry_msgs::TwistWithCovarianceStamped>("wind_estimate_out", 10);
     plan_sub_ = nh.subscribe("plan_in", 5, &SimUavNodelet::onPlan, this);
     step_timer_ = nh.createTimer(ros::Duration(step_s_), &SimUavNodelet::onStep, this);
     publish_timer_ = nh.createTimer(ros::Duration(1.0 / rate_hz), &SimUavNodelet::onPublish, this);
@@ -109,6 +113,7 @@ class SimUavNodelet : public nodelet::Nodelet {
       const Eigen::Vector3d w = wind_->step(t_, step_s_);
       const sim::MultirotorCommand cmd = ctl_->update(t_, step_s_, est_);
       plant_->step(step_s_, cmd, w, ground_m_);
+      wind_estimate_.update(w, step_s_);
       t_ += step_s_;
     }
   }
@@ -132,6 +137,13 @@ class SimUavNodelet : public nodelet::Nodelet {
     const auto& s = plant_->state();
     odom_pub_.publish(odometry(stamp, est_.p_world, est_.v_world, est_.heading_rad, est_.pitch_rad));
     truth_pub_.publish(odometry(stamp, s.p_world, s.v_world, s.heading_rad, s.pitch_rad));
+    if (wind_estimate_.value().allFinite()) {
+      geometry_msgs::TwistWithCovarianceStamped wind;
+      wind.header.stamp = stamp;
+      wind.header.frame_id = world_frame_;
+      wind.twist.twist.linear = toVector3(wind_estimate_.value());
+      wind_pub_.publish(wind);
+    }
     geometry_msgs::TransformStamped axis;
     axis.header.stamp = stamp;
     axis.header.frame_id = world_frame_;
@@ -158,9 +170,10 @@ class SimUavNodelet : public nodelet::Nodelet {
   std::optional<sim::TrackingController> ctl_;
   std::optional<sim::Odometry> odo_;
   std::optional<sim::WindModel> wind_;
+  sim::WindEstimate wind_estimate_;
   sim::EstimatedState est_;
   tf2_ros::TransformBroadcaster tf_;
-  ros::Publisher odom_pub_, truth_pub_;
+  ros::Publisher odom_pub_, truth_pub_, wind_pub_;
   ros::Subscriber plan_sub_;
   ros::Timer step_timer_, publish_timer_;
 };

@@ -11,6 +11,7 @@ PlanRequest buildPlanRequest(const PlanRequestInputs& in) {
   req.dt_s = in.dt_s;
   req.state = in.state;
   req.state.t_s = in.t_s;
+  req.wind_estimate_mps = in.wind_estimate_mps;
   req.worker = in.worker;
   const bool hold = in.hold_reference != nullptr;
   const bool has_leader_plan = i != 0 && in.leader_plan != nullptr && !in.leader_plan->empty();

@@ -53,6 +53,10 @@ std::vector<std::string> PlannerConfig::validate() const {
   require(e, nonneg(tracking_allowance_max_m) && tracking_allowance_max_m >= tracking_allowance_min_m,
           "path.tracking_allowance_max_m", tracking_allowance_max_m, "must be >= path.tracking_allowance_min_m");
   require(e, pos(tracking_allowance_decay_mps), "path.tracking_allowance_decay_mps", tracking_allowance_decay_mps, "must be > 0");
+  require(e, nonneg(wind_allowance_from_mps), "path.wind_allowance_from_mps", wind_allowance_from_mps, "must be >= 0");
+  require(e, nonneg(wind_allowance_m_per_mps), "path.wind_allowance_m_per_mps", wind_allowance_m_per_mps, "must be >= 0");
+  require(e, nonneg(wind_allowance_max_m), "path.wind_allowance_max_m", wind_allowance_max_m, "must be >= 0");
+  require(e, pos(wind_window_s), "path.wind_window_s", wind_window_s, "must be > 0");
   require(e, pos(max_projection_m), "path.max_projection_m", max_projection_m, "must be > 0");
   require(e, nonneg(path_merge_tolerance_m), "path.merge_tolerance_m", path_merge_tolerance_m, "must be >= 0");
   require(e, pos(search_margin_m), "path.search_margin_m", search_margin_m, "must be > 0");
@@ -109,6 +113,10 @@ PlannerConfig readPlannerConfig(ConfigReader& r, const std::string& prefix) {
   r.readDouble(key("path.tracking_allowance_min_m"), c.tracking_allowance_min_m, Range::nonNegative());
   r.readDouble(key("path.tracking_allowance_max_m"), c.tracking_allowance_max_m, Range::nonNegative());
   r.readDouble(key("path.tracking_allowance_decay_mps"), c.tracking_allowance_decay_mps, Range::positive());
+  r.readDouble(key("path.wind_allowance_from_mps"), c.wind_allowance_from_mps, Range::nonNegative());
+  r.readDouble(key("path.wind_allowance_m_per_mps"), c.wind_allowance_m_per_mps, Range::nonNegative());
+  r.readDouble(key("path.wind_allowance_max_m"), c.wind_allowance_max_m, Range::nonNegative());
+  r.readDouble(key("path.wind_window_s"), c.wind_window_s, Range::positive());
   r.readDouble(key("path.max_projection_m"), c.max_projection_m, Range::positive());
   r.readDouble(key("path.merge_tolerance_m"), c.path_merge_tolerance_m, Range::nonNegative());
   r.readDouble(key("path.search_margin_m"), c.search_margin_m, Range::positive());

@@ -133,6 +133,7 @@ void UavPlanner::reset() {
   brake_ = PlannedTrajectory{};
   flown_ = PlannedTrajectory{};
   tracking_deviation_m_ = 0.0;
+  wind_speeds_.clear();
   sequence_ = 0;
 }
 
@@ -147,6 +148,22 @@ void UavPlanner::updateTrackingAllowance(const PlanRequest& req) {
     const double d = (evaluateTrajectory(flown_, req.t_now_s).p - req.state.p_world).norm();
     if (std::isfinite(d)) tracking_deviation_m_ = std::max(tracking_deviation_m_, d);
   }
+}
+
+double UavPlanner::updateWindAllowance(const PlanRequest& req) {
+  if (!std::isfinite(req.t_now_s)) return 0.0;
+  // A clock that jumps back (a restarted simulation, a replayed bag) starts a new window.
+  if (!wind_speeds_.empty() && req.t_now_s < wind_speeds_.back().first) wind_speeds_.clear();
+  const Eigen::Vector3d& w = req.wind_estimate_mps;
+  if (w.head<2>().allFinite()) wind_speeds_.emplace_back(req.t_now_s, w.head<2>().norm());
+  while (!wind_speeds_.empty() && wind_speeds_.front().first < req.t_now_s - config_.wind_window_s) {
+    wind_speeds_.pop_front();
+  }
+  if (wind_speeds_.empty()) return 0.0;
+  double peak = 0.0;
+  for (const auto& [t, v] : wind_speeds_) peak = std::max(peak, v);
+  return std::clamp(config_.wind_allowance_m_per_mps * (peak - config_.wind_allowance_from_mps), 0.0,
+                    config_.wind_allowance_max_m);
 }
 
 // ---- fallbacks -------------------------------------------------------------------------------
@@ -414,9 +431,11 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
   PlanResult result;
   result.trajectory.uav_index = req.uav_index;
   updateTrackingAllowance(req);
-  const double allowance =
-      std::clamp(tracking_deviation_m_, config_.tracking_allowance_min_m, config_.tracking_allowance_max_m);
+  const double wind_allowance = updateWindAllowance(req);
+  const double allowance = std::clamp(tracking_deviation_m_, config_.tracking_allowance_min_m + wind_allowance,
+                                      config_.tracking_allowance_max_m + wind_allowance);
   result.tracking_allowance_m = allowance;
+  result.wind_allowance_m = wind_allowance;
   const auto finish = [&](PlanResult r) {
     flown_ = r.trajectory;
     r.timings.total_ms = msSince(t_start);

@@ -15,6 +15,7 @@
 #include "gesture_formation/planning/occupancy_map.hpp"
 #include "gesture_formation/planning/plan_request_builder.hpp"
 #include "gesture_formation/sim/random.hpp"
+#include "gesture_formation/sim/wind.hpp"
 
 namespace gesture_formation::sim {
 
@@ -78,6 +79,7 @@ struct UavRuntime {
   Odometry odo;
   std::unique_ptr<MissionPlanner> planner;
   EstimatedState est;
+  WindEstimate wind_estimate;  ///< the flight stack's wind estimate (planning's wind allowance)
   double next_plan_s = 0.0;
   std::optional<LeaderShare> share;                           ///< followers: last received from the leader
   std::vector<std::optional<PlanMessage>> received;  ///< plans received from the followers
@@ -295,6 +297,7 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
     in.state.a_world = u.plant.state().a_world;
     in.state.heading_rad = u.est.heading_rad;
     in.state.pitch_rad = u.est.pitch_rad;
+    in.wind_estimate_mps = u.wind_estimate.value();
     in.worker = wh;
     in.params = &params;
     in.leader_plan = share != nullptr ? &share->plan : nullptr;
@@ -487,6 +490,7 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
     for (auto& u : uavs) {
       const MultirotorCommand cmd = u->ctl.update(t, dt, u->est);
       u->plant.step(dt, cmd, w, world.ground_height_m);
+      u->wind_estimate.update(w, dt);
     }
   }
 

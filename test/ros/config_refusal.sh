@@ -43,6 +43,7 @@ check() {  # log, pattern, what
 for f in fp_bad gc_bad gc_vf vo_bad lb_bad sw_bad; do check $f "refuses to start" "refusal"; done
 check fp_bad "fp_bad/replanning_period_s: value 99 out of range" "out-of-range replanning_period_s"
 check fp_bad "fp_bad/max_share_age_s: missing" "missing max_share_age_s"
+check fp_bad "fp_bad/max_wind_estimate_age_s: missing" "missing max_wind_estimate_age_s"
 check fp_bad "fp_bad/avoid_all_plans: missing" "missing avoid_all_plans (the avoidance rule without a mission)"
 check fp_bad "limits.distance_max_m" "the missing YAML key limits.distance_max_m"
 check gc_bad "ratio_threshold" "the out-of-range YAML key ratio_threshold"

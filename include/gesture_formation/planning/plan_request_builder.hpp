@@ -15,6 +15,7 @@
 /// Plans are added in the order: the leader's, then followers 1, 2, … (the planner's input).
 /// Thread safety: pure function.
 
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -43,6 +44,8 @@ struct PlanRequestInputs {
   double t_s = 0.0;                  ///< now; sample 0 of the reference
   double dt_s = 0.2;                 ///< horizon step [s]
   UavKinematicState state;  ///< the UAV's current (estimated) state
+  /// The flight stack's wind estimate (world, m/s; non-finite: none) — PlanRequest::wind_estimate_mps.
+  Eigen::Vector3d wind_estimate_mps = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
   formation::WorkerHorizon worker;    ///< the worker's predicted trajectory (its steps = the horizon's)
   const formation::FormationParams* params = nullptr;  ///< required: the formation's parameters
   /// Followers: the leader's last received plan (null or empty: none; the reference then

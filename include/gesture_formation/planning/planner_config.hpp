@@ -66,6 +66,18 @@ struct PlannerConfig {
   double tracking_allowance_min_m = 0.3;
   double tracking_allowance_max_m = 0.5;
   double tracking_allowance_decay_mps = 0.02;
+  /// Wind allowance (docs/safety.md §4.7): a gust pushes a UAV off its plan before any
+  /// deviation can be measured, and the push grows with the air speed it brings (drag). So both
+  /// bounds of the tracking allowance grow by
+  ///   clamp(wind_allowance_m_per_mps · (v_peak − wind_allowance_from_mps), 0, wind_allowance_max_m),
+  /// v_peak = the largest horizontal speed of the flight stack's wind estimate
+  /// (PlanRequest::wind_estimate_mps) over the last wind_window_s — the site's gust level, as
+  /// a weather report's gust figure is the peak of its window. No estimate: no wind allowance.
+  /// (from ≥ 0, m_per_mps ≥ 0, max ≥ 0, window > 0.)
+  double wind_allowance_from_mps = 5.0;
+  double wind_allowance_m_per_mps = 0.05;
+  double wind_allowance_max_m = 0.3;
+  double wind_window_s = 120.0;
   /// Largest distance (m) a reference may be moved by the projection; > 0.
   double max_projection_m = 6.0;
   /// Consecutive reference points are merged into one path segment while every merged point

@@ -20,9 +20,12 @@
 /// nodelet code against. Fields may be added; do not rename.
 
 #include <cstdint>
+#include <deque>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -84,6 +87,10 @@ struct PlanRequest {
   /// Plans of the higher-priority UAVs as last received (any stamps; older plans get a
   /// margin growing with their age).
   std::vector<PlannedTrajectory> higher_priority_plans;
+  /// The flight stack's estimate of the wind at the UAV (world, m/s; e.g. mavros
+  /// `wind_estimation`); non-finite: none. Feeds the wind allowance
+  /// (PlannerConfig::wind_allowance_*).
+  Eigen::Vector3d wind_estimate_mps = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
 };
 
 enum class PlanStatus {
@@ -134,6 +141,8 @@ struct PlanResult {
   /// (PlannerConfig::tracking_allowance_*): the largest recent deviation of the state from the
   /// plan being flown.
   double tracking_allowance_m = 0.0;
+  /// The part of tracking_allowance_m's bounds due to the wind (PlannerConfig::wind_allowance_*).
+  double wind_allowance_m = 0.0;
 };
 
 class TrajectoryVerifier;
@@ -188,6 +197,8 @@ class UavPlanner {
                                                      std::string& why) const;
   void aimCamera(const PlanRequest& request, PlannedTrajectory& trajectory) const;
   void updateTrackingAllowance(const PlanRequest& request);
+  /// Records request.wind_estimate_mps; returns the wind allowance (PlannerConfig::wind_allowance_*).
+  double updateWindAllowance(const PlanRequest& request);
 
   PlannerConfig config_;
   std::string config_error_;
@@ -206,6 +217,8 @@ class UavPlanner {
   PlannedTrajectory flown_;
   double tracking_deviation_m_ = 0.0;
   double allowance_t_s_ = 0.0;
+  /// Horizontal wind-estimate speeds (t, m/s) of the last wind_window_s, for the wind allowance.
+  std::deque<std::pair<double, double>> wind_speeds_;
   std::uint32_t sequence_ = 0;
   bool keep_last_qp_ = false;
   std::unique_ptr<TrajectoryQpProblem> last_qp_;

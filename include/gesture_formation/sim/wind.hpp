@@ -5,6 +5,8 @@
 /// One field shared by all UAVs (the site is small against the wind's correlation length).
 /// Deterministic for its RNG. Thread safety: none.
 
+#include <cmath>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -39,6 +41,29 @@ class WindModel {
   double next_gust_s_ = 0.0;
   double gust_start_s_ = -1e9;
   Eigen::Vector3d gust_dir_ = Eigen::Vector3d::UnitX();
+};
+
+/// \brief Stands in for the flight stack's wind estimate (PX4's EKF2 wind states, published
+/// by mavros as `wind_estimation`; they converge over seconds): the wind at the UAV low-passed
+/// with `time_constant_s`, starting at the first sample; NaN before it.
+class WindEstimate {
+ public:
+  static constexpr double kDefaultTimeConstantS = 2.0;
+  explicit WindEstimate(double time_constant_s = kDefaultTimeConstantS) : tau_s_(time_constant_s) {}
+  /// \brief Advances by `dt_s` (≥ 0) towards the wind `wind_mps` and returns the estimate.
+  const Eigen::Vector3d& update(const Eigen::Vector3d& wind_mps, double dt_s) {
+    if (!value_.allFinite()) {
+      value_ = wind_mps;
+    } else {
+      value_ += (wind_mps - value_) * (1.0 - std::exp(-dt_s / tau_s_));
+    }
+    return value_;
+  }
+  const Eigen::Vector3d& value() const { return value_; }
+
+ private:
+  double tau_s_;
+  Eigen::Vector3d value_ = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
 };
 
 }  // namespace gesture_formation::sim

@@ -771,6 +771,94 @@ TEST(UavPlannerTest, TrackingAllowanceDecaysAndIsClamped) {
   EXPECT_DOUBLE_EQ(r.tracking_allowance_m, 0.1);  // forgotten with the plan
 }
 
+// The wind allowance (docs/safety.md §4.7): both bounds of the tracking allowance grow with the
+// peak of the flight stack's wind estimate over wind_window_s; no estimate, no wind allowance.
+TEST(UavPlannerTest, WindAllowanceFollowsThePeakWindEstimateOfTheWindow) {
+  const World& w = towers();
+  PlannerConfig cfg = testConfig();
+  cfg.tracking_allowance_min_m = 0.1;
+  cfg.tracking_allowance_max_m = 0.4;
+  cfg.wind_allowance_from_mps = 5.0;
+  cfg.wind_allowance_m_per_mps = 0.05;
+  cfg.wind_allowance_max_m = 0.3;
+  cfg.wind_window_s = 10.0;
+  UavPlanner planner(cfg, w.map, w.field);
+  const Eigen::Vector3d from(-8, -12, 10), worker(-5, -3, 1);
+  double t = 0.0;
+  PlanResult r = planner.plan(straightRequest(0, t, stateAt(from), from, from, 0.0, worker));
+  EXPECT_EQ(r.wind_allowance_m, 0.0);  // no estimate
+  EXPECT_DOUBLE_EQ(r.tracking_allowance_m, 0.1);
+  const auto at = [&](double t_s, const Eigen::Vector3d& wind) {
+    PlanRequest q = straightRequest(0, t_s, advance(r.trajectory, t_s), from, from, 0.0, worker);
+    q.wind_estimate_mps = wind;
+    return planner.plan(q);
+  };
+  r = at(t += 0.4, Eigen::Vector3d(3.0, 0.0, 0.0));  // below wind_allowance_from_mps
+  EXPECT_EQ(r.wind_allowance_m, 0.0);
+  r = at(t += 0.4, Eigen::Vector3d(6.0, -8.0, 5.0));  // 10 m/s horizontally (the vertical part is not counted)
+  EXPECT_NEAR(r.wind_allowance_m, 0.25, 1e-12);
+  EXPECT_NEAR(r.tracking_allowance_m, 0.35, 1e-12);  // the floor 0.1 + 0.25
+  const double peak_t = t;
+  r = at(t += 0.4, Eigen::Vector3d(2.0, 0.0, 0.0));  // the peak is held for the window ...
+  EXPECT_NEAR(r.wind_allowance_m, 0.25, 1e-12);
+  while (t < peak_t + 9.5) r = at(t += 0.4, Eigen::Vector3d(2.0, 0.0, 0.0));  // last: 9.6 s after the peak
+  EXPECT_NEAR(r.wind_allowance_m, 0.25, 1e-12) << "t = " << t;
+  t = peak_t + 10.5;
+  r = at(t, Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()));  // ... then forgotten
+  EXPECT_EQ(r.wind_allowance_m, 0.0) << "t = " << t;
+  r = at(t += 0.4, Eigen::Vector3d(40.0, 0.0, 0.0));  // capped at wind_allowance_max_m
+  EXPECT_NEAR(r.wind_allowance_m, 0.3, 1e-12);
+  // A measured deviation above the raised floor is kept up to the raised cap (0.4 + 0.3).
+  UavKinematicState s = advance(r.trajectory, t + 0.4);
+  s.p_world += Eigen::Vector3d(0.65, 0, 0);
+  PlanRequest q = straightRequest(0, t += 0.4, s, from, from, 0.0, worker);
+  q.wind_estimate_mps = Eigen::Vector3d(1.0, 0.0, 0.0);
+  r = planner.plan(q);
+  EXPECT_NEAR(r.tracking_allowance_m, 0.65, 1e-9);
+  planner.reset();  // forgotten with the plan
+  r = planner.plan(straightRequest(0, t, stateAt(from, t), from, from, 0.0, worker));
+  EXPECT_EQ(r.wind_allowance_m, 0.0);
+}
+
+// In wind, plans keep the wind allowance from the tower on top of the corridor clearance.
+TEST(UavPlannerTest, WindEstimateGrowsTheObstacleClearanceOfPlanning) {
+  const World& w = towers();
+  PlannerConfig cfg = testConfig();
+  cfg.tracking_allowance_min_m = 0.0;
+  const Eigen::Vector3d from(-6, 6, 6), to(2.7, 2.7, 6), worker(-8, 8, 1);  // ends hugging the tower
+  double calm = 0.0, windy = 0.0;
+  for (bool wind : {false, true}) {
+    UavPlanner planner(cfg, w.map, w.field);
+    PlanRequest q = straightRequest(0, 0.0, stateAt(from), from, to, 2.0, worker);
+    if (wind) q.wind_estimate_mps = Eigen::Vector3d(9.0, 7.0, 0.0);  // 11.4 m/s: 0.3 m (the cap)
+    const PlanResult r = planner.plan(q);
+    ASSERT_EQ(r.status, PlanStatus::kOptimized) << r.reason;
+    EXPECT_NEAR(r.wind_allowance_m, wind ? 0.3 : 0.0, 1e-12);
+    expectSafe(r.trajectory, *w.map, cfg);
+    double d = std::numeric_limits<double>::infinity();
+    for (double t = 0.0; t <= r.trajectory.tEnd() + 1e-9; t += r.trajectory.dt_s / 8) {
+      d = std::min(d, centreDistance(*w.map, evaluateTrajectory(r.trajectory, t).p, 3.0));
+    }
+    (wind ? windy : calm) = d;
+  }
+  EXPECT_LT(calm, cfg.obstacle_clearance_m + 0.25);  // calm: the plan hugs the corridor clearance
+  EXPECT_GE(windy, cfg.obstacle_clearance_m + 0.3 - cfg.corridor_margin_m) << "calm: " << calm;
+}
+
+TEST(UavPlannerTest, WindAllowanceKeysAreValidated) {
+  PlannerConfig c;
+  c.wind_allowance_from_mps = -1.0;
+  c.wind_allowance_m_per_mps = std::numeric_limits<double>::quiet_NaN();
+  c.wind_allowance_max_m = -0.1;
+  c.wind_window_s = 0.0;
+  std::string all;
+  for (const auto& e : c.validate()) all += e + "\n";
+  for (const char* key : {"path.wind_allowance_from_mps", "path.wind_allowance_m_per_mps", "path.wind_allowance_max_m",
+                          "path.wind_window_s"}) {
+    EXPECT_NE(all.find(key), std::string::npos) << key << " not in:\n" << all;
+  }
+  EXPECT_EQ(c.validate().size(), 4u) << all;
+}
 
 // PlanResult::corridors (for display): one per path segment when the QP stage ran, each
 // containing its segment, every sample after the first inside one of them; empty when the
