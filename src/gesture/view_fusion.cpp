@@ -30,6 +30,12 @@ std::vector<std::string> ViewFusionConfig::validate() const {
     e.push_back("view_fusion.elevation_max_deg must be in (elevation_min_deg=" + num(elevation_min_deg) + ", 90], got " +
                 num(elevation_max_deg));
   }
+  if (!(std::isfinite(vote_window_s) && vote_window_s >= 0.0 && vote_window_s <= 60.0)) {
+    e.push_back("view_fusion.vote_window_s must be in [0, 60], got " + num(vote_window_s));
+  }
+  if (!(vote_min_fraction > 0.0 && vote_min_fraction <= 1.0)) {
+    e.push_back("view_fusion.vote_min_fraction must be in (0, 1], got " + num(vote_min_fraction));
+  }
   return e;
 }
 
@@ -43,6 +49,8 @@ ViewFusionConfig readViewFusionConfig(ConfigReader& r) {
   r.readDouble(k + "distance_max_m", c.distance_max_m, Range::positive());
   r.readDouble(k + "elevation_min_deg", c.elevation_min_deg, Range::closed(-90.0, 90.0));
   r.readDouble(k + "elevation_max_deg", c.elevation_max_deg, Range::closed(-90.0, 90.0));
+  r.readDouble(k + "vote_window_s", c.vote_window_s, Range::closed(0.0, 60.0));
+  r.readDouble(k + "vote_min_fraction", c.vote_min_fraction, Range::closed(1e-9, 1.0));
   if (c.distance_max_m <= c.distance_min_m) {
     r.addError(k + "distance_max_m", "value " + common::formatDouble(c.distance_max_m) + " must exceed distance_min_m " +
                                          common::formatDouble(c.distance_min_m));
@@ -58,7 +66,8 @@ ViewFusion::ViewFusion(const ViewFusionConfig& config, int views, int max_gestur
     : config_(config),
       max_gesture_id_(std::max(1, max_gesture_id)),
       latest_(static_cast<std::size_t>(std::max(1, views))),
-      have_(static_cast<std::size_t>(std::max(1, views)), false) {
+      have_(static_cast<std::size_t>(std::max(1, views)), false),
+      history_(static_cast<std::size_t>(std::max(1, views))) {
   config_.min_agreeing_views = std::max(1, config_.min_agreeing_views);
 }
 
@@ -82,7 +91,31 @@ bool ViewFusion::observe(const ViewObservation& o, std::string* reason) {
   }
   latest_[i] = o;
   have_[i] = true;
+  auto& h = history_[i];
+  h.push_back(o);
+  const double keep_s = config_.vote_window_s + config_.max_age_s;
+  while (!h.empty() && h.front().t_s < o.t_s - keep_s) h.pop_front();
   return true;
+}
+
+int ViewFusion::viewVote(std::size_t i, double t_now) const {
+  if (!(config_.vote_window_s > 0.0)) return latest_[i].gesture_id;
+  std::vector<int> count(static_cast<std::size_t>(max_gesture_id_ + 1), 0);
+  int total = 0;
+  for (const ViewObservation& o : history_[i]) {
+    if (!(o.t_s > t_now - config_.vote_window_s && o.t_s <= t_now + config_.max_age_s)) continue;
+    if (!inEnvelope(o.distance_m, o.elevation_deg)) continue;
+    ++total;
+    ++count[static_cast<std::size_t>(o.gesture_id)];
+  }
+  int best = 0, best_count = 0;  // the most frequent gesture (≠ none); ties: the lower id
+  for (int g = 1; g <= max_gesture_id_; ++g) {
+    if (count[static_cast<std::size_t>(g)] > best_count) {
+      best = g;
+      best_count = count[static_cast<std::size_t>(g)];
+    }
+  }
+  return best_count > 0 && best_count >= config_.vote_min_fraction * total ? best : 0;
 }
 
 bool ViewFusion::inEnvelope(double distance_m, double elevation_deg) const {
@@ -101,7 +134,7 @@ FusedGesture ViewFusion::fuse(double t_now) const {
     if (!(t_now - o.t_s <= config_.max_age_s) || o.t_s > t_now + config_.max_age_s) continue;
     if (!inEnvelope(o.distance_m, o.elevation_deg)) continue;
     ++out.voting_views;
-    ++votes[static_cast<std::size_t>(o.gesture_id)];
+    ++votes[static_cast<std::size_t>(viewVote(i, t_now))];
   }
   int best = 0, best_votes = 0;
   bool unique = false;

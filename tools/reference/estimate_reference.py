@@ -30,6 +30,7 @@ DEFAULTS = {
     "initial_velocity_std_mps": 1.0,
     "gate_chi2": 16.27,
     "max_consecutive_rejections": 10,
+    "lost_timeout_s": 5.0,
 }
 
 
@@ -112,6 +113,8 @@ def main():
     x = None
     P = None
     t_state = None
+    t_fused = None
+    lost_timeout = merged(cfg, "lost_timeout_s")
     rejections = 0
     rows_out = []
     with open(a.inp) as f:
@@ -147,15 +150,26 @@ def main():
                     P = np.zeros((6, 6))
                     P[:3, :3] = meas[1]
                     P[3:, 3:] = np.eye(3) * sv0 ** 2
-                    t_state, accepted, rejections = t, 1, 0
+                    t_state, t_fused, accepted, rejections = t, t, 1, 0
                 else:
                     source = "none"
             elif math.isfinite(t) and t >= t_state:
-                dt = t - t_state
+                # constant velocity until lost_timeout_s after the last fused measurement; beyond
+                # it the position is held, the velocity forgotten, P_pp grows by σ_v0²·1 s per s
+                t_model_end = t_fused + lost_timeout
+                dt = max(0.0, min(t, t_model_end) - t_state)
+                dt_held = max(0.0, t - max(t_state, t_model_end))
                 F = np.eye(6)
                 F[:3, 3:] = dt * np.eye(3)
                 x = F @ x
-                P = F @ P @ F.T + Q
+                P = F @ P @ F.T
+                if t > t_model_end:
+                    x[3:] = 0.0
+                    P[:3, 3:] = 0.0
+                    P[3:, :3] = 0.0
+                    P[3:, 3:] = np.eye(3) * sv0 ** 2
+                    P[:3, :3] += np.eye(3) * sv0 ** 2 * dt_held
+                P = P + Q
                 t_state = t
                 if meas is not None:
                     z, S_m = meas
@@ -166,13 +180,13 @@ def main():
                         K = P @ Hm.T @ np.linalg.inv(S)
                         x = x + K @ y
                         P = (np.eye(6) - K @ Hm) @ P
-                        accepted, rejections = 1, 0
+                        accepted, rejections, t_fused = 1, 0, t
                     elif rejections >= max_rej:
                         x = np.concatenate([z, np.zeros(3)])
                         P = np.zeros((6, 6))
                         P[:3, :3] = S_m
                         P[3:, 3:] = np.eye(3) * sv0 ** 2
-                        accepted, rejections = 1, 0
+                        accepted, rejections, t_fused = 1, 0, t
                     else:
                         rejections += 1
             # else: time went backwards: nothing changes (a detection is dropped)

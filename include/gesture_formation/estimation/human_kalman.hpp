@@ -9,10 +9,12 @@
 ///
 /// Beyond the paper: Mahalanobis gating (χ²₃) with re-initialisation after more than
 /// `max_consecutive_rejections` rejections in a row, measurements older than the filter's
-/// time dropped and counted, non-finite input rejected, a "lost" flag after a timeout.
+/// time dropped and counted, non-finite input rejected, a "lost" flag after a timeout, after
+/// which the velocity is no longer extrapolated (see predict()).
 /// A rejected input never changes the state.
 /// Thread safety: none; one filter per thread (the nodelet guards it with a mutex).
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -35,7 +37,7 @@ struct HumanKalmanConfig {
   double initial_velocity_std_mps = 1.0;  ///< σ_v0 of the velocity at (re-)initialisation [m/s], > 0
   double gate_chi2 = 16.27;               ///< Mahalanobis gate, χ²₃ at 0.999, > 0
   int max_consecutive_rejections = 10;    ///< at most this many gated-out measurements in a row, ≥ 1
-  double lost_timeout_s = 5.0;            ///< no fused measurement for this long → lost [s], > 0
+  double lost_timeout_s = 5.0;            ///< no fused measurement for this long → lost, and no more extrapolation [s], > 0
 
   std::vector<std::string> validate() const {
     std::vector<std::string> e;
@@ -127,9 +129,18 @@ class HumanKalman {
 
   /// \brief Predicts the state to `t_s` (≥ time()), adding Q once. Returns false and changes
   /// nothing when not initialised, `t_s` is not finite, or `t_s` < time().
+  ///
+  /// The constant-velocity model holds for at most lost_timeout_s after the last fused
+  /// measurement. Beyond it (lost) the filter no longer extrapolates: the position is held where
+  /// the model left it, the velocity is forgotten (mean 0, covariance σ_v0² I, no correlation)
+  /// and the position covariance grows by σ_v0²·(1 s) per second — a random walk at σ_v0 — so a
+  /// worker who climbed out of view is not estimated tens of metres above the tower
+  /// (docs/safety.md §4.6), and the growing covariance lets him be re-acquired where he reappears.
   bool predict(double t_s) {
     if (!initialized_ || !std::isfinite(t_s) || t_s < t_) return false;
-    const double dt = t_s - t_;
+    const double t_model_end = t_last_fused_ + config_.lost_timeout_s;
+    const double dt = std::max(0.0, std::min(t_s, t_model_end) - t_);       // constant velocity
+    const double dt_held = std::max(0.0, t_s - std::max(t_, t_model_end));  // lost: position held
     Vector6d x = x_;
     x.head<3>() += dt * x_.tail<3>();
     // F P Fᵀ written out by blocks (F = [[I, dt I], [0, I]]).
@@ -140,6 +151,14 @@ class HumanKalman {
     P.topLeftCorner<3, 3>() = Ppp + dt * (Ppv + Ppv.transpose()) + dt * dt * Pvv;
     P.topRightCorner<3, 3>() = Ppv + dt * Pvv;
     P.bottomLeftCorner<3, 3>() = P.topRightCorner<3, 3>().transpose();
+    if (t_s > t_model_end) {
+      const double s0 = config_.initial_velocity_std_mps;
+      x.tail<3>().setZero();
+      P.topRightCorner<3, 3>().setZero();
+      P.bottomLeftCorner<3, 3>().setZero();
+      P.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity() * (s0 * s0);
+      P.topLeftCorner<3, 3>().diagonal().array() += s0 * s0 * dt_held * 1.0 /* s */;
+    }
     const double qp = config_.sigma_p_m * config_.sigma_p_m;
     const double qv = config_.sigma_v_mps * config_.sigma_v_mps;
     P.diagonal() += (Vector6d() << qp, qp, qp, qv, qv, qv).finished();

@@ -15,6 +15,11 @@
 ///    gate_envelope, its camera is inside the classifier's validated envelope (distance and
 ///    elevation of the camera from the worker within the training ranges) — a view outside
 ///    it, or of unknown geometry, does not vote;
+///  - with vote_window_s > 0 a view votes for the gesture it read most often among its
+///    classifications (inside the envelope) of the last vote_window_s, when that gesture has
+///    at least vote_min_fraction of them, else for none: a view that reads a gesture in a
+///    fraction of its frames (a poorer viewpoint, e.g. along the extended arm) still counts,
+///    and one stray frame does not (vote_window_s = 0: the newest classification votes);
 ///  - the fused id is the gesture id (≠ 0) with the most votes when that count is unique and
 ///    ≥ min_agreeing_views; otherwise 0 (none). "none" votes never outvote a gesture, so
 ///    a gesture seen by two of three views passes; a posture seen as a gesture by one view
@@ -23,6 +28,7 @@
 /// Thread safety: none; one instance per thread.
 
 #include <cstddef>
+#include <deque>
 #include <string>
 #include <vector>
 
@@ -39,13 +45,15 @@ struct ViewFusionConfig {
   double distance_max_m = 20.0;
   double elevation_min_deg = 0.0;
   double elevation_max_deg = 45.0;
+  double vote_window_s = 1.0;     ///< ≥ 0 [s]: a view votes its dominant gesture of this window (0: its newest)
+  double vote_min_fraction = 0.3; ///< (0, 1]: the dominant gesture's share of the window's classifications
 
   /// \brief Every problem, each naming the key; empty when valid.
   std::vector<std::string> validate() const;
 };
 
 /// \brief Reads `view_fusion.{min_agreeing_views, max_age_s, gate_envelope, distance_min_m,
-/// distance_max_m, elevation_min_deg, elevation_max_deg}` (missing keys: the defaults above
+/// distance_max_m, elevation_min_deg, elevation_max_deg, vote_window_s, vote_min_fraction}` (missing keys: the defaults above
 /// unless the reader requires every key).
 ViewFusionConfig readViewFusionConfig(common::ConfigReader& reader);
 
@@ -89,6 +97,10 @@ class ViewFusion {
   int max_gesture_id_;
   std::vector<ViewObservation> latest_;
   std::vector<bool> have_;
+  /// Per view: the observations of the last vote_window_s (+ max_age_s) before its newest.
+  std::vector<std::deque<ViewObservation>> history_;
+  /// The vote of view i at t_now (0: none), its newest observation being fresh and inside the envelope.
+  int viewVote(std::size_t i, double t_now) const;
 };
 
 }  // namespace gesture_formation::gesture

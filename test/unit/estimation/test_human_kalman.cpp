@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include <boost/math/distributions/chi_squared.hpp>
@@ -150,8 +151,10 @@ TEST(HumanKalmanTest, PredictedTrajectoryFollowsConstantVelocity) {
   ASSERT_EQ(traj.size(), 40u);
   for (std::size_t k = 0; k < traj.size(); ++k) {
     EXPECT_NEAR(traj[k].t_s, t0 + 0.2 * static_cast<double>(k), 1e-12);
-    const Eigen::Vector3d expected = kf.state().head<3>() + (traj[k].t_s - t0) * kf.state().tail<3>();
-    EXPECT_NEAR((traj[k].p_world - expected).norm(), 0.0, 1e-12);
+    // Constant velocity for lost_timeout_s (5 s) after the last fused measurement, then held.
+    const double moving_s = std::min(traj[k].t_s - t0, kf.config().lost_timeout_s);
+    const Eigen::Vector3d expected = kf.state().head<3>() + moving_s * kf.state().tail<3>();
+    EXPECT_NEAR((traj[k].p_world - expected).norm(), 0.0, 1e-12) << "k = " << k;
     if (k > 0) {
       EXPECT_GT(traj[k].cov_p.trace(), traj[k - 1].cov_p.trace());
     }
@@ -162,6 +165,42 @@ TEST(HumanKalmanTest, PredictedTrajectoryFollowsConstantVelocity) {
   EXPECT_NEAR((s.p_world - (kf.state().head<3>() + kf.state().tail<3>())).norm(), 0.0, 1e-12);
   EXPECT_DOUBLE_EQ(kf.time(), t0) << "predicted() must not change the filter";
   EXPECT_TRUE(HumanKalman().predictTrajectory(0, 0.2, 40).empty());
+}
+
+// docs/safety.md §4.6: a worker climbing at 0.5 m/s leaves the camera; the estimate must not keep
+// climbing with him for minutes (it reached 56 m above ground in delay_jitter seed 11).
+TEST(HumanKalmanTest, LostFilterHoldsThePositionAndGrowsItsCovariance) {
+  HumanKalman kf;  // lost_timeout_s 5 s, σ_v0 1 m/s
+  double t = 0.0;
+  for (int i = 0; i <= 40; ++i, t += 0.1) kf.step(t, meas(Eigen::Vector3d(0.0, 0.0, 8.0 + 0.5 * t), 0.05));
+  const double t_seen = kf.time();
+  const Eigen::Vector3d p_seen = kf.state().head<3>();
+  const double vz = kf.state()(5);
+  ASSERT_NEAR(vz, 0.5, 0.05);
+  // Within lost_timeout_s: constant velocity, as before.
+  EXPECT_NEAR(kf.predicted(t_seen + 4.0).p_world.z(), p_seen.z() + 4.0 * vz, 1e-9);
+  // Beyond it: held at the end of the model's 5 s, velocity forgotten, covariance growing.
+  const double z_held = p_seen.z() + 5.0 * vz;
+  double last_trace = 0.0;
+  for (double dt : {6.0, 30.0, 150.0}) {
+    const PredictedSample s = kf.predicted(t_seen + dt);
+    EXPECT_NEAR(s.p_world.z(), z_held, 1e-9) << dt << " s after the last measurement";
+    EXPECT_EQ(s.v_world, Eigen::Vector3d::Zero());
+    EXPECT_GT(s.cov_p.trace(), last_trace);
+    last_trace = s.cov_p.trace();
+  }
+  // The same through repeated predict() calls (the gfctl estimate and nodelet paths): no drift.
+  HumanKalman stepped = kf;
+  for (double tt = t_seen + 0.1; tt < t_seen + 150.0; tt += 0.1) ASSERT_TRUE(stepped.predict(tt));
+  EXPECT_NEAR(stepped.state().z(), z_held, 1e-9);
+  EXPECT_GT(stepped.covariance()(2, 2), 100.0) << "150 s held: a random walk at σ_v0 = 1 m/s, variance ≈ 145 m²";
+  EXPECT_TRUE(stepped.lost(stepped.time()));
+  // Re-acquired 20 m higher after 150 s: the grown covariance lets the measurement in at once.
+  const double t_back = t_seen + 150.0;
+  const UpdateOutcome o = stepped.step(t_back, meas(Eigen::Vector3d(0.0, 0.0, z_held + 20.0), 0.3));
+  EXPECT_EQ(o, UpdateOutcome::kFused);
+  EXPECT_NEAR(stepped.state().z(), z_held + 20.0, 0.1);
+  EXPECT_FALSE(stepped.lost(t_back));
 }
 
 // Consistency on tracks that follow the filter's own model (paper: x⁺ = F x + ε, ε ~ N(0, Q)

@@ -1,4 +1,6 @@
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -127,4 +129,78 @@ TEST(ViewFusionTest, ConfigReaderListsEveryBadKey) {
   bad.max_age_s = std::nan("");
   EXPECT_EQ(bad.validate().size(), 2u);
   EXPECT_TRUE(ViewFusionConfig{}.validate().empty());
+}
+
+namespace {
+
+/// Feeds view `view` ten classifications at 10 Hz ending at t_end; `ids[k]` is the k-th one's gesture.
+void feed(ViewFusion& f, int view, double t_end, const std::vector<int>& ids, double d = 10.0, double el = 20.0) {
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    const double t = t_end - 0.1 * static_cast<double>(ids.size() - 1 - k);
+    ASSERT_TRUE(f.observe(obs(view, t, ids[k], d, el)));
+  }
+}
+
+}  // namespace
+
+TEST(ViewFusionTest, OneStrayFrameInTheVoteWindowDoesNotVote) {
+  ViewFusionConfig c;  // vote_window_s 1.0, vote_min_fraction 0.3
+  c.min_agreeing_views = 1;
+  ViewFusion f(c, 1, 4);
+  feed(f, 0, 2.0, {0, 0, 0, 0, 0, 0, 0, 0, 0, 2});  // the newest frame reads "extend arm"
+  EXPECT_EQ(f.fuse(2.0).gesture_id, 0);
+  ViewFusionConfig newest = c;
+  newest.vote_window_s = 0.0;  // the newest classification votes: the stray frame fires
+  ViewFusion g(newest, 1, 4);
+  feed(g, 0, 2.0, {0, 0, 0, 0, 0, 0, 0, 0, 0, 2});
+  EXPECT_EQ(g.fuse(2.0).gesture_id, 2);
+}
+
+TEST(ViewFusionTest, AGestureReadInPartOfAViewsFramesVotes) {
+  ViewFusion f(ViewFusionConfig{}, 3, 4);                 // two agreeing views needed
+  feed(f, 0, 3.0, {4, 4, 4, 4, 4, 4, 4, 4, 4, 4});      // a good viewpoint
+  feed(f, 1, 3.0, {0, 4, 0, 4, 4, 0, 0, 4, 0, 0});      // along the raised arm: 4 of 10, newest none
+  feed(f, 2, 3.0, {0, 0, 0, 0, 0, 0, 0, 0, 0, 0});
+  FusedGesture g = f.fuse(3.0);
+  EXPECT_EQ(g.gesture_id, 4);
+  EXPECT_EQ(g.agreeing_views, 2);
+  ViewFusion h(ViewFusionConfig{}, 3, 4);
+  feed(h, 0, 3.0, {4, 4, 4, 4, 4, 4, 4, 4, 4, 4});
+  feed(h, 1, 3.0, {0, 4, 0, 0, 4, 0, 0, 0, 0, 0});      // 2 of 10 < 0.3: no vote
+  feed(h, 2, 3.0, {0, 0, 0, 0, 0, 0, 0, 0, 0, 0});
+  EXPECT_EQ(h.fuse(3.0).gesture_id, 0);
+  EXPECT_EQ(h.fuse(3.0).agreeing_views, 1);
+}
+
+TEST(ViewFusionTest, TheVoteWindowForgetsAndSkipsFramesOutsideTheEnvelope) {
+  ViewFusionConfig c;
+  c.min_agreeing_views = 1;
+  ViewFusion f(c, 1, 4);
+  feed(f, 0, 1.0, {3, 3, 3, 3, 3, 3, 3, 3, 3, 3});
+  EXPECT_EQ(f.fuse(1.0).gesture_id, 3);
+  feed(f, 0, 2.0, {0, 0, 0, 0, 0, 0, 0, 0, 0, 0});  // a second of "none": the gesture has left the window
+  EXPECT_EQ(f.fuse(2.0).gesture_id, 0);
+  ViewFusion g(c, 1, 4);
+  feed(g, 0, 1.0, {1, 1, 1, 1, 1, 1, 1, 1, 1, 1}, 10.0, 60.0);  // too steep: these do not count
+  feed(g, 0, 1.5, {0, 0, 0, 0, 0}, 10.0, 20.0);
+  EXPECT_EQ(g.fuse(1.5).gesture_id, 0);
+  EXPECT_EQ(g.fuse(1.5).voting_views, 1);
+}
+
+TEST(ViewFusionTest, VoteWindowKeysAreValidated) {
+  const std::string yaml = "view_fusion: {vote_window_s: -0.5, vote_min_fraction: 1.5}\n";
+  ConfigReader r = ConfigReader::fromString(yaml, "test.yaml", ConfigReader::MissingKeys::kUseDefaults);
+  (void)readViewFusionConfig(r);
+  EXPECT_FALSE(r.ok());
+  const std::string report = r.errorReport();
+  for (const char* key : {"view_fusion.vote_window_s", "view_fusion.vote_min_fraction"}) {
+    EXPECT_NE(report.find(key), std::string::npos) << key << " missing in:\n" << report;
+  }
+  ViewFusionConfig bad;
+  bad.vote_window_s = std::nan("");
+  bad.vote_min_fraction = 0.0;
+  const std::vector<std::string> problems = bad.validate();
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_NE(problems[0].find("vote_window_s"), std::string::npos) << problems[0];
+  EXPECT_NE(problems[1].find("vote_min_fraction"), std::string::npos) << problems[1];
 }
