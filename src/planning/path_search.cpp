@@ -146,6 +146,41 @@ common::Result<std::vector<Eigen::Vector3d>> GridPathSearch::search(const Eigen:
   open.emplace(kHeuristicWeight * h(va.x(), va.y(), va.z()), start);
   int expansions = 0;
   bool found = false;
+  long pocket_voxels = 0;  // > 0: the goal's closed pocket (no path), found by the flood below
+  // Breadth-first flood from the goal through the voxels the search may enter (clear, or the
+  // start): the number of voxels of the goal's pocket when it closes without reaching the
+  // start within kPocketMaxVoxels, else 0 (unknown: the search goes on).
+  const auto goalPocket = [&]() -> long {
+    if (flood_stamp_.size() < total) flood_stamp_.assign(total, 0u);
+    if (++flood_generation_ == 0) {
+      std::fill(flood_stamp_.begin(), flood_stamp_.end(), 0u);
+      flood_generation_ = 1;
+    }
+    const std::uint32_t fg = flood_generation_;
+    flood_queue_.clear();
+    flood_queue_.push_back(goal);
+    flood_stamp_[static_cast<std::size_t>(goal)] = fg;
+    for (std::size_t head = 0; head < flood_queue_.size(); ++head) {
+      const std::int32_t c = flood_queue_[head];
+      const int fx = lx + c % nx, fy = ly + (c / nx) % ny, fz = lz + c / (nx * ny);
+      for (int dz = -1; dz <= 1; ++dz) {
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int x = fx + dx, y = fy + dy, z = fz + dz;
+            if (!inBox(x, y, z)) continue;
+            const std::int32_t ni = lin(x, y, z);
+            if (flood_stamp_[static_cast<std::size_t>(ni)] == fg) continue;
+            if (ni == start) return 0;  // connected
+            if (field_.atLocal(x, y, z) < clearance_m) continue;
+            flood_stamp_[static_cast<std::size_t>(ni)] = fg;
+            flood_queue_.push_back(ni);
+            if (flood_queue_.size() > static_cast<std::size_t>(kPocketMaxVoxels)) return 0;  // too large to tell
+          }
+        }
+      }
+    }
+    return static_cast<long>(flood_queue_.size());
+  };
   while (!open.empty()) {
     const std::int32_t cur = open.top().second;
     open.pop();
@@ -156,6 +191,7 @@ common::Result<std::vector<Eigen::Vector3d>> GridPathSearch::search(const Eigen:
       break;
     }
     if (++expansions > max_expansions) break;
+    if (expansions == kPocketCheckAfter && (pocket_voxels = goalPocket()) > 0) break;
     const int cx = lx + cur % nx, cy = ly + (cur / nx) % ny, cz = lz + cur / (nx * ny);
     const float gc = g_[static_cast<std::size_t>(cur)];
     for (int dz = -1; dz <= 1; ++dz) {
@@ -182,7 +218,9 @@ common::Result<std::vector<Eigen::Vector3d>> GridPathSearch::search(const Eigen:
   if (!found) {
     std::ostringstream os;
     os << "A*: no path with clearance " << clearance_m << " m from (" << a.transpose() << ") to (" << b.transpose()
-       << ") within " << margin_m << " m (" << expansions << " expansions)";
+       << ") within " << margin_m << " m (" << expansions << " expansions";
+    if (pocket_voxels > 0) os << "; the goal lies in a closed pocket of " << pocket_voxels << " voxels";
+    os << ")";
     return R::fail(os.str());
   }
   std::vector<Eigen::Vector3d> raw;

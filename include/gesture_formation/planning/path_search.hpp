@@ -53,6 +53,11 @@ class GridPathSearch {
   /// ≥ clearance_m, inside the box around a, b grown by margin_m (clipped to the map grid),
   /// shortcut wherever a straight piece stays ≥ shortcut_clearance_m. The start and goal
   /// voxels count as free. Fails when the goal is unreachable within the box or the budget.
+  /// After kPocketCheckAfter expansions without reaching the goal, a breadth-first flood from
+  /// the goal (at most kPocketMaxVoxels voxels, same connectivity) checks whether the goal lies
+  /// in a closed pocket that does not hold the start — e.g. inside a tower's lattice — and
+  /// fails at once if so, instead of spending the whole budget on the start's side: the result
+  /// is the same (no path exists), only cheaper (docs/planning.md §10).
   common::Result<std::vector<Eigen::Vector3d>> search(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double clearance_m,
                                                       double shortcut_clearance_m, double margin_m, int max_expansions,
                                                       Stats* stats = nullptr) const;
@@ -65,6 +70,13 @@ class GridPathSearch {
   mutable std::vector<float> g_;
   mutable std::vector<std::int32_t> parent_;
   mutable std::vector<std::uint8_t> closed_;
+  mutable std::vector<std::uint32_t> flood_stamp_;
+  mutable std::uint32_t flood_generation_ = 0;
+  mutable std::vector<std::int32_t> flood_queue_;
+
+ public:
+  static constexpr int kPocketCheckAfter = 20'000;
+  static constexpr int kPocketMaxVoxels = 60'000;
 };
 
 }  // namespace gesture_formation::planning
