@@ -11,7 +11,7 @@
 #
 # Every finished mission appends one row (profile, seed, source commit, model sha256, metrics) to
 # the committed runs file docs/data/fault_matrix_runs.csv (GF_RUNS), and the report is computed
-# from that file: the ~1400 missions (≈ 4 CPU-hours) can be spread over sessions and machines. A
+# from that file: the ~1400 missions (≈ 4–10 CPU-hours) can be spread over sessions and machines. A
 # (profile, seed) already in the file is skipped, so the script resumes; start afresh after a change
 # that can move the figures (planner, simulator, model) by removing the file (the report lists the
 # commits its rows come from). Seeds are the outer loop, so a run stopped early covers every profile
@@ -95,7 +95,8 @@ cols = [("min_mutual_distance_m", "min mutual [m]", "{:.2f}"), ("min_obstacle_di
         ("human_estimate_error_rms_m", "estimate error RMS [m]", "{:.2f}")]
 extra = [("min_human_distance_m", "min human [m]", "{:.2f}"), ("plans_hold", "hold plans", "{:.0f}"),
          ("plans_fallback_brake", "brake fallbacks", "{:.0f}"), ("commands_stale", "stale commands", "{:.0f}"),
-         ("distance_error_rms_m", "distance error RMS [m]", "{:.2f}"), ("wall_time_s", "wall time [s]", "{:.1f}")]
+         ("false_adaptations", "false adaptations", "{:.0f}"), ("distance_error_rms_m", "distance error RMS [m]", "{:.2f}"),
+         ("wall_time_s", "wall time [s]", "{:.1f}")]
 rows, extra_rows, runs, violations = [], [], {}, []
 def cell(vals, fmt):
     if not vals:
@@ -125,7 +126,8 @@ with open(report, "w") as f:
     seeds = f"{n[0]}" if len(n) == 1 else f"{n[0]}–{n[-1]}"
     f.write(f"**Seeds run: {seeds} per profile ({total} missions).** The issue asks for 100 seeds "
             "× the matrix; the full run is `GF_SEEDS=100 tools/run_fault_matrix.sh` (resumes from the committed runs file "
-            "`docs/data/fault_matrix_runs.csv`; ~14 profiles × 100 × 10–25 s ≈ 4 CPU-hours). Rows from (commit, model "
+            "`docs/data/fault_matrix_runs.csv`; 14 profiles × 100 missions of 10–25 s CPU each on a fast core, 25–120 s "
+            "on a slow one ≈ 4–10 CPU-hours). Rows from (commit, model "
             "sha256 prefix): " + ", ".join(f"`{c}` / `{h}` ({sum(1 for r in all_rows if r['commit'] == c and r['model_sha256'] == h)})"
                                           for c, h in commits) + ".\n\n")
     f.write("Each cell: **min / median / max over seeds**. Safety thresholds: mutual ≥ Γ_dis 2.5 m, obstacle ≥ the "
@@ -136,7 +138,8 @@ with open(report, "w") as f:
     f.write("|---|---|" + "---|" * len(cols) + "\n")
     f.write("\n".join(rows) + "\n\n")
     f.write("Diagnostics (min / median / max): min human distance (UAV centre – worker mid-body), replannings in hold "
-            "mode, planner brake fallbacks, operator commands rejected as stale, UAV–worker distance error, wall time "
+            "mode, planner brake fallbacks, operator commands rejected as stale, gesture commands fired while the worker "
+            "performed no gesture (false adaptations), UAV–worker distance error, wall time "
             "of one mission (2 cores shared with other work).\n\n")
     f.write("| faults | " + " | ".join(h for _, h, _ in extra) + " |\n")
     f.write("|---|" + "---|" * len(extra) + "\n")
@@ -164,6 +167,10 @@ with open(report, "w") as f:
     else:
         f.write(f"**No safety violation in the {total} missions** (no min mutual < 2.5 m, no obstacle distance < 0.5 m, "
                 "no collision).\n")
+    false_total = sum(int(r["false_adaptations"] or 0) for r in all_rows)
+    false_missions = [f"`{r['profile']}` seed {r['seed']:.0f}" for r in all_rows if (r["false_adaptations"] or 0) > 0]
+    f.write(f"\n**False adaptations: {false_total} in the {total} missions**"
+            + (" (" + ", ".join(false_missions) + ").\n" if false_missions else ".\n"))
 print(f"wrote {report}: {total} missions, {len(violations)} with a safety violation")
 for v in violations:
     print("  VIOLATION", v)
