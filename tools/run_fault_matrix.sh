@@ -17,7 +17,8 @@
 # commits its rows come from). Seeds are the outer loop, so a run stopped early covers every profile
 # evenly. GF_JOBS missions run at once (default: the number of cores); GFCTL overrides the binary,
 # GF_MATRIX_DIR the missions' output (default build-faults/fault_matrix), GF_REPORT the table
-# (default docs/reliability.md).
+# (default docs/reliability.md), GF_PLOT its figure (default docs/images/fault_matrix.png, drawn by
+# tools/plot_fault_matrix.py with the tools venv's matplotlib).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SEEDS=${GF_SEEDS:-100}
@@ -70,7 +71,14 @@ ROW
   wait
 fi
 
-python3 - "$RUNS" "$REPORT" $PROFILES <<'PY'
+PLOT=${GF_PLOT:-$(dirname "$REPORT")/images/fault_matrix.png}
+PY_VENV=/opt/gesture_formation/venv/bin/python
+PLOT_REL=""
+if [ -x "$PY_VENV" ]; then
+  mkdir -p "$(dirname "$PLOT")"
+  "$PY_VENV" tools/plot_fault_matrix.py "$RUNS" "$PLOT" $PROFILES && PLOT_REL=$(realpath --relative-to="$(dirname "$REPORT")" "$PLOT")
+fi
+GF_PLOT_REL="$PLOT_REL" python3 - "$RUNS" "$REPORT" $PROFILES <<'PY'
 import csv, json, os, statistics, sys, datetime
 runs_file, report, profiles = sys.argv[1], sys.argv[2], sys.argv[3:]
 def number(v):
@@ -137,6 +145,10 @@ with open(report, "w") as f:
     f.write("| faults | seeds | " + " | ".join(h for _, h, _ in cols) + " |\n")
     f.write("|---|---|" + "---|" * len(cols) + "\n")
     f.write("\n".join(rows) + "\n\n")
+    if os.environ.get("GF_PLOT_REL"):
+        f.write(f"![every mission's minimum distances per fault profile]({os.environ['GF_PLOT_REL']})\n\n"
+                "(`tools/plot_fault_matrix.py`: one dot per mission, the bar at the median, the number at the minimum; "
+                "dashed: the safety thresholds.)\n\n")
     f.write("Diagnostics (min / median / max): min human distance (UAV centre – worker mid-body), replannings in hold "
             "mode, planner brake fallbacks, operator commands rejected as stale, gesture commands fired while the worker "
             "performed no gesture (false adaptations), UAV–worker distance error, wall time "
