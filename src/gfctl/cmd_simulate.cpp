@@ -13,6 +13,8 @@
 #include <map>
 #include <sstream>
 
+#include <opencv2/core/utility.hpp>
+
 #include "commands.hpp"
 #include "gesture_formation/common/csv.hpp"
 #include "gesture_formation/planning/catenary.hpp"
@@ -193,6 +195,10 @@ int cmdSimulate(const Args& args) {
   if (!checkOptions(args, {"scenario", "out"}, {"seed", "seeds", "duration", "model", "no-plot", "faults", "fault-profile"})) {
     return kExitBadInput;
   }
+  // A mission is one thread by design (deterministic; batches and the fault matrix run missions
+  // in parallel processes). OpenCV's thread pool only adds synchronisation to the small LSTM:
+  // one thread is ~5 % less CPU per mission, results unchanged (docs/simulation.md §3).
+  cv::setNumThreads(1);
   std::uint64_t seed = 1, seed_lo = 0, seed_hi = 0;
   bool batch = false;
   if (args.has("seed") && !parseUint(args.get("seed"), seed)) return badInput(args, "--seed: expected a non-negative integer, got '" + args.get("seed") + "'");
