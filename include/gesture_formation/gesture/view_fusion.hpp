@@ -8,10 +8,10 @@
 /// pointing direction, projects like an arm extended to the side. The formation watches the
 /// worker from several azimuths at once (the followers sit ±60° from the leader, Table II);
 /// a posture that looks like a gesture from one of them does not from the others. Each UAV
-/// classifies its own view (the same LSTM), the leader keeps the newest classification of
+/// classifies its own view (the same LSTM), the leader keeps the recent classifications of
 /// every view and, per leader frame, fuses them into the one id that goes to the
 /// GestureFilter (whose parameters stay the paper's):
-///  - a view votes only when its classification is fresh (t_now − t ≤ max_age_s) and, with
+///  - a view votes only when its newest classification is fresh (t_now − t ≤ max_age_s) and, with
 ///    gate_envelope, its camera is inside the classifier's validated envelope (distance and
 ///    elevation of the camera from the worker within the training ranges) — a view outside
 ///    it, or of unknown geometry, does not vote;
