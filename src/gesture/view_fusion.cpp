@@ -65,8 +65,6 @@ ViewFusionConfig readViewFusionConfig(ConfigReader& r) {
 ViewFusion::ViewFusion(const ViewFusionConfig& config, int views, int max_gesture_id)
     : config_(config),
       max_gesture_id_(std::max(1, max_gesture_id)),
-      latest_(static_cast<std::size_t>(std::max(1, views))),
-      have_(static_cast<std::size_t>(std::max(1, views)), false),
       history_(static_cast<std::size_t>(std::max(1, views))) {
   config_.min_agreeing_views = std::max(1, config_.min_agreeing_views);
 }
@@ -85,13 +83,11 @@ bool ViewFusion::observe(const ViewObservation& o, std::string* reason) {
                 std::to_string(max_gesture_id_));
   }
   const auto i = static_cast<std::size_t>(o.view);
-  if (have_[i] && o.t_s < latest_[i].t_s) {
-    return fail("view " + std::to_string(o.view) + ": t " + common::formatDouble(o.t_s) + " older than the stored " +
-                common::formatDouble(latest_[i].t_s));
-  }
-  latest_[i] = o;
-  have_[i] = true;
   auto& h = history_[i];
+  if (!h.empty() && o.t_s < h.back().t_s) {
+    return fail("view " + std::to_string(o.view) + ": t " + common::formatDouble(o.t_s) + " older than the stored " +
+                common::formatDouble(h.back().t_s));
+  }
   h.push_back(o);
   const double keep_s = config_.vote_window_s + config_.max_age_s;
   while (!h.empty() && h.front().t_s < o.t_s - keep_s) h.pop_front();
@@ -99,7 +95,7 @@ bool ViewFusion::observe(const ViewObservation& o, std::string* reason) {
 }
 
 int ViewFusion::viewVote(std::size_t i, double t_now) const {
-  if (!(config_.vote_window_s > 0.0)) return latest_[i].gesture_id;
+  if (!(config_.vote_window_s > 0.0)) return history_[i].back().gesture_id;
   std::vector<int> count(static_cast<std::size_t>(max_gesture_id_ + 1), 0);
   int total = 0;
   for (const ViewObservation& o : history_[i]) {
@@ -128,9 +124,9 @@ bool ViewFusion::inEnvelope(double distance_m, double elevation_deg) const {
 FusedGesture ViewFusion::fuse(double t_now) const {
   FusedGesture out;
   std::vector<int> votes(static_cast<std::size_t>(max_gesture_id_ + 1), 0);
-  for (std::size_t i = 0; i < latest_.size(); ++i) {
-    if (!have_[i]) continue;
-    const ViewObservation& o = latest_[i];
+  for (std::size_t i = 0; i < history_.size(); ++i) {
+    if (history_[i].empty()) continue;
+    const ViewObservation& o = history_[i].back();
     if (!(t_now - o.t_s <= config_.max_age_s) || o.t_s > t_now + config_.max_age_s) continue;
     if (!inEnvelope(o.distance_m, o.elevation_deg)) continue;
     ++out.voting_views;

@@ -89,15 +89,13 @@ class ViewFusion {
   /// Whether a view's geometry lies inside the validated envelope.
   bool inEnvelope(double distance_m, double elevation_deg) const;
 
-  int views() const { return static_cast<int>(latest_.size()); }
+  int views() const { return static_cast<int>(history_.size()); }
   const ViewFusionConfig& config() const { return config_; }
 
  private:
   ViewFusionConfig config_;
   int max_gesture_id_;
-  std::vector<ViewObservation> latest_;
-  std::vector<bool> have_;
-  /// Per view: the observations of the last vote_window_s (+ max_age_s) before its newest.
+  /// Per view: its observations of the last vote_window_s (+ max_age_s) up to its newest (back()).
   std::vector<std::deque<ViewObservation>> history_;
   /// The vote of view i at t_now (0: none), its newest observation being fresh and inside the envelope.
   int viewVote(std::size_t i, double t_now) const;
