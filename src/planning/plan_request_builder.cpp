@@ -1,5 +1,8 @@
 #include "gesture_formation/planning/plan_request_builder.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 namespace gesture_formation::planning {
 
 PlanRequest buildPlanRequest(const PlanRequestInputs& in) {
@@ -45,6 +48,38 @@ PlanRequest buildPlanRequest(const PlanRequestInputs& in) {
     if (hold || j < i || m->fallback || silent || in.rule.avoid_all_plans) req.higher_priority_plans.push_back(m->plan);
   }
   return req;
+}
+
+std::string holdReason(int uav_index, double t_s, double share_stamp_s, double worker_stamp_s,
+                       const FreshnessLimits& limits) {
+  const auto older = [&](double stamp, double limit) { return !std::isfinite(stamp) || !(t_s - stamp <= limit); };
+  if (uav_index == 0) {
+    return older(worker_stamp_s, limits.max_worker_age_s) ? "worker not seen for more than max_worker_age_s" : "";
+  }
+  if (older(share_stamp_s, limits.max_share_age_s)) return "leader share older than max_share_age_s";
+  if (older(worker_stamp_s, limits.max_worker_age_s)) return "worker estimate older than max_worker_age_s";
+  return "";
+}
+
+Eigen::Vector3d brakingPoint(const Eigen::Vector3d& p_world, const Eigen::Vector3d& v_world, double brake_accel_mps2) {
+  const double a = std::max(1e-3, brake_accel_mps2);
+  return p_world + v_world * (v_world.norm() / (2.0 * a));
+}
+
+formation::ReferenceTrajectory holdReference(const Eigen::Vector3d& hold_world, const Eigen::Vector3d& worker_world,
+                                             double heading_rad, int steps) {
+  const Eigen::Vector3d to_worker = worker_world - hold_world;
+  const double horizontal = to_worker.head<2>().norm();
+  const double heading = horizontal > 1e-6 ? std::atan2(to_worker.y(), to_worker.x()) : heading_rad;
+  const double pitch = std::atan2(to_worker.z(), std::max(1e-6, horizontal));
+  formation::ReferenceTrajectory ref;
+  ref.resize(steps);
+  for (int k = 0; k < steps; ++k) {
+    ref.p_world.col(k) = hold_world;
+    ref.heading_rad(k) = heading;
+    ref.pitch_rad(k) = pitch;
+  }
+  return ref;
 }
 
 }  // namespace gesture_formation::planning

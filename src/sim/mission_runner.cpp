@@ -210,6 +210,7 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
     modes.push_back(ModeChange{t, i, mode, reason});
   };
 
+  const planning::FreshnessLimits freshness{cfg.faults.max_share_age_s, cfg.faults.max_worker_age_s};
   auto replan = [&](int i, double t) {
     UavRuntime& u = *uavs[static_cast<std::size_t>(i)];
     if (u.offline) {
@@ -237,7 +238,7 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
       }
       const estimation::Vector6d& x = kf.state();
       worker_stamp = last_fused_s;
-      if (t - worker_stamp > cfg.faults.max_worker_age_s) hold = "worker not seen for more than max_worker_age_s";
+      hold = planning::holdReason(i, t, t, worker_stamp, freshness);
       const bool stale = !hold.empty() || kf.lost(t);
       v0 = stale ? Eigen::Vector3d::Zero() : Eigen::Vector3d(x.tail<3>());
       p0 = x.head<3>() + (stale ? 0.0 : (t - kf.time())) * v0;
@@ -252,11 +253,8 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
       }
       share = &*u.share;
       worker_stamp = share->worker_stamp_s;
-      if (t - share->stamp_s > cfg.faults.max_share_age_s) {
-        hold = "leader share older than max_share_age_s";
-      } else if (t - worker_stamp > cfg.faults.max_worker_age_s) {
-        hold = "worker estimate older than max_worker_age_s";
-      } else if (u.rejoined_s > -std::numeric_limits<double>::infinity()) {
+      hold = planning::holdReason(i, t, share->stamp_s, worker_stamp, freshness);
+      if (hold.empty() && u.rejoined_s > -std::numeric_limits<double>::infinity()) {
         for (int j = 1; j < n && hold.empty(); ++j) {
           const auto& m = u.received[static_cast<std::size_t>(j)];
           if (j != i && !uavs[static_cast<std::size_t>(j)]->offline && (!m || m->plan.t0_s < u.rejoined_s)) {
@@ -283,8 +281,8 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
     // known worker position; the stale data serve only as an obstacle and camera target.
     formation::ReferenceTrajectory hold_reference;
     if (!hold.empty()) {
-      if (!u.hold_p) u.hold_p = brakingPoint(u.est, cfg.controller.brake_accel_mps2);  // latched: no drift
-      hold_reference = holdReference(*u.hold_p, p0, u.est.heading_rad, hsteps);
+      if (!u.hold_p) u.hold_p = planning::brakingPoint(u.est.p_world, u.est.v_world, cfg.controller.brake_accel_mps2);  // latched: no drift
+      hold_reference = planning::holdReference(*u.hold_p, p0, u.est.heading_rad, hsteps);
     } else {
       u.hold_p.reset();
     }
@@ -507,27 +505,6 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
   MissionOutput out = metrics.finish(worker.episodes(), static_cast<double>(steps) * dt, wall_s);
   out.modes = std::move(modes);
   return R::ok(std::move(out));
-}
-
-Eigen::Vector3d brakingPoint(const EstimatedState& est, double brake_accel_mps2) {
-  const double a = std::max(1e-3, brake_accel_mps2);
-  return est.p_world + est.v_world * (est.v_world.norm() / (2.0 * a));
-}
-
-formation::ReferenceTrajectory holdReference(const Eigen::Vector3d& hold_world, const Eigen::Vector3d& worker_world,
-                                             double heading_rad, int steps) {
-  const Eigen::Vector3d to_worker = worker_world - hold_world;
-  const double horizontal = to_worker.head<2>().norm();
-  const double heading = horizontal > 1e-6 ? std::atan2(to_worker.y(), to_worker.x()) : heading_rad;
-  const double pitch = std::atan2(to_worker.z(), std::max(1e-6, horizontal));
-  formation::ReferenceTrajectory ref;
-  ref.resize(steps);
-  for (int k = 0; k < steps; ++k) {
-    ref.p_world.col(k) = hold_world;
-    ref.heading_rad(k) = heading;
-    ref.pitch_rad(k) = pitch;
-  }
-  return ref;
 }
 
 }  // namespace gesture_formation::sim

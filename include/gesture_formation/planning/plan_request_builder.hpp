@@ -17,6 +17,7 @@
 
 #include <limits>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "gesture_formation/formation/formation_geometry.hpp"
@@ -63,5 +64,29 @@ struct PlanRequestInputs {
 /// \brief The request (see the file comment). Preconditions: params non-null with a
 /// follower entry for uav_index; worker.steps() ≥ 1.
 PlanRequest buildPlanRequest(const PlanRequestInputs& in);
+
+// ---- hold (docs/safety.md §1 rules 2–4), shared by gfctl simulate and the FormationPlanner ----
+
+/// \brief Age limits of the data a UAV plans from (mission `faults.*`; FormationPlanner params).
+struct FreshnessLimits {
+  double max_share_age_s = 2.0;   ///< a follower's leader share (worker state) since the leader sent it
+  double max_worker_age_s = 3.0;  ///< the worker estimate since its last fused measurement
+};
+
+/// \brief Why UAV `uav_index` must hold at t_s (empty: it may track). The leader checks the age of
+/// its estimate (worker_stamp_s = the last fused measurement); a follower first the age of the
+/// leader's share (share_stamp_s = when the leader sent it), then of the estimate it carries.
+/// Non-finite stamps count as infinitely old.
+std::string holdReason(int uav_index, double t_s, double share_stamp_s, double worker_stamp_s,
+                       const FreshnessLimits& limits);
+
+/// \brief Where braking from velocity v at `brake_accel_mps2` ends: p + v|v|/(2a). A UAV entering
+/// hold latches this point and holds it until it tracks again (docs/safety.md §1 rule 3).
+Eigen::Vector3d brakingPoint(const Eigen::Vector3d& p_world, const Eigen::Vector3d& v_world, double brake_accel_mps2);
+
+/// \brief The hold reference: every step at `hold_world`, camera heading and pitch towards
+/// `worker_world` (the last known worker position; `heading_rad` when straight above/below).
+formation::ReferenceTrajectory holdReference(const Eigen::Vector3d& hold_world, const Eigen::Vector3d& worker_world,
+                                             double heading_rad, int steps);
 
 }  // namespace gesture_formation::planning

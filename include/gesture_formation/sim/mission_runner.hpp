@@ -86,12 +86,4 @@ common::Result<MissionOutput> runMission(const MissionConfig& config, const Miss
                                          const PlannerFactory& planners, MissionClassifier* classifier,
                                          std::uint64_t seed, double duration_s = 0.0);
 
-/// \brief Where braking from the estimated velocity at `brake_accel_mps2` ends: p + v|v|/(2a).
-/// A UAV entering hold latches this point and holds it until it tracks again (docs/safety.md §1).
-Eigen::Vector3d brakingPoint(const EstimatedState& est, double brake_accel_mps2);
-/// \brief The hold reference: every step at `hold_world`, camera heading and pitch towards
-/// `worker_world` (the last known worker position; `heading_rad` when straight above/below).
-formation::ReferenceTrajectory holdReference(const Eigen::Vector3d& hold_world, const Eigen::Vector3d& worker_world,
-                                             double heading_rad, int steps);
-
 }  // namespace gesture_formation::sim

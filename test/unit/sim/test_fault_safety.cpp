@@ -5,8 +5,10 @@
 
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <memory>
 
+#include "gesture_formation/planning/plan_request_builder.hpp"
 #include "gesture_formation/sim/link.hpp"
 #include "gesture_formation/sim/mission_runner.hpp"
 #include "sim_test_support.hpp"
@@ -184,18 +186,35 @@ TEST(LinkTest, ReorderAndDuplicateCounted) {
 }
 
 TEST(HoldReferenceTest, StopsAtTheBrakingPointAndLooksAtTheWorker) {
-  gf::sim::EstimatedState est;
-  est.p_world = Eigen::Vector3d(0, 0, 5);
-  est.v_world = Eigen::Vector3d(2, 0, 0);
-  const Eigen::Vector3d stop = gf::sim::brakingPoint(est, 4.0);
+  const Eigen::Vector3d stop = gf::planning::brakingPoint(Eigen::Vector3d(0, 0, 5), Eigen::Vector3d(2, 0, 0), 4.0);
   EXPECT_TRUE(stop.isApprox(Eigen::Vector3d(0.5, 0, 5)));  // v²/(2a) = 0.5 m ahead
-  const auto ref = gf::sim::holdReference(stop, Eigen::Vector3d(10.5, 5, 1), 0.3, 10);
+  const auto ref = gf::planning::holdReference(stop, Eigen::Vector3d(10.5, 5, 1), 0.3, 10);
   ASSERT_EQ(ref.steps(), 10);
   for (int k = 0; k < 10; ++k) {
     EXPECT_TRUE(ref.p_world.col(k).isApprox(stop));
     EXPECT_NEAR(ref.heading_rad(k), std::atan2(5.0, 10.0), 1e-12);
     EXPECT_NEAR(ref.pitch_rad(k), std::atan2(-4.0, std::hypot(10.0, 5.0)), 1e-12);
   }
+}
+
+// The rule-2 decision gfctl simulate and the FormationPlanner nodelet share (docs/safety.md §1).
+TEST(HoldReasonTest, EachAgeLimitDecidesWithItsOwnStamp) {
+  const gf::planning::FreshnessLimits lim{2.0, 3.0};
+  // Leader: only the estimate's age (the last fused measurement) counts.
+  EXPECT_EQ(gf::planning::holdReason(0, 10.0, 10.0, 7.0, lim), "");  // exactly 3 s: still fresh
+  EXPECT_EQ(gf::planning::holdReason(0, 10.0, 10.0, 6.9, lim), "worker not seen for more than max_worker_age_s");
+  EXPECT_EQ(gf::planning::holdReason(0, 10.0, -100.0, 9.0, lim), "");  // the share stamp is not the leader's
+  // Follower: the share's age first, then the estimate it carries.
+  EXPECT_EQ(gf::planning::holdReason(1, 10.0, 8.5, 9.0, lim), "");
+  EXPECT_EQ(gf::planning::holdReason(1, 10.0, 7.9, 9.0, lim), "leader share older than max_share_age_s");
+  EXPECT_EQ(gf::planning::holdReason(2, 10.0, 7.9, 1.0, lim), "leader share older than max_share_age_s");
+  EXPECT_EQ(gf::planning::holdReason(2, 10.0, 9.9, 6.5, lim), "worker estimate older than max_worker_age_s");
+  // No stamp at all (NaN / inf) is infinitely old, never fresh.
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  EXPECT_FALSE(gf::planning::holdReason(0, 10.0, 10.0, nan, lim).empty());
+  EXPECT_FALSE(gf::planning::holdReason(0, 10.0, 10.0, -inf, lim).empty());
+  EXPECT_FALSE(gf::planning::holdReason(1, 10.0, nan, 10.0, lim).empty());
+  EXPECT_FALSE(gf::planning::holdReason(1, 10.0, 10.0, inf, lim).empty());
 }
 
 // ---------------------------------------------------------------------------------------
