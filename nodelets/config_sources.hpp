@@ -47,11 +47,15 @@ inline bool loadWorldMap(const std::string& scenario_file, ParamLoader& params, 
   return true;
 }
 
-/// Loads the mission of `mission_file` (every problem into `params`).
+/// Loads the mission of `mission_file` (every problem into `params`), with the fault profile of
+/// the optional ~faults_file merged in (as `gfctl simulate --faults FILE`; every nodelet of a
+/// simulation gets the same pair).
 inline bool loadMission(const std::string& mission_file, ParamLoader& params, sim::MissionConfig& out) {
-  auto m = sim::loadMissionConfig(mission_file);
+  std::string faults_file;
+  params.loadOptional("faults_file", faults_file, "");
+  auto m = faults_file.empty() ? sim::loadMissionConfig(mission_file) : sim::loadMissionConfig(mission_file, faults_file);
   if (!m) {
-    params.addError("mission_file: " + m.reason());
+    params.addError((faults_file.empty() ? "mission_file: " : "mission_file + faults_file: ") + m.reason());
     return false;
   }
   out = std::move(*m);

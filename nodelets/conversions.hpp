@@ -302,6 +302,7 @@ inline common::Result<formation::FormationCommand> fromMsg(const gesture_formati
 inline comm::WorkerStateMessage toWire(const gesture_formation::WorkerState& s) {
   comm::WorkerStateMessage w;
   w.t_s = s.header.stamp.toSec();
+  w.last_fused_t_s = std::min(w.t_s, s.last_fused.toSec());
   w.p_world = toEigen(s.position);
   w.v_world = toEigen(s.velocity);
   for (std::size_t i = 0; i < 6; ++i) w.covariance_diag[i] = std::max(0.0, s.covariance[7 * i]);
@@ -315,6 +316,7 @@ inline gesture_formation::WorkerState fromWire(const comm::WorkerStateMessage& w
   for (int i = 0; i < 6; ++i) P(i, i) = w.covariance_diag[static_cast<std::size_t>(i)];
   gesture_formation::WorkerState s = toWorkerState(x, P);
   s.header.stamp = ros::Time(w.t_s);
+  s.last_fused = ros::Time(std::max(0.0, w.last_fused_t_s));
   s.lost = w.lost;
   s.predicted = true;
   s.source = "lcm";

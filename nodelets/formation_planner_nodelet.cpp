@@ -20,8 +20,18 @@
 //   ~scenario_file (the map), ~mission_file (optional: take formation + planner from a
 //   scenario's mission) or ~formation_config + ~planner_config, ~replanning_period_s,
 //   ~horizon_dt_s, ~horizon_steps, ~max_share_age_s, ~params_rate_hz, ~max_wind_estimate_age_s; without ~mission_file
-//   also ~avoid_all_plans, ~max_plan_age_s (with it: the mission's faults.avoid_all_plans and
-//   faults.max_plan_age_s, as gfctl simulate).
+//   also ~avoid_all_plans, ~max_plan_age_s, ~max_worker_age_s, ~brake_accel_mps2 (with it: the
+//   mission's faults.avoid_all_plans, faults.max_plan_age_s, faults.max_worker_age_s and
+//   controller.brake_accel_mps2, as gfctl simulate); optional ~faults_file (a fault profile merged
+//   into the mission, as `gfctl simulate --faults`).
+// Hold (docs/safety.md §1 rules 2–4, planning::holdReason — the decision gfctl simulate makes):
+// the leader holds when its estimate's last fused measurement (WorkerState.last_fused) is older
+// than max_worker_age_s; a follower when the leader's worker state (over LCM) is older than
+// max_share_age_s, or the estimate it carries older than max_worker_age_s. A holding UAV plans
+// to its latched braking point (planning::brakingPoint, holdReference: camera on the worker's last
+// known position), avoiding every received plan; its plan is flagged `fallback` (others avoid
+// it) with mode `hold` and the reason; the first replanning with fresh data tracks again.
+#include <cmath>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -56,6 +66,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     params.load("horizon_dt_s", horizon_dt_s_, 0.02, 1.0);
     params.load("horizon_steps", horizon_steps_, 2, formation::kMaxHorizonSteps);
     params.load("max_share_age_s", max_share_age_s_, 0.1, 10.0);
+    freshness_.max_share_age_s = max_share_age_s_;
     params.load("max_wind_estimate_age_s", max_wind_age_s_, 0.1, 60.0);
     double params_rate_hz = 0.0;
     params.load("params_rate_hz", params_rate_hz, 0.1, 50.0);
@@ -67,12 +78,16 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
         fcfg = mission.formation;
         pcfg = mission.planner;
         rule_ = planning::AvoidanceRule{mission.faults.avoid_all_plans, mission.faults.max_plan_age_s};
+        freshness_.max_worker_age_s = mission.faults.max_worker_age_s;
+        brake_accel_mps2_ = mission.controller.brake_accel_mps2;
       }
     } else {
       params.load("formation_config", formation_file);
       params.load("planner_config", planner_file);
       params.load("avoid_all_plans", rule_.avoid_all_plans);
       params.load("max_plan_age_s", rule_.max_plan_age_s, 0.01, 60.0);
+      params.load("max_worker_age_s", freshness_.max_worker_age_s, 0.1, 60.0);
+      params.load("brake_accel_mps2", brake_accel_mps2_, 0.1, 20.0);
       if (!formation_file.empty()) loadFormation(formation_file, params, fcfg);
       if (!planner_file.empty()) loadPlanner(planner_file, params, pcfg);
     }
@@ -215,14 +230,32 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
 
   void replan(double t) {
     if (!odom_ || !worker_) return;
-    const double age = t - worker_->header.stamp.toSec();
-    if (age > max_share_age_s_) {
-      NODELET_WARN_STREAM_THROTTLE(2.0, "FormationPlanner: worker state " << age << " s old: not planning");
-      return;  // never act on data older than its configured age (the controller keeps the plan / brakes)
+    // Rule 2: never follow data older than its age limit — hold instead (the same decision as
+    // gfctl simulate). A WorkerState without a fusion time (last_fused 0) counts as never fused.
+    const double fused_s = worker_->last_fused.isZero() ? std::nan("") : worker_->last_fused.toSec();
+    const std::string hold = planning::holdReason(uav_index_, t, worker_->header.stamp.toSec(), fused_s, freshness_);
+    const double age = std::max(0.0, t - worker_->header.stamp.toSec());
+    const bool stale = !hold.empty();
+    const Eigen::Vector3d v0 = stale || worker_->lost ? Eigen::Vector3d::Zero() : toEigen(worker_->velocity);
+    const Eigen::Vector3d p0 = toEigen(worker_->position) + age * v0;
+    const double hphi = stale ? heading_->heading() : heading_->update(v0);
+    if (hold != mode_reason_) {
+      if (stale) {
+        NODELET_WARN_STREAM("FormationPlanner UAV " << uav_index_ << ": hold: " << hold);
+      } else {
+        NODELET_INFO_STREAM("FormationPlanner UAV " << uav_index_ << ": track: fresh data");
+      }
+      mode_reason_ = hold;
     }
-    const Eigen::Vector3d v0 = worker_->lost ? Eigen::Vector3d::Zero() : toEigen(worker_->velocity);
-    const Eigen::Vector3d p0 = toEigen(worker_->position) + std::max(0.0, age) * v0;
-    const double hphi = heading_->update(v0);
+    // Hold: plan to the point where braking ends (latched until it tracks again), camera on the
+    // worker's last known position; the old estimate serves only as obstacle and camera target.
+    formation::ReferenceTrajectory hold_reference;
+    if (stale) {
+      if (!hold_p_) hold_p_ = planning::brakingPoint(odom_->p_world, odom_->v_world, brake_accel_mps2_);
+      hold_reference = planning::holdReference(*hold_p_, p0, odom_->heading_rad, horizon_steps_);
+    } else {
+      hold_p_.reset();
+    }
     planning::PlanRequestInputs in;
     in.uav_index = uav_index_;
     in.t_s = t;
@@ -237,6 +270,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     if (leader && t - leader->plan.t0_s <= max_share_age_s_) in.leader_plan = &leader->plan;
     in.received = &received_;
     in.rule = rule_;
+    in.hold_reference = stale ? &hold_reference : nullptr;
     const planning::PlanRequest req = planning::buildPlanRequest(in);
     const planning::PlanResult res = planner_->plan(req);
     if (res.status != planning::PlanStatus::kOptimized) {
@@ -250,6 +284,9 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
                                                    << " abandoned solve(s) still running in this process, docs/safety.md 4.5)");
     }
     auto msg = toMsg(res);
+    msg.fallback = msg.fallback || stale;  // a holding UAV has right of way (rule 3)
+    msg.mode = stale ? "hold" : "track";
+    msg.mode_reason = hold;
     msg.header.frame_id = world_frame_;
     msg.uav_index = uav_index_;
     msg.params_version = uav_index_ == formation::kLeader ? version_ : received_version_;
@@ -274,6 +311,10 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   std::uint64_t version_ = 0;           ///< leader: the parameters' version
   std::uint64_t received_version_ = 0;  ///< followers: the version received (0 over LCM: not carried)
   planning::AvoidanceRule rule_;
+  planning::FreshnessLimits freshness_;
+  double brake_accel_mps2_ = 0.0;
+  std::optional<Eigen::Vector3d> hold_p_;  ///< the latched stop point while holding
+  std::string mode_reason_;                ///< the current hold reason (empty: tracking)
   std::string last_command_, last_outcome_, last_source_, last_status_;
   ros::Time last_stamp_;
   std::vector<int> last_uavs_;

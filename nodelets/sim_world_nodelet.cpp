@@ -17,9 +17,11 @@
 //   of the leader: parameters and what became of each command), worker_estimate_in
 //   (WorkerState of the leader), gesture_status_in (the leader's gesture filter).
 // Sim time starts when every UAV's FormationPlanner is up. At the end (~duration_s, ≤ 0: the
-// mission's) writes ~output_dir/{metrics.json, timeline.csv, events.csv} and stops the clock.
+// mission's) writes ~output_dir/{metrics.json, timeline.csv, events.csv, modes.csv (the planners'
+// mode changes, from the plans' mode field)} and stops the clock.
 // Parameters (required): ~mission_file, ~seed, ~real_time_factor, ~clock_step_s,
-//   ~duration_s, ~output_dir, ~world_frame, ~leader_camera_frame.
+//   ~duration_s, ~output_dir, ~world_frame, ~leader_camera_frame; optional ~faults_file (a fault
+//   profile merged into the mission: camera blackouts, sensor dropouts, range outliers, wind).
 #include <algorithm>
 #include <mutex>
 #include <optional>
@@ -97,6 +99,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
     }
     command_pub_ = nh.advertise<gesture_formation::FormationCommand>("operator_command_out", 20);
     done_pub_ = nh.advertise<std_msgs::Bool>("done_out", 1, true);
+    plan_mode_.assign(static_cast<std::size_t>(n_), "");
     for (int i = 0; i < n_; ++i) {
       truth_subs_.push_back(nh.subscribe<nav_msgs::Odometry>(
           "uav" + std::to_string(i) + "/ground_truth", 10, [this, i](const nav_msgs::Odometry::ConstPtr& m) {
@@ -113,6 +116,14 @@ class SimWorldNodelet : public nodelet::Nodelet {
               return;
             }
             metrics_->plan(i, m->planned_at.toSec(), planVersion(*m), *status, m->planning_ms, m->reason);
+            // The planners' modes (docs/safety.md §1): hold replannings and every change → modes.csv.
+            if (m->mode == "hold") ++metrics_->counters().plans_hold;
+            auto& last = plan_mode_[static_cast<std::size_t>(i)];
+            if (!m->mode.empty() && m->mode != last) {
+              last = m->mode;
+              modes_.push_back(sim::ModeChange{m->planned_at.toSec(), i, m->mode,
+                                               m->mode_reason.empty() ? "fresh data" : m->mode_reason});
+            }
           }));
     }
     params_sub_ = nh.subscribe("leader_params_in", 20, &SimWorldNodelet::onParams, this);
@@ -315,15 +326,16 @@ class SimWorldNodelet : public nodelet::Nodelet {
   void finish() {
     finished_ = true;
     const double wall = (ros::WallTime::now() - wall0_).toSec();
-    // What the ROS system does not report (docs/ros.md): the planners' skipped and hold
-    // replannings, command ages, the LCM links' counters, QP sparse timeouts (logged by the planner).
-    metrics_->counters().not_measured = {"plans_skipped",  "plans_hold",          "commands_stale",
-                                         "messages_sent", "messages_lost",       "messages_duplicated",
-                                         "messages_reordered", "qp_sparse_timeouts"};
-    const sim::MissionOutput out = metrics_->finish(worker_->episodes(), t_, wall);
+    // What the ROS system does not report (docs/ros.md): the planners' skipped replannings,
+    // command ages, the LCM links' counters, QP sparse timeouts (logged by the planner).
+    metrics_->counters().not_measured = {"plans_skipped",  "commands_stale",      "messages_sent",
+                                         "messages_lost", "messages_duplicated", "messages_reordered",
+                                         "qp_sparse_timeouts"};
+    sim::MissionOutput out = metrics_->finish(worker_->episodes(), t_, wall);
+    out.modes = modes_;  // from the plans' mode fields (the planners' hold decisions)
     // metrics.json last: its appearance tells tools/run_ros_mission.sh that the files are complete.
     std::string err;
-    if (!sim::writeMissionFiles(output_dir_, out, n_, false, &err)) NODELET_ERROR_STREAM("SimWorld: " << err);
+    if (!sim::writeMissionFiles(output_dir_, out, n_, true, &err)) NODELET_ERROR_STREAM("SimWorld: " << err);
     if (const auto& left = metrics_->unmatchedOutcomes(); !left.empty()) {
       NODELET_WARN_STREAM("SimWorld: " << left.size() << " command outcome(s) matched no request (e.g. "
                                        << left.front().source << " at " << left.front().issued_s << " s)");
@@ -336,6 +348,8 @@ class SimWorldNodelet : public nodelet::Nodelet {
   }
 
   std::mutex mutex_;
+  std::vector<std::string> plan_mode_;   ///< per UAV: the mode of its last plan
+  std::vector<sim::ModeChange> modes_;   ///< every planner mode change (modes.csv)
   sim::MissionConfig cfg_;
   WorldMap world_;
   std::unique_ptr<sim::MissionClassifier> classifier_;

@@ -84,6 +84,7 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
     }
     const auto outcome = filter_.step(t, *m);
     if (!filter_.initialized()) return;
+    if (estimation::accepted(outcome)) last_fused_ = msg->header.stamp;
     auto out = toWorkerState(filter_.state(), filter_.covariance());
     out.header.stamp = ros::Time(filter_.time());
     out.header.frame_id = world_frame_;
@@ -91,6 +92,7 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
     out.accepted = estimation::accepted(outcome);
     out.lost = filter_.lost(t);
     out.predicted = false;
+    out.last_fused = last_fused_;
     state_pub_.publish(out);
   }
 
@@ -110,6 +112,7 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
     out.accepted = false;
     out.lost = filter_.lost(t);
     out.predicted = true;
+    out.last_fused = last_fused_;
     state_pub_.publish(out);
   }
 
@@ -122,6 +125,7 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
   double tf_timeout_s_ = 0.0;
   double last_uwb_m_ = std::nan("");
   ros::Time last_uwb_stamp_;
+  ros::Time last_fused_;  ///< the last accepted measurement's stamp (WorkerState.last_fused)
   tf2_ros::Buffer tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
   ros::Publisher state_pub_;

@@ -159,10 +159,13 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, Heartbeat
   return d.report(reason);
 }
 
-// ---- worker state: f64 t_s, p[3], v[3], cov_diag[6] (≥ 0), u8 flags(bit0 lost) -----------------
+// ---- worker state: f64 t_s, f64 last_fused_t_s (≤ t_s), p[3], v[3], cov_diag[6] (≥ 0),
+//      u8 flags(bit0 lost) -------------------------------------------------------------------
 
 EncodeResult encodePayload(const WorkerStateMessage& m) {
   if (!std::isfinite(m.t_s)) return EncodeResult::fail("worker_state.t_s not finite");
+  if (!std::isfinite(m.last_fused_t_s)) return EncodeResult::fail("worker_state.last_fused_t_s not finite");
+  if (m.last_fused_t_s > m.t_s) return EncodeResult::fail("worker_state.last_fused_t_s after t_s");
   if (!m.p_world.allFinite()) return EncodeResult::fail("worker_state.p_world not finite");
   if (!m.v_world.allFinite()) return EncodeResult::fail("worker_state.v_world not finite");
   for (double c : m.covariance_diag) {
@@ -170,6 +173,7 @@ EncodeResult encodePayload(const WorkerStateMessage& m) {
   }
   ByteWriter w;
   w.f64(m.t_s);
+  w.f64(m.last_fused_t_s);
   putVector(w, m.p_world);
   putVector(w, m.v_world);
   for (double c : m.covariance_diag) w.f64(c);
@@ -182,6 +186,9 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, WorkerSta
   WorkerStateMessage m;
   std::uint8_t flags = 0;
   d.f64(m.t_s, "worker_state.t_s");
+  if (d.f64(m.last_fused_t_s, "worker_state.last_fused_t_s") && m.last_fused_t_s > m.t_s) {
+    d.fail(PayloadError::kOutOfRange, "worker_state.last_fused_t_s");
+  }
   d.vec3(m.p_world, "worker_state.p_world");
   d.vec3(m.v_world, "worker_state.v_world");
   for (std::size_t i = 0; i < m.covariance_diag.size(); ++i) {

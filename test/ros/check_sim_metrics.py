@@ -47,8 +47,13 @@ def main():
     check(m.get("gestures_performed") == 0 and m.get("false_adaptations") == 1,
           f"the injected gesture (no worker gesture before 72 s) is 1 false adaptation "
           f"(performed {m.get('gestures_performed')}, false {m.get('false_adaptations')})")
-    check("plans_hold" in m.get("not_measured_keys", []) and m.get("plans_hold") is None,
+    check("commands_stale" in m.get("not_measured_keys", []) and m.get("commands_stale") is None,
           "what ROS cannot observe is null and listed (not_measured_keys)")
+    check(m.get("plans_hold") == 0 and "plans_hold" not in m.get("not_measured_keys", []),
+          f"no hold replanning in a mission without faults (plans_hold {m.get('plans_hold')}, from the plans' mode)")
+    modes = list(csv.DictReader(open(f"{out}/modes.csv")))
+    check(sorted(r["uav"] for r in modes) == ["1", "2", "L"] and all(r["mode"] == "track" for r in modes),
+          f"modes.csv: each UAV tracks from its first plan ({[(r['uav'], r['mode']) for r in modes]})")
     rows = list(csv.DictReader(open(f"{out}/events.csv")))
     op = [r for r in rows if r["source"] == "operator" and abs(num(r["t"]) - 20.0) < 0.02]
     ok = len(op) == 1 and op[0]["status"] == "applied" and \

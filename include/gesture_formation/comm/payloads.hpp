@@ -48,6 +48,9 @@ struct Heartbeat {
 /// \brief The leader's worker estimate (DESIGN §3): state at t_s with the covariance diagonal.
 struct WorkerStateMessage {
   double t_s = 0.0;
+  /// When the estimator last fused a measurement [s], ≤ t_s: the estimate's age for the hold rule
+  /// (docs/safety.md §1 rule 2: max_worker_age_s) is t_now − last_fused_t_s.
+  double last_fused_t_s = 0.0;
   Eigen::Vector3d p_world = Eigen::Vector3d::Zero();  ///< [m] ENU
   Eigen::Vector3d v_world = Eigen::Vector3d::Zero();  ///< [m/s] ENU
   /// pxx, pyy, pzz [m²], pvxx, pvyy, pvzz [(m/s)²]; each ≥ 0.

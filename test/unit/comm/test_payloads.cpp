@@ -99,35 +99,49 @@ TEST(CommPayloadsTest, HeartbeatRoundTrip) {
 TEST(CommPayloadsTest, WorkerStateRoundTripAndNonFinite) {
   WorkerStateMessage m;
   m.t_s = 3.5;
+  m.last_fused_t_s = 2.75;
   m.p_world = {1, -2, 3.25};
   m.v_world = {0.1, 0.2, -0.3};
   m.covariance_diag = {0.01, 0.02, 0.03, 0.4, 0.5, 0.6};
   m.lost = true;
   const auto b = encoded(m);
-  ASSERT_EQ(b.size(), 13 * 8 + 1u);
+  ASSERT_EQ(b.size(), 14 * 8 + 1u);
   WorkerStateMessage d;
   ASSERT_EQ(decode(b, d), PayloadError::kNone);
+  EXPECT_EQ(d.t_s, m.t_s);
+  EXPECT_EQ(d.last_fused_t_s, m.last_fused_t_s);
   EXPECT_EQ(d.p_world, m.p_world);
   EXPECT_EQ(d.v_world, m.v_world);
   EXPECT_EQ(d.covariance_diag, m.covariance_diag);
   EXPECT_TRUE(d.lost);
   // Every double replaced by NaN / inf in turn is refused naming the field; d is untouched.
-  for (std::size_t f = 0; f < 13; ++f) {
+  for (std::size_t f = 0; f < 14; ++f) {
     for (double bad_value : {kNaN, kInf, -kInf}) {
       auto bad = b;
       putDouble(bad, 8 * f, bad_value);
       WorkerStateMessage untouched = d;
       std::string reason;
-      ASSERT_EQ(decode(bad, untouched, &reason), PayloadError::kNonFinite) << f;
+      const PayloadError e = decode(bad, untouched, &reason);
+      ASSERT_EQ(e, PayloadError::kNonFinite) << f << " " << reason;
       EXPECT_NE(reason.find("worker_state."), std::string::npos);
       EXPECT_EQ(untouched.t_s, d.t_s);
+      EXPECT_EQ(untouched.last_fused_t_s, d.last_fused_t_s);
     }
   }
   auto neg = b;
-  putDouble(neg, 8 * 7, -0.1);
+  putDouble(neg, 8 * 8, -0.1);
   std::string reason;
   EXPECT_EQ(decode(neg, d, &reason), PayloadError::kOutOfRange);
   EXPECT_EQ(reason, "out_of_range: worker_state.covariance_diag[0]");
+  // A fusion after the state's own time is malformed (it would make the estimate look fresher).
+  auto future = b;
+  putDouble(future, 8, 3.6);
+  EXPECT_EQ(decode(future, d, &reason), PayloadError::kOutOfRange);
+  EXPECT_EQ(reason, "out_of_range: worker_state.last_fused_t_s");
+  EXPECT_EQ(d.last_fused_t_s, 2.75);
+  WorkerStateMessage later = m;
+  later.last_fused_t_s = 4.0;
+  EXPECT_FALSE(encodePayload(later));
   m.p_world.x() = kNaN;
   EXPECT_FALSE(encodePayload(m));
 }

@@ -1,0 +1,32 @@
+#!/bin/bash
+# The hold rule in the ROS system (docs/safety.md §1 rules 2–4, §2.2): simulation.launch with a
+# fault profile that blinds the leader's camera from 8 to 14 s. Every FormationPlanner must hold
+# (mode `hold` in its plans, SimWorld's modes.csv) once the estimate's last fused measurement is
+# older than max_worker_age_s (3 s) — the leader from its own estimate, the followers from the
+# estimate they receive over LCM — brake to a stop, and track again when detections return; Γ_dis
+# and no collision throughout (test/ros/check_hold.py).
+set -o pipefail
+source "$(dirname "$0")/common.bash"
+[ "$(id -u)" -eq 0 ] || { echo "SKIP: needs root (unshare -n keeps LCM on this machine)"; exit 0; }
+make_key "$T/keys"
+mkdir -p "$T/out"
+cat > "$T/blackout.yaml" <<YAML
+faults:
+  camera_blackouts: [[8, 14]]
+YAML
+cat > "$T/inner.sh" <<INNER
+ip link set lo up && ip route add 224.0.0.0/4 dev lo || exit 1
+roslaunch -p $PORT gesture_formation simulation.launch key_file:=$T/keys output_dir:=$T/out duration:=24 \
+  real_time_factor:=1.5 faults:=$T/blackout.yaml > "$T/launch.log" 2>&1 &
+launch=\$!
+for _ in \$(seq 120); do [ -f "$T/out/metrics.json" ] && break; sleep 0.5; done
+sleep 0.5
+python3 "$SRC/test/ros/check_hold.py" "$T/out" 8 14 3.0
+rc=\$?
+kill -INT \$launch; wait \$launch
+exit \$rc
+INNER
+timeout 85 unshare -n bash "$T/inner.sh"
+rc=$?
+[ $rc -eq 0 ] || { echo "--- launch.log (errors, holds)"; grep -aE "ERROR|refuses|hold|track" "$T/launch.log" | head -30; }
+exit $rc
