@@ -20,17 +20,19 @@
 //   ~scenario_file (the map), ~mission_file (optional: take formation + planner from a
 //   scenario's mission) or ~formation_config + ~planner_config, ~replanning_period_s,
 //   ~horizon_dt_s, ~horizon_steps, ~max_share_age_s, ~params_rate_hz, ~max_wind_estimate_age_s; without ~mission_file
-//   also ~avoid_all_plans, ~max_plan_age_s, ~max_worker_age_s, ~brake_accel_mps2 (with it: the
-//   mission's faults.avoid_all_plans, faults.max_plan_age_s, faults.max_worker_age_s and
-//   controller.brake_accel_mps2, as gfctl simulate); optional ~faults_file (a fault profile merged
-//   into the mission, as `gfctl simulate --faults`).
+//   also ~avoid_all_plans, ~max_plan_age_s, ~max_worker_age_s, ~brake_accel_mps2,
+//   ~search_timeout_s, ~search_height_m, ~search_vertical_speed_mps, ~search_period_s (with it: the mission's faults.* of the
+//   same names and controller.brake_accel_mps2, as gfctl simulate); optional ~faults_file (a fault
+//   profile merged into the mission, as `gfctl simulate --faults`).
 // Hold (docs/safety.md §1 rules 2–4, planning::holdReason — the decision gfctl simulate makes):
 // the leader holds when its estimate's last fused measurement (WorkerState.last_fused) is older
 // than max_worker_age_s; a follower when the leader's worker state (over LCM) is older than
 // max_share_age_s, or the estimate it carries older than max_worker_age_s. A holding UAV plans
 // to its latched braking point (planning::brakingPoint, holdReference: camera on the worker's last
 // known position), avoiding every received plan; its plan is flagged `fallback` (others avoid
-// it) with mode `hold` and the reason; the first replanning with fresh data tracks again.
+// it) with mode `hold` and the reason; the first replanning with fresh data tracks again. The
+// leader, holding because it has not seen the worker, searches (mode `search`, for at most
+// search_timeout_s): its camera sweeps up and down through the estimate (planning::searchTargets).
 #include <cmath>
 #include <map>
 #include <mutex>
@@ -79,6 +81,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
         pcfg = mission.planner;
         rule_ = planning::AvoidanceRule{mission.faults.avoid_all_plans, mission.faults.max_plan_age_s};
         freshness_.max_worker_age_s = mission.faults.max_worker_age_s;
+        search_ = mission.faults.search;
         brake_accel_mps2_ = mission.controller.brake_accel_mps2;
       }
     } else {
@@ -88,6 +91,10 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
       params.load("max_plan_age_s", rule_.max_plan_age_s, 0.01, 60.0);
       params.load("max_worker_age_s", freshness_.max_worker_age_s, 0.1, 60.0);
       params.load("brake_accel_mps2", brake_accel_mps2_, 0.1, 20.0);
+      params.load("search_timeout_s", search_.timeout_s, 0.0, 3600.0);
+      params.load("search_height_m", search_.height_m, 0.1, 100.0);
+      params.load("search_vertical_speed_mps", search_.vertical_speed_mps, 0.01, 10.0);
+      params.load("search_period_s", search_.period_s, 0.5, 120.0);
       if (!formation_file.empty()) loadFormation(formation_file, params, fcfg);
       if (!planner_file.empty()) loadPlanner(planner_file, params, pcfg);
     }
@@ -236,16 +243,18 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     const std::string hold = planning::holdReason(uav_index_, t, worker_->header.stamp.toSec(), fused_s, freshness_);
     const double age = std::max(0.0, t - worker_->header.stamp.toSec());
     const bool stale = !hold.empty();
+    const bool search = planning::searching(uav_index_, hold, t, fused_s, freshness_, search_);
+    const std::string mode = search ? "search" : stale ? "hold" : "track";
     const Eigen::Vector3d v0 = stale || worker_->lost ? Eigen::Vector3d::Zero() : toEigen(worker_->velocity);
     const Eigen::Vector3d p0 = toEigen(worker_->position) + age * v0;
     const double hphi = stale ? heading_->heading() : heading_->update(v0);
-    if (hold != mode_reason_) {
+    if (mode != mode_) {
       if (stale) {
-        NODELET_WARN_STREAM("FormationPlanner UAV " << uav_index_ << ": hold: " << hold);
+        NODELET_WARN_STREAM("FormationPlanner UAV " << uav_index_ << ": " << mode << ": " << hold);
       } else {
         NODELET_INFO_STREAM("FormationPlanner UAV " << uav_index_ << ": track: fresh data");
       }
-      mode_reason_ = hold;
+      mode_ = mode;
     }
     // Hold: plan to the point where braking ends (latched until it tracks again), camera on the
     // worker's last known position; the old estimate serves only as obstacle and camera target.
@@ -271,6 +280,11 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     in.received = &received_;
     in.rule = rule_;
     in.hold_reference = stale ? &hold_reference : nullptr;
+    formation::HorizonPoints search_targets;
+    if (search) {
+      search_targets = planning::searchTargets(p0, t, horizon_dt_s_, horizon_steps_, fused_s, freshness_, search_);
+      in.camera_target = &search_targets;
+    }
     const planning::PlanRequest req = planning::buildPlanRequest(in);
     const planning::PlanResult res = planner_->plan(req);
     if (res.status != planning::PlanStatus::kOptimized) {
@@ -285,7 +299,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     }
     auto msg = toMsg(res);
     msg.fallback = msg.fallback || stale;  // a holding UAV has right of way (rule 3)
-    msg.mode = stale ? "hold" : "track";
+    msg.mode = mode;
     msg.mode_reason = hold;
     msg.header.frame_id = world_frame_;
     msg.uav_index = uav_index_;
@@ -314,7 +328,8 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   planning::FreshnessLimits freshness_;
   double brake_accel_mps2_ = 0.0;
   std::optional<Eigen::Vector3d> hold_p_;  ///< the latched stop point while holding
-  std::string mode_reason_;                ///< the current hold reason (empty: tracking)
+  planning::SearchConfig search_;
+  std::string mode_ = "track";             ///< track | hold | search (logged on change)
   std::string last_command_, last_outcome_, last_source_, last_status_;
   ros::Time last_stamp_;
   std::vector<int> last_uavs_;

@@ -117,7 +117,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
             }
             metrics_->plan(i, m->planned_at.toSec(), planVersion(*m), *status, m->planning_ms, m->reason);
             // The planners' modes (docs/safety.md §1): hold replannings and every change → modes.csv.
-            if (m->mode == "hold") ++metrics_->counters().plans_hold;
+            if (m->mode == "hold" || m->mode == "search") ++metrics_->counters().plans_hold;
             auto& last = plan_mode_[static_cast<std::size_t>(i)];
             if (!m->mode.empty() && m->mode != last) {
               last = m->mode;

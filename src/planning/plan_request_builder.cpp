@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 namespace gesture_formation::planning {
 
@@ -16,6 +17,7 @@ PlanRequest buildPlanRequest(const PlanRequestInputs& in) {
   req.state.t_s = in.t_s;
   req.wind_estimate_mps = in.wind_estimate_mps;
   req.worker = in.worker;
+  if (in.camera_target != nullptr) req.camera_target = *in.camera_target;
   const bool hold = in.hold_reference != nullptr;
   const bool has_leader_plan = i != 0 && in.leader_plan != nullptr && !in.leader_plan->empty();
   if (hold) {
@@ -64,6 +66,44 @@ std::string holdReason(int uav_index, double t_s, double share_stamp_s, double w
 Eigen::Vector3d brakingPoint(const Eigen::Vector3d& p_world, const Eigen::Vector3d& v_world, double brake_accel_mps2) {
   const double a = std::max(1e-3, brake_accel_mps2);
   return p_world + v_world * (v_world.norm() / (2.0 * a));
+}
+
+std::vector<std::string> SearchConfig::validate(const std::string& prefix) const {
+  std::vector<std::string> e;
+  const auto num = [](double v) {
+    std::ostringstream os;
+    os << v;
+    return os.str();
+  };
+  if (!(std::isfinite(timeout_s) && timeout_s >= 0.0)) e.push_back(prefix + "search_timeout_s must be >= 0, got " + num(timeout_s));
+  if (!(std::isfinite(height_m) && height_m > 0.0)) e.push_back(prefix + "search_height_m must be > 0, got " + num(height_m));
+  if (!(std::isfinite(vertical_speed_mps) && vertical_speed_mps > 0.0)) {
+    e.push_back(prefix + "search_vertical_speed_mps must be > 0, got " + num(vertical_speed_mps));
+  }
+  if (!(std::isfinite(period_s) && period_s > 0.0)) e.push_back(prefix + "search_period_s must be > 0, got " + num(period_s));
+  return e;
+}
+
+bool searching(int uav_index, const std::string& hold_reason, double t_s, double worker_stamp_s,
+               const FreshnessLimits& limits, const SearchConfig& config) {
+  return uav_index == 0 && config.timeout_s > 0.0 && hold_reason == "worker not seen for more than max_worker_age_s" &&
+         std::isfinite(worker_stamp_s) && t_s - worker_stamp_s <= limits.max_worker_age_s + config.timeout_s;
+}
+
+formation::HorizonPoints searchTargets(const Eigen::Vector3d& last_worker_world, double t_s, double dt_s, int steps,
+                                       double worker_stamp_s, const FreshnessLimits& limits, const SearchConfig& config) {
+  formation::HorizonPoints out(3, std::max(0, steps));
+  const double t_begin = worker_stamp_s + limits.max_worker_age_s;
+  const double period = config.period_s > 0.0 ? config.period_s : 1.0;
+  for (int k = 0; k < out.cols(); ++k) {
+    const double t = t_s + k * dt_s;
+    const double phase = std::max(0.0, t - t_begin) / period;
+    const double f = phase - std::floor(phase);
+    const double w = f < 0.25 ? 4.0 * f : (f < 0.75 ? 2.0 - 4.0 * f : 4.0 * f - 4.0);  // 0 → 1 → 0 → −1 → 0
+    const double amplitude = std::min(config.height_m, config.vertical_speed_mps * std::max(0.0, t - worker_stamp_s));
+    out.col(k) = last_worker_world + Eigen::Vector3d(0.0, 0.0, amplitude * w);
+  }
+  return out;
 }
 
 formation::ReferenceTrajectory holdReference(const Eigen::Vector3d& hold_world, const Eigen::Vector3d& worker_world,

@@ -276,17 +276,19 @@ std::optional<PlannedTrajectory> UavPlanner::separateHoldPoint(const PlanRequest
 }
 
 void UavPlanner::aimCamera(const PlanRequest& req, PlannedTrajectory& tr) const {
-  // Keep looking at the worker within the rate limits (closed-form filter: no failure modes),
-  // else hold the current angles.
+  // Keep looking at the worker (or the search's targets) within the rate limits (closed-form
+  // filter: no failure modes), else hold the current angles.
   const int n = static_cast<int>(tr.samples.size());
   CameraTrackingProblem cam;
   cam.dt_s = tr.dt_s;
   cam.heading0_rad = std::isfinite(req.state.heading_rad) ? req.state.heading_rad : 0.0;
   cam.pitch0_rad = std::isfinite(req.state.pitch_rad) ? req.state.pitch_rad : 0.0;
-  const bool worker_ok = req.worker.steps() == n && req.worker.p_world.allFinite();
+  const bool search = req.camera_target.cols() == n && req.camera_target.allFinite();
+  const formation::HorizonPoints& target = search ? req.camera_target : req.worker.p_world;
+  const bool worker_ok = search || (req.worker.steps() == n && req.worker.p_world.allFinite());
   if (worker_ok) {
     for (const auto& s : tr.samples) cam.p_world.push_back(s.p_world);
-    for (int k = 0; k < n; ++k) cam.target_world.push_back(req.worker.p_world.col(k));
+    for (int k = 0; k < n; ++k) cam.target_world.push_back(target.col(k));
     cam.max_heading_rate_radps = config_.limits.max_heading_rate_radps;
     cam.max_pitch_rate_radps = config_.limits.max_pitch_rate_radps;
     cam.min_pitch_rad = config_.limits.min_pitch_rad;
@@ -786,7 +788,8 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
     cam.heading0_rad = req.state.heading_rad;
     cam.pitch0_rad = req.state.pitch_rad;
     cam.p_world = sol.p;
-    for (int k = 0; k <= N; ++k) cam.target_world.push_back(req.worker.p_world.col(k));
+    const bool search = req.camera_target.cols() == req.worker.steps() && req.camera_target.allFinite();
+    for (int k = 0; k <= N; ++k) cam.target_world.push_back(search ? req.camera_target.col(k) : req.worker.p_world.col(k));
     cam.max_heading_rate_radps = config_.limits.max_heading_rate_radps;
     cam.max_pitch_rate_radps = config_.limits.max_pitch_rate_radps;
     cam.min_pitch_rad = config_.limits.min_pitch_rad;

@@ -60,6 +60,7 @@ std::vector<std::string> FaultConfig::validate(const std::string& prefix) const 
   check(e, max_worker_age_s > 0, max_worker_age_s, prefix, "max_worker_age_s", "> 0");
   check(e, max_command_age_s > 0, max_command_age_s, prefix, "max_command_age_s", "> 0");
   check(e, max_plan_age_s > 0, max_plan_age_s, prefix, "max_plan_age_s", "> 0");
+  for (auto& problem : search.validate(prefix)) e.push_back(std::move(problem));
   return e;
 }
 
@@ -385,6 +386,10 @@ common::Result<MissionConfig> parseMissionConfig(const std::string& yaml, const 
   }
   r.readDouble(fk + "max_share_age_s", c.faults.max_share_age_s, Range::positive());
   r.readDouble(fk + "max_worker_age_s", c.faults.max_worker_age_s, Range::positive());
+  r.readDouble(fk + "search_timeout_s", c.faults.search.timeout_s, Range::nonNegative());
+  r.readDouble(fk + "search_height_m", c.faults.search.height_m, Range::positive());
+  r.readDouble(fk + "search_vertical_speed_mps", c.faults.search.vertical_speed_mps, Range::positive());
+  r.readDouble(fk + "search_period_s", c.faults.search.period_s, Range::positive());
   r.readDouble(fk + "max_command_age_s", c.faults.max_command_age_s, Range::positive());
   r.readDouble(fk + "max_plan_age_s", c.faults.max_plan_age_s, Range::positive());
   r.readBool(fk + "avoid_all_plans", c.faults.avoid_all_plans);

@@ -270,9 +270,11 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
       params = share->params;
       version = share->params_version;
     }
+    // The leader searches with its camera for a worker it lost (for a bounded time) while it holds.
+    const bool search = planning::searching(i, hold, t, worker_stamp, freshness, cfg.faults.search);
     if (!hold.empty()) {
       ++M.plans_hold;
-      setMode(i, t, "hold", hold);
+      setMode(i, t, search ? "search" : "hold", hold);
     } else {
       setMode(i, t, "track", "fresh data");
     }
@@ -301,6 +303,11 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
     in.leader_plan = share != nullptr ? &share->plan : nullptr;
     in.received = &u.received;
     in.hold_reference = hold.empty() ? nullptr : &hold_reference;
+    formation::HorizonPoints search_targets;
+    if (search) {
+      search_targets = planning::searchTargets(p0, t, hdt, hsteps, worker_stamp, freshness, cfg.faults.search);
+      in.camera_target = &search_targets;
+    }
     in.rule = planning::AvoidanceRule{cfg.faults.avoid_all_plans, cfg.faults.max_plan_age_s};
     const planning::PlanRequest req = planning::buildPlanRequest(in);
     const planning::PlanResult res = u.planner->plan(req);

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Checks a ROS simulation run with a camera blackout [A, B] (test/ros/worker_lost_hold.sh):
-every UAV enters hold between A + max_worker_age_s (less one camera frame: the last detection
+every UAV enters hold (the leader: search) between A + max_worker_age_s (less one camera frame: the last detection
 before the blackout) and 1.5 s later, none before, each is slow
 while holding, each tracks again within 6 s after B; Γ_dis, no collision, plans_hold counted.
 Usage: check_hold.py OUT_DIR A B MAX_WORKER_AGE_S"""
@@ -24,7 +24,7 @@ timeline = list(csv.DictReader(open(f"{out}/timeline.csv")))
 labels = ["L", "1", "2"]
 for uav in range(3):
     rows = [(float(r["t"]), r["mode"], r["reason"]) for r in modes if r["uav"] == labels[uav]]
-    holds = [r for r in rows if r[1] == "hold"]
+    holds = [r for r in rows if r[1] == ("search" if uav == 0 else "hold")]  # the leader searches (safety.md §2.2)
     check(len(holds) >= 1 and all(a + age - 0.1 <= t <= a + age + 1.5 for t, _, _ in holds),
           f"UAV {uav} holds only after the estimate is {age} s old: {holds}")
     if holds:

@@ -57,6 +57,8 @@ struct PlanRequestInputs {
   const std::vector<std::optional<ReceivedPlan>>* received = nullptr;
   /// Non-null: the UAV holds — this is its reference, and it avoids every received plan.
   const formation::ReferenceTrajectory* hold_reference = nullptr;
+  /// Non-null: where the camera looks instead of the worker prediction (PlanRequest::camera_target).
+  const formation::HorizonPoints* camera_target = nullptr;
   AvoidanceRule rule;
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
@@ -83,6 +85,34 @@ std::string holdReason(int uav_index, double t_s, double share_stamp_s, double w
 /// \brief Where braking from velocity v at `brake_accel_mps2` ends: p + v|v|/(2a). A UAV entering
 /// hold latches this point and holds it until it tracks again (docs/safety.md §1 rule 3).
 Eigen::Vector3d brakingPoint(const Eigen::Vector3d& p_world, const Eigen::Vector3d& v_world, double brake_accel_mps2);
+
+/// \brief The leader's camera search for a worker it lost (docs/safety.md §2.2): while it holds
+/// because it has not seen the worker for more than max_worker_age_s, it stays at its hold point
+/// (nothing moves on old data) and sweeps its camera along the vertical through the worker's
+/// estimate, as far up and down as he could have climbed since he was last seen — a worker on a
+/// tower climbs out of a camera that keeps looking where he was. Followers hold as before.
+struct SearchConfig {
+  double timeout_s = 60.0;           ///< search for at most this long after the hold began, then look at the estimate; 0: never
+  double height_m = 15.0;            ///< the sweep's largest offset above / below the estimate [m], > 0
+  double vertical_speed_mps = 0.5;   ///< assumed climbing speed: the offset grows by this × the estimate's age, > 0
+  double period_s = 8.0;             ///< up, back, down, back once [s], > 0
+  /// Every problem, each naming the key under `prefix` (search_timeout_s, search_height_m,
+  /// search_vertical_speed_mps, search_period_s); empty when valid.
+  std::vector<std::string> validate(const std::string& prefix) const;
+};
+
+/// \brief Whether UAV `uav_index` searches at t_s: the leader only, only for the hold reason
+/// "worker not seen for more than max_worker_age_s", only until max_worker_age_s + timeout_s
+/// after the last fused measurement.
+bool searching(int uav_index, const std::string& hold_reason, double t_s, double worker_stamp_s,
+               const FreshnessLimits& limits, const SearchConfig& config);
+
+/// \brief The search's camera targets for steps k = 0..steps−1 at t_k = t_s + k·dt_s: the
+/// estimate raised by A(t_k)·w(phase), A = min(height_m, vertical_speed × (t_k − worker_stamp_s)),
+/// w a triangle wave 0 → 1 → 0 → −1 → 0 per period_s, phase 0 when the hold began (worker_stamp_s
+/// + max_worker_age_s): close to the estimate first (a short occlusion), wider the longer he is lost.
+formation::HorizonPoints searchTargets(const Eigen::Vector3d& last_worker_world, double t_s, double dt_s, int steps,
+                                       double worker_stamp_s, const FreshnessLimits& limits, const SearchConfig& config);
 
 /// \brief The hold reference: every step at `hold_world`, camera heading and pitch towards
 /// `worker_world` (the last known worker position; `heading_rad` when straight above/below).

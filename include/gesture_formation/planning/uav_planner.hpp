@@ -84,6 +84,9 @@ struct PlanRequest {
   formation::ReferenceTrajectory reference;
   /// The worker's predicted trajectory, same steps (a moving obstacle; camera target).
   formation::WorkerHorizon worker;
+  /// Where the camera looks instead, same steps (empty: at `worker`). Set while the leader searches
+  /// for a worker it lost (planning::searchTargets); the keep-out still uses `worker`.
+  formation::HorizonPoints camera_target;
   /// Plans of the higher-priority UAVs as last received (any stamps; older plans get a
   /// margin growing with their age).
   std::vector<PlannedTrajectory> higher_priority_plans;

@@ -24,6 +24,7 @@
 #include "gesture_formation/gesture/gesture_filter.hpp"
 #include "gesture_formation/gesture/gesture_mapping.hpp"
 #include "gesture_formation/gesture/view_fusion.hpp"
+#include "gesture_formation/planning/plan_request_builder.hpp"
 #include "gesture_formation/planning/planner_config.hpp"
 #include "gesture_formation/sim/link.hpp"
 #include "gesture_formation/sim/multirotor.hpp"
@@ -96,6 +97,9 @@ struct FaultConfig {
   /// ones): a higher-priority UAV no longer relies on a lower-priority one to dodge it, which a
   /// late or lost fallback flag makes unsafe (docs/safety.md §2.1).
   bool avoid_all_plans = true;
+  /// The leader's camera search for a worker it lost (keys search_timeout_s, search_height_m,
+  /// search_vertical_speed_mps, search_period_s; docs/safety.md §2.2).
+  planning::SearchConfig search;
   std::vector<std::string> validate(const std::string& prefix = "") const;
   /// \brief Whether follower `uav`'s computer is down at `t_s` (a follower_dropouts window).
   bool followerOffline(int uav, double t_s) const;

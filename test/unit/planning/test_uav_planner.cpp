@@ -176,6 +176,37 @@ TEST(UavPlannerTest, FreeSpacePlanFollowsReferenceAndVerifies) {
   EXPECT_NEAR(common::wrapAngle(last.heading_rad - std::atan2(d.y(), d.x())), 0.0, 0.05);
 }
 
+// The leader's camera search (docs/safety.md §2.2): a camera target replaces the worker as what
+// the camera looks at, while the worker keeps its keep-out; the positions are the same plan's.
+TEST(UavPlannerTest, CameraTargetSteersTheCameraNotThePath) {
+  const World& w = towers();
+  const Eigen::Vector3d from(-8, -12, 10), worker(-5, -3, 1);
+  PlanRequest look = straightRequest(0, 0.0, stateAt(from), from, from, 0.0, worker);
+  PlanRequest search = look;
+  search.camera_target = search.worker.p_world;
+  for (int k = 0; k < search.camera_target.cols(); ++k) search.camera_target(2, k) += 20.0;  // 20 m above him
+  UavPlanner a(testConfig(), w.map, w.field), b(testConfig(), w.map, w.field);
+  const PlanResult ra = a.plan(look), rb = b.plan(search);
+  ASSERT_EQ(ra.status, PlanStatus::kOptimized) << ra.reason;
+  ASSERT_EQ(rb.status, PlanStatus::kOptimized) << rb.reason;
+  ASSERT_EQ(ra.trajectory.samples.size(), rb.trajectory.samples.size());
+  for (std::size_t k = 0; k < ra.trajectory.samples.size(); ++k) {
+    EXPECT_TRUE(ra.trajectory.samples[k].p_world.isApprox(rb.trajectory.samples[k].p_world, 1e-9)) << k;
+  }
+  // Looking at the worker: down; at the target 20 m above him: up, as far as the gimbal allows.
+  const auto& la = ra.trajectory.samples.back();
+  const auto& lb = rb.trajectory.samples.back();
+  const Eigen::Vector3d d = worker - la.p_world;
+  EXPECT_NEAR(la.pitch_rad, std::atan2(d.z(), d.head<2>().norm()), 0.05);
+  EXPECT_GT(lb.pitch_rad, la.pitch_rad + 0.5);
+  EXPECT_LE(lb.pitch_rad, testConfig().limits.max_pitch_rad + 1e-9);
+  // A target of the wrong length is ignored (the worker again).
+  PlanRequest bad = look;
+  bad.camera_target = search.camera_target.leftCols(3);
+  UavPlanner c(testConfig(), w.map, w.field);
+  EXPECT_NEAR(c.plan(bad).trajectory.samples.back().pitch_rad, la.pitch_rad, 1e-9);
+}
+
 TEST(UavPlannerTest, ReferenceInsideTowerIsProjectedAndPlanAvoidsIt) {
   const World& w = towers();
   UavPlanner planner(testConfig(), w.map, w.field);

@@ -197,6 +197,42 @@ TEST(HoldReferenceTest, StopsAtTheBrakingPointAndLooksAtTheWorker) {
   }
 }
 
+TEST(SearchTest, OnlyTheLeaderSearchesForALostWorkerForABoundedTime) {
+  const gf::planning::FreshnessLimits lim{2.0, 3.0};
+  gf::planning::SearchConfig cfg;  // 60 s, 15 m, 8 s
+  const std::string lost = "worker not seen for more than max_worker_age_s";
+  EXPECT_TRUE(gf::planning::searching(0, lost, 10.0, 5.0, lim, cfg));
+  EXPECT_TRUE(gf::planning::searching(0, lost, 68.0, 5.0, lim, cfg));    // 3 + 60 s after the last fusion
+  EXPECT_FALSE(gf::planning::searching(0, lost, 68.1, 5.0, lim, cfg));   // then it only holds
+  EXPECT_FALSE(gf::planning::searching(1, "worker estimate older than max_worker_age_s", 10.0, 5.0, lim, cfg));
+  EXPECT_FALSE(gf::planning::searching(0, "", 10.0, 9.0, lim, cfg));
+  cfg.timeout_s = 0.0;
+  EXPECT_FALSE(gf::planning::searching(0, lost, 10.0, 5.0, lim, cfg));
+  EXPECT_FALSE(gf::planning::searching(0, lost, 10.0, std::numeric_limits<double>::quiet_NaN(), lim, gf::planning::SearchConfig{}));
+  // The sweep: from the estimate when the hold began (5 + 3 s), up, back, down, back every 8 s,
+  // as far as 0.5 m/s × the estimate's age.
+  const Eigen::Vector3d last(1, 2, 3);
+  const auto tg = gf::planning::searchTargets(last, 8.0, 1.0, 10, 5.0, lim, gf::planning::SearchConfig{});
+  ASSERT_EQ(tg.cols(), 10);
+  const double want[] = {0, 1.0, 2.5, 1.5, 0, -2.0, -4.5, -2.5, 0, 3.0};
+  for (int k = 0; k < 10; ++k) {
+    EXPECT_NEAR(tg(2, k) - 3.0, want[k], 1e-9) << k;
+    EXPECT_EQ(tg.col(k).head<2>(), last.head<2>());
+  }
+  EXPECT_EQ(gf::planning::SearchConfig{}.validate("faults.").size(), 0u);
+  gf::planning::SearchConfig bad{-1.0, 0.0, 0.0, std::nan("")};
+  const auto problems = bad.validate("faults.");
+  ASSERT_EQ(problems.size(), 4u);
+  EXPECT_NE(problems[0].find("faults.search_timeout_s"), std::string::npos);
+  EXPECT_NE(problems[1].find("faults.search_height_m"), std::string::npos);
+  EXPECT_NE(problems[2].find("faults.search_vertical_speed_mps"), std::string::npos);
+  EXPECT_NE(problems[3].find("faults.search_period_s"), std::string::npos);
+  // The amplitude stops at height_m.
+  const auto late = gf::planning::searchTargets(last, 70.0, 1.0, 8, 5.0, lim, gf::planning::SearchConfig{});
+  EXPECT_LE(late.row(2).maxCoeff(), 3.0 + 15.0 + 1e-9);
+  EXPECT_NEAR(late.row(2).maxCoeff() - 3.0, 15.0, 1e-9);  // the top of the cycle at 74 s (phase 8.25)
+}
+
 // The rule-2 decision gfctl simulate and the FormationPlanner nodelet share (docs/safety.md §1).
 TEST(HoldReasonTest, EachAgeLimitDecidesWithItsOwnStamp) {
   const gf::planning::FreshnessLimits lim{2.0, 3.0};
@@ -270,7 +306,9 @@ TEST(FaultSafetyTest, WorkerLostFor60sAllHoldThenResume) {
     }
   }
   for (int i = 0; i < 3; ++i) {
-    EXPECT_EQ(modeAt(*r.out, i, 60.0), "hold") << i;
+    // The leader searches with its camera from its hold point (search_timeout_s 60 s), the
+    // followers hold (docs/safety.md §2.2).
+    EXPECT_EQ(modeAt(*r.out, i, 60.0), i == 0 ? "search" : "hold") << i;
     EXPECT_EQ(modeAt(*r.out, i, 80.0), "track") << i;
     EXPECT_LT(rowAt(*r.out, 60.0).uavs[static_cast<std::size_t>(i)].speed_mps, 0.5) << i;
   }
