@@ -9,8 +9,9 @@ T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 fail() { echo "FAIL: $*" >&2; exit 1; }
 
-# Leader sees "extend arm" (2) all along; follower 1 agrees only from t = 0.2; follower 2 sees
-# none, and at t = 0.3 "raise arm" (4).
+# Leader sees "extend arm" (2) all along; follower 1 agrees from t = 0.1 (in its 1 s vote window:
+# half its frames at t = 0.1, two thirds at 0.2: it votes, view_fusion.vote_min_fraction 0.5);
+# follower 2 sees none, and at t = 0.3 "raise arm" (4) in one frame of four (no vote).
 cat > "$T/g0.csv" <<CSV
 t,gesture_id,p0,p1,p2,p3,p4,distance_m,elevation_deg
 0.0,2,0,0,1,0,0,10,20
@@ -21,7 +22,7 @@ CSV
 cat > "$T/g1.csv" <<CSV
 t,gesture_id,distance_m,elevation_deg
 0.0,0,8,20
-0.1,0,8,20
+0.1,2,8,20
 0.2,2,8,20
 0.3,2,30,20
 CSV
@@ -34,8 +35,8 @@ t,gesture_id,distance_m,elevation_deg
 CSV
 "$GFCTL" fuse-views --in "$T/g0.csv,$T/g1.csv,$T/g2.csv" --out "$T/f.csv" --config "$SRC/config/gestures.yaml" > /dev/null
 got=$(cut -d, -f2 "$T/f.csv" | tail -n +2 | tr '\n' ' ')
-# t=0.3: follower 1 is 30 m away (outside the envelope) → leader 2 vs follower 2 4: a tie → 0.
-[ "$got" = "0 0 2 0 " ] || fail "fused ids '$got', expected '0 0 2 0 '"
+# t=0.3: follower 1 is 30 m away (outside the envelope): only the leader votes 2 → 0.
+[ "$got" = "0 2 2 0 " ] || fail "fused ids '$got', expected '0 2 2 0 '"
 [ "$(sed -n 5p "$T/f.csv")" = "0.3,0,2,1" ] || fail "t=0.3 row: $(sed -n 5p "$T/f.csv") (expected 2 voting views, 1 agreeing)"
 
 # Single camera (the paper): the leader's ids pass unchanged.
