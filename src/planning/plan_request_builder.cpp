@@ -2,7 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
+
+#include "gesture_formation/common/csv.hpp"
 
 namespace gesture_formation::planning {
 
@@ -70,11 +71,7 @@ Eigen::Vector3d brakingPoint(const Eigen::Vector3d& p_world, const Eigen::Vector
 
 std::vector<std::string> SearchConfig::validate(const std::string& prefix) const {
   std::vector<std::string> e;
-  const auto num = [](double v) {
-    std::ostringstream os;
-    os << v;
-    return os.str();
-  };
+  const auto num = [](double v) { return common::formatDouble(v); };
   if (!(std::isfinite(timeout_s) && timeout_s >= 0.0)) e.push_back(prefix + "search_timeout_s must be >= 0, got " + num(timeout_s));
   if (!(std::isfinite(height_m) && height_m > 0.0)) e.push_back(prefix + "search_height_m must be > 0, got " + num(height_m));
   if (!(std::isfinite(vertical_speed_mps) && vertical_speed_mps > 0.0)) {
