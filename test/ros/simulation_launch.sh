@@ -19,30 +19,33 @@ for _ in \$(seq 50); do rosparam get /use_sim_time > /dev/null 2>&1 && break; sl
 timeout 80 python3 "$SRC/test/ros/sim_check.py"
 rc=\$?
 # The operator's CLI: a valid command is sent (and reaches follower 2 over LCM), a bad one refused.
-# (Watch first: the mission's own request at t = 20 s changes the distances again.)
-timeout 20 python3 -c "
+# The mission's own request at t = 20 s (all.distance_m -1) changes the distances too: the command
+# is sent once that request has been applied (sim time >= 21 s; the next request is at 40 s), and
+# follower 2's distance must go from its value then (8 = 8 + 1 (gesture) - 1 (request)) up by 1.
+timeout 40 python3 -c "
 import rospy, time
 from gesture_formation.msg import FormationParams as F
 rospy.init_node('d2', anonymous=True)
-d = [None]
-def cb(m):
-    if m.uavs[2].distance_m == 10.0: d[0] = 10.0
-sub = rospy.Subscriber('/uav2/formation_params', F, cb)
+seen = []
+sub = rospy.Subscriber('/uav2/formation_params', F, lambda m: seen.append(m.uavs[2].distance_m))
 t0 = time.time()
-while sub.get_num_connections() == 0 and time.time() - t0 < 5:
+while (rospy.get_time() < 21.0 or not seen) and time.time() - t0 < 30:
     time.sleep(0.05)
-time.sleep(0.5)
-open('$T/d2.ready', 'w').close()
-while time.time() - t0 < 10 and d[0] is None:
+before = seen[-1] if seen else None
+n = len(seen)
+open('$T/d2.ready', 'w').write(repr(before))
+t1 = time.time()
+while time.time() - t1 < 10 and not any(d != before for d in seen[n:]):
     time.sleep(0.05)
-print(d[0])" > "$T/d2.txt" 2>/dev/null &
+after = [d for d in seen[n:] if d != before]
+print(before, after[0] if after else None)" > "$T/d2.txt" 2>/dev/null &
 watch=\$!
-for _ in \$(seq 100); do [ -f "$T/d2.ready" ] && break; sleep 0.1; done
+for _ in \$(seq 400); do [ -f "$T/d2.ready" ] && break; sleep 0.1; done
 python3 "$SRC/tools/gf_command.py" followers distance_m 1 || { echo "FAIL: gf_command.py followers distance_m 1"; rc=\$((rc+1)); }
 wait \$watch
 d2=\$(cat "$T/d2.txt")
-[ "\$d2" = "10.0" ] && echo "PASS: operator command via tools/gf_command.py: follower 2 d = \$d2 m over LCM" \
-  || { echo "FAIL: follower 2 d never 10.0 after the operator command (got '\$d2')"; rc=\$((rc+1)); }
+[ "\$d2" = "8.0 9.0" ] && echo "PASS: operator command via tools/gf_command.py at sim t >= 21 s: follower 2 d 8.0 -> 9.0 m over LCM" \
+  || { echo "FAIL: follower 2 d not 8.0 -> 9.0 after the operator command (got '\$d2': before, after)"; rc=\$((rc+1)); }
 python3 "$SRC/tools/gf_command.py" follower7 distance_m 1 2>&1 | grep -q "refused" && echo "PASS: bad target refused by the OperatorInterface" \
   || { echo "FAIL: follower7 not refused"; rc=\$((rc+1)); }
 # SimWorld writes its files when the 40 s are over.
