@@ -32,7 +32,8 @@
 // known position), avoiding every received plan; its plan is flagged `fallback` (others avoid
 // it) with mode `hold` and the reason; the first replanning with fresh data tracks again. The
 // leader, holding because it has not seen the worker, searches (mode `search`, for at most
-// search_timeout_s): its camera sweeps up and down through the estimate (planning::searchTargets).
+// search_timeout_s): once the estimator has lost him (WorkerState.lost) its camera sweeps up and
+// down through the estimate (planning::HoldPlanner, as gfctl simulate).
 #include <cmath>
 #include <map>
 #include <mutex>
@@ -111,6 +112,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     }
     NODELET_INFO_STREAM("FormationPlanner (UAV " << uav_index_ << ") loaded:\n" << params.loaded());
     params_ = fcfg.params;
+    hold_ = planning::HoldPlanner(freshness_, search_, brake_accel_mps2_);
     heading_.emplace(fcfg.worker_heading);
     if (uav_index_ == formation::kLeader) {
       auto st = formation::FormationState::create(fcfg.params, fcfg.limits, fcfg.duplicates);
@@ -243,11 +245,26 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     const std::string hold = planning::holdReason(uav_index_, t, worker_->header.stamp.toSec(), fused_s, freshness_);
     const double age = std::max(0.0, t - worker_->header.stamp.toSec());
     const bool stale = !hold.empty();
-    const bool search = planning::searching(uav_index_, hold, t, fused_s, freshness_, search_);
-    const std::string mode = search ? "search" : stale ? "hold" : "track";
     const Eigen::Vector3d v0 = stale || worker_->lost ? Eigen::Vector3d::Zero() : toEigen(worker_->velocity);
     const Eigen::Vector3d p0 = toEigen(worker_->position) + age * v0;
     const double hphi = stale ? heading_->heading() : heading_->update(v0);
+    // Hold: plan to the point where braking ends (latched until it tracks again), camera on the
+    // worker estimate; the old estimate serves only as obstacle and camera target. The leader that
+    // lost the worker searches with its camera (the decision gfctl simulate makes, same code).
+    planning::HoldPlanner::Situation situation;
+    situation.uav_index = uav_index_;
+    situation.t_s = t;
+    situation.dt_s = horizon_dt_s_;
+    situation.steps = horizon_steps_;
+    situation.hold_reason = hold;
+    situation.worker_stamp_s = fused_s;
+    situation.worker_lost = worker_->lost != 0;
+    situation.p_world = odom_->p_world;
+    situation.v_world = odom_->v_world;
+    situation.heading_rad = odom_->heading_rad;
+    situation.worker_world = p0;
+    const planning::HoldPlanner::Decision decision = hold_.decide(situation);
+    const std::string& mode = decision.mode;
     if (mode != mode_) {
       if (stale) {
         NODELET_WARN_STREAM("FormationPlanner UAV " << uav_index_ << ": " << mode << ": " << hold);
@@ -255,15 +272,6 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
         NODELET_INFO_STREAM("FormationPlanner UAV " << uav_index_ << ": track: fresh data");
       }
       mode_ = mode;
-    }
-    // Hold: plan to the point where braking ends (latched until it tracks again), camera on the
-    // worker's last known position; the old estimate serves only as obstacle and camera target.
-    formation::ReferenceTrajectory hold_reference;
-    if (stale) {
-      if (!hold_p_) hold_p_ = planning::brakingPoint(odom_->p_world, odom_->v_world, brake_accel_mps2_);
-      hold_reference = planning::holdReference(*hold_p_, p0, odom_->heading_rad, horizon_steps_);
-    } else {
-      hold_p_.reset();
     }
     planning::PlanRequestInputs in;
     in.uav_index = uav_index_;
@@ -279,12 +287,8 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     if (leader && t - leader->plan.t0_s <= max_share_age_s_) in.leader_plan = &leader->plan;
     in.received = &received_;
     in.rule = rule_;
-    in.hold_reference = stale ? &hold_reference : nullptr;
-    formation::HorizonPoints search_targets;
-    if (search) {
-      search_targets = planning::searchTargets(p0, t, horizon_dt_s_, horizon_steps_, fused_s, freshness_, search_);
-      in.camera_target = &search_targets;
-    }
+    in.hold_reference = decision.holding() ? &decision.reference : nullptr;
+    if (decision.camera_target.cols() > 0) in.camera_target = &decision.camera_target;
     const planning::PlanRequest req = planning::buildPlanRequest(in);
     const planning::PlanResult res = planner_->plan(req);
     if (res.status != planning::PlanStatus::kOptimized) {
@@ -327,7 +331,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   planning::AvoidanceRule rule_;
   planning::FreshnessLimits freshness_;
   double brake_accel_mps2_ = 0.0;
-  std::optional<Eigen::Vector3d> hold_p_;  ///< the latched stop point while holding
+  planning::HoldPlanner hold_;             ///< hold / search decision, latched braking point
   planning::SearchConfig search_;
   std::string mode_ = "track";             ///< track | hold | search (logged on change)
   std::string last_command_, last_outcome_, last_source_, last_status_;

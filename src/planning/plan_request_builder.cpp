@@ -87,18 +87,17 @@ bool searching(int uav_index, const std::string& hold_reason, double t_s, double
          std::isfinite(worker_stamp_s) && t_s - worker_stamp_s <= limits.max_worker_age_s + config.timeout_s;
 }
 
-formation::HorizonPoints searchTargets(const Eigen::Vector3d& last_worker_world, double t_s, double dt_s, int steps,
-                                       double worker_stamp_s, const FreshnessLimits& limits, const SearchConfig& config) {
+formation::HorizonPoints searchTargets(const Eigen::Vector3d& worker_world, double t_s, double dt_s, int steps,
+                                       double worker_stamp_s, double sweep_begin_s, const SearchConfig& config) {
   formation::HorizonPoints out(3, std::max(0, steps));
-  const double t_begin = worker_stamp_s + limits.max_worker_age_s;
   const double period = config.period_s > 0.0 ? config.period_s : 1.0;
   for (int k = 0; k < out.cols(); ++k) {
     const double t = t_s + k * dt_s;
-    const double phase = std::max(0.0, t - t_begin) / period;
+    const double phase = std::max(0.0, t - sweep_begin_s) / period;
     const double f = phase - std::floor(phase);
     const double w = f < 0.25 ? 4.0 * f : (f < 0.75 ? 2.0 - 4.0 * f : 4.0 * f - 4.0);  // 0 → 1 → 0 → −1 → 0
     const double amplitude = std::min(config.height_m, config.vertical_speed_mps * std::max(0.0, t - worker_stamp_s));
-    out.col(k) = last_worker_world + Eigen::Vector3d(0.0, 0.0, amplitude * w);
+    out.col(k) = worker_world + Eigen::Vector3d(0.0, 0.0, amplitude * w);
   }
   return out;
 }
@@ -117,6 +116,28 @@ formation::ReferenceTrajectory holdReference(const Eigen::Vector3d& hold_world, 
     ref.pitch_rad(k) = pitch;
   }
   return ref;
+}
+
+HoldPlanner::Decision HoldPlanner::decide(const Situation& s) {
+  Decision d;
+  if (s.hold_reason.empty()) {
+    hold_p_.reset();
+    sweep_begin_s_ = std::numeric_limits<double>::quiet_NaN();
+    return d;
+  }
+  if (!hold_p_) hold_p_ = brakingPoint(s.p_world, s.v_world, brake_accel_mps2_);  // latched: no drift
+  d.reference = holdReference(*hold_p_, s.worker_world, s.heading_rad, s.steps);
+  const bool search =
+      s.worker_lost && searching(s.uav_index, s.hold_reason, s.t_s, s.worker_stamp_s, limits_, search_);
+  if (!search) {
+    sweep_begin_s_ = std::numeric_limits<double>::quiet_NaN();
+    d.mode = "hold";
+    return d;
+  }
+  if (!std::isfinite(sweep_begin_s_)) sweep_begin_s_ = s.t_s;
+  d.mode = "search";
+  d.camera_target = searchTargets(s.worker_world, s.t_s, s.dt_s, s.steps, s.worker_stamp_s, sweep_begin_s_, search_);
+  return d;
 }
 
 }  // namespace gesture_formation::planning

@@ -86,7 +86,7 @@ struct UavRuntime {
   bool offline = false;                                      ///< follower dropout in progress
   double rejoined_s = -std::numeric_limits<double>::infinity();  ///< end of the last dropout
   std::string mode = "start";                                ///< last mode recorded (ModeChange)
-  std::optional<Eigen::Vector3d> hold_p;                     ///< latched hold point while holding
+  planning::HoldPlanner hold;                                ///< hold / search decision and its latched state
 };
 
 void addCounters(MissionMetrics& M, const LinkCounters& c) {
@@ -151,6 +151,8 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
     u->planner = planners(i);
     u->next_plan_s = cfg.replanning_period_s * static_cast<double>(i) / static_cast<double>(n);
     u->received.resize(static_cast<std::size_t>(n));
+    u->hold = planning::HoldPlanner(planning::FreshnessLimits{cfg.faults.max_share_age_s, cfg.faults.max_worker_age_s},
+                                    cfg.faults.search, cfg.controller.brake_accel_mps2);
     uavs.push_back(std::move(u));
   }
 
@@ -230,6 +232,7 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
     std::uint64_t version = 0;
     const LeaderShare* share = nullptr;
     double worker_stamp = 0.0;
+    bool worker_lost = false;
     std::string hold;  // non-empty: hold a safe position (docs/safety.md), the reason
     if (i == 0) {
       if (!kf.initialized()) {
@@ -238,10 +241,13 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
       }
       const estimation::Vector6d& x = kf.state();
       worker_stamp = last_fused_s;
+      worker_lost = kf.lost(t);
       hold = planning::holdReason(i, t, t, worker_stamp, freshness);
-      const bool stale = !hold.empty() || kf.lost(t);
+      const bool stale = !hold.empty() || worker_lost;
       v0 = stale ? Eigen::Vector3d::Zero() : Eigen::Vector3d(x.tail<3>());
-      p0 = x.head<3>() + (stale ? 0.0 : (t - kf.time())) * v0;
+      // Stale: the estimator's prediction (constant velocity for lost_timeout_s, then held) — what
+      // the WorkerEstimator nodelet publishes — serves as camera target and obstacle only.
+      p0 = stale ? kf.predicted(t).p_world : Eigen::Vector3d(x.head<3>() + (t - kf.time()) * v0);
       hphi = stale ? human_heading.heading() : human_heading.update(v0);
       params = fstate.params();
       version = params_version;
@@ -270,24 +276,29 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
       params = share->params;
       version = share->params_version;
     }
-    // The leader searches with its camera for a worker it lost (for a bounded time) while it holds.
-    const bool search = planning::searching(i, hold, t, worker_stamp, freshness, cfg.faults.search);
-    if (!hold.empty()) {
+    // Hold (stop where braking at the controller's deceleration ends, camera on the worker
+    // estimate; the stale data serve only as an obstacle and camera target) or, the leader that
+    // lost the worker, search with the camera — the decision the FormationPlanner makes too.
+    planning::HoldPlanner::Situation situation;
+    situation.uav_index = i;
+    situation.t_s = t;
+    situation.dt_s = hdt;
+    situation.steps = hsteps;
+    situation.hold_reason = hold;
+    situation.worker_stamp_s = worker_stamp;
+    situation.worker_lost = worker_lost;
+    situation.p_world = u.est.p_world;
+    situation.v_world = u.est.v_world;
+    situation.heading_rad = u.est.heading_rad;
+    situation.worker_world = p0;
+    const planning::HoldPlanner::Decision decision = u.hold.decide(situation);
+    if (decision.holding()) {
       ++M.plans_hold;
-      setMode(i, t, search ? "search" : "hold", hold);
+      setMode(i, t, decision.mode, hold);
     } else {
       setMode(i, t, "track", "fresh data");
     }
     const formation::WorkerHorizon wh = formation::constantVelocityHorizon(p0, v0, hphi, hsteps, hdt);
-    // Hold: stop where braking at the controller's deceleration ends, camera on the last
-    // known worker position; the stale data serve only as an obstacle and camera target.
-    formation::ReferenceTrajectory hold_reference;
-    if (!hold.empty()) {
-      if (!u.hold_p) u.hold_p = planning::brakingPoint(u.est.p_world, u.est.v_world, cfg.controller.brake_accel_mps2);  // latched: no drift
-      hold_reference = planning::holdReference(*u.hold_p, p0, u.est.heading_rad, hsteps);
-    } else {
-      u.hold_p.reset();
-    }
     planning::PlanRequestInputs in;
     in.uav_index = i;
     in.t_s = t;
@@ -302,12 +313,8 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
     in.params = &params;
     in.leader_plan = share != nullptr ? &share->plan : nullptr;
     in.received = &u.received;
-    in.hold_reference = hold.empty() ? nullptr : &hold_reference;
-    formation::HorizonPoints search_targets;
-    if (search) {
-      search_targets = planning::searchTargets(p0, t, hdt, hsteps, worker_stamp, freshness, cfg.faults.search);
-      in.camera_target = &search_targets;
-    }
+    in.hold_reference = decision.holding() ? &decision.reference : nullptr;
+    if (decision.camera_target.cols() > 0) in.camera_target = &decision.camera_target;
     in.rule = planning::AvoidanceRule{cfg.faults.avoid_all_plans, cfg.faults.max_plan_age_s};
     const planning::PlanRequest req = planning::buildPlanRequest(in);
     const planning::PlanResult res = u.planner->plan(req);

@@ -3,7 +3,8 @@
 # fault profile that blinds the leader's camera from 8 to 14 s. Every FormationPlanner must hold
 # (mode `hold` in its plans, SimWorld's modes.csv) once the estimate's last fused measurement is
 # older than max_worker_age_s (3 s) — the leader from its own estimate, the followers from the
-# estimate they receive over LCM — brake to a stop, and track again when detections return; Γ_dis
+# estimate they receive over LCM — brake to a stop, the leader search with its camera once its
+# estimator has lost the worker (lost_timeout_s 5 s), and track again when detections return; Γ_dis
 # and no collision throughout (test/ros/check_hold.py).
 set -o pipefail
 source "$(dirname "$0")/common.bash"
@@ -21,7 +22,7 @@ roslaunch -p $PORT gesture_formation simulation.launch key_file:=$T/keys output_
 launch=\$!
 for _ in \$(seq 120); do [ -f "$T/out/metrics.json" ] && break; sleep 0.5; done
 sleep 0.5
-python3 "$SRC/test/ros/check_hold.py" "$T/out" 8 14 3.0
+python3 "$SRC/test/ros/check_hold.py" "$T/out" 8 14 3.0 5.0
 rc=\$?
 kill -INT \$launch; wait \$launch
 exit \$rc

@@ -88,9 +88,12 @@ Eigen::Vector3d brakingPoint(const Eigen::Vector3d& p_world, const Eigen::Vector
 
 /// \brief The leader's camera search for a worker it lost (docs/safety.md §2.2): while it holds
 /// because it has not seen the worker for more than max_worker_age_s, it stays at its hold point
-/// (nothing moves on old data) and sweeps its camera along the vertical through the worker's
-/// estimate, as far up and down as he could have climbed since he was last seen — a worker on a
-/// tower climbs out of a camera that keeps looking where he was. Followers hold as before.
+/// (nothing moves on old data). As long as the estimator still extrapolates (constant velocity for
+/// its lost_timeout_s) the camera follows that prediction, as in a plain hold; once the estimator
+/// has lost him (the position is held where the model left it) the camera sweeps along the
+/// vertical through that estimate, as far up and down as he could have climbed since he was last
+/// seen — a worker on a tower climbs out of a camera that keeps looking where he was. Followers
+/// hold as before.
 struct SearchConfig {
   double timeout_s = 60.0;           ///< search for at most this long after the hold began, then look at the estimate; 0: never
   double height_m = 15.0;            ///< the sweep's largest offset above / below the estimate [m], > 0
@@ -101,22 +104,72 @@ struct SearchConfig {
   std::vector<std::string> validate(const std::string& prefix) const;
 };
 
-/// \brief Whether UAV `uav_index` searches at t_s: the leader only, only for the hold reason
+/// \brief Whether UAV `uav_index` may search at t_s: the leader only, only for the hold reason
 /// "worker not seen for more than max_worker_age_s", only until max_worker_age_s + timeout_s
-/// after the last fused measurement.
+/// after the last fused measurement. (HoldPlanner sweeps only once the estimator has lost him.)
 bool searching(int uav_index, const std::string& hold_reason, double t_s, double worker_stamp_s,
                const FreshnessLimits& limits, const SearchConfig& config);
 
 /// \brief The search's camera targets for steps k = 0..steps−1 at t_k = t_s + k·dt_s: the
 /// estimate raised by A(t_k)·w(phase), A = min(height_m, vertical_speed × (t_k − worker_stamp_s)),
-/// w a triangle wave 0 → 1 → 0 → −1 → 0 per period_s, phase 0 when the hold began (worker_stamp_s
-/// + max_worker_age_s): close to the estimate first (a short occlusion), wider the longer he is lost.
-formation::HorizonPoints searchTargets(const Eigen::Vector3d& last_worker_world, double t_s, double dt_s, int steps,
-                                       double worker_stamp_s, const FreshnessLimits& limits, const SearchConfig& config);
+/// w a triangle wave 0 → 1 → 0 → −1 → 0 per period_s, phase 0 at sweep_begin_s (when the sweep
+/// began): close to the estimate first, wider the longer he is lost.
+formation::HorizonPoints searchTargets(const Eigen::Vector3d& worker_world, double t_s, double dt_s, int steps,
+                                       double worker_stamp_s, double sweep_begin_s, const SearchConfig& config);
 
 /// \brief The hold reference: every step at `hold_world`, camera heading and pitch towards
 /// `worker_world` (the last known worker position; `heading_rad` when straight above/below).
 formation::ReferenceTrajectory holdReference(const Eigen::Vector3d& hold_world, const Eigen::Vector3d& worker_world,
                                              double heading_rad, int steps);
+
+/// \brief The hold / search part of one UAV's replanning (docs/safety.md §1 rules 2–4, §2.2),
+/// with its state — the latched braking point, the sweep's start. gfctl simulate's UAVs and the
+/// FormationPlanner nodelet each own one and call decide() once per replanning, so both run the
+/// same sequence. Not thread-safe (one per UAV, called from its planning thread).
+class HoldPlanner {
+ public:
+  HoldPlanner() = default;
+  HoldPlanner(const FreshnessLimits& limits, const SearchConfig& search, double brake_accel_mps2)
+      : limits_(limits), search_(search), brake_accel_mps2_(brake_accel_mps2) {}
+
+  /// What the UAV knows at one replanning.
+  struct Situation {
+    int uav_index = 0;
+    double t_s = 0.0;
+    double dt_s = 0.2;                  ///< horizon step [s]
+    int steps = 0;                      ///< horizon steps
+    std::string hold_reason;            ///< holdReason() or the caller's own rule; empty: track
+    double worker_stamp_s = 0.0;        ///< the estimate's last fused measurement
+    bool worker_lost = false;           ///< the estimator no longer extrapolates (HumanKalman::lost, WorkerState.lost)
+    Eigen::Vector3d p_world = Eigen::Vector3d::Zero();   ///< the UAV's estimated position
+    Eigen::Vector3d v_world = Eigen::Vector3d::Zero();   ///< … velocity
+    double heading_rad = 0.0;                            ///< … heading
+    Eigen::Vector3d worker_world = Eigen::Vector3d::Zero();  ///< the worker estimate at t_s (its prediction)
+    EIGEN_MAKE_ALIGNED_OPERATOR_NEW
+  };
+
+  /// The decision: track (nothing else set), hold (reference) or search (reference + camera target).
+  struct Decision {
+    std::string mode = "track";                ///< "track", "hold" or "search"
+    formation::ReferenceTrajectory reference;  ///< hold / search: at the latched braking point, camera on worker_world
+    formation::HorizonPoints camera_target;    ///< search: the sweep (steps columns); otherwise 0 columns
+    bool holding() const { return mode != "track"; }
+  };
+
+  /// \brief Decides (see the struct comments). Entering hold latches brakingPoint(p, v) until the
+  /// UAV tracks again; the sweep's phase starts at the first replanning that searches and restarts
+  /// after any replanning that does not.
+  Decision decide(const Situation& s);
+
+  /// The latched hold point (empty while tracking).
+  const std::optional<Eigen::Vector3d>& holdPoint() const { return hold_p_; }
+
+ private:
+  FreshnessLimits limits_;
+  SearchConfig search_;
+  double brake_accel_mps2_ = 4.0;
+  std::optional<Eigen::Vector3d> hold_p_;
+  double sweep_begin_s_ = std::numeric_limits<double>::quiet_NaN();
+};
 
 }  // namespace gesture_formation::planning

@@ -209,10 +209,10 @@ TEST(SearchTest, OnlyTheLeaderSearchesForALostWorkerForABoundedTime) {
   cfg.timeout_s = 0.0;
   EXPECT_FALSE(gf::planning::searching(0, lost, 10.0, 5.0, lim, cfg));
   EXPECT_FALSE(gf::planning::searching(0, lost, 10.0, std::numeric_limits<double>::quiet_NaN(), lim, gf::planning::SearchConfig{}));
-  // The sweep: from the estimate when the hold began (5 + 3 s), up, back, down, back every 8 s,
-  // as far as 0.5 m/s × the estimate's age.
+  // The sweep: from the estimate when the sweep began (here 8 s), up, back, down, back every 8 s,
+  // as far as 0.5 m/s × the estimate's age (last fused at 5 s).
   const Eigen::Vector3d last(1, 2, 3);
-  const auto tg = gf::planning::searchTargets(last, 8.0, 1.0, 10, 5.0, lim, gf::planning::SearchConfig{});
+  const auto tg = gf::planning::searchTargets(last, 8.0, 1.0, 10, 5.0, 8.0, gf::planning::SearchConfig{});
   ASSERT_EQ(tg.cols(), 10);
   const double want[] = {0, 1.0, 2.5, 1.5, 0, -2.0, -4.5, -2.5, 0, 3.0};
   for (int k = 0; k < 10; ++k) {
@@ -228,9 +228,82 @@ TEST(SearchTest, OnlyTheLeaderSearchesForALostWorkerForABoundedTime) {
   EXPECT_NE(problems[2].find("faults.search_vertical_speed_mps"), std::string::npos);
   EXPECT_NE(problems[3].find("faults.search_period_s"), std::string::npos);
   // The amplitude stops at height_m.
-  const auto late = gf::planning::searchTargets(last, 70.0, 1.0, 8, 5.0, lim, gf::planning::SearchConfig{});
+  const auto late = gf::planning::searchTargets(last, 70.0, 1.0, 8, 5.0, 8.0, gf::planning::SearchConfig{});
   EXPECT_LE(late.row(2).maxCoeff(), 3.0 + 15.0 + 1e-9);
   EXPECT_NEAR(late.row(2).maxCoeff() - 3.0, 15.0, 1e-9);  // the top of the cycle at 74 s (phase 8.25)
+}
+
+// The stateful sequence gfctl simulate and the FormationPlanner share: latch the braking point,
+// look at the prediction while the estimator extrapolates, sweep once it has lost the worker.
+TEST(HoldPlannerTest, HoldsAtTheLatchedPointAndSweepsOnlyOnceTheEstimatorLostTheWorker) {
+  const gf::planning::FreshnessLimits lim{2.0, 3.0};
+  gf::planning::HoldPlanner hp(lim, gf::planning::SearchConfig{}, 4.0);
+  gf::planning::HoldPlanner::Situation s;
+  s.uav_index = 0;
+  s.dt_s = 1.0;
+  s.steps = 10;
+  s.worker_stamp_s = 5.0;
+  s.p_world = Eigen::Vector3d(0, 0, 5);
+  s.v_world = Eigen::Vector3d(2, 0, 0);
+  s.worker_world = Eigen::Vector3d(10.5, 0, 1);
+  s.t_s = 7.0;  // fresh
+  auto d = hp.decide(s);
+  EXPECT_EQ(d.mode, "track");
+  EXPECT_FALSE(d.holding());
+  EXPECT_FALSE(hp.holdPoint());
+  EXPECT_EQ(d.camera_target.cols(), 0);
+  // 3.2 s without a fusion: hold; the estimator still extrapolates, so the camera follows it.
+  s.t_s = 8.2;
+  s.hold_reason = "worker not seen for more than max_worker_age_s";
+  d = hp.decide(s);
+  EXPECT_EQ(d.mode, "hold");
+  ASSERT_TRUE(hp.holdPoint());
+  EXPECT_TRUE(hp.holdPoint()->isApprox(Eigen::Vector3d(0.5, 0, 5)));
+  ASSERT_EQ(d.reference.steps(), 10);
+  EXPECT_TRUE(d.reference.p_world.col(9).isApprox(Eigen::Vector3d(0.5, 0, 5)));
+  EXPECT_NEAR(d.reference.pitch_rad(0), std::atan2(-4.0, 10.0), 1e-12);
+  EXPECT_EQ(d.camera_target.cols(), 0);
+  // The UAV drifts while braking: the hold point stays latched.
+  s.t_s = 9.0;
+  s.p_world = Eigen::Vector3d(0.3, 0, 5);
+  s.v_world = Eigen::Vector3d(1, 0, 0);
+  d = hp.decide(s);
+  EXPECT_TRUE(d.reference.p_world.col(0).isApprox(Eigen::Vector3d(0.5, 0, 5)));
+  // The estimator has lost him (5 s): the sweep starts at the estimate, phase 0 now.
+  s.t_s = 10.4;
+  s.worker_lost = true;
+  d = hp.decide(s);
+  EXPECT_EQ(d.mode, "search");
+  ASSERT_EQ(d.camera_target.cols(), 10);
+  EXPECT_TRUE(d.camera_target.col(0).isApprox(s.worker_world));
+  EXPECT_NEAR(d.camera_target(2, 2) - 1.0, std::min(15.0, 0.5 * (12.4 - 5.0)) * 1.0, 1e-9);  // 2 s: the top
+  EXPECT_TRUE(d.reference.p_world.col(0).isApprox(Eigen::Vector3d(0.5, 0, 5)));
+  // The next replanning continues the same sweep (phase from 10.4 s).
+  s.t_s = 11.4;
+  const auto again = hp.decide(s);
+  EXPECT_NEAR(again.camera_target(2, 0), d.camera_target(2, 1), 1e-12);
+  // A follower in the same situation only holds.
+  gf::planning::HoldPlanner follower(lim, gf::planning::SearchConfig{}, 4.0);
+  auto fs = s;
+  fs.uav_index = 1;
+  fs.hold_reason = "worker estimate older than max_worker_age_s";
+  EXPECT_EQ(follower.decide(fs).mode, "hold");
+  // 60 s after the hold began the search ends: hold, camera on the estimate.
+  s.t_s = 68.1;
+  d = hp.decide(s);
+  EXPECT_EQ(d.mode, "hold");
+  EXPECT_EQ(d.camera_target.cols(), 0);
+  // Fresh data: track, the latch released; the next hold latches where the UAV is then.
+  s.hold_reason.clear();
+  s.worker_lost = false;
+  EXPECT_EQ(hp.decide(s).mode, "track");
+  EXPECT_FALSE(hp.holdPoint());
+  s.hold_reason = "worker not seen for more than max_worker_age_s";
+  s.v_world.setZero();
+  s.p_world = Eigen::Vector3d(3, 3, 6);
+  hp.decide(s);
+  ASSERT_TRUE(hp.holdPoint());
+  EXPECT_TRUE(hp.holdPoint()->isApprox(Eigen::Vector3d(3, 3, 6)));
 }
 
 // The rule-2 decision gfctl simulate and the FormationPlanner nodelet share (docs/safety.md §1).
