@@ -13,7 +13,13 @@
 // Parameters (required): ~models_root (third_party_models), ~gesture_model (the LSTM's .onnx),
 //   ~detector (movenet_multipose | blazepose), ~skeleton (movenet_lightning | blazepose_landmark),
 //   ~detect_every_k, ~min_depth_m, ~max_depth_m, ~depth_scale_m, ~max_depth_dt_s
-//   (a depth image further than this from the colour image's stamp is not used).
+//   (a depth image further than this from the colour image's stamp is not used; the nodelet keeps the
+//   last kDepthBuffer depth images and uses the one nearest the colour image's stamp — the two
+//   topics are not delivered in order, and a colour image processed late must still find its depth).
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <deque>
 #include <mutex>
 #include <optional>
 
@@ -81,9 +87,14 @@ class PerceptionNodelet : public nodelet::Nodelet {
       if (k) camera_.emplace(*k);
       else NODELET_WARN_STREAM_THROTTLE(5.0, "Perception: " << k.reason());
     });
-    depth_sub_ = nh.subscribe<sensor_msgs::Image>("depth_in", 2, [this](const sensor_msgs::Image::ConstPtr& m) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      depth_ = m;
+    // On the multi-threaded handle with its own lock: a depth image is stored at once, also while a
+    // colour image is being processed (on the single-threaded handle it would queue behind it and
+    // the depth stream would fall behind the colour stream on a busy computer).
+    depth_sub_ = getMTNodeHandle().subscribe<sensor_msgs::Image>("depth_in", 2, [this](const sensor_msgs::Image::ConstPtr& m) {
+      std::lock_guard<std::mutex> lock(depth_mutex_);
+      depths_.push_back(m);
+      while (depths_.size() > kDepthBuffer) depths_.pop_front();
+      depth_arrived_.notify_all();
     });
     image_sub_ = nh.subscribe("image_in", 2, &PerceptionNodelet::onImage, this);
   }
@@ -115,8 +126,9 @@ class PerceptionNodelet : public nodelet::Nodelet {
       if (t.identity_changed) last_score_ = 0.0f;
       if (t.worker_detection >= 0) last_score_ = t.detections[static_cast<std::size_t>(t.worker_detection)].score;
       d.confidence = last_score_;
-      if (depth_ && camera_ && std::abs((depth_->header.stamp - msg->header.stamp).toSec()) <= max_depth_dt_s_) {
-        auto depth = toDepth(*depth_);
+      const sensor_msgs::Image::ConstPtr depth_msg = nearestDepth(msg->header.stamp);
+      if (depth_msg && camera_) {
+        auto depth = toDepth(*depth_msg);
         const estimation::Box box{d.u, d.v, d.w, d.h};
         auto range = depth ? estimation::stereoDistance(*depth, box, *camera_, stereo_)
                            : common::Result<double>::fail(depth.reason());
@@ -143,10 +155,37 @@ class PerceptionNodelet : public nodelet::Nodelet {
   std::unique_ptr<perception::PerceptionPipeline> pipeline_;
   std::optional<gesture::GestureClassifier> classifier_;
   estimation::StereoDistanceConfig stereo_;
+  /// The stored depth image nearest `stamp`, if within max_depth_dt_s (else null). When none is
+  /// stored and no depth image newer than `stamp` has arrived yet, its depth image may still be in
+  /// flight (the topics are not ordered): wait for it, at most max_depth_dt_s of wall time.
+  sensor_msgs::Image::ConstPtr nearestDepth(const ros::Time& stamp) {
+    std::unique_lock<std::mutex> lock(depth_mutex_);
+    const auto nearest = [&]() {
+      sensor_msgs::Image::ConstPtr best;
+      double best_dt = max_depth_dt_s_;
+      for (const auto& d : depths_) {
+        const double dt = std::abs((d->header.stamp - stamp).toSec());
+        if (dt <= best_dt) {
+          best_dt = dt;
+          best = d;
+        }
+      }
+      return best;
+    };
+    const auto settled = [&]() { return nearest() || (!depths_.empty() && depths_.back()->header.stamp > stamp); };
+    if (!depths_.empty()) {  // no depth stream at all: do not wait
+      depth_arrived_.wait_for(lock, std::chrono::duration<double>(max_depth_dt_s_), settled);
+    }
+    return nearest();
+  }
+
+  static constexpr std::size_t kDepthBuffer = 10;  ///< depth images kept (≥ 0.3 s at 30 Hz)
   double max_depth_dt_s_ = 0.0;
   float last_score_ = 0.0f;
   std::optional<estimation::CameraModel> camera_;
-  sensor_msgs::Image::ConstPtr depth_;
+  std::mutex depth_mutex_;                         ///< guards depths_ only
+  std::condition_variable depth_arrived_;
+  std::deque<sensor_msgs::Image::ConstPtr> depths_;  ///< the last kDepthBuffer depth images
   ros::Publisher detection_pub_, gesture_pub_;
   ros::Subscriber info_sub_, depth_sub_, image_sub_;
 };
