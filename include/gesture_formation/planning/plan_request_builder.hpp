@@ -118,7 +118,7 @@ formation::HorizonPoints searchTargets(const Eigen::Vector3d& worker_world, doub
                                        double worker_stamp_s, double sweep_begin_s, const SearchConfig& config);
 
 /// \brief The hold reference: every step at `hold_world`, camera heading and pitch towards
-/// `worker_world` (the last known worker position; `heading_rad` when straight above/below).
+/// `worker_world` (the worker estimate; `heading_rad` when straight above/below).
 formation::ReferenceTrajectory holdReference(const Eigen::Vector3d& hold_world, const Eigen::Vector3d& worker_world,
                                              double heading_rad, int steps);
 
