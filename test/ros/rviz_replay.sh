@@ -14,17 +14,9 @@ if [ -z "$BAG" ]; then
 fi
 # roslaunch starts the master (-p PORT)
 SHOT=${GF_RVIZ_SHOT:-$T/shot.png}
-xvfb-run -a -s "-screen 0 1200x800x24" bash -c "
-  roslaunch -p $PORT gesture_formation replay.launch bag:=$BAG start:=$START loop:=true > '$T/replay.log' 2>&1 &
-  l=\$!
-  sleep ${GF_RVIZ_WAIT:-10}
-  import -window root '$SHOT'
-  kill -INT \$l; wait \$l" || true
-[ -s "$SHOT" ] || { echo "FAIL: no screenshot"; tail -20 "$T/replay.log"; exit 1; }
-grep -q "ERROR.*rviz\|Could not load" "$T/replay.log" && fail "rviz reported an error: $(grep -m1 ERROR "$T/replay.log")"
 PY=/opt/gesture_formation/venv/bin/python
 [ -x "$PY" ] || PY=python3
-"$PY" - "$SHOT" <<'PY' || fails=$((fails + 1))
+cat > "$T/colours.py" <<'PY'
 import sys
 import numpy as np
 from PIL import Image
@@ -46,4 +38,18 @@ for name, mask in checks.items():
     print(f"{'PASS' if ok else 'FAIL'}: {name}: {n} pixels")
 sys.exit(bad)
 PY
+# rviz needs a few seconds to load and draw (longer on a busy computer): a screenshot every 2 s
+# from GF_RVIZ_WAIT (10 s) on, until the colours are there or 40 s have passed; the last one is judged.
+xvfb-run -a -s "-screen 0 1200x800x24" bash -c "
+  roslaunch -p $PORT gesture_formation replay.launch bag:=$BAG start:=$START loop:=true > '$T/replay.log' 2>&1 &
+  l=\$!
+  sleep ${GF_RVIZ_WAIT:-10}
+  for _ in \$(seq 16); do
+    import -window root '$SHOT' && '$PY' '$T/colours.py' '$SHOT' > /dev/null 2>&1 && break
+    sleep 2
+  done
+  kill -INT \$l; wait \$l" || true
+[ -s "$SHOT" ] || { echo "FAIL: no screenshot"; tail -20 "$T/replay.log"; exit 1; }
+grep -q "ERROR.*rviz\|Could not load" "$T/replay.log" && fail "rviz reported an error: $(grep -m1 ERROR "$T/replay.log")"
+"$PY" "$T/colours.py" "$SHOT" || fails=$((fails + 1))
 exit $fails
