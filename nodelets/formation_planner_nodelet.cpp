@@ -28,8 +28,8 @@
 // the leader holds when its estimate's last fused measurement (WorkerState.last_fused) is older
 // than max_worker_age_s; a follower when the leader's worker state (over LCM) is older than
 // max_share_age_s, or the estimate it carries older than max_worker_age_s. A holding UAV plans
-// to its latched braking point (planning::brakingPoint, holdReference: camera on the worker's last
-// known position), avoiding every received plan; its plan is flagged `fallback` (others avoid
+// to its latched braking point (planning::HoldPlanner: camera on the worker estimate, the
+// estimator's prediction), avoiding every received plan; its plan is flagged `fallback` (others avoid
 // it) with mode `hold` and the reason; the first replanning with fresh data tracks again. The
 // leader, holding because it has not seen the worker, searches (mode `search`, for at most
 // search_timeout_s): once the estimator has lost him (WorkerState.lost) its camera sweeps up and
