@@ -2,7 +2,8 @@
 // Namespaces: uavs (body spheres), frusta (camera frusta, line lists), worker (estimate),
 // worker_cov (3σ covariance ellipsoid of the position), worker_truth (simulation only),
 // references (stage-1 references), plans (planned trajectories), paths (stage-2 paths:
-// the centre lines of the safe corridors), map (occupied voxels of ~scenario_file), status
+// the centre lines of the safe corridors), modes (the plan's mode and reason above a UAV that does
+// not track: hold, search), map (occupied voxels of ~scenario_file), status
 // (gesture filter and last command text). Colours per UAV: leader red, follower 1 green,
 // follower 2 blue, then orange, purple.
 //
@@ -192,6 +193,16 @@ class VisualizerNodelet : public nodelet::Nodelet {
         corridors.color = color(i, 0.35f);
         corridors.points = p->corridor_edges;
         if (corridors.points.size() >= 2 && corridors.points.size() % 2 == 0) a.markers.push_back(corridors);
+        // A UAV that does not track says why (hold / search, docs/safety.md §1–2), above its body.
+        if (o && !p->mode.empty() && p->mode != "track") {
+          auto label = marker("modes", i, visualization_msgs::Marker::TEXT_VIEW_FACING, now);
+          label.pose.position = o->pose.pose.position;
+          label.pose.position.z += 1.5;
+          label.scale.z = 0.6;
+          label.color = color(i);
+          label.text = p->mode + (p->mode_reason.empty() ? "" : ": " + p->mode_reason);
+          a.markers.push_back(label);
+        }
       }
     }
     geometry_msgs::Point text_at;

@@ -20,10 +20,33 @@ ip link set lo up && ip route add 224.0.0.0/4 dev lo || exit 1
 roslaunch -p $PORT gesture_formation simulation.launch key_file:=$T/keys output_dir:=$T/out duration:=24 \
   real_time_factor:=1.5 faults:=$T/blackout.yaml > "$T/launch.log" 2>&1 &
 launch=\$!
+for _ in \$(seq 50); do rosparam get /use_sim_time > /dev/null 2>&1 && break; sleep 0.2; done
+python3 "$SRC/test/ros/watch_modes.py" "$T/modes.txt" > /dev/null 2>&1 &
+watch=\$!
 for _ in \$(seq 120); do [ -f "$T/out/metrics.json" ] && break; sleep 0.5; done
 sleep 0.5
 python3 "$SRC/test/ros/check_hold.py" "$T/out" 8 14 3.0 5.0
 rc=\$?
+kill \$watch
+# rviz shows why a UAV does not track: the Visualizer's mode labels during the blackout.
+python3 - "$T/modes.txt" <<'PY' || rc=\$((rc+1))
+import sys
+rows = [l.split(" ", 2) for l in open(sys.argv[1]).read().splitlines()]
+rows = [(float(t), int(i), text) for t, i, text in rows]
+bad = 0
+def check(ok, what):
+    global bad
+    print(("PASS: " if ok else "FAIL: ") + what)
+    bad += 0 if ok else 1
+lead = [r for r in rows if r[1] == 0]
+check(any(t >= 13.0 and x.startswith("search: worker not seen") for t, _, x in lead),
+      "rviz label 'search: worker not seen ...' above the leader: %s" % sorted({x for _, _, x in lead}))
+for i in (1, 2):
+    check(any(x.startswith("hold: worker estimate older") for _, j, x in rows if j == i), "rviz label 'hold: ...' above follower %d" % i)
+check(rows and not any(t < 10.5 or t > 16.5 for t, _, _ in rows),
+      "labels only while not tracking (10.9-14.5 s): %s" % ([r[0] for r in rows[:1]] + [r[0] for r in rows[-1:]]))
+sys.exit(bad)
+PY
 kill -INT \$launch; wait \$launch
 exit \$rc
 INNER
