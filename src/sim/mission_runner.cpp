@@ -130,6 +130,7 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
   const double hphi0 = human_heading.heading();
   const formation::UavReference lref0 = formation::leaderReference(w0.p_world, hphi0, cfg.formation.params.leader);
   std::vector<std::unique_ptr<UavRuntime>> uavs;
+  const planning::FreshnessLimits freshness{cfg.faults.max_share_age_s, cfg.faults.max_worker_age_s};
   for (int i = 0; i < n; ++i) {
     const formation::UavReference ref =
         i == 0 ? lref0
@@ -151,8 +152,7 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
     u->planner = planners(i);
     u->next_plan_s = cfg.replanning_period_s * static_cast<double>(i) / static_cast<double>(n);
     u->received.resize(static_cast<std::size_t>(n));
-    u->hold = planning::HoldPlanner(planning::FreshnessLimits{cfg.faults.max_share_age_s, cfg.faults.max_worker_age_s},
-                                    cfg.faults.search, cfg.controller.brake_accel_mps2);
+    u->hold = planning::HoldPlanner(freshness, cfg.faults.search, cfg.controller.brake_accel_mps2);
     uavs.push_back(std::move(u));
   }
 
@@ -212,7 +212,6 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
     modes.push_back(ModeChange{t, i, mode, reason});
   };
 
-  const planning::FreshnessLimits freshness{cfg.faults.max_share_age_s, cfg.faults.max_worker_age_s};
   auto replan = [&](int i, double t) {
     UavRuntime& u = *uavs[static_cast<std::size_t>(i)];
     if (u.offline) {
