@@ -252,6 +252,145 @@ QpMatrices TrajectoryQp::assemble(const TrajectoryQpProblem& pr) {
 
 namespace {
 
+/// The condensed form (trajectory_qp.hpp): per axis p_k = cp_k + Sp.row(k−1)·a_axis and
+/// v_k = cv_k + Sv.row(k−1)·a_axis for k = 1..N; x = [a_x(1..N) a_y(1..N) a_z(1..N)].
+struct Condensed {
+  Eigen::MatrixXd Sp, Sv;      ///< N×N, lower triangular, shared by the axes
+  Eigen::Matrix3Xd cp, cv;     ///< 3×N, the parts from p0, v0, a0
+  Eigen::MatrixXd H, C;        ///< 3N×3N (block diagonal), n_in×3N
+  Eigen::VectorXd g, l, u;
+  double cost_constant = 0.0;
+};
+
+Condensed condense(const TrajectoryQpProblem& pr) {
+  const int N = pr.intervals;
+  const double dt = pr.dt_s;
+  Condensed q;
+  q.Sp = Eigen::MatrixXd::Zero(N, N);
+  q.Sv = Eigen::MatrixXd::Zero(N, N);
+  q.cp.resize(3, N);
+  q.cv.resize(3, N);
+  // Forward recursion of the dynamics over coefficient rows (row k−1 ↔ sample k; sample 0 is
+  // the fixed initial state, a_0 = pr.a0 a constant).
+  Eigen::RowVectorXd sv = Eigen::RowVectorXd::Zero(N), sp = Eigen::RowVectorXd::Zero(N);
+  Eigen::Vector3d cv = pr.v0, cp = pr.p0;
+  for (int k = 0; k < N; ++k) {
+    Eigen::RowVectorXd sp_next = sp + dt * sv;
+    Eigen::Vector3d cp_next = cp + dt * cv;
+    Eigen::RowVectorXd sv_next = sv;
+    Eigen::Vector3d cv_next = cv;
+    if (k == 0) {
+      cp_next += pr.a0 * (dt * dt / 3.0);
+      cv_next += pr.a0 * (dt / 2.0);
+    } else {
+      sp_next(k - 1) += dt * dt / 3.0;
+      sv_next(k - 1) += dt / 2.0;
+    }
+    sp_next(k) += dt * dt / 6.0;
+    sv_next(k) += dt / 2.0;
+    sp = std::move(sp_next);
+    sv = std::move(sv_next);
+    cp = cp_next;
+    cv = cv_next;
+    q.Sp.row(k) = sp;
+    q.Sv.row(k) = sv;
+    q.cp.col(k) = cp;
+    q.cv.col(k) = cv;
+  }
+
+  // Cost, one N×N block per axis (the same for the three): a term c(s·x + e)² adds 2c sᵀs to
+  // H, 2c e sᵀ to g and c e² to the constant.
+  const int n = 3 * N;
+  const double wr = dt * pr.w_reference, wa = dt * pr.w_acceleration, wj = pr.w_jerk / dt, wt = pr.w_terminal_velocity;
+  Eigen::MatrixXd Hb = 2.0 * wr * (q.Sp.transpose() * q.Sp);
+  Hb.diagonal().array() += 2.0 * wa + 4.0 * wj;  // jerk: a_k appears in (a_k − a_{k−1}) and (a_{k+1} − a_k)
+  Hb(N - 1, N - 1) -= 2.0 * wj;                  // a_N has no successor
+  for (int k = 1; k < N; ++k) {
+    Hb(k, k - 1) -= 2.0 * wj;
+    Hb(k - 1, k) -= 2.0 * wj;
+  }
+  Hb.noalias() += 2.0 * wt * q.Sv.row(N - 1).transpose() * q.Sv.row(N - 1);
+  q.H = Eigen::MatrixXd::Zero(n, n);
+  q.g = Eigen::VectorXd::Zero(n);
+  for (int i = 0; i < 3; ++i) {
+    q.H.block(i * N, i * N, N, N) = Hb;
+    Eigen::VectorXd e(N);  // p_k's constant minus the reference
+    for (int k = 1; k <= N; ++k) e(k - 1) = q.cp(i, k - 1) - pr.reference[static_cast<std::size_t>(k)](i);
+    auto gi = q.g.segment(i * N, N);
+    gi.noalias() += 2.0 * wr * (q.Sp.transpose() * e);
+    gi(0) -= 2.0 * wj * pr.a0(i);  // (a_1 − a_0)²
+    gi.noalias() += 2.0 * wt * q.cv(i, N - 1) * q.Sv.row(N - 1).transpose();
+    q.cost_constant += wr * e.squaredNorm() + wj * pr.a0(i) * pr.a0(i) + wt * q.cv(i, N - 1) * q.cv(i, N - 1);
+  }
+
+  // Inequalities, in assemble()'s order.
+  const int n_poly = NormPolygon::kRows;
+  const int n_in = static_cast<int>(pr.constraints.size()) + n_poly * (N + (N - 1) + N);
+  q.C = Eigen::MatrixXd::Zero(n_in, n);
+  q.l = Eigen::VectorXd::Constant(n_in, -kInf);
+  q.u = Eigen::VectorXd::Constant(n_in, kInf);
+  int row = 0;
+  for (const auto& c : pr.constraints) {
+    const int k = c.sample - 1;
+    for (int i = 0; i < 3; ++i) {
+      if (c.a(i) != 0.0) q.C.row(row).segment(i * N, k + 1) = c.a(i) * q.Sp.row(k).head(k + 1);
+    }
+    q.u(row) = c.b - c.a.dot(q.cp.col(k));
+    ++row;
+  }
+  const auto dv = pr.velocity.directions();
+  const auto hv = pr.velocity.halfWidths();
+  const auto da = pr.acceleration.directions();
+  const auto ha = pr.acceleration.halfWidths();
+  for (int k = 1; k <= N; ++k) {
+    for (int r = 0; r < n_poly; ++r) {
+      const double dcv = dv.row(r).dot(q.cv.col(k - 1));
+      for (int i = 0; i < 3; ++i) {
+        if (dv(r, i) != 0.0) q.C.row(row).segment(i * N, k) = dv(r, i) * q.Sv.row(k - 1).head(k);
+      }
+      q.l(row) = -hv(r) - dcv;
+      q.u(row) = hv(r) - dcv;
+      ++row;
+      if (k < N) {  // middle Bézier control point v_k + a_k dt/2
+        for (int i = 0; i < 3; ++i) {
+          if (dv(r, i) != 0.0) {
+            q.C.row(row).segment(i * N, k) = dv(r, i) * q.Sv.row(k - 1).head(k);
+            q.C(row, i * N + k - 1) += dv(r, i) * dt / 2.0;
+          }
+        }
+        q.l(row) = -hv(r) - dcv;
+        q.u(row) = hv(r) - dcv;
+        ++row;
+      }
+      for (int i = 0; i < 3; ++i) {
+        if (da(r, i) != 0.0) q.C(row, i * N + k - 1) = da(r, i);
+      }
+      q.l(row) = -ha(r);
+      q.u(row) = ha(r);
+      ++row;
+    }
+  }
+  return q;
+}
+
+}  // namespace
+
+QpMatrices TrajectoryQp::assembleCondensed(const TrajectoryQpProblem& pr) {
+  Condensed c = condense(pr);
+  QpMatrices m;
+  m.H = c.H.sparseView();
+  m.C = c.C.sparseView();
+  m.A.resize(0, c.H.cols());
+  m.b.resize(0);
+  m.g = std::move(c.g);
+  m.l = std::move(c.l);
+  m.u = std::move(c.u);
+  m.cost_constant = c.cost_constant;
+  return m;
+}
+
+namespace {
+
 namespace pq = proxsuite::proxqp;
 using Status = TrajectoryQpSolution::Status;
 
@@ -372,6 +511,35 @@ QpMatricesSolution TrajectoryQp::solveMatrices(std::shared_ptr<const QpMatrices>
   return out;
 }
 
+namespace {
+
+/// ProxQP dense on the condensed form; x (size 3N) empty when the solver threw.
+QpMatricesSolution solveCondensedDense(const Condensed& q, const Eigen::VectorXd* x0, double eps_abs, int max_iterations) {
+  QpMatricesSolution out;
+  out.dense_backend = true;
+  try {
+    pq::dense::QP<double> qp(q.H.rows(), 0, q.C.rows(), false, pq::DenseBackend::PrimalDualLDLT);
+    // No Ruiz equilibration: ProxQP's dense one costs ~4 ms on the ~900 × 120 rows here, 5× the
+    // rest of the solve, and the condensed rows are already of order one (docs/planning.md §6.4).
+    qp.init(q.H, q.g, proxsuite::nullopt, proxsuite::nullopt, q.C, q.l, q.u, /*compute_preconditioner=*/false);
+    runSolver(qp, x0, eps_abs, max_iterations, out);
+  } catch (const std::exception&) {
+    out = QpMatricesSolution{};
+  }
+  return out;
+}
+
+/// p, v from a by the dynamics' recursion (exact to rounding).
+void integrate(const TrajectoryQpProblem& pr, TrajectoryQpSolution& out) {
+  const double dt = pr.dt_s;
+  for (int k = 0; k < pr.intervals; ++k) {
+    out.p[k + 1] = out.p[k] + out.v[k] * dt + out.a[k] * (dt * dt / 3.0) + out.a[k + 1] * (dt * dt / 6.0);
+    out.v[k + 1] = out.v[k] + (out.a[k] + out.a[k + 1]) * (dt / 2.0);
+  }
+}
+
+}  // namespace
+
 TrajectoryQpSolution TrajectoryQp::solve(const TrajectoryQpProblem& pr, const TrajectoryQpSolution* warm) const {
   TrajectoryQpSolution out;
   const std::string bad = checkProblem(pr);
@@ -381,43 +549,76 @@ TrajectoryQpSolution TrajectoryQp::solve(const TrajectoryQpProblem& pr, const Tr
     return out;
   }
   const int N = pr.intervals;
-  const int n = 9 * N;
-  auto m = std::make_shared<QpMatrices>(assemble(pr));
-  out.variables = n;
-  out.equalities = static_cast<int>(m->b.size());
-  out.inequalities = static_cast<int>(m->l.size());
-
-  Eigen::VectorXd x0;
-  if (warm != nullptr && static_cast<int>(warm->p.size()) == N + 1 && static_cast<int>(warm->v.size()) == N + 1 &&
-      static_cast<int>(warm->a.size()) == N + 1) {
-    x0.resize(n);
-    for (int k = 1; k <= N; ++k) {
-      x0.segment<3>(var(k, 0, 0)) = warm->p[k];
-      x0.segment<3>(var(k, 1, 0)) = warm->v[k];
-      x0.segment<3>(var(k, 2, 0)) = warm->a[k];
-    }
-    if (!x0.allFinite()) x0.resize(0);
-  }
-  out.warm_started = x0.size() == n;
-  const QpMatricesSolution r =
-      solveMatrices(m, out.warm_started ? &x0 : nullptr, pr.eps_abs, pr.max_iterations, pr.solve_timeout_s);
-  out.sparse_timed_out = r.sparse_timed_out;
-  out.dense_backend = r.dense_backend;
-  out.iterations = r.iterations;
+  const bool have_warm = warm != nullptr && static_cast<int>(warm->p.size()) == N + 1 &&
+                         static_cast<int>(warm->v.size()) == N + 1 && static_cast<int>(warm->a.size()) == N + 1;
   out.p.assign(N + 1, pr.p0);
   out.v.assign(N + 1, pr.v0);
   out.a.assign(N + 1, pr.a0);
-  if (r.x.size() != n) {
-    out.status = TrajectoryQpSolution::Status::kNumerical;
-    out.reason = "QP solver failed (threw)";
-    return out;
+
+  QpMatricesSolution r;
+  if (pr.formulation == TrajectoryQpProblem::Formulation::kCondensed) {
+    const Condensed q = condense(pr);
+    Eigen::VectorXd x0;
+    if (have_warm) {
+      x0.resize(3 * N);
+      for (int k = 1; k <= N; ++k) {
+        for (int i = 0; i < 3; ++i) x0(i * N + k - 1) = warm->a[static_cast<std::size_t>(k)](i);
+      }
+      if (!x0.allFinite()) x0.resize(0);
+    }
+    r = solveCondensedDense(q, x0.size() == 3 * N ? &x0 : nullptr, pr.eps_abs, pr.max_iterations);
+    if (r.x.size() == 3 * N && r.x.allFinite()) {
+      out.condensed = true;
+      out.warm_started = x0.size() == 3 * N;
+      out.variables = 3 * N;
+      out.equalities = 0;
+      out.inequalities = static_cast<int>(q.C.rows());
+      for (int k = 1; k <= N; ++k) {
+        for (int i = 0; i < 3; ++i) out.a[static_cast<std::size_t>(k)](i) = r.x(i * N + k - 1);
+      }
+      integrate(pr, out);
+    }
   }
-  const Eigen::VectorXd& x = r.x;
-  for (int k = 1; k <= N; ++k) {
-    out.p[k] = x.segment<3>(var(k, 0, 0));
-    out.v[k] = x.segment<3>(var(k, 1, 0));
-    out.a[k] = x.segment<3>(var(k, 2, 0));
+
+  if (!out.condensed) {  // the sparse form (asked for, or the condensed solve threw)
+    const int n = 9 * N;
+    auto m = std::make_shared<QpMatrices>(assemble(pr));
+    out.variables = n;
+    out.equalities = static_cast<int>(m->b.size());
+    out.inequalities = static_cast<int>(m->l.size());
+    Eigen::VectorXd x0;
+    if (have_warm) {
+      x0.resize(n);
+      for (int k = 1; k <= N; ++k) {
+        x0.segment<3>(var(k, 0, 0)) = warm->p[k];
+        x0.segment<3>(var(k, 1, 0)) = warm->v[k];
+        x0.segment<3>(var(k, 2, 0)) = warm->a[k];
+      }
+      if (!x0.allFinite()) x0.resize(0);
+    }
+    out.warm_started = x0.size() == n;
+    r = solveMatrices(m, out.warm_started ? &x0 : nullptr, pr.eps_abs, pr.max_iterations, pr.solve_timeout_s);
+    if (r.x.size() != n) {
+      out.status = TrajectoryQpSolution::Status::kNumerical;
+      out.reason = "QP solver failed (threw)";
+      out.sparse_timed_out = r.sparse_timed_out;
+      out.dense_backend = r.dense_backend;
+      return out;
+    }
+    if (!r.x.allFinite()) {
+      out.status = TrajectoryQpSolution::Status::kNumerical;
+      out.reason = "QP solution is not finite";
+      return out;
+    }
+    for (int k = 1; k <= N; ++k) {
+      out.p[k] = r.x.segment<3>(var(k, 0, 0));
+      out.v[k] = r.x.segment<3>(var(k, 1, 0));
+      out.a[k] = r.x.segment<3>(var(k, 2, 0));
+    }
   }
+  out.sparse_timed_out = r.sparse_timed_out;
+  out.dense_backend = r.dense_backend;
+  out.iterations = r.iterations;
   out.primal_residual = maxViolation(pr, out.p, out.v, out.a);
   out.objective = cost(pr, out.p, out.v, out.a);
   out.status = r.status;
@@ -438,10 +639,6 @@ TrajectoryQpSolution TrajectoryQp::solve(const TrajectoryQpProblem& pr, const Tr
     std::ostringstream os;
     os << " (sparse solve abandoned after " << pr.solve_timeout_s << " s, dense backend)";
     if (!out.reason.empty()) out.reason += os.str();
-  }
-  if (out.solved() && !x.allFinite()) {
-    out.status = TrajectoryQpSolution::Status::kNumerical;
-    out.reason = "QP solution is not finite";
   }
   // ProxQP's criterion is on the equilibrated problem; insist on the original scale too.
   if (out.solved() && !(out.primal_residual <= 100.0 * pr.eps_abs + 1e-9)) {

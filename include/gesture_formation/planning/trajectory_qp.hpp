@@ -16,6 +16,16 @@
 ///     Bézier on each interval, so it stays in V between samples too;
 ///   - acceleration in the inner polyhedron A at every sample (a(t) is linear in between).
 ///
+/// Two formulations (`TrajectoryQpProblem::formulation`):
+///   - kCondensed (default): the dynamics eliminated — per axis p_k = c_k + S_p a, v_k = c'_k + S_v a
+///     with lower-triangular N×N S_p, S_v shared by the three axes — leaving the 3N accelerations,
+///     no equalities and the same inequality rows (dense); solved by ProxQP's dense backend, which is
+///     bounded by max_iter (no thread, no timeout needed). p and v are then recomputed from a by the
+///     recursion above, so the dynamics hold to rounding. ~4× cheaper per replanning than the sparse
+///     form (docs/planning.md §6.4).
+///   - kSparse: the 9N-variable form above, solved by ProxQP's sparse backend with the time bound
+///     below; the condensed solve also falls back to it when the dense backend throws.
+///
 /// Time bound: ProxQP's sparse solver can loop forever (0.7.2–0.8.0: its LDLᵀ row update corrupts
 /// the elimination tree; `max_iter` does not bound it; docs/safety.md §4.5). So the sparse solve
 /// runs on its own thread and is waited for at most `solve_timeout_s`; past that it is abandoned
@@ -69,6 +79,7 @@ struct TrajectoryQpProblem {
   int max_iterations = 4000;
   /// Wall-clock bound (s) of the sparse solve before the dense fallback, > 0.
   double solve_timeout_s = 2.0;
+  enum class Formulation { kCondensed, kSparse } formulation = Formulation::kCondensed;
 };
 
 struct TrajectoryQpSolution {
@@ -84,6 +95,8 @@ struct TrajectoryQpSolution {
   /// produced this solution (after a timeout, or because sparse solves are disabled).
   bool sparse_timed_out = false;
   bool dense_backend = false;
+  /// Solved in the condensed form (accelerations only; `variables` = 3N, `equalities` = 0).
+  bool condensed = false;
   bool solved() const { return status == Status::kSolved; }
 };
 
@@ -112,6 +125,9 @@ class TrajectoryQp {
   TrajectoryQpSolution solve(const TrajectoryQpProblem& problem, const TrajectoryQpSolution* warm = nullptr) const;
   /// \brief The matrices solve() hands to ProxQP (problem must be valid: see solve()).
   static QpMatrices assemble(const TrajectoryQpProblem& problem);
+  /// \brief The condensed form's matrices (dense; A, b empty; x = [a_x(1..N) a_y(1..N) a_z(1..N)])
+  /// in the same form as QpMatrices, with H, C as sparse views for inspection and tests.
+  static QpMatrices assembleCondensed(const TrajectoryQpProblem& problem);
   /// \brief ProxQP on assembled matrices with the time bound above: sparse on a worker thread,
   /// waited for `timeout_s`, then dense. `x0` (optional, size of H): primal warm start.
   static QpMatricesSolution solveMatrices(std::shared_ptr<const QpMatrices> matrices, const Eigen::VectorXd* x0,
