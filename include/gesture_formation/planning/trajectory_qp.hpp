@@ -17,14 +17,14 @@
 ///   - acceleration in the inner polyhedron A at every sample (a(t) is linear in between).
 ///
 /// Two formulations (`TrajectoryQpProblem::formulation`):
-///   - kCondensed (default): the dynamics eliminated — per axis p_k = c_k + S_p a, v_k = c'_k + S_v a
+///   - kCondensed (experimental, not the default — docs/planning.md §6.3.1): the dynamics eliminated — per axis p_k = c_k + S_p a, v_k = c'_k + S_v a
 ///     with lower-triangular N×N S_p, S_v shared by the three axes — leaving the 3N accelerations,
 ///     no equalities and the same inequality rows (dense); solved by ProxQP's dense backend, which is
 ///     bounded by max_iter (no thread, no timeout needed). p and v are then recomputed from a by the
-///     recursion above, so the dynamics hold to rounding. ~4× cheaper per replanning than the sparse
-///     form (docs/planning.md §6.4).
-///   - kSparse: the 9N-variable form above, solved by ProxQP's sparse backend with the time bound
-///     below; the condensed solve also falls back to it when the dense backend throws.
+///     recursion above, so the dynamics hold to rounding. ~30 % cheaper per QP than the sparse form,
+///     but the missions it flies meet more infeasible replannings (planning.md §6.3.1).
+///   - kSparse (default): the 9N-variable form above, solved by ProxQP's sparse backend with the
+///     time bound below; it also decides every QP the condensed form does not solve.
 ///
 /// Time bound: ProxQP's sparse solver can loop forever (0.7.2–0.8.0: its LDLᵀ row update corrupts
 /// the elimination tree; `max_iter` does not bound it; docs/safety.md §4.5). So the sparse solve
@@ -79,7 +79,7 @@ struct TrajectoryQpProblem {
   int max_iterations = 4000;
   /// Wall-clock bound (s) of the sparse solve before the dense fallback, > 0.
   double solve_timeout_s = 2.0;
-  enum class Formulation { kCondensed, kSparse } formulation = Formulation::kCondensed;
+  enum class Formulation { kCondensed, kSparse } formulation = Formulation::kSparse;
 };
 
 struct TrajectoryQpSolution {
@@ -136,6 +136,8 @@ class TrajectoryQp {
   /// is no longer counted); from kMaxAbandonedSolves on, only the dense backend is used.
   static int abandonedSolves();
   static constexpr int kMaxAbandonedSolves = 2;
+  /// Dense iterations allowed to the condensed form before the sparse form takes the QP over.
+  static constexpr int kCondensedMaxIterations = 100;
 
   /// \brief Worst violation of every constraint of `problem` (dynamics equalities, rows,
   /// velocity/acceleration polyhedra incl. the Bézier points) by p, v, a: ≤ 0 when all hold.

@@ -158,13 +158,14 @@ TEST(QpTimeBound, AnOrdinarySparseSolveStaysOnTheSparseBackend) {
   EXPECT_LE(s.p[5].x(), 0.5 + 1e-6);
 }
 
-// The default (condensed) form is solved by the dense backend, which max_iter bounds: no worker
-// thread and no timeout are involved (the sparse time bound is not needed on that path).
-TEST(QpTimeBound, TheDefaultCondensedSolveUsesTheBoundedDenseBackend) {
+// The condensed form is solved by the dense backend, which max_iter bounds: no worker thread and
+// no timeout are involved (the sparse time bound is not needed on that path).
+TEST(QpTimeBound, TheCondensedSolveUsesTheBoundedDenseBackend) {
   TrajectoryQpProblem pr;
   pr.intervals = 10;
   pr.reference.assign(11, Eigen::Vector3d(1.0, 0.0, 2.0));
   pr.constraints.push_back({5, Eigen::Vector3d::UnitX(), 0.5, PositionConstraint::Kind::kCorridor});
+  pr.formulation = TrajectoryQpProblem::Formulation::kCondensed;
   const TrajectoryQpSolution s = TrajectoryQp().solve(pr);
   ASSERT_TRUE(s.solved()) << s.reason;
   EXPECT_TRUE(s.condensed);
@@ -172,7 +173,7 @@ TEST(QpTimeBound, TheDefaultCondensedSolveUsesTheBoundedDenseBackend) {
   EXPECT_FALSE(s.sparse_timed_out);
   EXPECT_EQ(s.variables, 30);
   EXPECT_LE(s.p[5].x(), 0.5 + 1e-6);
-  pr.max_iterations = 1;  // the bound: reports max iterations rather than running on
+  pr.max_iterations = 1;  // the bound: reports max iterations rather than running on (decided by the sparse form)
   pr.reference.assign(11, Eigen::Vector3d(9.0, 3.0, 2.0));
   const TrajectoryQpSolution bounded = TrajectoryQp().solve(pr);
   EXPECT_EQ(bounded.status, TrajectoryQpSolution::Status::kMaxIterations) << bounded.reason;

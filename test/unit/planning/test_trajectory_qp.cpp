@@ -127,8 +127,9 @@ TEST_P(TrajectoryQpFormulationTest, SolutionsSatisfyEveryConstraintAndAreOptimal
 }
 
 // The condensed matrices state the same problem: for any accelerations (p, v rolled out by the
-// dynamics), ½xᵀHx + gᵀx + const equals the cost, and every row Cx − l, u − Cx equals the
-// corresponding row of the 9N-variable form.
+// dynamics), ½xᵀHx + gᵀx + const equals the cost, and every row's slacks Cx − l, u − Cx are the
+// corresponding row's of the 9N-variable form times one positive factor per row (the condensed
+// rows are equilibrated to unit ∞-norm).
 TEST(TrajectoryQpTest, CondensedMatricesReproduceTheCostAndTheRowsOfTheSparseForm) {
   std::mt19937 rng(77);
   std::uniform_real_distribution<double> U(-3.0, 3.0);
@@ -161,12 +162,39 @@ TEST(TrajectoryQpTest, CondensedMatricesReproduceTheCostAndTheRowsOfTheSparseFor
     EXPECT_NEAR(got, want, 1e-9 * (1.0 + std::abs(want))) << "trial " << trial;
     EXPECT_LT((m.A * xs - m.b).cwiseAbs().maxCoeff(), 1e-9);  // the rollout satisfies the sparse form's dynamics
     const Eigen::VectorXd cc = c.C * xc, cs = m.C * xs;
+    // A second point: the per-row factor must be the same at both, and positive.
+    Eigen::VectorXd xc2 = xc, xs2 = xs;
+    {
+      std::vector<Eigen::Vector3d> p2(N + 1, pr.p0), v2(N + 1, pr.v0), a2(N + 1, pr.a0);
+      for (int k = 1; k <= N; ++k) {
+        a2[static_cast<std::size_t>(k)] = Eigen::Vector3d(U(rng), U(rng), U(rng));
+        for (int i = 0; i < 3; ++i) xc2(i * N + k - 1) = a2[static_cast<std::size_t>(k)](i);
+      }
+      for (int k = 0; k < N; ++k) {
+        const auto i = static_cast<std::size_t>(k);
+        p2[i + 1] = p2[i] + v2[i] * pr.dt_s + a2[i] * (pr.dt_s * pr.dt_s / 3.0) + a2[i + 1] * (pr.dt_s * pr.dt_s / 6.0);
+        v2[i + 1] = v2[i] + (a2[i] + a2[i + 1]) * (pr.dt_s / 2.0);
+      }
+      for (int k = 1; k <= N; ++k) {
+        xs2.segment<3>(9 * (k - 1)) = p2[static_cast<std::size_t>(k)];
+        xs2.segment<3>(9 * (k - 1) + 3) = v2[static_cast<std::size_t>(k)];
+        xs2.segment<3>(9 * (k - 1) + 6) = a2[static_cast<std::size_t>(k)];
+      }
+    }
+    const Eigen::VectorXd cc2 = c.C * xc2, cs2 = m.C * xs2;
+    const Eigen::MatrixXd Cd(c.C);
     for (int r = 0; r < cc.size(); ++r) {
+      EXPECT_NEAR(Cd.row(r).cwiseAbs().maxCoeff(), 1.0, 1e-12) << "row " << r << " not equilibrated";
+      // factor = Δ(sparse row value) / Δ(condensed row value) between the two points
+      const double dc = cc2(r) - cc(r), ds = cs2(r) - cs(r);
+      ASSERT_GT(std::abs(dc), 1e-9) << "row " << r;
+      const double f = ds / dc;
+      EXPECT_GT(f, 0.0) << "row " << r;
       if (m.u(r) < 1e19) {
-        EXPECT_NEAR(c.u(r) - cc(r), m.u(r) - cs(r), 1e-9 * (1.0 + std::abs(m.u(r)))) << "row " << r;
+        EXPECT_NEAR(f * (c.u(r) - cc(r)), m.u(r) - cs(r), 1e-8 * (1.0 + std::abs(m.u(r)))) << "row " << r;
       }
       if (m.l(r) > -1e19) {
-        EXPECT_NEAR(cc(r) - c.l(r), cs(r) - m.l(r), 1e-9 * (1.0 + std::abs(m.l(r)))) << "row " << r;
+        EXPECT_NEAR(f * (cc(r) - c.l(r)), cs(r) - m.l(r), 1e-8 * (1.0 + std::abs(m.l(r)))) << "row " << r;
       }
       EXPECT_EQ(c.u(r) < 1e19, m.u(r) < 1e19) << "row " << r;
       EXPECT_EQ(c.l(r) > -1e19, m.l(r) > -1e19) << "row " << r;
@@ -226,11 +254,13 @@ TEST(TrajectoryQpTest, InfeasibleAndBadInputAreReported) {
   std::mt19937 rng(9);
   const TrajectoryQp solver;
   TrajectoryQpProblem pr = randomProblem(rng, 10);
+  pr.formulation = TrajectoryQpProblem::Formulation::kCondensed;  // a failure goes to the sparse form
   // Sample 1 must be 5 m away from p0: impossible within 0.2 s at 4 m/s.
   pr.constraints.push_back({1, -Eigen::Vector3d::UnitX(), -(pr.p0.x() + 5.0), PositionConstraint::Kind::kUav});
   const TrajectoryQpSolution s = solver.solve(pr);
   EXPECT_FALSE(s.solved());
   EXPECT_FALSE(s.reason.empty());
+  EXPECT_FALSE(s.condensed) << "a failure is decided by the sparse form, not by the condensed one";
   TrajectoryQpProblem bad = randomProblem(rng, 10);
   bad.reference[3].x() = std::nan("");
   const TrajectoryQpSolution b = solver.solve(bad);
