@@ -28,7 +28,9 @@ checks = {
     "leader red": (r > 150) & (g < 90) & (b < 90),
     "follower 1 green": (g > 130) & (r < 90) & (b < 90),
     "follower 2 blue": (b > 150) & (r < 90) & (g < 140),
-    "worker covariance yellow": (r > 150) & (g > 130) & (b < 90),
+    # semi-transparent (alpha 0.6) and shaded over the dark background: median (143, 132, 21),
+    # lit side up to (166, 153, 21), dark side (107, 100, 21) — r ≈ g, both far above b
+    "worker covariance yellow": (r > 100) & (g > 90) & (b < 60) & (abs(r - g) < 40),
 }
 bad = 0
 for name, mask in checks.items():
