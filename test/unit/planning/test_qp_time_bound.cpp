@@ -144,12 +144,18 @@ TEST(QpTimeBound, ANonPositiveTimeoutIsRejected) {
   EXPECT_NE(s.reason.find("solve_timeout_s must be > 0, got 0"), std::string::npos) << s.reason;
 }
 
-TEST(QpTimeBound, AnOrdinarySparseSolveStaysOnTheSparseBackend) {
+/// 10 intervals towards (1, 0, 2) with sample 5 held to x ≤ 0.5 (an active row).
+static TrajectoryQpProblem tenIntervalProblem(TrajectoryQpProblem::Formulation formulation) {
   TrajectoryQpProblem pr;
   pr.intervals = 10;
   pr.reference.assign(11, Eigen::Vector3d(1.0, 0.0, 2.0));
   pr.constraints.push_back({5, Eigen::Vector3d::UnitX(), 0.5, PositionConstraint::Kind::kCorridor});
-  pr.formulation = TrajectoryQpProblem::Formulation::kSparse;
+  pr.formulation = formulation;
+  return pr;
+}
+
+TEST(QpTimeBound, AnOrdinarySparseSolveStaysOnTheSparseBackend) {
+  const TrajectoryQpProblem pr = tenIntervalProblem(TrajectoryQpProblem::Formulation::kSparse);
   const TrajectoryQpSolution s = TrajectoryQp().solve(pr);
   ASSERT_TRUE(s.solved()) << s.reason;
   EXPECT_FALSE(s.sparse_timed_out);
@@ -161,11 +167,7 @@ TEST(QpTimeBound, AnOrdinarySparseSolveStaysOnTheSparseBackend) {
 // The condensed form is solved by the dense backend, which max_iter bounds: no worker thread and
 // no timeout are involved (the sparse time bound is not needed on that path).
 TEST(QpTimeBound, TheCondensedSolveUsesTheBoundedDenseBackend) {
-  TrajectoryQpProblem pr;
-  pr.intervals = 10;
-  pr.reference.assign(11, Eigen::Vector3d(1.0, 0.0, 2.0));
-  pr.constraints.push_back({5, Eigen::Vector3d::UnitX(), 0.5, PositionConstraint::Kind::kCorridor});
-  pr.formulation = TrajectoryQpProblem::Formulation::kCondensed;
+  TrajectoryQpProblem pr = tenIntervalProblem(TrajectoryQpProblem::Formulation::kCondensed);
   const TrajectoryQpSolution s = TrajectoryQp().solve(pr);
   ASSERT_TRUE(s.solved()) << s.reason;
   EXPECT_TRUE(s.condensed);

@@ -126,13 +126,40 @@ TEST_P(TrajectoryQpFormulationTest, SolutionsSatisfyEveryConstraintAndAreOptimal
   EXPECT_EQ(solved, 30);
 }
 
+/// Random accelerations in [−3, 3] for k = 1..N (drawn x, y, z per sample), p and v rolled out
+/// by the dynamics, and the point in both forms' variables.
+struct Rollout {
+  std::vector<Eigen::Vector3d> p, v, a;
+  Eigen::VectorXd xc, xs;  ///< condensed [a_x a_y a_z], sparse [p_1 v_1 a_1 …]
+};
+Rollout randomRollout(const TrajectoryQpProblem& pr, std::mt19937& rng) {
+  std::uniform_real_distribution<double> U(-3.0, 3.0);
+  const int N = pr.intervals;
+  Rollout o{std::vector<Eigen::Vector3d>(N + 1, pr.p0), std::vector<Eigen::Vector3d>(N + 1, pr.v0),
+            std::vector<Eigen::Vector3d>(N + 1, pr.a0), Eigen::VectorXd(3 * N), Eigen::VectorXd(9 * N)};
+  for (int k = 1; k <= N; ++k) {
+    o.a[static_cast<std::size_t>(k)] = Eigen::Vector3d(U(rng), U(rng), U(rng));
+    for (int i = 0; i < 3; ++i) o.xc(i * N + k - 1) = o.a[static_cast<std::size_t>(k)](i);
+  }
+  for (int k = 0; k < N; ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    o.p[i + 1] = o.p[i] + o.v[i] * pr.dt_s + o.a[i] * (pr.dt_s * pr.dt_s / 3.0) + o.a[i + 1] * (pr.dt_s * pr.dt_s / 6.0);
+    o.v[i + 1] = o.v[i] + (o.a[i] + o.a[i + 1]) * (pr.dt_s / 2.0);
+  }
+  for (int k = 1; k <= N; ++k) {
+    o.xs.segment<3>(9 * (k - 1)) = o.p[static_cast<std::size_t>(k)];
+    o.xs.segment<3>(9 * (k - 1) + 3) = o.v[static_cast<std::size_t>(k)];
+    o.xs.segment<3>(9 * (k - 1) + 6) = o.a[static_cast<std::size_t>(k)];
+  }
+  return o;
+}
+
 // The condensed matrices state the same problem: for any accelerations (p, v rolled out by the
 // dynamics), ½xᵀHx + gᵀx + const equals the cost, and every row's slacks Cx − l, u − Cx are the
 // corresponding row's of the 9N-variable form times one positive factor per row (the condensed
 // rows are equilibrated to unit ∞-norm).
 TEST(TrajectoryQpTest, CondensedMatricesReproduceTheCostAndTheRowsOfTheSparseForm) {
   std::mt19937 rng(77);
-  std::uniform_real_distribution<double> U(-3.0, 3.0);
   for (int trial = 0; trial < 10; ++trial) {
     const int N = 3 + 4 * trial;
     const TrajectoryQpProblem pr = randomProblem(rng, N);
@@ -141,46 +168,16 @@ TEST(TrajectoryQpTest, CondensedMatricesReproduceTheCostAndTheRowsOfTheSparseFor
     ASSERT_EQ(c.H.rows(), 3 * N);
     ASSERT_EQ(c.A.rows(), 0);
     ASSERT_EQ(c.C.rows(), m.C.rows());
-    std::vector<Eigen::Vector3d> p(N + 1, pr.p0), v(N + 1, pr.v0), a(N + 1, pr.a0);
-    Eigen::VectorXd xc(3 * N), xs(9 * N);
-    for (int k = 1; k <= N; ++k) {
-      a[static_cast<std::size_t>(k)] = Eigen::Vector3d(U(rng), U(rng), U(rng));
-      for (int i = 0; i < 3; ++i) xc(i * N + k - 1) = a[static_cast<std::size_t>(k)](i);
-    }
-    for (int k = 0; k < N; ++k) {
-      const auto i = static_cast<std::size_t>(k);
-      p[i + 1] = p[i] + v[i] * pr.dt_s + a[i] * (pr.dt_s * pr.dt_s / 3.0) + a[i + 1] * (pr.dt_s * pr.dt_s / 6.0);
-      v[i + 1] = v[i] + (a[i] + a[i + 1]) * (pr.dt_s / 2.0);
-    }
-    for (int k = 1; k <= N; ++k) {
-      xs.segment<3>(9 * (k - 1)) = p[static_cast<std::size_t>(k)];
-      xs.segment<3>(9 * (k - 1) + 3) = v[static_cast<std::size_t>(k)];
-      xs.segment<3>(9 * (k - 1) + 6) = a[static_cast<std::size_t>(k)];
-    }
-    const double want = TrajectoryQp::cost(pr, p, v, a);
+    const Rollout one = randomRollout(pr, rng);
+    const Eigen::VectorXd &xc = one.xc, &xs = one.xs;
+    const double want = TrajectoryQp::cost(pr, one.p, one.v, one.a);
     const double got = 0.5 * xc.dot(c.H * xc) + c.g.dot(xc) + c.cost_constant;
     EXPECT_NEAR(got, want, 1e-9 * (1.0 + std::abs(want))) << "trial " << trial;
     EXPECT_LT((m.A * xs - m.b).cwiseAbs().maxCoeff(), 1e-9);  // the rollout satisfies the sparse form's dynamics
     const Eigen::VectorXd cc = c.C * xc, cs = m.C * xs;
     // A second point: the per-row factor must be the same at both, and positive.
-    Eigen::VectorXd xc2 = xc, xs2 = xs;
-    {
-      std::vector<Eigen::Vector3d> p2(N + 1, pr.p0), v2(N + 1, pr.v0), a2(N + 1, pr.a0);
-      for (int k = 1; k <= N; ++k) {
-        a2[static_cast<std::size_t>(k)] = Eigen::Vector3d(U(rng), U(rng), U(rng));
-        for (int i = 0; i < 3; ++i) xc2(i * N + k - 1) = a2[static_cast<std::size_t>(k)](i);
-      }
-      for (int k = 0; k < N; ++k) {
-        const auto i = static_cast<std::size_t>(k);
-        p2[i + 1] = p2[i] + v2[i] * pr.dt_s + a2[i] * (pr.dt_s * pr.dt_s / 3.0) + a2[i + 1] * (pr.dt_s * pr.dt_s / 6.0);
-        v2[i + 1] = v2[i] + (a2[i] + a2[i + 1]) * (pr.dt_s / 2.0);
-      }
-      for (int k = 1; k <= N; ++k) {
-        xs2.segment<3>(9 * (k - 1)) = p2[static_cast<std::size_t>(k)];
-        xs2.segment<3>(9 * (k - 1) + 3) = v2[static_cast<std::size_t>(k)];
-        xs2.segment<3>(9 * (k - 1) + 6) = a2[static_cast<std::size_t>(k)];
-      }
-    }
+    const Rollout two = randomRollout(pr, rng);
+    const Eigen::VectorXd &xc2 = two.xc, &xs2 = two.xs;
     const Eigen::VectorXd cc2 = c.C * xc2, cs2 = m.C * xs2;
     const Eigen::MatrixXd Cd(c.C);
     for (int r = 0; r < cc.size(); ++r) {
