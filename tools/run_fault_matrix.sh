@@ -15,7 +15,9 @@
 # (profile, seed) already in the file is skipped, so the script resumes; start afresh after a change
 # that can move the figures (planner, simulator, model) by removing the file (the report lists the
 # commits its rows come from). Seeds are the outer loop, so a run stopped early covers every profile
-# evenly. GF_JOBS missions run at once (default: the number of cores); GFCTL overrides the binary,
+# evenly. GF_JOBS missions run at once (default: the number of cores), each classifying its camera
+# views on one thread when the jobs fill the cores (gfctl simulate --threads; results do not depend
+# on it); GFCTL overrides the binary,
 # GF_MATRIX_DIR the missions' output (default build-faults/fault_matrix), GF_REPORT the table
 # (default docs/reliability.md), GF_PLOT its figure (default docs/images/fault_matrix.png, drawn by
 # tools/plot_fault_matrix.py with the tools venv's matplotlib).
@@ -27,6 +29,8 @@ OUT=${GF_MATRIX_DIR:-build-faults/fault_matrix}
 REPORT=${GF_REPORT:-docs/reliability.md}
 RUNS=${GF_RUNS:-docs/data/fault_matrix_runs.csv}
 JOBS=${GF_JOBS:-$(nproc)}
+THREADS=()
+[ "$JOBS" -ge "$(nproc)" ] && THREADS=(--threads 1)
 SCENARIO=config/scenarios/power_towers.yaml
 PROFILES=${GF_PROFILES:-"nominal loss10 loss30 loss50 delay_jitter dup_reorder follower_dropout worker_lost_5s worker_lost_60s sensor_dropouts range_outliers gusts planner_outage harsh"}
 COLUMNS_CSV="profile,seed,commit,model_sha256,min_mutual_distance_m,min_obstacle_distance_m,min_obstacle_uav,min_obstacle_t_s,collisions,requests_applied,requests_total,false_adaptations,human_estimate_error_rms_m,min_human_distance_m,plans_hold,plans_fallback_brake,commands_stale,distance_error_rms_m,wall_time_s"
@@ -42,7 +46,7 @@ if [ "${1:-}" != "--report-only" ]; then
   one() {  # one PROFILE SEED: run the mission, append its row (under a lock: jobs run in parallel)
     local p=$1 seed=$2 dir="$OUT/$1/seed_$2"
     rm -rf "$dir"
-    "$GFCTL" simulate --scenario "$SCENARIO" --fault-profile "$p" --seed "$seed" --out "$dir" --no-plot \
+    "$GFCTL" simulate --scenario "$SCENARIO" --fault-profile "$p" --seed "$seed" --out "$dir" --no-plot "${THREADS[@]}" \
       > "$OUT/$p.seed_$seed.log" 2>&1 || { echo "FAIL $p seed $seed (see $OUT/$p.seed_$seed.log)"; return 0; }
     python3 - "$dir/metrics.json" "$p" "$seed" "$COMMIT" "$MODEL_SHA" "$COLUMNS_CSV" "$RUNS" <<'ROW'
 import fcntl, json, sys

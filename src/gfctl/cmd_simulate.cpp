@@ -1,5 +1,5 @@
 // gfctl simulate --scenario FILE --out DIR [--seed N] [--seeds A..B] [--duration S] [--model ONNX] [--no-plot]
-//                [--faults FILE | --fault-profile NAME]
+//                [--faults FILE | --fault-profile NAME] [--threads N]
 // (DESIGN §8.4; docs/simulation.md)
 #include <sys/stat.h>
 
@@ -12,6 +12,7 @@
 #include <iostream>
 #include <map>
 #include <sstream>
+#include <thread>
 
 #include <opencv2/core/utility.hpp>
 
@@ -33,9 +34,10 @@ int cmdSimulate(const Args& args);
 const Registrar kRegistrar{
     "simulate",
     "--scenario FILE --out DIR [--seed N | --seeds A..B] [--duration S] [--model ONNX] [--no-plot] "
-    "[--faults FILE | --fault-profile NAME]   closed-loop mission: metrics.json, timeline.csv, events.csv, modes.csv, "
+    "[--faults FILE | --fault-profile NAME] [--threads N]   closed-loop mission: metrics.json, timeline.csv, events.csv, modes.csv, "
     "timeline.png (DESIGN 8.4); --faults replaces mission.faults with FILE's faults: section, --fault-profile NAME "
-    "uses <scenario dir>/../faults/NAME.yaml (config/faults/; docs/safety.md)",
+    "uses <scenario dir>/../faults/NAME.yaml (config/faults/; docs/safety.md); --threads N classifies the UAVs' "
+    "camera views of a frame on N threads (default: the UAV count, at most the cores; results do not depend on it)",
     cmdSimulate};
 
 bool makeDir(const std::string& path) {
@@ -192,13 +194,21 @@ int runOne(const Args& args, Loaded& L, std::uint64_t seed, double duration, con
 }
 
 int cmdSimulate(const Args& args) {
-  if (!checkOptions(args, {"scenario", "out"}, {"seed", "seeds", "duration", "model", "no-plot", "faults", "fault-profile"})) {
+  if (!checkOptions(args, {"scenario", "out"}, {"seed", "seeds", "duration", "model", "no-plot", "faults", "fault-profile", "threads"})) {
     return kExitBadInput;
   }
-  // A mission is one thread by design (deterministic; batches and the fault matrix run missions
-  // in parallel processes). OpenCV's thread pool only adds synchronisation to the small LSTM:
-  // one thread is ~5 % less CPU per mission, results unchanged (docs/simulation.md §3).
+  // A mission's simulation is one thread by design (deterministic; batches and the fault matrix
+  // run missions in parallel processes); only the views of a camera frame are classified
+  // concurrently (--threads: one network per thread, as each UAV classifies on its own
+  // computer; the same values). OpenCV's own thread pool only adds synchronisation to the small
+  // LSTM: one thread is ~5 % less CPU per mission, results unchanged (docs/simulation.md §3).
   cv::setNumThreads(1);
+  std::uint64_t threads_arg = 0;
+  if (args.has("threads") && (!parseUint(args.get("threads"), threads_arg) || threads_arg < 1 ||
+                              threads_arg > static_cast<std::uint64_t>(sim::kMaxClassifierThreads))) {
+    return badInput(args, "--threads: expected an integer 1.." + std::to_string(sim::kMaxClassifierThreads) + ", got '" +
+                              args.get("threads") + "'");
+  }
   std::uint64_t seed = 1, seed_lo = 0, seed_hi = 0;
   bool batch = false;
   if (args.has("seed") && !parseUint(args.get("seed"), seed)) return badInput(args, "--seed: expected a non-negative integer, got '" + args.get("seed") + "'");
@@ -244,7 +254,10 @@ int cmdSimulate(const Args& args) {
   L.mission = std::move(*mission);
   const std::string model = args.has("model") ? args.get("model") : L.mission.gesture_model;
   if (!model.empty()) {
-    auto c = sim::loadOnnxClassifier(model);
+    const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    const int threads = threads_arg > 0 ? static_cast<int>(threads_arg)
+                                        : std::clamp(L.mission.formation.params.uavCount(), 1, std::min(cores, sim::kMaxClassifierThreads));
+    auto c = sim::loadOnnxClassifier(model, threads);
     if (!c) return badInput(args, model + ": cannot load the gesture model: " + c.reason());
     L.classifier = std::move(*c);
   } else {

@@ -1,30 +1,121 @@
 #include "gesture_formation/sim/leader_camera.hpp"
 
 #include <algorithm>
+#include <condition_variable>
 #include <limits>
+#include <mutex>
+#include <thread>
 
 #include "gesture_formation/sim/random.hpp"
 
 namespace gesture_formation::sim {
 
+std::vector<std::optional<gesture::Classification>> MissionClassifier::classifyAll(
+    const std::vector<const gesture::SkeletonWindow*>& windows) {
+  std::vector<std::optional<gesture::Classification>> out(windows.size());
+  for (std::size_t i = 0; i < windows.size(); ++i) {
+    auto c = classify(*windows[i]);
+    if (c) out[i] = *c;
+  }
+  return out;
+}
+
 namespace {
 
+/// The ONNX LSTM; classifyAll spreads a frame's windows over `nets_.size()` threads: the caller
+/// takes windows 0, T, 2T, …, persistent worker j windows j, j + T, … with its own network.
 class OnnxClassifier : public MissionClassifier {
  public:
-  explicit OnnxClassifier(gesture::GestureClassifier c) : c_(std::move(c)) {}
-  common::Result<gesture::Classification> classify(const gesture::SkeletonWindow& w) override { return c_.classify(w); }
+  explicit OnnxClassifier(std::vector<gesture::GestureClassifier> nets) : nets_(std::move(nets)) {
+    for (std::size_t j = 1; j < nets_.size(); ++j) workers_.emplace_back([this, j] { work(j); });
+  }
+  ~OnnxClassifier() override {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    start_.notify_all();
+    for (auto& w : workers_) w.join();
+  }
+  OnnxClassifier(const OnnxClassifier&) = delete;
+  OnnxClassifier& operator=(const OnnxClassifier&) = delete;
+
+  common::Result<gesture::Classification> classify(const gesture::SkeletonWindow& w) override {
+    return nets_.front().classify(w);
+  }
+
+  std::vector<std::optional<gesture::Classification>> classifyAll(
+      const std::vector<const gesture::SkeletonWindow*>& windows) override {
+    std::vector<std::optional<gesture::Classification>> out(windows.size());
+    if (workers_.empty() || windows.size() < 2) {
+      for (std::size_t i = 0; i < windows.size(); ++i) run(0, *windows[i], out[i]);
+      return out;
+    }
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      batch_ = &windows;
+      results_ = &out;
+      pending_ = static_cast<int>(workers_.size());
+      ++generation_;
+    }
+    start_.notify_all();
+    share(0);
+    std::unique_lock<std::mutex> lock(mutex_);
+    done_.wait(lock, [this] { return pending_ == 0; });
+    batch_ = nullptr;
+    results_ = nullptr;
+    return out;
+  }
 
  private:
-  gesture::GestureClassifier c_;
+  void run(std::size_t net, const gesture::SkeletonWindow& w, std::optional<gesture::Classification>& slot) {
+    auto c = nets_[net].classify(w);
+    if (c) slot = *c;
+  }
+  /// Thread j's share of the current batch (each slot is written by exactly one thread).
+  void share(std::size_t j) {
+    for (std::size_t i = j; i < batch_->size(); i += nets_.size()) run(j, *(*batch_)[i], (*results_)[i]);
+  }
+  void work(std::size_t j) {
+    std::uint64_t seen = 0;
+    std::unique_lock<std::mutex> lock(mutex_);
+    for (;;) {
+      start_.wait(lock, [&] { return stop_ || generation_ != seen; });
+      if (stop_) return;
+      seen = generation_;
+      lock.unlock();
+      share(j);
+      lock.lock();
+      if (--pending_ == 0) done_.notify_one();
+    }
+  }
+
+  std::vector<gesture::GestureClassifier> nets_;
+  std::vector<std::thread> workers_;
+  std::mutex mutex_;
+  std::condition_variable start_, done_;
+  const std::vector<const gesture::SkeletonWindow*>* batch_ = nullptr;
+  std::vector<std::optional<gesture::Classification>>* results_ = nullptr;
+  std::uint64_t generation_ = 0;
+  int pending_ = 0;
+  bool stop_ = false;
 };
 
 }  // namespace
 
-common::Result<std::unique_ptr<MissionClassifier>> loadOnnxClassifier(const std::string& onnx_path) {
+common::Result<std::unique_ptr<MissionClassifier>> loadOnnxClassifier(const std::string& onnx_path, int threads) {
   using R = common::Result<std::unique_ptr<MissionClassifier>>;
-  auto c = gesture::GestureClassifier::load(onnx_path);
-  if (!c) return R::fail(c.reason());
-  return R::ok(std::make_unique<OnnxClassifier>(std::move(*c)));
+  if (threads < 1 || threads > kMaxClassifierThreads) {
+    return R::fail("classifier threads: expected 1.." + std::to_string(kMaxClassifierThreads) + ", got " +
+                   std::to_string(threads));
+  }
+  std::vector<gesture::GestureClassifier> nets;
+  for (int j = 0; j < threads; ++j) {
+    auto c = gesture::GestureClassifier::load(onnx_path);  // a separate network per thread
+    if (!c) return R::fail(c.reason());
+    nets.push_back(std::move(*c));
+  }
+  return R::ok(std::make_unique<OnnxClassifier>(std::move(nets)));
 }
 
 LeaderCamera::LeaderCamera(const MissionConfig& config, const planning::OccupancyMap* map, std::uint64_t seed)
@@ -69,16 +160,18 @@ LeaderCameraFrame LeaderCamera::frame(double t, const MultirotorState& leader, c
   }
   const std::vector<gesture::SynthFrame> skeletons = worker.skeletonsAt(t, cameras);
   out.skeleton = skeletons.front();
-  // A camera's FIFO and classifier: a gap breaks the FIFO's temporal consistency.
-  const auto classify = [&](gesture::SkeletonWindow& window, double& last_visible, const gesture::Skeleton2D& sk)
-      -> std::optional<gesture::Classification> {
+  // A camera's FIFO: a gap breaks its temporal consistency. A full FIFO is classified below,
+  // all cameras of the frame together (MissionClassifier::classifyAll).
+  std::vector<const gesture::SkeletonWindow*> windows;
+  std::vector<std::optional<gesture::Classification>*> slots;
+  const auto push = [&](gesture::SkeletonWindow& window, double& last_visible, const gesture::Skeleton2D& sk,
+                        std::optional<gesture::Classification>& slot) {
     if (t - last_visible > kSkeletonGapS) window.clear();
     window.push(sk);
     last_visible = t;
-    if (classifier == nullptr || !window.full()) return std::nullopt;
-    auto c = classifier->classify(window);
-    if (!c) return std::nullopt;
-    return *c;
+    if (classifier == nullptr || !window.full()) return;
+    windows.push_back(&window);
+    slots.push_back(&slot);
   };
   while (follower_cams_.size() < followers.size()) {
     const auto i = static_cast<std::uint64_t>(follower_cams_.size());
@@ -88,16 +181,19 @@ LeaderCameraFrame LeaderCamera::frame(double t, const MultirotorState& leader, c
                                                              makeRng(seed_, Stream::kFollowerCamera, 3 * i + 2)),
                                             {}, -1e9});
   }
+  out.followers.resize(followers.size());  // not resized again: slots point into it
   for (std::size_t i = 0; i < followers.size(); ++i) {
-    FollowerView v;
+    FollowerView& v = out.followers[i];
     FollowerCamera& fc = follower_cams_[i];
     const SensorFrame seen = fc.sensors.observe(follower_poses[i], ws.feet_world, ws.p_world, cfg_.worker.height_m, false);
     v.visible = (i >= online.size() || online[i]) && seen.visible();
-    if (v.visible) v.classification = classify(fc.window, fc.last_visible_s, skeletons[i + 1].skeleton);
-    out.followers.push_back(std::move(v));
+    if (v.visible) push(fc.window, fc.last_visible_s, skeletons[i + 1].skeleton, v.classification);
   }
-  if (!frame.visible()) return out;
-  out.classification = classify(window_, last_visible_s_, out.skeleton.skeleton);
+  if (frame.visible()) push(window_, last_visible_s_, out.skeleton.skeleton, out.classification);
+  if (!windows.empty()) {
+    auto results = classifier->classifyAll(windows);
+    for (std::size_t i = 0; i < slots.size() && i < results.size(); ++i) *slots[i] = std::move(results[i]);
+  }
   return out;
 }
 

@@ -3,6 +3,9 @@
 #    "[2].distance_m +2" at t = 10 s; follower 2's reference goes 8 → 10 m and its actual
 #    distance follows, the leader's and follower 1's references never change.
 # 2. A bad mission section is refused (exit 2) with every problem named (field and value).
+# 3. --threads (the camera views classified concurrently) changes nothing: the run of 1. with
+#    --threads 1 and --threads 3 writes byte-identical timeline, events and modes; a bad
+#    --threads value is refused (exit 2) naming it.
 # Usage: gfctl_simulate_subset_and_errors.sh GFCTL SRC
 set -euo pipefail
 GFCTL=$1
@@ -16,7 +19,7 @@ cat >> "$TMP/subset.yaml" <<'Y'
     - {t_s: 10, target: [2], parameter: distance_m, increment: 2}
 Y
 "$GFCTL" simulate --scenario "$TMP/subset.yaml" --out "$TMP/out" --seed 2 --duration 20 --no-plot \
-  --model "$SRC/third_party_models/gesture_lstm/gesture_lstm.onnx" > /dev/null
+  --model "$SRC/third_party_models/gesture_lstm/gesture_lstm.onnx" --threads 3 > /dev/null
 python3 - "$TMP/out/timeline.csv" "$TMP/out/events.csv" <<'PY'
 import csv, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
@@ -58,3 +61,16 @@ for want in "mission.uavs\[0\].plant.mass_kg: missing" "mission.uavs\[1\].plant.
   grep -q "$want" "$TMP/bad.log" || { echo "FAIL bad mission: no message matching '$want'"; cat "$TMP/bad.log"; exit 1; }
 done
 echo "ok: bad mission refused with every problem named"
+# 3. Threads change nothing (the classifications reach the timeline's gesture columns).
+"$GFCTL" simulate --scenario "$TMP/subset.yaml" --out "$TMP/out1" --seed 2 --duration 20 --no-plot \
+  --model "$SRC/third_party_models/gesture_lstm/gesture_lstm.onnx" --threads 1 > /dev/null
+for f in timeline.csv events.csv modes.csv; do
+  cmp -s "$TMP/out/$f" "$TMP/out1/$f" || { echo "FAIL --threads 3 vs 1: $f differs"; diff "$TMP/out/$f" "$TMP/out1/$f" | head; exit 1; }
+done
+set +e
+"$GFCTL" simulate --scenario "$TMP/subset.yaml" --out "$TMP/bad_threads" --no-plot --threads 0 > "$TMP/threads.log" 2>&1
+rc=$?
+set -e
+[ $rc -eq 2 ] && grep -q "\-\-threads: expected an integer 1..16, got '0'" "$TMP/threads.log" ||
+  { echo "FAIL --threads 0: exit $rc"; cat "$TMP/threads.log"; exit 1; }
+echo "ok: --threads 1 and 3 give identical files; --threads 0 refused"

@@ -38,9 +38,19 @@ class MissionClassifier {
  public:
   virtual ~MissionClassifier() = default;
   virtual common::Result<gesture::Classification> classify(const gesture::SkeletonWindow& window) = 0;
+  /// \brief The windows of one camera frame (one per UAV that sees the worker), classified:
+  /// element i is what classify(*windows[i]) gives (nullopt when it fails). The default calls
+  /// classify() in order; an implementation may classify them concurrently — each UAV runs
+  /// its own classifier on its own computer — but must return exactly the same values.
+  virtual std::vector<std::optional<gesture::Classification>> classifyAll(
+      const std::vector<const gesture::SkeletonWindow*>& windows);
 };
-/// \brief Loads the ONNX LSTM (gesture::GestureClassifier).
-common::Result<std::unique_ptr<MissionClassifier>> loadOnnxClassifier(const std::string& onnx_path);
+/// \brief The most threads loadOnnxClassifier accepts (one per UAV's camera is the useful most).
+inline constexpr int kMaxClassifierThreads = 16;
+/// \brief Loads the ONNX LSTM (gesture::GestureClassifier). `threads` ≥ 1: classifyAll runs
+/// on up to that many threads, each with its own copy of the network (OpenCV's Net is not
+/// re-entrant); the results do not depend on it (docs/simulation.md §3).
+common::Result<std::unique_ptr<MissionClassifier>> loadOnnxClassifier(const std::string& onnx_path, int threads = 1);
 
 /// \brief Fires at steps k = round(n · period_s / step_s), n = 0, 1, 2, … of a clock that
 /// advances in fixed steps of step_s (k = 0 at t = 0).
