@@ -163,7 +163,8 @@ int runOne(const Args& args, Loaded& L, std::uint64_t seed, double duration, con
             << m.false_adaptations << "\n"
             << "  distance error rms " << m.distance_error_rms_m << " m, angle error rms " << m.angle_error_rms_deg
             << " deg, estimate error rms " << m.human_estimate_error_rms_m << " m, planning median "
-            << m.planning_ms_median << " ms p99 " << m.planning_ms_p99 << " ms (fallback previous "
+            << m.planning_ms_median << " ms p99 " << m.planning_ms_p99 << " ms max " << m.planning_ms_max
+            << " ms (fallback previous "
             << m.plans_fallback_previous << ", brake " << m.plans_fallback_brake << " of " << m.plans
             << ", QP sparse timeouts " << m.qp_sparse_timeouts << ")\n"
             << "  faults: hold plans " << m.plans_hold << ", skipped " << m.plans_skipped << ", stale commands "
@@ -291,6 +292,7 @@ int cmdSimulate(const Args& args) {
       {"gesture_mean_latency_s", &sim::MissionMetrics::gesture_mean_latency_s},
       {"planning_ms_median", &sim::MissionMetrics::planning_ms_median},
       {"planning_ms_p99", &sim::MissionMetrics::planning_ms_p99},
+      {"planning_ms_max", &sim::MissionMetrics::planning_ms_max},
       {"human_estimate_error_rms_m", &sim::MissionMetrics::human_estimate_error_rms_m},
       {"real_time_factor", &sim::MissionMetrics::real_time_factor}};
   const std::vector<std::pair<const char*, int sim::MissionMetrics::*>> ikeys = {

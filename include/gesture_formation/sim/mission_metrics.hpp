@@ -63,6 +63,7 @@ struct MissionMetrics {
   int false_adaptations = 0;
   double planning_ms_median = 0.0;     ///< wall clock
   double planning_ms_p99 = 0.0;        ///< wall clock
+  double planning_ms_max = 0.0;        ///< wall clock: the slowest replanning (a failed one names its cause: ≤ 4 solves)
   double human_estimate_error_rms_m = 0.0;
   // diagnostics
   int requests_total = 0;              ///< operator requests + gestures performed

@@ -175,6 +175,21 @@ TEST(MetricsAccumulatorTest, AdaptationStartIsTheEarliestPlanOfAnAddressedUavWit
   EXPECT_EQ(out.metrics.plan_failure_reasons.begin()->first, "QP primal infeasible at # s");
 }
 
+TEST(MetricsAccumulatorTest, PlanningTimeMedianP99AndMax) {
+  const BoxWorld w;
+  const auto cfg = openField();
+  MetricsAccumulator acc(cfg, w.exact(), 1);
+  using PS = gf::planning::PlanStatus;
+  // 200 plans of 1..200 ms, fed out of order: median 100.5, p99 the 198th value, max 200.
+  for (int i = 0; i < 200; ++i) acc.plan(0, 0.1 * i, 0, PS::kOptimized, static_cast<double>((i * 37) % 200 + 1), "");
+  const auto out = acc.finish({}, 30.0, 1.0);
+  EXPECT_DOUBLE_EQ(out.metrics.planning_ms_median, 100.5);
+  EXPECT_DOUBLE_EQ(out.metrics.planning_ms_p99, 198.0);
+  EXPECT_DOUBLE_EQ(out.metrics.planning_ms_max, 200.0);
+  EXPECT_NE(gf::sim::metricsJson(out.metrics).find("\"planning_ms_max\": 200,"), std::string::npos)
+      << gf::sim::metricsJson(out.metrics);
+}
+
 TEST(MetricsAccumulatorTest, OutcomesFindTheirPendingRequestAndAnAppliedOneStaysApplied) {
   const BoxWorld w;
   const auto cfg = openField();
