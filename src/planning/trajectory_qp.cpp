@@ -82,6 +82,61 @@ std::string checkProblem(const TrajectoryQpProblem& pr) {
   return e.str();
 }
 
+/// One inequality row of the QP in the state of one sample k ≥ 1:
+/// l ≤ wp·p_k + wv·v_k + wa·a_k ≤ u (zero weights: the variable is absent).
+struct InequalityRow {
+  int sample = 0;
+  Eigen::Vector3d wp = Eigen::Vector3d::Zero(), wv = Eigen::Vector3d::Zero(), wa = Eigen::Vector3d::Zero();
+  double l = -kInf, u = kInf;
+};
+
+/// Calls f(row) for every inequality of `pr` in the QP's row order — the position constraints,
+/// then per sample k = 1..N and speed-polygon row r: v_k, the middle Bézier control point
+/// v_k + a_k dt/2 of v on [t_k, t_k+1] (k < N), a_k. assemble(), condense() and maxViolation()
+/// all read the rows from here.
+template <class F>
+void forEachInequality(const TrajectoryQpProblem& pr, F&& f) {
+  InequalityRow row;
+  for (const auto& c : pr.constraints) {
+    row = InequalityRow{};
+    row.sample = c.sample;
+    row.wp = c.a;
+    row.u = c.b;
+    f(row);
+  }
+  const int N = pr.intervals;
+  const double dt = pr.dt_s;
+  const auto dv = pr.velocity.directions();
+  const auto hv = pr.velocity.halfWidths();
+  const auto da = pr.acceleration.directions();
+  const auto ha = pr.acceleration.halfWidths();
+  for (int k = 1; k <= N; ++k) {
+    for (int r = 0; r < NormPolygon::kRows; ++r) {
+      row = InequalityRow{};
+      row.sample = k;
+      row.wv = dv.row(r).transpose();
+      row.l = -hv(r);
+      row.u = hv(r);
+      f(row);
+      if (k < N) {
+        row.wa = dv.row(r).transpose() * (dt / 2.0);
+        f(row);
+      }
+      row = InequalityRow{};
+      row.sample = k;
+      row.wa = da.row(r).transpose();
+      row.l = -ha(r);
+      row.u = ha(r);
+      f(row);
+    }
+  }
+}
+
+int inequalityCount(const TrajectoryQpProblem& pr) {
+  const int N = pr.intervals;
+  return static_cast<int>(pr.constraints.size()) + NormPolygon::kRows * (N + (N - 1) + N);
+}
+
 }  // namespace
 
 double TrajectoryQp::maxViolation(const TrajectoryQpProblem& pr, const std::vector<Eigen::Vector3d>& p,
@@ -99,16 +154,12 @@ double TrajectoryQp::maxViolation(const TrajectoryQpProblem& pr, const std::vect
     upd(ep.cwiseAbs().maxCoeff());
     upd(ev.cwiseAbs().maxCoeff());
   }
-  for (const auto& c : pr.constraints) upd(c.a.dot(p[c.sample]) - c.b);
-  const auto dv = pr.velocity.directions();
-  const auto hv = pr.velocity.halfWidths();
-  const auto da = pr.acceleration.directions();
-  const auto ha = pr.acceleration.halfWidths();
-  for (int k = 1; k <= N; ++k) {
-    upd(((dv * v[k]).cwiseAbs() - hv).maxCoeff());
-    if (k < N) upd(((dv * (v[k] + a[k] * (dt / 2.0))).cwiseAbs() - hv).maxCoeff());
-    upd(((da * a[k]).cwiseAbs() - ha).maxCoeff());
-  }
+  forEachInequality(pr, [&](const InequalityRow& r) {
+    const auto k = static_cast<std::size_t>(r.sample);
+    const double x = r.wp.dot(p[k]) + r.wv.dot(v[k]) + r.wa.dot(a[k]);
+    if (r.u < kInf) upd(x - r.u);
+    if (r.l > -kInf) upd(r.l - x);
+  });
   return worst;
 }
 
@@ -129,8 +180,7 @@ QpMatrices TrajectoryQp::assemble(const TrajectoryQpProblem& pr) {
   const double dt = pr.dt_s;
   const int n = 9 * N;
   const int n_eq = 6 * N;
-  const int n_poly = NormPolygon::kRows;
-  const int n_in = static_cast<int>(pr.constraints.size()) + n_poly * (N + (N - 1) + N);
+  const int n_in = inequalityCount(pr);
   QpMatrices m;
 
   // Cost: ½xᵀHx + gᵀx; a term c‖Mx − m‖² adds 2c MᵀM to H and −2c Mᵀm to g.
@@ -198,49 +248,19 @@ QpMatrices TrajectoryQp::assemble(const TrajectoryQpProblem& pr) {
   // Inequalities l ≤ Cx ≤ u.
   Triplets ct;
   ct.reserve(static_cast<std::size_t>(n_in) * 6);
-  Eigen::VectorXd& l = m.l;
-  Eigen::VectorXd& u = m.u;
-  l = Eigen::VectorXd::Constant(n_in, -kInf);
-  u = Eigen::VectorXd::Constant(n_in, kInf);
+  m.l.resize(n_in);
+  m.u.resize(n_in);
   row = 0;
-  for (const auto& c : pr.constraints) {
+  forEachInequality(pr, [&](const InequalityRow& r) {
     for (int i = 0; i < 3; ++i) {
-      if (c.a(i) != 0.0) ct.emplace_back(row, var(c.sample, 0, i), c.a(i));
+      if (r.wp(i) != 0.0) ct.emplace_back(row, var(r.sample, 0, i), r.wp(i));
+      if (r.wv(i) != 0.0) ct.emplace_back(row, var(r.sample, 1, i), r.wv(i));
+      if (r.wa(i) != 0.0) ct.emplace_back(row, var(r.sample, 2, i), r.wa(i));
     }
-    u(row) = c.b;
+    m.l(row) = r.l;
+    m.u(row) = r.u;
     ++row;
-  }
-  const auto dv = pr.velocity.directions();
-  const auto hv = pr.velocity.halfWidths();
-  const auto da = pr.acceleration.directions();
-  const auto ha = pr.acceleration.halfWidths();
-  for (int k = 1; k <= N; ++k) {
-    for (int r = 0; r < n_poly; ++r) {
-      for (int i = 0; i < 3; ++i) {
-        if (dv(r, i) != 0.0) ct.emplace_back(row, var(k, 1, i), dv(r, i));
-      }
-      l(row) = -hv(r);
-      u(row) = hv(r);
-      ++row;
-      if (k < N) {  // middle Bézier control point of v on [t_k, t_{k+1}]
-        for (int i = 0; i < 3; ++i) {
-          if (dv(r, i) != 0.0) {
-            ct.emplace_back(row, var(k, 1, i), dv(r, i));
-            ct.emplace_back(row, var(k, 2, i), dv(r, i) * dt / 2.0);
-          }
-        }
-        l(row) = -hv(r);
-        u(row) = hv(r);
-        ++row;
-      }
-      for (int i = 0; i < 3; ++i) {
-        if (da(r, i) != 0.0) ct.emplace_back(row, var(k, 2, i), da(r, i));
-      }
-      l(row) = -ha(r);
-      u(row) = ha(r);
-      ++row;
-    }
-  }
+  });
   m.C.resize(n_in, n);
   m.C.setFromTriplets(ct.begin(), ct.end());
 
@@ -323,53 +343,32 @@ Condensed condense(const TrajectoryQpProblem& pr) {
     q.cost_constant += wr * e.squaredNorm() + wj * pr.a0(i) * pr.a0(i) + wt * q.cv(i, N - 1) * q.cv(i, N - 1);
   }
 
-  // Inequalities, in assemble()'s order.
-  const int n_poly = NormPolygon::kRows;
-  const int n_in = static_cast<int>(pr.constraints.size()) + n_poly * (N + (N - 1) + N);
+  // Inequalities, in assemble()'s order: p_k = cp_k + Sp.row(k−1)·a, v_k = cv_k + Sv.row(k−1)·a
+  // (both depend on a_1..a_k only), a_k a variable.
+  const int n_in = inequalityCount(pr);
   q.C = Eigen::MatrixXd::Zero(n_in, n);
-  q.l = Eigen::VectorXd::Constant(n_in, -kInf);
-  q.u = Eigen::VectorXd::Constant(n_in, kInf);
+  q.l.resize(n_in);
+  q.u.resize(n_in);
   int row = 0;
-  for (const auto& c : pr.constraints) {
-    const int k = c.sample - 1;
+  forEachInequality(pr, [&](const InequalityRow& r) {
+    const int k = r.sample;
+    double constant = 0.0;  // the row's part from the initial state
     for (int i = 0; i < 3; ++i) {
-      if (c.a(i) != 0.0) q.C.row(row).segment(i * N, k + 1) = c.a(i) * q.Sp.row(k).head(k + 1);
+      auto coeffs = q.C.row(row).segment(i * N, k);
+      if (r.wp(i) != 0.0) {
+        coeffs.noalias() += r.wp(i) * q.Sp.row(k - 1).head(k);
+        constant += r.wp(i) * q.cp(i, k - 1);
+      }
+      if (r.wv(i) != 0.0) {
+        coeffs.noalias() += r.wv(i) * q.Sv.row(k - 1).head(k);
+        constant += r.wv(i) * q.cv(i, k - 1);
+      }
+      if (r.wa(i) != 0.0) q.C(row, i * N + k - 1) += r.wa(i);
     }
-    q.u(row) = c.b - c.a.dot(q.cp.col(k));
+    q.l(row) = r.l > -kInf ? r.l - constant : -kInf;
+    q.u(row) = r.u < kInf ? r.u - constant : kInf;
     ++row;
-  }
-  const auto dv = pr.velocity.directions();
-  const auto hv = pr.velocity.halfWidths();
-  const auto da = pr.acceleration.directions();
-  const auto ha = pr.acceleration.halfWidths();
-  for (int k = 1; k <= N; ++k) {
-    for (int r = 0; r < n_poly; ++r) {
-      const double dcv = dv.row(r).dot(q.cv.col(k - 1));
-      for (int i = 0; i < 3; ++i) {
-        if (dv(r, i) != 0.0) q.C.row(row).segment(i * N, k) = dv(r, i) * q.Sv.row(k - 1).head(k);
-      }
-      q.l(row) = -hv(r) - dcv;
-      q.u(row) = hv(r) - dcv;
-      ++row;
-      if (k < N) {  // middle Bézier control point v_k + a_k dt/2
-        for (int i = 0; i < 3; ++i) {
-          if (dv(r, i) != 0.0) {
-            q.C.row(row).segment(i * N, k) = dv(r, i) * q.Sv.row(k - 1).head(k);
-            q.C(row, i * N + k - 1) += dv(r, i) * dt / 2.0;
-          }
-        }
-        q.l(row) = -hv(r) - dcv;
-        q.u(row) = hv(r) - dcv;
-        ++row;
-      }
-      for (int i = 0; i < 3; ++i) {
-        if (da(r, i) != 0.0) q.C(row, i * N + k - 1) = da(r, i);
-      }
-      q.l(row) = -ha(r);
-      q.u(row) = ha(r);
-      ++row;
-    }
-  }
+  });
   // Row equilibration (each row of C to unit ∞-norm, its bounds with it): an equivalent problem.
   // ProxQP's own (Ruiz) costs ~4 ms here, and without any, its dense solver declared feasible QPs
   // of the power-tower mission primal infeasible (seed 5: 28 failed replannings instead of 4).
