@@ -96,14 +96,8 @@ struct InequalityRow {
 /// all read the rows from here.
 template <class F>
 void forEachInequality(const TrajectoryQpProblem& pr, F&& f) {
-  InequalityRow row;
-  for (const auto& c : pr.constraints) {
-    row = InequalityRow{};
-    row.sample = c.sample;
-    row.wp = c.a;
-    row.u = c.b;
-    f(row);
-  }
+  const Eigen::Vector3d z = Eigen::Vector3d::Zero();
+  for (const auto& c : pr.constraints) f(InequalityRow{c.sample, c.a, z, z, -kInf, c.b});
   const int N = pr.intervals;
   const double dt = pr.dt_s;
   const auto dv = pr.velocity.directions();
@@ -112,22 +106,10 @@ void forEachInequality(const TrajectoryQpProblem& pr, F&& f) {
   const auto ha = pr.acceleration.halfWidths();
   for (int k = 1; k <= N; ++k) {
     for (int r = 0; r < NormPolygon::kRows; ++r) {
-      row = InequalityRow{};
-      row.sample = k;
-      row.wv = dv.row(r).transpose();
-      row.l = -hv(r);
-      row.u = hv(r);
-      f(row);
-      if (k < N) {
-        row.wa = dv.row(r).transpose() * (dt / 2.0);
-        f(row);
-      }
-      row = InequalityRow{};
-      row.sample = k;
-      row.wa = da.row(r).transpose();
-      row.l = -ha(r);
-      row.u = ha(r);
-      f(row);
+      const Eigen::Vector3d d = dv.row(r).transpose();
+      f(InequalityRow{k, z, d, z, -hv(r), hv(r)});
+      if (k < N) f(InequalityRow{k, z, d, d * (dt / 2.0), -hv(r), hv(r)});
+      f(InequalityRow{k, z, z, da.row(r).transpose(), -ha(r), ha(r)});
     }
   }
 }
