@@ -69,6 +69,7 @@ std::vector<std::string> PlannerConfig::validate() const {
   require(e, pos(mutual_distance_m), "qp.mutual_distance_m", mutual_distance_m, "must be > 0");
   require(e, nonneg(age_margin_speed_mps), "qp.age_margin_speed_mps", age_margin_speed_mps, "must be >= 0");
   require(e, nonneg(brake_envelope_age_s), "qp.brake_envelope_age_s", brake_envelope_age_s, "must be >= 0");
+  require(e, nonneg(brake_envelope_lead_s), "qp.brake_envelope_lead_s", brake_envelope_lead_s, "must be >= 0");
   require(e, pos(worker_safety_distance_m), "qp.worker_safety_distance_m", worker_safety_distance_m, "must be > 0");
   require(e, nonneg(qp_distance_buffer_m), "qp.distance_buffer_m", qp_distance_buffer_m, "must be >= 0");
   require(e, pos(qp_eps_abs) && qp_eps_abs <= 1e-3, "qp.eps_abs", qp_eps_abs, "must be in (0, 1e-3]");
@@ -127,6 +128,7 @@ PlannerConfig readPlannerConfig(ConfigReader& r, const std::string& prefix) {
   r.readDouble(key("qp.mutual_distance_m"), c.mutual_distance_m, Range::positive());
   r.readDouble(key("qp.age_margin_speed_mps"), c.age_margin_speed_mps, Range::nonNegative());
   r.readDouble(key("qp.brake_envelope_age_s"), c.brake_envelope_age_s, Range::nonNegative());
+  r.readDouble(key("qp.brake_envelope_lead_s"), c.brake_envelope_lead_s, Range::nonNegative());
   r.readDouble(key("qp.worker_safety_distance_m"), c.worker_safety_distance_m, Range::positive());
   r.readDouble(key("qp.distance_buffer_m"), c.qp_distance_buffer_m, Range::nonNegative());
   r.readDouble(key("qp.eps_abs"), c.qp_eps_abs, Range::openClosed(0.0, 1e-3));

@@ -77,10 +77,10 @@ Eigen::Vector3d brakeStop(const Eigen::Vector3d& p, const Eigen::Vector3d& v, co
   return p + 0.5 * b.speed_mps * b.t_stop_s * b.dir;
 }
 
-std::vector<Eigen::Vector3d> brakeEnvelope(const PlannedTrajectory& plan, double t_now, const DynamicLimits& limits) {
+std::vector<Eigen::Vector3d> brakeEnvelope(const PlannedTrajectory& plan, double t_until, const DynamicLimits& limits) {
   std::vector<Eigen::Vector3d> out;
   if (plan.samples.empty()) return out;
-  const double t_last = std::isfinite(t_now) ? std::min(std::max(t_now, plan.t0_s), plan.tEnd()) : plan.t0_s;
+  const double t_last = std::isfinite(t_until) ? std::min(std::max(t_until, plan.t0_s), plan.tEnd()) : plan.t0_s;
   const auto add = [&](double t) {
     const TrajectoryPoint x = evaluateTrajectory(plan, t);
     const Eigen::Vector3d stop = brakeStop(x.p, x.v, limits, plan.dt_s);
@@ -91,6 +91,15 @@ std::vector<Eigen::Vector3d> brakeEnvelope(const PlannedTrajectory& plan, double
   }
   add(t_last);
   return out;
+}
+
+std::vector<Eigen::Vector3d> keptBrakeEnvelope(const PlannedTrajectory& other, int own_index, double t_now,
+                                               const PlannerConfig& config) {
+  if (config.brake_envelope_lead_s > 0.0 && other.uav_index > own_index) {
+    return brakeEnvelope(other, t_now + config.brake_envelope_lead_s, config.limits);
+  }
+  if (t_now - other.t0_s > config.brake_envelope_age_s) return brakeEnvelope(other, t_now, config.limits);
+  return {};
 }
 
 Eigen::Vector3d closestPointOnSegment(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& x) {
@@ -153,14 +162,12 @@ VerificationReport TrajectoryVerifier::verify(const PlannedTrajectory& tr, doubl
   const TrajectoryPoint start = evaluateTrajectory(tr, tr.t0_s);
   std::vector<double> start_dist(others.size());
   for (std::size_t j = 0; j < others.size(); ++j) start_dist[j] = (start.p - evaluateTrajectory(others[j], tr.t0_s).p).norm();
-  // Braking envelopes of the plans old enough to have been replaced by a brake plan we did not get.
+  // Braking envelopes: where the others may have stopped (or stop before we learn of it).
   std::vector<std::vector<Eigen::Vector3d>> envelope(others.size());
   std::vector<double> start_envelope(others.size(), std::numeric_limits<double>::infinity());
   for (std::size_t j = 0; j < others.size(); ++j) {
-    if (t_now - others[j].t0_s > config_.brake_envelope_age_s) {
-      envelope[j] = brakeEnvelope(others[j], t_now, L);
-      start_envelope[j] = distanceToPolyline(envelope[j], start.p);
-    }
+    envelope[j] = keptBrakeEnvelope(others[j], tr.uav_index, t_now, config_);
+    if (!envelope[j].empty()) start_envelope[j] = distanceToPolyline(envelope[j], start.p);
   }
   const bool has_worker = worker.steps() > 0;
   const double start_worker = has_worker ? (start.p - workerPositionAt(worker, worker_t0, worker_dt, tr.t0_s)).norm() : 0.0;

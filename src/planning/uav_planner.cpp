@@ -701,14 +701,15 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
       addSeparation(k, evaluateTrajectory(other, req.t_now_s + k * dt).p, recoveringDistance(config_, margin, d0, k * dt, true),
                     PositionConstraint::Kind::kUav);
     }
-    if (age <= config_.brake_envelope_age_s) continue;
-    // An old plan may have been replaced by a brake plan that did not arrive: keep Γ_dis from
-    // every point where its UAV could have stopped (one half-space per envelope segment and
-    // step, through the segment's point nearest to the linearisation point: the whole segment
-    // lies on its far side).
+    // A plan may have been replaced by a brake plan that did not arrive yet (an old one), or, a
+    // lower-priority UAV's, be by its next one (the lead): keep Γ_dis from every point where its UAV could stop
+    // (one half-space per envelope segment and step, through the segment's point nearest to the
+    // linearisation point: the whole segment lies on its far side).
     // Fewer segments: the polyline simplified to within kEnvelopeTolerance, which the margin adds.
     constexpr double kEnvelopeTolerance = 0.05;
-    const std::vector<Eigen::Vector3d> env = simplifyPolyline(brakeEnvelope(other, req.t_now_s, config_.limits), kEnvelopeTolerance);
+    const std::vector<Eigen::Vector3d> kept = keptBrakeEnvelope(other, req.uav_index, req.t_now_s, config_);
+    if (kept.empty()) continue;
+    const std::vector<Eigen::Vector3d> env = simplifyPolyline(kept, kEnvelopeTolerance);
     const double d0_env = distanceToPolyline(env, p0);
     const std::size_t segments = env.size() > 1 ? env.size() - 1 : env.size();
     for (std::size_t i = 0; i < segments; ++i) {

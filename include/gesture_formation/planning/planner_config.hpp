@@ -109,6 +109,17 @@ struct PlannerConfig {
   /// time between the plan's t0 and now), kept Γ_dis away with the same recovery rule.
   /// Default: one replanning period (0.4 s) plus latency.
   double brake_envelope_age_s = 0.5;
+  /// Look-ahead of the braking envelope (s, ≥ 0) for the plans of *lower-priority* UAVs (higher
+  /// uav_index; avoided under the avoid-all-plans rule): with lead > 0 each of them, however
+  /// fresh, adds its envelope, covering brake times up to t_now + lead. A lower-priority UAV
+  /// yields to every higher-priority plan (with age margins), so its replanning fails more
+  /// often, and then it brakes where its plan had it move out of the way; the others learn of it
+  /// only when its brake plan arrives and they replan (a replanning period plus the link's
+  /// latency later), flying until then plans that may count on it having moved away
+  /// (docs/safety.md §4.10, dup_reorder seed 32). Higher-priority plans keep the age rule only:
+  /// a lower-priority UAV already yields to them. 0: the age rule for every plan (as before).
+  /// Default: two replanning periods.
+  double brake_envelope_lead_s = 0.8;
   /// Distance (m) kept from the worker's predicted (mid-body) position, > 0.
   double worker_safety_distance_m = 3.0;
   /// Extra distance (m) added to the inter-UAV and worker half-spaces in the QP only, so that

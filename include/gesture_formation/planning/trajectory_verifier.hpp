@@ -11,8 +11,8 @@
 ///   - ‖v‖ ≤ max_speed, |v_z| ≤ max_vertical_speed, ‖a‖ ≤ max_acceleration, |a_z| ≤ max
 ///     vertical acceleration (relative tolerance), heading/pitch steps within their rate limits;
 ///   - distance ≥ Γ_dis + age_margin_speed·age to every other plan at the same time, and ≥ Γ_dis
-///     to the braking envelope (brakeEnvelope()) of every other plan older than
-///     brake_envelope_age_s;
+///     to the braking envelope (keptBrakeEnvelope()) of every other plan older than
+///     brake_envelope_age_s and of every lower-priority UAV's plan (brake_envelope_lead_s);
 ///   - distance ≥ worker_safety_distance_m to the worker's predicted position.
 /// On the first interval [t0, t0+dt], which starts from the measured state, a limit the state
 /// itself already violates only has to not get worse (min(limit, value at t0)); a separation
@@ -62,12 +62,20 @@ BrakeProfile brakeProfile(const Eigen::Vector3d& v_world, const DynamicLimits& l
 Eigen::Vector3d brakeStop(const Eigen::Vector3d& p_world, const Eigen::Vector3d& v_world, const DynamicLimits& limits,
                           double dt_s);
 
-/// \brief The braking envelope of another UAV's plan at t_now_s (PlannerConfig::brake_envelope_age_s):
-/// brakeStop() of the plan's state at each of its sample times in [t0, min(t_now, tEnd)] and
-/// at that end time, in time order — a polyline of ≥ 1 point (empty only for an empty plan).
-/// A UAV that followed the plan and braked at any of those times stopped on it (between the
-/// sample times: within the chord error, a few cm at the limits).
-std::vector<Eigen::Vector3d> brakeEnvelope(const PlannedTrajectory& plan, double t_now_s, const DynamicLimits& limits);
+/// \brief The braking envelope of another UAV's plan at t_until_s (PlannerConfig::brake_envelope_age_s,
+/// brake_envelope_lead_s): brakeStop() of the plan's state at each of its sample times in
+/// [t0, min(t_until, tEnd)] and at that end time, in time order — a polyline of ≥ 1 point (empty
+/// only for an empty plan). A UAV that followed the plan and braked at any of those times stopped
+/// on it (between the sample times: within the chord error, a few cm at the limits).
+std::vector<Eigen::Vector3d> brakeEnvelope(const PlannedTrajectory& plan, double t_until_s, const DynamicLimits& limits);
+
+/// \brief The braking envelope UAV own_index, planning at t_now_s, keeps Γ_dis from, for another
+/// UAV's plan: for a lower-priority UAV's (other.uav_index > own_index) with
+/// config.brake_envelope_lead_s > 0, its envelope up to t_now + lead; else, for a plan older than
+/// brake_envelope_age_s, up to t_now; else none (empty). The planner's QP and the verifier both
+/// take it from here.
+std::vector<Eigen::Vector3d> keptBrakeEnvelope(const PlannedTrajectory& other, int own_index, double t_now_s,
+                                               const PlannerConfig& config);
 
 /// \brief The point of segment [a, b] nearest to x (a when a == b).
 Eigen::Vector3d closestPointOnSegment(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& x);

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <memory>
 
 #include "gesture_formation/common/angles.hpp"
@@ -561,6 +562,111 @@ TEST(UavPlannerTest, StalePlanOfAStoppedUavIsNotFollowedIntoIt) {
     s = advance(r.trajectory, t);
   }
   EXPECT_LT(closest, cfg.mutual_distance_m + 1.0);  // it did come up to the stopped UAV (the check bit)
+}
+
+namespace {
+
+/// The other UAV of ClosestToAUavThatBrakes…: at rest at o0 until 10 s, then its plans have it
+/// accelerate at `accel` (to 2 m/s) along `dir` — out of our way — until its replanning fails at
+/// t_brake and it brakes where it is.
+struct BrakingOther {
+  Eigen::Vector3d o0, dir;
+  double accel = 2.0, t_brake = 11.0;
+};
+
+/// Closest approach (m) between our UAV and that other UAV over 10–14 s (perfect tracking on both
+/// sides). We replan every 0.4 s from 10 s, flying at 4 m/s along y = −12 towards +x, the
+/// reference running on at 4 m/s through the other's position to (6, −12, 10). The other sends a
+/// plan every 0.4 s (made at 9.8, 10.2, …; 0.1 s on the link); the one it makes when it brakes is
+/// held back 0.5 s (dup_reorder), so for one more replanning we have only its plan before, which
+/// flies on out of the way.
+double closestToAUavThatBrakesBeforeItsNextPlanArrives(const PlannerConfig& cfg, const BrakingOther& o, std::string& log) {
+  const World& w = towers();
+  UavPlanner planner(cfg, w.map, w.field);
+  const double latency = 0.1, held_back = 0.5, vmax = 2.0;
+  const auto along = [&](double t) {  // its planned motion (position, velocity)
+    const double tau = std::max(0.0, t - 10.0), tau1 = vmax / o.accel;
+    const double s = tau < tau1 ? 0.5 * o.accel * tau * tau : 0.5 * o.accel * tau1 * tau1 + vmax * (tau - tau1);
+    return std::make_pair(Eigen::Vector3d(o.o0 + o.dir * s), Eigen::Vector3d(o.dir * std::min(vmax, o.accel * tau)));
+  };
+  const auto [p_b, v_b] = along(o.t_brake);
+  const BrakeProfile brake = brakeProfile(v_b, cfg.limits, 0.2);
+  const auto truth = [&](double t) {  // where it really is: on its plans until t_brake, then braking
+    if (t <= o.t_brake) return along(t);
+    const double tau = std::min(t - o.t_brake, brake.t_stop_s);
+    return std::make_pair(Eigen::Vector3d(p_b + brake.dir * (brake.speed_mps * tau - 0.5 * brake.decel_mps2 * tau * tau)),
+                          Eigen::Vector3d(brake.dir * (brake.speed_mps - brake.decel_mps2 * tau)));
+  };
+  const auto planMadeAt = [&](double t0) {
+    PlannedTrajectory p;
+    p.uav_index = 2;
+    p.t0_s = t0;
+    p.dt_s = 0.2;
+    for (int k = 0; k < 41; ++k) {
+      const auto [q, v] = t0 < o.t_brake - 1e-9 ? along(t0 + 0.2 * k) : truth(t0 + 0.2 * k);
+      TrajectorySample smp;
+      smp.p_world = q;
+      smp.v_world = v;
+      p.samples.push_back(smp);
+    }
+    return p;
+  };
+  const Eigen::Vector3d from(-8, -12, 10), to(6, -12, 10);
+  UavKinematicState s = stateAt(from, 10.0);
+  s.v_world = Eigen::Vector3d(4.0, 0, 0);
+  double closest = std::numeric_limits<double>::infinity();
+  for (double t = 10.0; t < 14.0 - 1e-9; t += 0.4) {
+    double made = 9.8;  // the newest of its plans that has arrived by t
+    for (double t0 = 9.8; t0 <= t + 1e-9; t0 += 0.4) {
+      const bool the_brake_plan = t0 >= o.t_brake - 1e-9 && t0 < o.t_brake + 0.4 - 1e-9;
+      if (t0 + latency + (the_brake_plan ? held_back : 0.0) <= t + 1e-9) made = t0;
+    }
+    PlanRequest req = straightRequest(0, t, s, from, to, 4.0, Eigen::Vector3d(-5, -3, 1));
+    for (int k = 0; k < req.reference.steps(); ++k) {  // the reference left `from` at 10 s
+      const double d = std::min(1.0, 4.0 * std::max(0.0, t - 10.0 + k * req.dt_s) / (to - from).norm());
+      req.reference.p_world.col(k) = from + d * (to - from);
+    }
+    req.higher_priority_plans = {planMadeAt(made)};
+    const PlanResult r = planner.plan(req);
+    if (r.trajectory.empty()) return -1.0;
+    log += "t=" + std::to_string(t) + " with its plan of " + std::to_string(made) + ": " + toString(r.status) + " " + r.reason + "\n";
+    for (double tt = t; tt <= t + 0.4 + 1e-9; tt += 0.02) {
+      closest = std::min(closest, (evaluateTrajectory(r.trajectory, tt).p - truth(tt).first).norm());
+    }
+    s = advance(r.trajectory, t + 0.4);
+  }
+  return closest;
+}
+
+}  // namespace
+
+// dup_reorder seed 32 (docs/safety.md §4.10): a fresh plan of another UAV that moves out of the
+// way lets our plan head at speed for where that UAV is now; if its replanning fails and it
+// brakes before its next plan reaches us, braking ourselves comes too late. With
+// brake_envelope_lead_s every plan also keeps Γ_dis from where its UAV would stop if it braked
+// before our next replanning can learn of it. The four cases are those of a grid (brake at
+// 10.8–11.4 s, 1 or 2 m/s², up or sideways, 1–3 m ahead) that came closer than Γ_dis without it.
+TEST(UavPlannerTest, UavThatBrakesBeforeItsNextPlanArrivesIsNotRunInto) {
+  PlannerConfig cfg = testConfig();
+  ASSERT_GT(cfg.brake_envelope_lead_s, 0.0) << "the shipped default";
+  const Eigen::Vector3d side(0, 1, 0);
+  const std::vector<BrakingOther> cases = {{Eigen::Vector3d(2, -12, 10), side, 2.0, 11.2},
+                                           {Eigen::Vector3d(1, -12, 10), side, 2.0, 10.8},
+                                           {Eigen::Vector3d(3, -12, 10), side, 1.0, 11.2},
+                                           {Eigen::Vector3d(2, -12, 10), side, 1.0, 11.2}};
+  PlannerConfig none = cfg;
+  none.brake_envelope_lead_s = 0.0;
+  double closest_without = std::numeric_limits<double>::infinity();
+  for (std::size_t c = 0; c < cases.size(); ++c) {
+    std::string log, log0;
+    const double with_lead = closestToAUavThatBrakesBeforeItsNextPlanArrives(cfg, cases[c], log);
+    EXPECT_GE(with_lead, cfg.mutual_distance_m - 1e-3) << "case " << c << "\n" << log;
+    const double without = closestToAUavThatBrakesBeforeItsNextPlanArrives(none, cases[c], log0);
+    EXPECT_GE(without, 0.0) << "case " << c << "\n" << log0;
+    closest_without = std::min(closest_without, without);
+  }
+  // The check bites: without the lead the same loops come closer than Γ_dis (2.31 m at most).
+  EXPECT_LT(closest_without, cfg.mutual_distance_m - 0.1);
 }
 
 // Replanning keeps failing and the brake plan does not verify (another UAV hovers inside
