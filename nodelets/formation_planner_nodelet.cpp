@@ -24,6 +24,9 @@
 //   ~search_timeout_s, ~search_height_m, ~search_vertical_speed_mps, ~search_period_s (with it: the mission's faults.* of the
 //   same names and controller.brake_accel_mps2, as gfctl simulate); optional ~faults_file (a fault
 //   profile merged into the mission, as `gfctl simulate --faults`).
+// Listen before moving (docs/safety.md §2.4, planning::listeningReason — gfctl simulate's rule for a
+// rejoining follower): from its first replanning, the planner holds until it has a plan made since
+// then from every other follower, or for at most max_plan_age_s.
 // Hold (docs/safety.md §1 rules 2–4, planning::holdReason — the decision gfctl simulate makes):
 // the leader holds when its estimate's last fused measurement (WorkerState.last_fused) is older
 // than max_worker_age_s; a follower when the leader's worker state (over LCM) is older than
@@ -242,7 +245,27 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     // Rule 2: never follow data older than its age limit — hold instead (the same decision as
     // gfctl simulate). A WorkerState without a fusion time (last_fused 0) counts as never fused.
     const double fused_s = worker_->last_fused.isZero() ? std::nan("") : worker_->last_fused.toSec();
-    const std::string hold = planning::holdReason(uav_index_, t, worker_->header.stamp.toSec(), fused_s, freshness_);
+    std::string hold = planning::holdReason(uav_index_, t, worker_->header.stamp.toSec(), fused_s, freshness_);
+    // Listen before moving (docs/safety.md §2.4): a (re)started planner knows no other UAV's plan;
+    // it holds until every other follower's plan made since its first replanning has arrived, or
+    // for at most max_plan_age_s (a UAV not heard from by then has right of way, as a silent one).
+    if (!std::isfinite(listen_since_s_)) listen_since_s_ = t;
+    if (hold.empty() && listening_) {
+      const bool waited = t - listen_since_s_ > rule_.max_plan_age_s;
+      hold = planning::listeningReason(uav_index_, listen_since_s_, received_, [waited](int) { return waited; });
+      if (hold.empty()) {
+        listening_ = false;
+        std::string unheard;
+        for (int j = 1; j < uav_count_; ++j) {
+          const auto& m = received_[static_cast<std::size_t>(j)];
+          if (j != uav_index_ && (!m || m->plan.t0_s < listen_since_s_)) unheard += " " + std::to_string(j);
+        }
+        if (!unheard.empty()) {
+          NODELET_WARN_STREAM("FormationPlanner UAV " << uav_index_ << ": no plan since the start from UAV(s)" << unheard
+                                                      << " after max_plan_age_s; tracking without them");
+        }
+      }
+    }
     const double age = std::max(0.0, t - worker_->header.stamp.toSec());
     const bool stale = !hold.empty();
     const Eigen::Vector3d v0 = stale || worker_->lost ? Eigen::Vector3d::Zero() : toEigen(worker_->velocity);
@@ -334,6 +357,8 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   planning::HoldPlanner hold_;             ///< hold / search decision, latched braking point
   planning::SearchConfig search_;
   std::string mode_ = "track";             ///< track | hold | search (logged on change)
+  double listen_since_s_ = std::nan("");   ///< the first replanning (planning::listeningReason)
+  bool listening_ = true;
   std::string last_command_, last_outcome_, last_source_, last_status_;
   ros::Time last_stamp_;
   std::vector<int> last_uavs_;

@@ -260,12 +260,8 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
       worker_stamp = share->worker_stamp_s;
       hold = planning::holdReason(i, t, share->stamp_s, worker_stamp, freshness);
       if (hold.empty() && u.rejoined_s > -std::numeric_limits<double>::infinity()) {
-        for (int j = 1; j < n && hold.empty(); ++j) {
-          const auto& m = u.received[static_cast<std::size_t>(j)];
-          if (j != i && !uavs[static_cast<std::size_t>(j)]->offline && (!m || m->plan.t0_s < u.rejoined_s)) {
-            hold = "rejoined: waiting for a plan from every other UAV";
-          }
-        }
+        hold = planning::listeningReason(i, u.rejoined_s, u.received,
+                                         [&](int j) { return uavs[static_cast<std::size_t>(j)]->offline; });
         if (hold.empty()) u.rejoined_s = -std::numeric_limits<double>::infinity();
       }
       const bool stale = !hold.empty();

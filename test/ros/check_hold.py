@@ -25,6 +25,13 @@ timeline = list(csv.DictReader(open(f"{out}/timeline.csv")))
 labels = ["L", "1", "2"]
 for uav in range(3):
     rows = [(float(r["t"]), r["mode"], r["reason"]) for r in modes if r["uav"] == labels[uav]]
+    # Listen before moving (docs/safety.md §2.4): the first replanning(s) hold until every other
+    # follower's plan has arrived, then track — long before the blackout; the checks below are
+    # about the blackout's hold.
+    check(len(rows) >= 2 and rows[0][1] == "hold" and rows[0][2].startswith("listening:") and rows[1][1] == "track"
+          and rows[1][0] - rows[0][0] <= 0.85 and rows[1][0] < a, f"UAV {uav} listens at its start, then tracks: {rows[:2]}")
+    if rows and rows[0][2].startswith("listening:"):
+        rows = rows[2:] if len(rows) >= 2 and rows[1][1] == "track" else rows[1:]
     holds = [r for r in rows if r[1] == "hold"]
     check(len(holds) >= 1 and all(a + age - 0.1 <= t <= a + age + 1.5 for t, _, _ in holds),
           f"UAV {uav} holds only after the estimate is {age} s old: {holds}")

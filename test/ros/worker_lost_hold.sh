@@ -43,8 +43,13 @@ check(any(t >= 13.0 and x.startswith("search: worker not seen") for t, _, x in l
       "rviz label 'search: worker not seen ...' above the leader: %s" % sorted({x for _, _, x in lead}))
 for i in (1, 2):
     check(any(x.startswith("hold: worker estimate older") for _, j, x in rows if j == i), "rviz label 'hold: ...' above follower %d" % i)
-check(rows and not any(t < 10.5 or t > 16.5 for t, _, _ in rows),
-      "labels only while not tracking (10.9-14.5 s): %s" % ([r[0] for r in rows[:1]] + [r[0] for r in rows[-1:]]))
+# Not tracking: the start's listening (docs/safety.md §2.4; its own label, before 1.5 s) and the blackout.
+start = [r for r in rows if r[2].startswith("hold: listening:")]
+check(rows and all(t < 1.5 for t, _, _ in start) and
+      not any((t < 10.5 or t > 16.5) and not x.startswith("hold: listening:") for t, _, x in rows),
+      "labels only while not tracking (listening < 1.5 s: %s; the blackout 10.9-14.5 s: %s)"
+      % ([r[0] for r in start[-1:]], [r[0] for r in rows if not r[2].startswith("hold: listening:")][:1] +
+         [r[0] for r in rows if not r[2].startswith("hold: listening:")][-1:]))
 sys.exit(bad)
 PY
 kill -INT \$launch; wait \$launch
