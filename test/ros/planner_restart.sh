@@ -1,0 +1,96 @@
+#!/bin/bash
+# A follower's onboard planner restarts (docs/safety.md §2.4; the reboot of gfctl simulate's
+# follower_dropout, here in the ROS system): simulation.launch, follower 2's FormationPlanner
+# nodelet unloaded at 10 s (sim time) and loaded again at 16 s into the same manager. While it is
+# gone its SimUav flies the last plan to its end and holds there, the others avoid that plan;
+# loaded again, it knows no plan of the others and must listen before it moves — hold with the
+# listening reason at its first replanning, then track — and Γ_dis and no collision hold
+# throughout (SimWorld's modes.csv and metrics.json).
+set -o pipefail
+source "$(dirname "$0")/common.bash"
+[ "$(id -u)" -eq 0 ] || { echo "SKIP: needs root (unshare -n keeps LCM on this machine)"; exit 0; }
+make_key "$T/keys"
+mkdir -p "$T/out"
+cat > "$T/restart.py" <<'PY'
+"""At sim time 10 s unloads /uav2/formation_planner (SIGINT to its loader process), at 16 s loads
+it again into /uav2/manager with the remaps of launch/sim_uav.launch (its private parameters are
+still on the parameter server). Prints what it did with the sim times."""
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+
+import rospy
+
+rospy.init_node("planner_restart", anonymous=True)
+while not rospy.is_shutdown() and rospy.get_time() < 10.0:
+    time.sleep(0.02)
+info = subprocess.run(["rosnode", "info", "/uav2/formation_planner"], capture_output=True, text=True).stdout
+pid = re.search(r"Pid: (\d+)", info)
+if not pid:
+    print("FAIL: no pid of /uav2/formation_planner:", info)
+    sys.exit(1)
+os.kill(int(pid.group(1)), signal.SIGINT)
+print("unloaded /uav2/formation_planner at %.2f s" % rospy.get_time(), flush=True)
+while not rospy.is_shutdown() and rospy.get_time() < 16.0:
+    time.sleep(0.02)
+remaps = ["odometry_in:=odometry", "worker_state_in:=worker_state", "plans_in:=lcm/plans",
+          "wind_estimate_in:=wind_estimation", "plan_out:=plan", "formation_params_in:=formation_params",
+          "formation_params_out:=formation_params", "formation_command_in:=formation_command"]
+env = dict(os.environ, ROS_NAMESPACE="/uav2")
+subprocess.Popen(["rosrun", "nodelet", "nodelet", "load", "gesture_formation/FormationPlanner", "manager",
+                  "__name:=formation_planner"] + remaps, env=env)
+print("loaded /uav2/formation_planner again at %.2f s" % rospy.get_time(), flush=True)
+rospy.spin()
+PY
+cat > "$T/inner.sh" <<INNER
+ip link set lo up && ip route add 224.0.0.0/4 dev lo || exit 1
+roslaunch -p $PORT gesture_formation simulation.launch key_file:=$T/keys output_dir:=$T/out duration:=30 \
+  real_time_factor:=1.5 > "$T/launch.log" 2>&1 &
+launch=\$!
+for _ in \$(seq 50); do rosparam get /use_sim_time > /dev/null 2>&1 && break; sleep 0.2; done
+python3 "$T/restart.py" > "$T/restart.log" 2>&1 &
+restart=\$!
+for _ in \$(seq 140); do [ -f "$T/out/metrics.json" ] && break; sleep 0.5; done
+sleep 0.5
+cat "$T/restart.log"
+python3 - "$T/out" <<'PY'
+import csv
+import json
+import sys
+
+out = sys.argv[1]
+bad = 0
+
+
+def check(ok, what):
+    global bad
+    print(("PASS: " if ok else "FAIL: ") + what)
+    bad += 0 if ok else 1
+
+
+m = json.load(open(out + "/metrics.json"))
+rows = [(float(r["t"]), r["mode"], r["reason"]) for r in csv.DictReader(open(out + "/modes.csv")) if r["uav"] == "2"]
+again = [r for r in rows if r[0] >= 16.0]
+# Loading takes a few seconds (the map's distance field: ~2.7 s of sim time here).
+check(len(again) >= 2 and again[0][1] == "hold" and again[0][2].startswith("listening:") and again[0][0] < 21.0,
+      "follower 2 listens at its first plan after the restart: %s" % again[:1])
+check(len(again) >= 2 and again[1][1] == "track" and again[1][0] - again[0][0] <= 0.85,
+      "then tracks within 2 replanning periods: %s" % again[1:2])
+check(not [r for r in rows if 1.5 < r[0] < 16.0 and r[1] != "track"], "no other mode change before the restart: %s" % rows)
+check(m["sim_time_s"] > 29.0, "the mission ran to its end (%.1f s)" % m["sim_time_s"])
+check(m["min_mutual_distance_m"] >= 2.5, "min mutual distance %.2f m >= 2.5" % m["min_mutual_distance_m"])
+check(m["collisions"] == 0, "collisions %d" % m["collisions"])
+sys.exit(bad)
+PY
+rc=\$?
+kill \$restart 2>/dev/null
+kill -INT \$launch; wait \$launch
+exit \$rc
+INNER
+timeout 100 unshare -n bash "$T/inner.sh"
+rc=$?
+[ $rc -eq 0 ] || { echo "--- launch.log (errors, FormationPlanner)"; grep -aE "ERROR|refuses|uav2|UAV 2" "$T/launch.log" | head -30; }
+exit $rc
