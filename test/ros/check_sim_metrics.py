@@ -52,7 +52,8 @@ def main():
     # Listen before moving (docs/safety.md §2.4): each FormationPlanner holds from its first
     # replanning until a plan made since then has arrived from every other follower — one or two
     # replanning periods (0.4 s) at the start; no other hold in a mission without faults.
-    check(isinstance(m.get("plans_hold"), int) and m.get("plans_hold") <= 3 * 2 and "plans_hold" not in m.get("not_measured_keys", []),
+    check(isinstance(m.get("plans_hold"), int) and m.get("plans_hold") <= 3 * 2
+          and "plans_hold" not in m.get("not_measured_keys", []),
           f"no hold replanning in a mission without faults but the start's listening, at most 2 per UAV "
           f"(plans_hold {m.get('plans_hold')}, from the plans' mode)")
     modes = list(csv.DictReader(open(f"{out}/modes.csv")))
@@ -60,7 +61,8 @@ def main():
     ok = all(len(rows) == 2 and rows[0][1] == "hold" and rows[0][2].startswith("listening:") and rows[1][1] == "track"
              and 0.0 < rows[1][0] - rows[0][0] <= 0.8 + 0.05 for rows in per_uav.values())
     check(ok and len(modes) == 6,
-          f"modes.csv: each UAV listens at its first plan, then tracks within 2 replanning periods and stays tracking ({per_uav})")
+          f"modes.csv: each UAV listens at its first plan, then tracks within 2 replanning periods and stays "
+          f"tracking ({per_uav})")
     rows = list(csv.DictReader(open(f"{out}/events.csv")))
     op = [r for r in rows if r["source"] == "operator" and abs(num(r["t"]) - 20.0) < 0.02]
     ok = len(op) == 1 and op[0]["status"] == "applied" and \

@@ -580,7 +580,8 @@ struct BrakingOther {
 /// plan every 0.4 s (made at 9.8, 10.2, …; 0.1 s on the link); the one it makes when it brakes is
 /// held back 0.5 s (dup_reorder), so for one more replanning we have only its plan before, which
 /// flies on out of the way.
-double closestToAUavThatBrakesBeforeItsNextPlanArrives(const PlannerConfig& cfg, const BrakingOther& o, std::string& log) {
+double closestToAUavThatBrakesBeforeItsNextPlanArrives(const PlannerConfig& cfg, const BrakingOther& o,
+                                                        std::string& log) {
   const World& w = towers();
   UavPlanner planner(cfg, w.map, w.field);
   const double latency = 0.1, held_back = 0.5, vmax = 2.0;
@@ -594,7 +595,8 @@ double closestToAUavThatBrakesBeforeItsNextPlanArrives(const PlannerConfig& cfg,
   const auto truth = [&](double t) {  // where it really is: on its plans until t_brake, then braking
     if (t <= o.t_brake) return along(t);
     const double tau = std::min(t - o.t_brake, brake.t_stop_s);
-    return std::make_pair(Eigen::Vector3d(p_b + brake.dir * (brake.speed_mps * tau - 0.5 * brake.decel_mps2 * tau * tau)),
+    const double s = brake.speed_mps * tau - 0.5 * brake.decel_mps2 * tau * tau;
+    return std::make_pair(Eigen::Vector3d(p_b + brake.dir * s),
                           Eigen::Vector3d(brake.dir * (brake.speed_mps - brake.decel_mps2 * tau)));
   };
   const auto planMadeAt = [&](double t0) {
@@ -629,7 +631,8 @@ double closestToAUavThatBrakesBeforeItsNextPlanArrives(const PlannerConfig& cfg,
     req.higher_priority_plans = {planMadeAt(made)};
     const PlanResult r = planner.plan(req);
     if (r.trajectory.empty()) return -1.0;
-    log += "t=" + std::to_string(t) + " with its plan of " + std::to_string(made) + ": " + toString(r.status) + " " + r.reason + "\n";
+    log += "t=" + std::to_string(t) + " with its plan of " + std::to_string(made) + ": " + toString(r.status) + " " +
+           r.reason + "\n";
     for (double tt = t; tt <= t + 0.4 + 1e-9; tt += 0.02) {
       closest = std::min(closest, (evaluateTrajectory(r.trajectory, tt).p - truth(tt).first).norm());
     }
