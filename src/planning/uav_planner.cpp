@@ -759,11 +759,18 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
     // statistics need the cause; costs up to three more solves, only on failure). The most
     // frequent cause first: a relaxed problem that is still infeasible costs 2–4× the failed
     // solve before ProxQP proves it (power towers seed 7: ~450 ms of a 560 ms failed replanning
-    // with the worker and UAV families tried first, docs/planning.md §7).
+    // with the worker and UAV families tried first, docs/planning.md §7). Not beyond the time
+    // budget: the fallback must not wait for a diagnosis (harsh seed 1: 1.6 s, mostly re-solves).
     std::string cause;
     using Kind = PositionConstraint::Kind;
     for (const auto& [kind, name] : {std::pair{Kind::kCorridor, "corridors"}, std::pair{Kind::kUav, "UAV separation"},
                                      std::pair{Kind::kWorker, "worker separation"}}) {
+      if (config_.time_budget_ms > 0.0 && msSince(t_start) > config_.time_budget_ms) {
+        std::ostringstream os;
+        os << " (cause not diagnosed: the time budget of " << config_.time_budget_ms << " ms is spent)";
+        cause = os.str();
+        break;
+      }
       TrajectoryQpProblem relaxed = qp;
       const auto before = relaxed.constraints.size();
       relaxed.constraints.erase(std::remove_if(relaxed.constraints.begin(), relaxed.constraints.end(),

@@ -303,6 +303,40 @@ TEST(UavPlannerTest, NanReferenceFallsBackToPreviousPlanThenBrake) {
   EXPECT_NE(n.reason.find("state.p_world"), std::string::npos) << n.reason;
 }
 
+// An infeasible QP names its cause by re-solving without each constraint family (docs/planning.md
+// §7.1) — but not beyond the time budget: the fallback must not wait for the diagnosis.
+TEST(UavPlannerTest, InfeasibleQpNamesItsCauseWithinTheTimeBudgetOnly) {
+  const World& w = towers();
+  // At 4 m/s towards another UAV hovering 3.8 m ahead (fresh plan): stopping needs 2.7 m, Γ_dis +
+  // buffer leaves 1.15 m — infeasible, and feasible without the UAV separation constraints.
+  const Eigen::Vector3d from(-8, -12, 10), other_p(-4.2, -12, 10);
+  PlannedTrajectory other;
+  other.uav_index = 0;
+  other.t0_s = 10.0;
+  other.dt_s = 0.2;
+  for (int k = 0; k < 41; ++k) {
+    TrajectorySample smp;
+    smp.p_world = other_p;
+    other.samples.push_back(smp);
+  }
+  UavKinematicState s = stateAt(from, 10.0);
+  s.v_world = Eigen::Vector3d(4.0, 0, 0);
+  PlanRequest req = straightRequest(1, 10.0, s, from, Eigen::Vector3d(6, -12, 10), 4.0, Eigen::Vector3d(-5, -3, 1));
+  req.higher_priority_plans = {other};
+  PlannerConfig cfg = testConfig();  // time budget off: the cause is always named
+  const PlanResult named = UavPlanner(cfg, w.map, w.field).plan(req);
+  ASSERT_NE(named.status, PlanStatus::kOptimized) << named.reason;
+  EXPECT_NE(named.reason.find("QP primal infeasible (feasible without the UAV separation constraints)"), std::string::npos)
+      << named.reason;
+  cfg.time_budget_ms = 1e-3;  // spent before the first re-solve
+  const PlanResult quick = UavPlanner(cfg, w.map, w.field).plan(req);
+  ASSERT_NE(quick.status, PlanStatus::kOptimized) << quick.reason;
+  EXPECT_NE(quick.reason.find("QP primal infeasible (cause not diagnosed: the time budget of 0.001 ms is spent)"),
+            std::string::npos)
+      << quick.reason;
+  EXPECT_EQ(quick.status, named.status);  // the same fallback either way
+}
+
 TEST(UavPlannerTest, FailedVerificationFallsBack) {
   // A verification clearance larger than the corridors keep (0.8 m from centres − 0.17 m
   // half-diagonal ≈ 0.63 m from cubes) makes plans that pass close to the tower fail
