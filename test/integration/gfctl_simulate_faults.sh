@@ -38,6 +38,20 @@ print(("FAIL " if problems else "ok   ") + "harsh: " + (", ".join(problems) if p
 sys.exit(1 if problems else 0)
 PY
 
+# Regression (docs/safety.md §4.10): dup_reorder seed 32 — the leader headed at speed for where a
+# yielding follower still was, the follower braked and its brake plan came 0.5 s late; before the
+# braking envelope ahead of lower-priority plans the two came to 2.22 m at 286 s (3.90 m since).
+"$GFCTL" simulate --scenario "$SRC/config/scenarios/power_towers.yaml" --fault-profile dup_reorder --seed 32 \
+  --duration 295 --threads 1 --out "$TMP/d32" --no-plot > "$TMP/d32.log" 2>&1 || { echo "FAIL dup_reorder 32: gfctl exited $?"; cat "$TMP/d32.log"; exit 1; }
+python3 - "$TMP/d32" <<'PY' || fail=1
+import json, sys
+m = json.load(open(sys.argv[1] + "/metrics.json"))
+ok = m["min_mutual_distance_m"] >= 2.5 and m["collisions"] == 0 and m["messages_reordered"] > 0
+print(("ok   " if ok else "FAIL ") + f"dup_reorder seed 32 to 295 s: mutual {m['min_mutual_distance_m']:.2f} m (>= 2.5), "
+      f"collisions {m['collisions']}, reordered {m['messages_reordered']}")
+sys.exit(0 if ok else 1)
+PY
+
 # Bad fault files: exit 2, every problem listed with its field and value.
 cat > "$TMP/bad.yaml" <<'YAML'
 faults:
