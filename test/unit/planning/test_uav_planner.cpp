@@ -77,6 +77,20 @@ UavKinematicState stateAt(const Eigen::Vector3d& p, double t = 0.0) {
   return s;
 }
 
+/// Another UAV's plan hovering at p: 41 samples of 0.2 s from t0.
+PlannedTrajectory hoveringPlan(int uav, double t0, const Eigen::Vector3d& p) {
+  PlannedTrajectory tr;
+  tr.uav_index = uav;
+  tr.t0_s = t0;
+  tr.dt_s = 0.2;
+  for (int k = 0; k < 41; ++k) {
+    TrajectorySample smp;
+    smp.p_world = p;
+    tr.samples.push_back(smp);
+  }
+  return tr;
+}
+
 /// Independent check of obstacle clearance: brute force over the occupied voxel centres near
 /// the point (true distance to the centres, not the field's lower bound).
 double centreDistance(const OccupancyMap& map, const Eigen::Vector3d& p, double radius) {
@@ -310,15 +324,7 @@ TEST(UavPlannerTest, InfeasibleQpNamesItsCauseWithinTheTimeBudgetOnly) {
   // At 4 m/s towards another UAV hovering 3.8 m ahead (fresh plan): stopping needs 2.7 m, Γ_dis +
   // buffer leaves 1.15 m — infeasible, and feasible without the UAV separation constraints.
   const Eigen::Vector3d from(-8, -12, 10), other_p(-4.2, -12, 10);
-  PlannedTrajectory other;
-  other.uav_index = 0;
-  other.t0_s = 10.0;
-  other.dt_s = 0.2;
-  for (int k = 0; k < 41; ++k) {
-    TrajectorySample smp;
-    smp.p_world = other_p;
-    other.samples.push_back(smp);
-  }
+  const PlannedTrajectory other = hoveringPlan(0, 10.0, other_p);
   UavKinematicState s = stateAt(from, 10.0);
   s.v_world = Eigen::Vector3d(4.0, 0, 0);
   PlanRequest req = straightRequest(1, 10.0, s, from, Eigen::Vector3d(6, -12, 10), 4.0, Eigen::Vector3d(-5, -3, 1));
