@@ -112,11 +112,27 @@ int runBench(int argc, char** argv) {
 int main(int argc, char** argv) {
   using namespace gesture_formation::gfctl;
   if (argc < 2 || std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0 ||
-      std::strcmp(argv[1], "help") == 0) {
+      (std::strcmp(argv[1], "help") == 0 && argc < 3)) {
     usage(argc < 2 ? stderr : stdout);
     return argc < 2 ? kExitBadInput : kExitOk;
   }
   if (std::strcmp(argv[1], "bench") == 0) return runBench(argc, argv);
+  // `gfctl <command> --help` (or -h) and `gfctl help <command>`: that command's usage on stdout.
+  const bool help_for = std::strcmp(argv[1], "help") == 0;
+  bool asks_help = help_for;
+  for (int i = 2; i < argc; ++i) asks_help = asks_help || std::strcmp(argv[i], "--help") == 0 || std::strcmp(argv[i], "-h") == 0;
+  if (asks_help) {
+    const char* name = help_for ? argv[2] : argv[1];
+    for (const auto& c : commandRegistry()) {
+      if (std::strcmp(name, c.name) == 0) {
+        std::printf("usage: gfctl %s %s\n", c.name, c.usage);
+        return kExitOk;
+      }
+    }
+    std::cerr << "gfctl: unknown command '" << name << "'\n";
+    usage(stderr);
+    return kExitBadInput;
+  }
   Args args;
   args.command = argv[1];
   for (int i = 2; i < argc; ++i) {

@@ -23,6 +23,19 @@ CFG=$SRC/config/estimator.yaml
 IN=$SRC/test/data/flights/sample_flight.csv
 expect 2 "usage: gfctl" --
 expect 2 "unknown command 'nope'" -- nope
+# Help: one command's usage on stdout, exit 0 (--help, -h anywhere after it, or `help <command>`).
+for form in "simulate --help" "simulate --scenario x -h" "help simulate"; do
+  # shellcheck disable=SC2086
+  "$GFCTL" $form > "$T/stdout" 2> "$T/stderr"
+  got=$?
+  if [ "$got" != 0 ] || ! grep -q "^usage: gfctl simulate --scenario FILE --out DIR" "$T/stdout" || [ -s "$T/stderr" ]; then
+    echo "FAIL: gfctl $form -> exit $got, stdout: $(head -c 200 "$T/stdout"), stderr: $(cat "$T/stderr")"; fails=$((fails + 1))
+  else
+    echo "ok: gfctl $form -> 0: $(head -c 60 "$T/stdout")"
+  fi
+done
+expect 2 "unknown command 'nope'" -- help nope
+expect 2 "unknown command 'nope'" -- nope --help
 expect 2 "missing required option --in" -- estimate --config "$CFG" --out "$T/o.csv"
 expect 2 "unknown option --bogus" -- estimate --config "$CFG" --in "$IN" --out "$T/o.csv" --bogus 1
 expect 2 "$T/none.csv: cannot open file" -- estimate --config "$CFG" --in "$T/none.csv" --out "$T/o.csv"
