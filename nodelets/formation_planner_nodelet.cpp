@@ -251,19 +251,17 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     // for at most max_plan_age_s (a UAV not heard from by then has right of way, as a silent one).
     if (!std::isfinite(listen_since_s_)) listen_since_s_ = t;
     if (hold.empty() && listening_) {
-      const bool waited = t - listen_since_s_ > rule_.max_plan_age_s;
-      hold = planning::listeningReason(uav_index_, listen_since_s_, received_, [waited](int) { return waited; });
-      if (hold.empty()) {
+      const std::vector<int> unheard = planning::unheardFollowers(uav_index_, listen_since_s_, received_, nullptr);
+      if (unheard.empty() || t - listen_since_s_ > rule_.max_plan_age_s) {
         listening_ = false;
-        std::string unheard;
-        for (int j = 1; j < uav_count_; ++j) {
-          const auto& m = received_[static_cast<std::size_t>(j)];
-          if (j != uav_index_ && (!m || m->plan.t0_s < listen_since_s_)) unheard += " " + std::to_string(j);
-        }
         if (!unheard.empty()) {
-          NODELET_WARN_STREAM("FormationPlanner UAV " << uav_index_ << ": no plan since the start from UAV(s)" << unheard
+          std::string list;
+          for (int j : unheard) list += " " + std::to_string(j);
+          NODELET_WARN_STREAM("FormationPlanner UAV " << uav_index_ << ": no plan since the start from UAV(s)" << list
                                                       << " after max_plan_age_s; tracking without them");
         }
+      } else {
+        hold = planning::listeningReason(uav_index_, listen_since_s_, received_, nullptr);
       }
     }
     const double age = std::max(0.0, t - worker_->header.stamp.toSec());

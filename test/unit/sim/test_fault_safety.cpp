@@ -358,6 +358,16 @@ TEST(ListeningTest, WaitsForAPlanMadeSinceTheResetFromEveryOtherPresentFollower)
   EXPECT_EQ(pl::listeningReason(3, 15.0, rx, present), "");
   EXPECT_EQ(pl::listeningReason(0, 15.0, rx, present), waiting);  // the leader: follower 3's missing
   EXPECT_EQ(pl::listeningReason(0, 15.0, rx, nullptr), waiting);  // no absent predicate: wait for all
+  // The same rule as a list (the FormationPlanner nodelet names the UAVs it stopped waiting for).
+  EXPECT_EQ(pl::unheardFollowers(0, 15.0, rx, nullptr), std::vector<int>{3});
+  rx[2] = plan(2, 14.0);
+  EXPECT_EQ(pl::unheardFollowers(0, 15.0, rx, nullptr), (std::vector<int>{2, 3}));
+  EXPECT_EQ(pl::unheardFollowers(0, 15.0, rx, [](int j) { return j == 2; }), std::vector<int>{3});
+  EXPECT_EQ(pl::unheardFollowers(2, 15.0, rx, present), std::vector<int>{3});  // not itself
+  rx[2] = plan(2, 15.5);
+  rx[3] = plan(3, 15.1);
+  EXPECT_TRUE(pl::unheardFollowers(0, 15.0, rx, present).empty());
+  EXPECT_EQ(pl::listeningReason(0, 15.0, rx, present), "");
 }
 
 // ---------------------------------------------------------------------------------------
