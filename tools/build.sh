@@ -3,6 +3,7 @@
 # macros work without a workspace). Extra arguments are passed to ninja (e.g. a target).
 #   tools/build.sh            # everything: core, gfctl, nodelets, tests, benchmarks
 #   tools/build.sh gfctl      # just the CLI
+case "${1:-}" in -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;; esac  # the comment above
 set -eo pipefail
 cd "$(dirname "$0")/.."
 # Debian's python3 first: a pyenv shim breaks catkin (docs/toolchain.md, trap 1).

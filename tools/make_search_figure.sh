@@ -3,6 +3,7 @@
 # seed 1, the leader's camera blind 8–25 s while the worker climbs the west tower, once with the
 # camera search and once without (search_timeout_s: 0), drawn by tools/plot_search.py.
 # Usage: tools/make_search_figure.sh [GFCTL]   (default: build/devel/lib/gesture_formation/gfctl)
+case "${1:-}" in -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;; esac  # the comment above
 set -euo pipefail
 cd "$(dirname "$0")/.."
 GFCTL=${1:-build/devel/lib/gesture_formation/gfctl}

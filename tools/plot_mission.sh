@@ -3,6 +3,7 @@
 # writes OUT/scene.json (the scenario's solids, as gfctl simulate writes them) and calls
 # tools/plot_timeline.py with the tools venv's matplotlib. Used by tools/run_ros_mission.sh and
 # tools/run_multihost.sh.   tools/plot_mission.sh OUT MISSION_FILE [BUILD_DIR]
+case "${1:-}" in -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;; esac  # the comment above
 set -eo pipefail
 cd "$(dirname "$0")/.."
 OUT=$1

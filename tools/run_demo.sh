@@ -11,6 +11,7 @@
 #   GF_DEMO_SEED=7 tools/run_demo.sh      # another seed (any run_ros_mission.sh option may follow)
 # Exit code: non-zero when the setup, the build or the mission failed (did not finish, or a
 # collision). The one-process variant without ROS is `gfctl simulate` (README).
+case "${1:-}" in -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;; esac  # the comment above
 set -eo pipefail
 cd "$(dirname "$0")/.."
 tools/setup.sh > /dev/null

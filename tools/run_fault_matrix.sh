@@ -21,6 +21,7 @@
 # GF_MATRIX_DIR the missions' output (default build-faults/fault_matrix), GF_REPORT the table
 # (default docs/reliability.md), GF_PLOT its figure (default docs/images/fault_matrix.png, drawn by
 # tools/plot_fault_matrix.py with the tools venv's matplotlib).
+case "${1:-}" in -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;; esac  # the comment above
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SEEDS=${GF_SEEDS:-100}

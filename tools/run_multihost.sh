@@ -14,6 +14,7 @@
 # Writes OUT/metrics.json, events.csv, timeline.csv (SimWorld, as gfctl simulate), timeline.png,
 # radio.json (relay counters), logs/. Needs root (network namespaces). Exit code: 0 when the mission finished
 # without a collision; 1 when it did not finish or a UAV collided; 2 for bad arguments.
+case "${1:-}" in -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;; esac  # the comment above
 set -eo pipefail  # not -u: devel/setup.bash reads unset variables
 cd "$(dirname "$0")/.."
 SRC=$PWD

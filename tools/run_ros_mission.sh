@@ -13,6 +13,7 @@
 # Defaults: --out results/demo, the whole mission (451 s), --rtf 2 (sim seconds per wall second).
 # Exit code: 0 when the mission finished without a collision; 1 when it did not finish or a UAV
 # collided; 2 for bad arguments or a missing build.
+case "${1:-}" in -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;; esac  # the comment above
 set -eo pipefail  # not -u: devel/setup.bash reads unset variables
 cd "$(dirname "$0")/.."
 SRC=$PWD

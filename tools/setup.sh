@@ -7,6 +7,7 @@
 #
 # Environment: GF_PREFIX (default /opt/gesture_formation) is where proxsuite and the tools
 # venv live; CMakeLists.txt looks there by default.
+case "${1:-}" in -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;; esac  # the comment above
 set -eo pipefail
 
 GF_PREFIX="${GF_PREFIX:-/opt/gesture_formation}"
