@@ -1,0 +1,140 @@
+#include "gesture_formation/gesture/view_triangulation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Dense>
+#include <Eigen/Geometry>
+
+#include "gesture_formation/common/angles.hpp"
+
+namespace gesture_formation::gesture {
+
+namespace {
+
+double angleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return common::radToDeg(std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)));
+}
+
+}  // namespace
+
+std::vector<std::string> TriangulationConfig::validate() const {
+  std::vector<std::string> e;
+  if (!(min_confidence >= 0.0 && min_confidence < 1.0)) {
+    e.push_back("min_confidence: expected [0, 1), got " + std::to_string(min_confidence));
+  }
+  if (!(min_ray_angle_deg > 0.0 && min_ray_angle_deg < 90.0)) {
+    e.push_back("min_ray_angle_deg: expected (0, 90), got " + std::to_string(min_ray_angle_deg));
+  }
+  return e;
+}
+
+Skeleton3D triangulate(const std::vector<CalibratedSkeleton>& views, const TriangulationConfig& config) {
+  Skeleton3D out;
+  std::vector<estimation::CameraModel> cameras;
+  cameras.reserve(views.size());
+  for (const auto& v : views) cameras.emplace_back(v.intrinsics);
+  const double min_sin = std::sin(common::degToRad(config.min_ray_angle_deg));
+  for (int k = 0; k < kNumKeypoints; ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    // Least squares: Σ w (I − r rᵀ) p = Σ w (I − r rᵀ) c over the rays (c, r), r unit, world frame.
+    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d b = Eigen::Vector3d::Zero();
+    std::vector<Eigen::Vector3d> rays;
+    std::vector<std::size_t> used;
+    for (std::size_t v = 0; v < views.size(); ++v) {
+      const CalibratedSkeleton& cs = views[v];
+      const double c = cs.skeleton.c[i];
+      if (!(c >= config.min_confidence) || c <= 0.0) continue;
+      if (!cs.R_world_camera.allFinite() || !cs.p_world_camera.allFinite()) continue;
+      const auto ray_camera = cameras[v].rayThroughPixel(Eigen::Vector2d(cs.skeleton.x[i], cs.skeleton.y[i]));
+      if (!ray_camera) continue;
+      const Eigen::Vector3d r = (cs.R_world_camera * *ray_camera).normalized();
+      const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - r * r.transpose();
+      A += c * P;
+      b += c * P * cs.p_world_camera;
+      rays.push_back(r);
+      used.push_back(v);
+    }
+    if (rays.size() < 2) continue;
+    double widest = 0.0;
+    for (std::size_t a = 0; a < rays.size(); ++a) {
+      for (std::size_t c = a + 1; c < rays.size(); ++c) widest = std::max(widest, rays[a].cross(rays[c]).norm());
+    }
+    if (widest < min_sin) continue;
+    const Eigen::Vector3d p = A.ldlt().solve(b);
+    if (!p.allFinite()) continue;
+    double worst = 0.0;
+    for (std::size_t v : used) {
+      const CalibratedSkeleton& cs = views[v];
+      const auto px = cameras[v].project(cs.R_world_camera.transpose() * (p - cs.p_world_camera));
+      if (!px) {
+        worst = std::numeric_limits<double>::infinity();
+        break;
+      }
+      worst = std::max(worst, (*px - Eigen::Vector2d(cs.skeleton.x[i], cs.skeleton.y[i])).norm());
+    }
+    if (!std::isfinite(worst)) continue;  // behind a camera that saw it: inconsistent rays
+    out.p_world[i] = p;
+    out.valid[i] = true;
+    out.views[i] = static_cast<int>(used.size());
+    out.reprojection_px[i] = worst;
+  }
+  return out;
+}
+
+std::optional<BodyFrame> bodyFrameOf(const Skeleton3D& s) {
+  for (int k : {kLeftShoulder, kRightShoulder, kLeftHip, kRightHip}) {
+    if (!s.valid[static_cast<std::size_t>(k)]) return std::nullopt;
+  }
+  const Eigen::Vector3d ls = s.p_world[kLeftShoulder], rs = s.p_world[kRightShoulder];
+  const Eigen::Vector3d mid_shoulder = 0.5 * (ls + rs);
+  const Eigen::Vector3d mid_hip = 0.5 * (s.p_world[kLeftHip] + s.p_world[kRightHip]);
+  const Eigen::Vector3d lateral = ls - rs, torso = mid_shoulder - mid_hip;
+  if (lateral.norm() < 0.15 || lateral.norm() > 0.7 || torso.norm() < 0.2 || torso.norm() > 1.0) return std::nullopt;
+  const Eigen::Vector3d y = lateral.normalized();
+  const Eigen::Vector3d z_raw = torso - torso.dot(y) * y;
+  if (z_raw.norm() < 0.1) return std::nullopt;  // torso along the shoulder axis: not a body
+  const Eigen::Vector3d z = z_raw.normalized();
+  BodyFrame f;
+  f.R_world_body.col(0) = y.cross(z);
+  f.R_world_body.col(1) = y;
+  f.R_world_body.col(2) = z;
+  f.p_world_origin = mid_shoulder;
+  return f;
+}
+
+ArmGeometry armGeometry(const Skeleton3D& s, bool left_arm) {
+  ArmGeometry g;
+  const auto shoulder = static_cast<std::size_t>(left_arm ? kLeftShoulder : kRightShoulder);
+  const auto elbow = static_cast<std::size_t>(left_arm ? kLeftElbow : kRightElbow);
+  const auto wrist = static_cast<std::size_t>(left_arm ? kLeftWrist : kRightWrist);
+  const auto frame = bodyFrameOf(s);
+  if (!frame || !s.valid[shoulder] || !s.valid[wrist]) return g;
+  const Eigen::Vector3d arm_world = s.p_world[wrist] - s.p_world[shoulder];
+  if (arm_world.norm() < 1e-3) return g;
+  g.valid = true;
+  g.direction_body = frame->R_world_body.transpose() * arm_world.normalized();
+  g.from_outward_deg = angleDeg(g.direction_body, Eigen::Vector3d(0.0, left_arm ? 1.0 : -1.0, 0.0));
+  g.from_up_deg = angleDeg(g.direction_body, Eigen::Vector3d::UnitZ());
+  g.from_forward_deg = angleDeg(g.direction_body, Eigen::Vector3d::UnitX());
+  if (s.valid[elbow]) {
+    const double path = (s.p_world[elbow] - s.p_world[shoulder]).norm() + (s.p_world[wrist] - s.p_world[elbow]).norm();
+    if (path > 1e-3) g.reach_ratio = arm_world.norm() / path;
+  }
+  return g;
+}
+
+int oneArmGesture3D(const Skeleton3D& s, const ArmGestureThresholds& t) {
+  int best = kNone;
+  for (bool left : {true, false}) {
+    const ArmGeometry g = armGeometry(s, left);
+    if (!g.valid) continue;
+    if (g.from_up_deg <= t.raise_max_deg) return kRaiseArmUp;
+    if (g.from_outward_deg <= t.extend_max_deg && g.reach_ratio >= t.min_reach_ratio) best = kExtendArmSide;
+  }
+  return best;
+}
+
+}  // namespace gesture_formation::gesture

@@ -1,0 +1,195 @@
+// gesture/view_triangulation.hpp: 3-D skeleton from calibrated views and DESIGN §2's one-arm
+// gestures tested in it (docs/gestures.md §6, the step after the 2-of-3 vote).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include <Eigen/Geometry>
+
+#include "gesture_formation/common/angles.hpp"
+#include "gesture_formation/gesture/skeleton_synth.hpp"
+#include "gesture_formation/gesture/view_triangulation.hpp"
+
+namespace gf = gesture_formation;
+using gf::common::degToRad;
+using gf::gesture::CalibratedSkeleton;
+using gf::gesture::Motion;
+using gf::gesture::Skeleton3D;
+using gf::gesture::SkeletonSynthesizer;
+using gf::gesture::SynthConfig;
+using gf::gesture::SynthSequence;
+using gf::gesture::TriangulationConfig;
+
+namespace {
+
+/// A camera at distance d, elevation e, azimuth a [deg] around a body whose frame is the world
+/// (x forward, y left, z up, feet at 0), looking at (0, 0, aim_z): the generator's geometry
+/// without its aim jitter (which the tests then meet as a pose error of ~0.2–0.4°).
+CalibratedSkeleton cameraAt(double d, double e_deg, double a_deg, double aim_z) {
+  const double e = degToRad(e_deg), a = degToRad(a_deg);
+  const Eigen::Vector3d aim(0.0, 0.0, aim_z);
+  CalibratedSkeleton c;
+  c.p_world_camera = aim + d * Eigen::Vector3d(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
+  const Eigen::Vector3d zc = (aim - c.p_world_camera).normalized();
+  const Eigen::Vector3d xc = zc.cross(Eigen::Vector3d::UnitZ()).normalized();
+  const Eigen::Vector3d yc = zc.cross(xc);
+  c.R_world_camera << xc, yc, zc;
+  return c;
+}
+
+/// Projects a body exactly (no noise) into a camera: confidence 1 where it lands in the image.
+void projectInto(const gf::gesture::Body3D& body, CalibratedSkeleton& cam) {
+  const gf::estimation::CameraModel model(cam.intrinsics);
+  for (int k = 0; k < gf::gesture::kNumKeypoints; ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    const auto px = model.project(cam.R_world_camera.transpose() * (body.p[i] - cam.p_world_camera));
+    cam.skeleton.c[i] = px ? 1.0 : 0.0;
+    if (px) {
+      cam.skeleton.x[i] = px->x();
+      cam.skeleton.y[i] = px->y();
+    }
+  }
+}
+
+}  // namespace
+
+TEST(ViewTriangulationTest, ExactViewsRecoverTheBodyAndItsFrame) {
+  SkeletonSynthesizer synth(SynthConfig{}, 3);
+  const gf::gesture::Body3D body = synth.pose(Motion::kExtendArmSide, 1.0, 0.0, true);
+  std::vector<CalibratedSkeleton> views{cameraAt(10.0, 20.0, 0.0, 1.0), cameraAt(9.0, 30.0, 60.0, 1.0),
+                                        cameraAt(12.0, 15.0, -60.0, 1.0)};
+  for (auto& v : views) projectInto(body, v);
+  const Skeleton3D s = gf::gesture::triangulate(views, TriangulationConfig{});
+  for (int k = 0; k < gf::gesture::kNumKeypoints; ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    ASSERT_TRUE(s.valid[i]) << "keypoint " << k;
+    EXPECT_EQ(s.views[i], 3);
+    EXPECT_LT((s.p_world[i] - body.p[i]).norm(), 1e-6) << "keypoint " << k;
+    EXPECT_LT(s.reprojection_px[i], 1e-4);
+  }
+  // The body frame of the generator's body is the world frame (it stands upright, facing +x).
+  const auto frame = gf::gesture::bodyFrameOf(s);
+  ASSERT_TRUE(frame);
+  EXPECT_LT((frame->R_world_body - Eigen::Matrix3d::Identity()).norm(), 0.05);
+  // Its left arm is extended (abduction 70–110°, ±15° forward: ≤ 25° from +y), the right hangs.
+  const auto left = gf::gesture::armGeometry(s, true), right = gf::gesture::armGeometry(s, false);
+  ASSERT_TRUE(left.valid && right.valid);
+  EXPECT_LE(left.from_outward_deg, 25.5);
+  EXPECT_GT(left.reach_ratio, 0.99);
+  EXPECT_GT(right.from_up_deg, 150.0);
+  EXPECT_EQ(gf::gesture::oneArmGesture3D(s), gf::gesture::kExtendArmSide);
+}
+
+TEST(ViewTriangulationTest, OneViewOrNearlyParallelRaysGiveNoPoint) {
+  SkeletonSynthesizer synth(SynthConfig{}, 4);
+  const gf::gesture::Body3D body = synth.pose(Motion::kRaiseArmUp, 1.0, 0.0, false);
+  std::vector<CalibratedSkeleton> one{cameraAt(10.0, 20.0, 30.0, 1.0)};
+  projectInto(body, one[0]);
+  const Skeleton3D s1 = gf::gesture::triangulate(one, TriangulationConfig{});
+  for (bool v : s1.valid) EXPECT_FALSE(v);
+  EXPECT_FALSE(gf::gesture::bodyFrameOf(s1));
+  EXPECT_EQ(gf::gesture::oneArmGesture3D(s1), gf::gesture::kNone);
+  // Two cameras 3° apart (< min_ray_angle_deg 10°): no depth, nothing triangulated.
+  std::vector<CalibratedSkeleton> close{cameraAt(10.0, 20.0, 30.0, 1.0), cameraAt(10.0, 20.0, 33.0, 1.0)};
+  for (auto& v : close) projectInto(body, v);
+  const Skeleton3D s2 = gf::gesture::triangulate(close, TriangulationConfig{});
+  for (bool v : s2.valid) EXPECT_FALSE(v);
+  // A keypoint one view misses (confidence 0) is triangulated from the other two.
+  std::vector<CalibratedSkeleton> three{cameraAt(10.0, 20.0, 0.0, 1.0), cameraAt(9.0, 30.0, 60.0, 1.0),
+                                        cameraAt(12.0, 15.0, -60.0, 1.0)};
+  for (auto& v : three) projectInto(body, v);
+  three[1].skeleton.c[gf::gesture::kRightWrist] = 0.0;
+  three[2].skeleton.c[gf::gesture::kRightWrist] = 0.1;  // below min_confidence 0.3
+  three[2].skeleton.c[gf::gesture::kNose] = 0.0;
+  const Skeleton3D s3 = gf::gesture::triangulate(three, TriangulationConfig{});
+  EXPECT_FALSE(s3.valid[gf::gesture::kRightWrist]);  // one view left
+  EXPECT_TRUE(s3.valid[gf::gesture::kNose]);
+  EXPECT_EQ(s3.views[gf::gesture::kNose], 2);
+  // A view with a non-finite pose is skipped, not propagated.
+  three[0].p_world_camera.x() = std::nan("");
+  const Skeleton3D s4 = gf::gesture::triangulate(three, TriangulationConfig{});
+  EXPECT_EQ(s4.views[gf::gesture::kLeftHip], 2);
+  for (int k = 0; k < gf::gesture::kNumKeypoints; ++k) {
+    if (s4.valid[static_cast<std::size_t>(k)]) {
+      EXPECT_TRUE(s4.p_world[static_cast<std::size_t>(k)].allFinite());
+    }
+  }
+}
+
+TEST(ViewTriangulationTest, ConfigErrorsNameTheFieldAndValue) {
+  TriangulationConfig c;
+  EXPECT_TRUE(c.validate().empty());
+  c.min_confidence = 1.5;
+  c.min_ray_angle_deg = 0.0;
+  const auto e = c.validate();
+  ASSERT_EQ(e.size(), 2u);
+  EXPECT_NE(e[0].find("min_confidence"), std::string::npos);
+  EXPECT_NE(e[0].find("1.5"), std::string::npos);
+  EXPECT_NE(e[1].find("min_ray_angle_deg"), std::string::npos);
+}
+
+namespace {
+
+/// Per motion: the share of frames the 3-D test reads as `id` over `count` performances seen by
+/// three cameras (leader at a random azimuth, followers ±60°, Table II-like: 6–18 m, 5–40° above;
+/// the generator's noise, dropouts, box jitter and aim jitter). Gestures: their frames at the pose
+/// (label ≠ 0); other motions: every frame between the motion's start and end.
+struct Share {
+  int hits = 0, frames = 0, unknown = 0;
+  double rate() const { return frames > 0 ? static_cast<double>(hits) / frames : 0.0; }
+};
+Share share3D(Motion m, int id, int count, std::uint64_t seed) {
+  SkeletonSynthesizer synth(SynthConfig{}, seed);
+  std::mt19937_64 rng(seed + 1000);
+  std::uniform_real_distribution<double> dist(6.0, 18.0), elev(5.0, 40.0), azim(-180.0, 180.0);
+  Share out;
+  for (int n = 0; n < count; ++n) {
+    const double e = elev(rng), a = azim(rng);
+    const std::vector<SkeletonSynthesizer::View> cams{{dist(rng), e, a}, {dist(rng), e, a + 60.0}, {dist(rng), e, a - 60.0}};
+    const std::vector<SynthSequence> views = synth.generateViewsFrom(m, cams);
+    for (std::size_t k = 0; k < views.front().frames.size(); ++k) {
+      const double t = views.front().frames[k].t_s;
+      const bool gesture = gf::gesture::gestureIdOf(m) != gf::gesture::kNone;
+      if (gesture ? views.front().frames[k].label == gf::gesture::kNone
+                  : (t < views.front().motion_start_s || t > views.front().motion_end_s)) {
+        continue;
+      }
+      std::vector<CalibratedSkeleton> calibrated;
+      for (const SynthSequence& v : views) {
+        CalibratedSkeleton c = cameraAt(v.distance_m, v.elevation_deg, v.azimuth_deg, 0.55 * v.height_m);
+        c.skeleton = v.frames[k].skeleton;
+        calibrated.push_back(c);
+      }
+      const Skeleton3D s = gf::gesture::triangulate(calibrated, TriangulationConfig{});
+      ++out.frames;
+      if (!gf::gesture::bodyFrameOf(s)) ++out.unknown;
+      if (gf::gesture::oneArmGesture3D(s) == id) ++out.hits;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+// What one 2-D view cannot do (docs/gestures.md §6): the arm pointing forward-outward, which a
+// single camera reads as "extend an arm" from ~30° beside it, is not an extended arm in 3-D.
+// Per frame, three noisy views (40 performances per motion, fixed seeds) — measured 2026-12-02 with
+// the default thresholds (27.5°): extend 0.89 and raise 0.90 of the frames at the pose (the rest:
+// the generator's least extended arms, 24.9° from the outward axis, plus noise; 2 % without a body
+// frame); pointing read as extend 0.0005; the balancing lunge, whose leading arm the generator puts
+// between "extend" and "raise" (30–60° above the horizontal), 0.014 / 0.037; every other motion 0.
+// The bounds leave room for other noise draws, not for a 2-D-like confusion.
+TEST(ViewTriangulationTest, ThreeNoisyViewsTellExtendAndRaiseFromTheirNearMisses) {
+  const int n = 40;
+  EXPECT_GE(share3D(Motion::kExtendArmSide, gf::gesture::kExtendArmSide, n, 11).rate(), 0.85);
+  EXPECT_GE(share3D(Motion::kRaiseArmUp, gf::gesture::kRaiseArmUp, n, 12).rate(), 0.85);
+  EXPECT_LE(share3D(Motion::kArmPartwayOrPointing, gf::gesture::kExtendArmSide, n, 27).rate(), 0.01);
+  for (Motion m : {Motion::kArmPartwayOrPointing, Motion::kBalanceLunge, Motion::kReachUpBolt, Motion::kClimbingLadder,
+                   Motion::kWalking, Motion::kHoldObjectAtChest, Motion::kArmsFoldedLow, Motion::kToolAtWaist,
+                   Motion::kIdle, Motion::kCrossArms, Motion::kPalmsTogether}) {
+    const auto seed = static_cast<std::uint64_t>(m);
+    EXPECT_LE(share3D(m, gf::gesture::kExtendArmSide, n, 20 + seed).rate(), 0.05) << gf::gesture::toString(m);
+    EXPECT_LE(share3D(m, gf::gesture::kRaiseArmUp, n, 40 + seed).rate(), 0.06) << gf::gesture::toString(m);
+  }
+}
