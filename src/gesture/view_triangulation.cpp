@@ -30,6 +30,19 @@ std::vector<std::string> TriangulationConfig::validate() const {
   return e;
 }
 
+std::vector<std::string> ArmGestureThresholds::validate() const {
+  std::vector<std::string> e;
+  const auto angle = [&e](const char* name, double v) {
+    if (!(v > 0.0 && v < 90.0)) e.push_back(std::string(name) + ": expected (0, 90) deg, got " + std::to_string(v));
+  };
+  angle("extend_max_deg", extend_max_deg);
+  angle("raise_max_deg", raise_max_deg);
+  if (!(min_reach_ratio > 0.0 && min_reach_ratio <= 1.0)) {
+    e.push_back("min_reach_ratio: expected (0, 1], got " + std::to_string(min_reach_ratio));
+  }
+  return e;
+}
+
 Skeleton3D triangulate(const std::vector<CalibratedSkeleton>& views, const TriangulationConfig& config) {
   Skeleton3D out;
   std::vector<estimation::CameraModel> cameras;

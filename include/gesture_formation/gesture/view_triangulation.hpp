@@ -84,10 +84,14 @@ ArmGeometry armGeometry(const Skeleton3D& s, bool left_arm);
 /// (gesture/skeleton_synth.hpp: extend = abduction 70–110°, ±15° forward, i.e. ≤ 25° from the
 /// outward axis; raise ≤ 25° from vertical) plus a margin for triangulation error.
 struct ArmGestureThresholds {
-  double extend_max_deg = 27.5;
-  double raise_max_deg = 27.5;
-  double min_reach_ratio = 0.85;   ///< straight arm (elbow angle ≳ 120°)
+  double extend_max_deg = 27.5;    ///< [deg], in (0, 90)
+  double raise_max_deg = 27.5;     ///< [deg], in (0, 90)
+  double min_reach_ratio = 0.85;   ///< straight arm (elbow angle ≳ 120°), in (0, 1]
+
+  /// \brief Every problem, each naming the field and the value; empty when valid.
+  std::vector<std::string> validate() const;
 };
+/// `thresholds` must be valid.
 int oneArmGesture3D(const Skeleton3D& s, const ArmGestureThresholds& thresholds = {});
 
 }  // namespace gesture_formation::gesture

@@ -127,6 +127,15 @@ TEST(ViewTriangulationTest, ConfigErrorsNameTheFieldAndValue) {
   EXPECT_NE(e[0].find("min_confidence"), std::string::npos);
   EXPECT_NE(e[0].find("1.5"), std::string::npos);
   EXPECT_NE(e[1].find("min_ray_angle_deg"), std::string::npos);
+  gf::gesture::ArmGestureThresholds t;
+  EXPECT_TRUE(t.validate().empty());
+  t.extend_max_deg = 95.0;
+  t.min_reach_ratio = 0.0;
+  const auto et = t.validate();
+  ASSERT_EQ(et.size(), 2u);
+  EXPECT_NE(et[0].find("extend_max_deg"), std::string::npos);
+  EXPECT_NE(et[0].find("95"), std::string::npos);
+  EXPECT_NE(et[1].find("min_reach_ratio"), std::string::npos);
 }
 
 namespace {
