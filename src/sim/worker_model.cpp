@@ -262,22 +262,13 @@ std::vector<gesture::SynthFrame> WorkerModel::skeletonsAt(double t_s, const std:
 gesture::CalibratedSkeleton WorkerModel::calibrated(std::size_t view, const gesture::Skeleton2D& skeleton,
                                                     const WorkerState& ws) const {
   const gesture::SynthSequence& seq = view == 0 ? current_ : other_views_.at(view - 1);
-  const double el = common::degToRad(seq.elevation_deg), az = common::degToRad(seq.azimuth_deg);
-  // The generator's camera in the body frame (x forward, y left, z up, feet at 0), then the world.
-  const Eigen::Vector3d centre(0.0, 0.0, 0.55 * seq.height_m);
-  const Eigen::Vector3d cam = centre + seq.distance_m * Eigen::Vector3d(std::cos(el) * std::cos(az),
-                                                                        std::cos(el) * std::sin(az), std::sin(el));
-  const Eigen::Vector3d zc = (centre - cam).normalized();
-  const Eigen::Vector3d xc = zc.cross(Eigen::Vector3d::UnitZ()).normalized();
-  const Eigen::Vector3d yc = zc.cross(xc);
-  Eigen::Matrix3d R_body_camera;
-  R_body_camera << xc, yc, zc;
+  // The generator's camera in the body frame (the synthesizer aims at 0.55 of the height), then the world.
+  gesture::CalibratedSkeleton c = gesture::cameraAround(seq.distance_m, seq.elevation_deg, seq.azimuth_deg,
+                                                        0.55 * seq.height_m, config_.synth.camera);
   const Eigen::Matrix3d R_world_body = Eigen::AngleAxisd(ws.heading_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  gesture::CalibratedSkeleton c;
   c.skeleton = skeleton;
-  c.R_world_camera = R_world_body * R_body_camera;
-  c.p_world_camera = ws.feet_world + R_world_body * cam;
-  c.intrinsics = config_.synth.camera;
+  c.R_world_camera = R_world_body * c.R_world_camera;
+  c.p_world_camera = ws.feet_world + R_world_body * c.p_world_camera;
   return c;
 }
 

@@ -25,19 +25,10 @@ using gf::gesture::TriangulationConfig;
 
 namespace {
 
-/// A camera at distance d, elevation e, azimuth a [deg] around a body whose frame is the world
-/// (x forward, y left, z up, feet at 0), looking at (0, 0, aim_z): the generator's geometry
-/// without its aim jitter (which the tests then meet as a pose error of ~0.2–0.4°).
+/// The generator's viewpoint without its aim jitter (which the tests then meet as a pose error of
+/// ~0.2–0.4°), the body frame being the world.
 CalibratedSkeleton cameraAt(double d, double e_deg, double a_deg, double aim_z) {
-  const double e = degToRad(e_deg), a = degToRad(a_deg);
-  const Eigen::Vector3d aim(0.0, 0.0, aim_z);
-  CalibratedSkeleton c;
-  c.p_world_camera = aim + d * Eigen::Vector3d(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
-  const Eigen::Vector3d zc = (aim - c.p_world_camera).normalized();
-  const Eigen::Vector3d xc = zc.cross(Eigen::Vector3d::UnitZ()).normalized();
-  const Eigen::Vector3d yc = zc.cross(xc);
-  c.R_world_camera << xc, yc, zc;
-  return c;
+  return gf::gesture::cameraAround(d, e_deg, a_deg, aim_z);
 }
 
 /// Projects a body exactly (no noise) into a camera: confidence 1 where it lands in the image.
