@@ -78,6 +78,10 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
                         << (vcfg.gate_envelope ? "on" : "off") << " [" << vcfg.distance_min_m << ", "
                         << vcfg.distance_max_m << "] m, [" << vcfg.elevation_min_deg << ", " << vcfg.elevation_max_deg
                         << "] deg\n");
+    if (vcfg.confirm_3d) {
+      NODELET_WARN("GestureCommander: view_fusion.confirm_3d has no effect over ROS yet: the views' observations "
+                   "carry no skeletons (docs/gestures.md 6)");
+    }
     filter_.emplace(fcfg);
     fusion_.emplace(vcfg, views_, fcfg.max_gesture_id);
     sequence_ = static_cast<std::uint64_t>(ros::WallTime::now().toNSec() / 1000);

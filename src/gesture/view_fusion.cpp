@@ -36,6 +36,15 @@ std::vector<std::string> ViewFusionConfig::validate() const {
   if (!(vote_min_fraction > 0.0 && vote_min_fraction <= 1.0)) {
     e.push_back("view_fusion.vote_min_fraction must be in (0, 1], got " + num(vote_min_fraction));
   }
+  if (!(confirm_3d_min_fraction > 0.0 && confirm_3d_min_fraction <= 1.0)) {
+    e.push_back("view_fusion.confirm_3d_min_fraction must be in (0, 1], got " + num(confirm_3d_min_fraction));
+  }
+  if (confirm_3d_min_frames < 1 || confirm_3d_min_frames > 1000) {
+    e.push_back("view_fusion.confirm_3d_min_frames must be in [1, 1000], got " + std::to_string(confirm_3d_min_frames));
+  }
+  if (!(std::isfinite(confirm_3d_max_dt_s) && confirm_3d_max_dt_s > 0.0 && confirm_3d_max_dt_s <= 1.0)) {
+    e.push_back("view_fusion.confirm_3d_max_dt_s must be in (0, 1], got " + num(confirm_3d_max_dt_s));
+  }
   return e;
 }
 
@@ -51,6 +60,10 @@ ViewFusionConfig readViewFusionConfig(ConfigReader& r) {
   r.readDouble(k + "elevation_max_deg", c.elevation_max_deg, Range::closed(-90.0, 90.0));
   r.readDouble(k + "vote_window_s", c.vote_window_s, Range::closed(0.0, 60.0));
   r.readDouble(k + "vote_min_fraction", c.vote_min_fraction, Range::closed(1e-9, 1.0));
+  r.readBool(k + "confirm_3d", c.confirm_3d);
+  r.readDouble(k + "confirm_3d_min_fraction", c.confirm_3d_min_fraction, Range::closed(1e-9, 1.0));
+  r.readInt(k + "confirm_3d_min_frames", c.confirm_3d_min_frames, Range::closed(1, 1000));
+  r.readDouble(k + "confirm_3d_max_dt_s", c.confirm_3d_max_dt_s, Range::closed(1e-9, 1.0));
   if (c.distance_max_m <= c.distance_min_m) {
     r.addError(k + "distance_max_m", "value " + common::formatDouble(c.distance_max_m) + " must exceed distance_min_m " +
                                          common::formatDouble(c.distance_min_m));
@@ -145,8 +158,54 @@ FusedGesture ViewFusion::fuse(double t_now) const {
     }
   }
   out.agreeing_views = best_votes;
-  if (best_votes >= config_.min_agreeing_views && unique) out.gesture_id = best;
+  if (best_votes >= config_.min_agreeing_views && unique) {
+    out.gesture_id = best;
+  } else if (config_.confirm_3d && unique && best_votes + 1 == config_.min_agreeing_views &&
+             (best == kExtendArmSide || best == kRaiseArmUp) && confirmedIn3D(best, t_now)) {
+    out.gesture_id = best;
+    out.confirmed_3d = true;
+  }
   return out;
+}
+
+bool ViewFusion::confirmedIn3D(int g, double t_now) const {
+  // One 3-D frame per observation of the most observed view inside the window and the envelope:
+  // with it, every other view's observation nearest in time (≤ confirm_3d_max_dt_s) that carries a
+  // calibrated skeleton; triangulated when at least two views take part.
+  const auto usable = [&](const ViewObservation& o) {
+    return o.calibrated && o.t_s > t_now - config_.vote_window_s && o.t_s <= t_now + config_.max_age_s &&
+           inEnvelope(o.distance_m, o.elevation_deg);
+  };
+  std::size_t ref = 0, ref_count = 0;
+  for (std::size_t i = 0; i < history_.size(); ++i) {
+    const auto c = static_cast<std::size_t>(std::count_if(history_[i].begin(), history_[i].end(), usable));
+    if (c > ref_count) {
+      ref = i;
+      ref_count = c;
+    }
+  }
+  if (ref_count == 0) return false;
+  int frames = 0, hits = 0;
+  std::vector<CalibratedSkeleton> views;
+  for (const ViewObservation& o : history_[ref]) {
+    if (!usable(o)) continue;
+    views.assign(1, *o.calibrated);
+    for (std::size_t i = 0; i < history_.size(); ++i) {
+      if (i == ref) continue;
+      const ViewObservation* nearest = nullptr;
+      for (const ViewObservation& p : history_[i]) {
+        if (!usable(p) || std::abs(p.t_s - o.t_s) > config_.confirm_3d_max_dt_s) continue;
+        if (nearest == nullptr || std::abs(p.t_s - o.t_s) < std::abs(nearest->t_s - o.t_s)) nearest = &p;
+      }
+      if (nearest != nullptr) views.push_back(*nearest->calibrated);
+    }
+    if (views.size() < 2) continue;
+    const Skeleton3D s = triangulate(views, TriangulationConfig{});
+    if (!bodyFrameOf(s)) continue;
+    ++frames;
+    if (oneArmGesture3D(s) == g) ++hits;
+  }
+  return frames >= config_.confirm_3d_min_frames && hits >= config_.confirm_3d_min_fraction * frames;
 }
 
 }  // namespace gesture_formation::gesture

@@ -19,6 +19,20 @@ double angleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 
 }  // namespace
 
+CalibratedSkeleton cameraAround(double distance_m, double elevation_deg, double azimuth_deg, double aim_height_m,
+                                const estimation::CameraIntrinsics& intrinsics) {
+  const double e = common::degToRad(elevation_deg), a = common::degToRad(azimuth_deg);
+  const Eigen::Vector3d aim(0.0, 0.0, aim_height_m);
+  CalibratedSkeleton c;
+  c.intrinsics = intrinsics;
+  c.p_world_camera = aim + distance_m * Eigen::Vector3d(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
+  const Eigen::Vector3d zc = (aim - c.p_world_camera).normalized();
+  const Eigen::Vector3d xc = zc.cross(Eigen::Vector3d::UnitZ()).normalized();
+  const Eigen::Vector3d yc = zc.cross(xc);
+  c.R_world_camera << xc, yc, zc;
+  return c;
+}
+
 std::vector<std::string> TriangulationConfig::validate() const {
   std::vector<std::string> e;
   if (!(min_confidence >= 0.0 && min_confidence < 1.0)) {

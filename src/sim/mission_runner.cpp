@@ -6,6 +6,8 @@
 #include <optional>
 #include <sstream>
 
+#include <Eigen/Geometry>
+
 #include "gesture_formation/common/angles.hpp"
 #include "gesture_formation/estimation/human_kalman.hpp"
 #include "gesture_formation/estimation/measurement_model.hpp"
@@ -418,7 +420,7 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
       bool classified = false;
       const std::optional<Eigen::Vector3d> worker_est =
           kf.initialized() ? std::optional<Eigen::Vector3d>(kf.predicted(t).p_world) : std::nullopt;
-      const auto observation = [&](int view, const gesture::Classification& c) {
+      const auto observation = [&](int view, const gesture::Classification& c, const gesture::CalibratedSkeleton& cal) {
         gesture::ViewObservation o;
         o.view = view;
         o.t_s = t;
@@ -430,14 +432,27 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
           o.distance_m = rel.norm();
           o.elevation_deg = common::radToDeg(std::asin(std::clamp(rel.z() / std::max(1e-9, rel.norm()), -1.0, 1.0)));
         }
+        if (cfg.view_fusion.confirm_3d) {
+          // The camera pose as the UAV knows it: the rendering pose moved by its odometry's
+          // position and heading errors.
+          const UavRuntime& u = *uavs[static_cast<std::size_t>(view)];
+          const MultirotorState truth = u.plant.state();
+          gesture::CalibratedSkeleton known = cal;
+          known.p_world_camera += u.est.p_world - truth.p_world;
+          known.R_world_camera =
+              Eigen::AngleAxisd(common::wrapAngle(u.est.heading_rad - truth.heading_rad), Eigen::Vector3d::UnitZ()) *
+              cal.R_world_camera;
+          o.calibrated = known;
+        }
         return o;
       };
-      if (cf.classification) classified = fusion.observe(observation(0, *cf.classification));
+      if (cf.classification) classified = fusion.observe(observation(0, *cf.classification, cf.calibrated));
       // The followers' votes travel the link; those that arrived by now are counted (older ones
       // age out of the vote: view_fusion.max_age_s).
       for (std::size_t i = 0; i < cf.followers.size(); ++i) {
         if (cf.followers[i].classification) {
-          vote_links[i + 1]->send(t, observation(static_cast<int>(i) + 1, *cf.followers[i].classification));
+          vote_links[i + 1]->send(t, observation(static_cast<int>(i) + 1, *cf.followers[i].classification,
+                                                 cf.followers[i].calibrated));
         }
       }
       for (int i = 1; follower_views && i < n; ++i) {

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <iterator>
 
+#include <Eigen/Geometry>
+
 #include "gesture_formation/common/angles.hpp"
 #include "gesture_formation/sim/random.hpp"
 #include "validate_util.hpp"
@@ -255,6 +257,19 @@ std::vector<gesture::SynthFrame> WorkerModel::skeletonsAt(double t_s, const std:
   for (const auto& v : other_views_) out.push_back(v.frames[std::min(k, v.frames.size() - 1)]);
   for (auto& f : out) f.t_s = t_s;
   return out;
+}
+
+gesture::CalibratedSkeleton WorkerModel::calibrated(std::size_t view, const gesture::Skeleton2D& skeleton,
+                                                    const WorkerState& ws) const {
+  const gesture::SynthSequence& seq = view == 0 ? current_ : other_views_.at(view - 1);
+  // The generator's camera in the body frame (the synthesizer aims at 0.55 of the height), then the world.
+  gesture::CalibratedSkeleton c = gesture::cameraAround(seq.distance_m, seq.elevation_deg, seq.azimuth_deg,
+                                                        0.55 * seq.height_m, config_.synth.camera);
+  const Eigen::Matrix3d R_world_body = Eigen::AngleAxisd(ws.heading_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  c.skeleton = skeleton;
+  c.R_world_camera = R_world_body * c.R_world_camera;
+  c.p_world_camera = ws.feet_world + R_world_body * c.p_world_camera;
+  return c;
 }
 
 int WorkerModel::performingAt(double t_s) const {

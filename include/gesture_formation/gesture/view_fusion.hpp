@@ -31,10 +31,12 @@
 
 #include <cstddef>
 #include <deque>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "gesture_formation/common/config_reader.hpp"
+#include "gesture_formation/gesture/view_triangulation.hpp"
 
 namespace gesture_formation::gesture {
 
@@ -49,13 +51,22 @@ struct ViewFusionConfig {
   double elevation_max_deg = 45.0;
   double vote_window_s = 1.0;     ///< ≥ 0 [s]: a view votes its dominant gesture of this window (0: its newest)
   double vote_min_fraction = 0.5; ///< (0, 1]: the dominant gesture's share of the window's classifications
+  /// 3-D confirmation (docs/gestures.md §6): a one-arm gesture (extend 2, raise 4) one vote short of
+  /// min_agreeing_views counts when the views' triangulated skeletons of the vote window show it
+  /// (gesture/view_triangulation.hpp) in at least confirm_3d_min_fraction of at least
+  /// confirm_3d_min_frames frames. Needs observations that carry calibrated skeletons.
+  bool confirm_3d = false;
+  double confirm_3d_min_fraction = 0.5;  ///< (0, 1]
+  int confirm_3d_min_frames = 5;         ///< ≥ 1
+  double confirm_3d_max_dt_s = 0.034;    ///< views' frames at most this apart form one 3-D frame [s], > 0
 
   /// \brief Every problem, each naming the key; empty when valid.
   std::vector<std::string> validate() const;
 };
 
 /// \brief Reads `view_fusion.{min_agreeing_views, max_age_s, gate_envelope, distance_min_m,
-/// distance_max_m, elevation_min_deg, elevation_max_deg, vote_window_s, vote_min_fraction}` (missing keys: the defaults above
+/// distance_max_m, elevation_min_deg, elevation_max_deg, vote_window_s, vote_min_fraction, confirm_3d,
+/// confirm_3d_min_fraction, confirm_3d_min_frames, confirm_3d_max_dt_s}` (missing keys: the defaults above
 /// unless the reader requires every key).
 ViewFusionConfig readViewFusionConfig(common::ConfigReader& reader);
 
@@ -66,6 +77,8 @@ struct ViewObservation {
   int gesture_id = 0;           ///< the classifier's argmax, 0..max_gesture_id
   double distance_m = -1.0;     ///< camera → worker [m]; < 0 or NaN: unknown
   double elevation_deg = 0.0;   ///< camera above the worker [deg] (NaN: unknown)
+  /// The frame's skeleton with the camera's pose (for confirm_3d; empty: the view takes no part).
+  std::optional<CalibratedSkeleton> calibrated;
 };
 
 /// \brief The fused verdict of one frame.
@@ -73,6 +86,7 @@ struct FusedGesture {
   int gesture_id = 0;      ///< what goes to the GestureFilter
   int voting_views = 0;    ///< fresh views inside the envelope
   int agreeing_views = 0;  ///< votes for gesture_id (for 0: votes of the best gesture, which fell short)
+  bool confirmed_3d = false;  ///< gesture_id passed with the 3-D confirmation as its last vote
 };
 
 /// \brief Keeps the newest observation per view and fuses them.
@@ -101,6 +115,8 @@ class ViewFusion {
   std::vector<std::deque<ViewObservation>> history_;
   /// The vote of view i at t_now (0: none), its newest observation being fresh and inside the envelope.
   int viewVote(std::size_t i, double t_now) const;
+  /// Whether the triangulated frames of the vote window show one-arm gesture g (confirm_3d).
+  bool confirmedIn3D(int g, double t_now) const;
 };
 
 }  // namespace gesture_formation::gesture

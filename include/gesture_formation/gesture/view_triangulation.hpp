@@ -35,6 +35,13 @@ struct CalibratedSkeleton {
   estimation::CameraIntrinsics intrinsics;
 };
 
+/// \brief A camera distance_m from the point (0, 0, aim_height_m) of a body frame (x forward, y left,
+/// z up, feet at 0), elevation_deg above the horizontal and azimuth_deg around z from x, looking at
+/// that point with its image rows horizontal — the viewpoints of gesture/skeleton_synth.hpp without
+/// their aim jitter (±3 % of the height). The pose is in the body frame; the skeleton is empty.
+CalibratedSkeleton cameraAround(double distance_m, double elevation_deg, double azimuth_deg, double aim_height_m,
+                                const estimation::CameraIntrinsics& intrinsics = {});
+
 /// \brief Parameters of the triangulation.
 struct TriangulationConfig {
   double min_confidence = 0.3;      ///< a keypoint below this confidence is not used, in [0, 1)

@@ -20,6 +20,7 @@
 #include <Eigen/Core>
 
 #include "gesture_formation/gesture/skeleton_synth.hpp"
+#include "gesture_formation/gesture/view_triangulation.hpp"
 
 namespace gesture_formation::sim {
 
@@ -98,6 +99,14 @@ class WorkerModel {
   /// starts. Element 0 is exactly what skeletonAt(t_s, cameras[0]) would return. Pass the
   /// same number of cameras at every call (≥ 1).
   std::vector<gesture::SynthFrame> skeletonsAt(double t_s, const std::vector<Eigen::Vector3d>& cameras);
+
+  /// \brief View `view`'s skeleton `skeleton` (of the current motion, as skeletonsAt returned it)
+  /// with the pose of the camera that rendered it, in the world at the worker's true state `ws`:
+  /// the motion's viewpoint (distance, elevation, azimuth around the body, fixed when the motion
+  /// started) carried along with the worker, aimed at the body's centre (the generator's aim
+  /// jitter, ±3 % of the height, is left out: a pose error of ~0.3°). Requires a motion started
+  /// with more than `view` cameras.
+  gesture::CalibratedSkeleton calibrated(std::size_t view, const gesture::Skeleton2D& skeleton, const WorkerState& ws) const;
 
   /// \brief Gestures started so far, in order.
   const std::vector<GestureEpisode>& episodes() const { return episodes_; }

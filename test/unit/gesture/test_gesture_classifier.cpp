@@ -18,6 +18,7 @@
 #include "gesture_formation/gesture/gesture_classifier.hpp"
 #include "gesture_formation/gesture/gesture_filter.hpp"
 #include "gesture_formation/gesture/view_fusion.hpp"
+#include "gesture_formation/gesture/view_triangulation.hpp"
 #include "gesture_formation/gesture/skeleton_synth.hpp"
 #include "gesture_formation/perception/perception_pipeline.hpp"
 
@@ -232,10 +233,13 @@ TEST(GestureEndToEndTest, DISABLED_WorkMotionsFireNothing) {
 /// Classifier per view + ViewFusion (config/gestures.yaml: 2 agreeing views, envelope) +
 /// filter (paper parameters) over one performance seen by several cameras at once; returns
 /// the fired gesture ids with their times.
-std::vector<std::pair<double, int>> firedCommandsFused(GestureClassifier& classifier, const std::vector<SynthSequence>& views) {
+/// With fusion_config.confirm_3d each observation carries its skeleton and the rendering camera's
+/// pose (gesture::cameraAround, the body frame as the world; no aim jitter).
+std::vector<std::pair<double, int>> firedCommandsFused(GestureClassifier& classifier, const std::vector<SynthSequence>& views,
+                                                      const ViewFusionConfig& fusion_config = {}) {
   auto filter = GestureFilter::create(GestureFilterConfig{});
   EXPECT_TRUE(filter) << filter.reason();
-  ViewFusion fusion(ViewFusionConfig{}, static_cast<int>(views.size()), 4);
+  ViewFusion fusion(fusion_config, static_cast<int>(views.size()), 4);
   std::vector<SkeletonWindow> windows(views.size());
   std::vector<std::pair<double, int>> fired;
   const std::size_t frames = views.front().frames.size();
@@ -254,6 +258,11 @@ std::vector<std::pair<double, int>> firedCommandsFused(GestureClassifier& classi
       o.gesture_id = c->gesture_id;
       o.distance_m = views[v].distance_m;
       o.elevation_deg = views[v].elevation_deg;
+      if (fusion_config.confirm_3d) {
+        o.calibrated = gesture_formation::gesture::cameraAround(views[v].distance_m, views[v].elevation_deg,
+                                                                views[v].azimuth_deg, 0.55 * views[v].height_m);
+        o.calibrated->skeleton = f.skeleton;
+      }
       EXPECT_TRUE(fusion.observe(o));
     }
     if (!windows[0].full()) continue;
@@ -264,32 +273,52 @@ std::vector<std::pair<double, int>> firedCommandsFused(GestureClassifier& classi
   return fired;
 }
 
-// The formation's three cameras (leader, followers at ±60°, Table II) watching the same work
-// motions: the multi-view vote removes the single-view ambiguity above.
+/// One performance of `m` seen by the formation's three cameras (leader at a random azimuth and
+/// elevation, followers ±60° at the same elevation, Table II), drawn from `rng` in that order.
+struct ThreeViews {
+  std::vector<SynthSequence> views;
+  std::string where;
+};
+ThreeViews threeCameras(SkeletonSynthesizer& synth, Motion m, std::mt19937_64& rng, double d_min, double d_max,
+                        double e_min, double e_max) {
+  std::uniform_real_distribution<double> dist(d_min, d_max), elev(e_min, e_max), azim(-180.0, 180.0);
+  const double e = elev(rng), a = azim(rng);
+  const double d0 = dist(rng), d1 = dist(rng), d2 = dist(rng);
+  std::vector<SkeletonSynthesizer::View> cams{{d0, e, a}, {d1, e, a + 60.0}, {d2, e, a - 60.0}};
+  ThreeViews out{synth.generateViewsFrom(m, cams), "elevation " + std::to_string(e) + ", leader azimuth " + std::to_string(a)};
+  EXPECT_EQ(out.views.size(), 3u);
+  return out;
+}
+
+ViewFusionConfig withConfirm3D() {
+  ViewFusionConfig c;
+  c.confirm_3d = true;
+  return c;
+}
+
+// The formation's three cameras watching the same work motions: the multi-view vote removes the
+// single-view ambiguity above — with the 3-D confirmation of a one-vote-short gesture too.
 TEST(GestureEndToEndTest, WorkMotionsSeenByTheFormationsThreeCamerasFireNothing) {
   GestureClassifier classifier = loadModel();
-  std::uniform_real_distribution<double> dist(5.0, 20.0), elev(0.0, 45.0), azim(-180.0, 180.0);
-  expectWorkMotionsFireNothing([&](SkeletonSynthesizer& synth, Motion m, std::mt19937_64& rng) {
-    const double e = elev(rng), a = azim(rng);
-    const double d0 = dist(rng), d1 = dist(rng), d2 = dist(rng);
-    std::vector<SkeletonSynthesizer::View> cams{{d0, e, a}, {d1, e, a + 60.0}, {d2, e, a - 60.0}};
-    const auto views = synth.generateViewsFrom(m, cams);
-    EXPECT_EQ(views.size(), 3u);
-    return std::make_pair(firedCommandsFused(classifier, views),
-                          "elevation " + std::to_string(e) + ", leader azimuth " + std::to_string(a));
-  });
+  for (const ViewFusionConfig& fusion : {ViewFusionConfig{}, withConfirm3D()}) {
+    expectWorkMotionsFireNothing([&](SkeletonSynthesizer& synth, Motion m, std::mt19937_64& rng) {
+      const ThreeViews p = threeCameras(synth, m, rng, 5.0, 20.0, 0.0, 45.0);
+      return std::make_pair(firedCommandsFused(classifier, p.views, fusion),
+                            p.where + (fusion.confirm_3d ? ", confirm_3d" : ""));
+    });
+  }
 }
 
 TEST(GestureEndToEndTest, GestureHeldThreeSecondsSeenByThreeCamerasFiresOnce) {
   GestureClassifier classifier = loadModel();
-  std::uniform_real_distribution<double> dist(6.0, 18.0), elev(5.0, 40.0), azim(-180.0, 180.0);
-  expectThreeSecondGesturesFireOnce([&](SkeletonSynthesizer& synth, Motion m, std::mt19937_64& rng) {
-    const double e = elev(rng), a = azim(rng);
-    const double d0 = dist(rng), d1 = dist(rng), d2 = dist(rng);
-    std::vector<SkeletonSynthesizer::View> cams{{d0, e, a}, {d1, e, a + 60.0}, {d2, e, a - 60.0}};
-    const auto views = synth.generateViewsFrom(m, cams);
-    return Performance{firedCommandsFused(classifier, views), views[0].motion_start_s, views[0].motion_end_s};
-  });
+  for (const ViewFusionConfig& fusion : {ViewFusionConfig{}, withConfirm3D()}) {
+    SCOPED_TRACE(fusion.confirm_3d ? "confirm_3d" : "2-of-3 vote");
+    expectThreeSecondGesturesFireOnce([&](SkeletonSynthesizer& synth, Motion m, std::mt19937_64& rng) {
+      const ThreeViews p = threeCameras(synth, m, rng, 6.0, 18.0, 5.0, 40.0);
+      return Performance{firedCommandsFused(classifier, p.views, fusion), p.views[0].motion_start_s,
+                         p.views[0].motion_end_s};
+    });
+  }
 }
 
 TEST(SkeletonSynthTest, FurtherViewsLeaveThePrimaryViewAsTheSingleViewOutput) {

@@ -8,7 +8,9 @@
 #include <Eigen/Geometry>
 
 #include "gesture_formation/common/angles.hpp"
+#include "gesture_formation/common/config_reader.hpp"
 #include "gesture_formation/gesture/skeleton_synth.hpp"
+#include "gesture_formation/gesture/view_fusion.hpp"
 #include "gesture_formation/gesture/view_triangulation.hpp"
 
 namespace gf = gesture_formation;
@@ -23,19 +25,10 @@ using gf::gesture::TriangulationConfig;
 
 namespace {
 
-/// A camera at distance d, elevation e, azimuth a [deg] around a body whose frame is the world
-/// (x forward, y left, z up, feet at 0), looking at (0, 0, aim_z): the generator's geometry
-/// without its aim jitter (which the tests then meet as a pose error of ~0.2–0.4°).
+/// The generator's viewpoint without its aim jitter (which the tests then meet as a pose error of
+/// ~0.2–0.4°), the body frame being the world.
 CalibratedSkeleton cameraAt(double d, double e_deg, double a_deg, double aim_z) {
-  const double e = degToRad(e_deg), a = degToRad(a_deg);
-  const Eigen::Vector3d aim(0.0, 0.0, aim_z);
-  CalibratedSkeleton c;
-  c.p_world_camera = aim + d * Eigen::Vector3d(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
-  const Eigen::Vector3d zc = (aim - c.p_world_camera).normalized();
-  const Eigen::Vector3d xc = zc.cross(Eigen::Vector3d::UnitZ()).normalized();
-  const Eigen::Vector3d yc = zc.cross(xc);
-  c.R_world_camera << xc, yc, zc;
-  return c;
+  return gf::gesture::cameraAround(d, e_deg, a_deg, aim_z);
 }
 
 /// Projects a body exactly (no noise) into a camera: confidence 1 where it lands in the image.
@@ -200,5 +193,101 @@ TEST(ViewTriangulationTest, ThreeNoisyViewsTellExtendAndRaiseFromTheirNearMisses
     const auto seed = static_cast<std::uint64_t>(m);
     EXPECT_LE(share3D(m, gf::gesture::kExtendArmSide, n, 20 + seed).rate(), 0.05) << gf::gesture::toString(m);
     EXPECT_LE(share3D(m, gf::gesture::kRaiseArmUp, n, 40 + seed).rate(), 0.06) << gf::gesture::toString(m);
+  }
+}
+
+// ---------------------------------------------------------------------------------------
+// ViewFusion with confirm_3d (docs/gestures.md §6): one view reads a one-arm gesture, the other
+// does not; the triangulated skeletons of the vote window decide whether it counts.
+namespace {
+
+/// 1.2 s of observations at 15 Hz from two cameras (leader at 0°, follower at +60°) of one body;
+/// view 0 reads `id0`, view 1 `id1`. Returns the fused verdict at the end.
+gf::gesture::FusedGesture fuseTwoViews(const gf::gesture::Body3D& body, int id0, int id1, bool confirm_3d,
+                                       bool with_skeletons = true, int frames = 18) {
+  gf::gesture::ViewFusionConfig config;
+  config.confirm_3d = confirm_3d;
+  gf::gesture::ViewFusion fusion(config, 3, 4);
+  std::vector<CalibratedSkeleton> cams{cameraAt(10.0, 20.0, 0.0, 1.0), cameraAt(9.0, 25.0, 60.0, 1.0)};
+  for (auto& c : cams) projectInto(body, c);
+  double t = 0.0;
+  for (int k = 0; k < frames; ++k) {
+    t = 10.0 + k / 15.0;
+    for (int v = 0; v < 2; ++v) {
+      gf::gesture::ViewObservation o;
+      o.view = v;
+      o.t_s = t;
+      o.gesture_id = v == 0 ? id0 : id1;
+      o.distance_m = 10.0;
+      o.elevation_deg = 20.0;
+      if (with_skeletons) o.calibrated = cams[static_cast<std::size_t>(v)];
+      EXPECT_TRUE(fusion.observe(o));
+    }
+  }
+  return fusion.fuse(t);
+}
+
+}  // namespace
+
+TEST(ViewFusion3DTest, AGestureOneViewMissesCountsWhenTheArmIsThereIn3D) {
+  SkeletonSynthesizer synth(SynthConfig{}, 5);
+  const auto extend = synth.pose(Motion::kExtendArmSide, 1.0, 0.0, false);
+  EXPECT_EQ(fuseTwoViews(extend, 2, 0, false).gesture_id, 0);  // the 2-of-3 vote alone: one vote short
+  const auto f = fuseTwoViews(extend, 2, 0, true);
+  EXPECT_EQ(f.gesture_id, 2);
+  EXPECT_TRUE(f.confirmed_3d);
+  EXPECT_EQ(f.agreeing_views, 1);
+  const auto raise = synth.pose(Motion::kRaiseArmUp, 1.0, 0.0, true);
+  EXPECT_EQ(fuseTwoViews(raise, 0, 4, true).gesture_id, 4);
+  // Two agreeing views need no confirmation (and get none).
+  const auto two = fuseTwoViews(extend, 2, 2, true);
+  EXPECT_EQ(two.gesture_id, 2);
+  EXPECT_FALSE(two.confirmed_3d);
+}
+
+TEST(ViewFusion3DTest, APostureThatIsNotTheGestureIn3DDoesNotCount) {
+  SkeletonSynthesizer synth(SynthConfig{}, 6);
+  // The arm pointing forward-outward (the near-miss one view reads as "extend"), and a raised arm
+  // read as "extend" by one view: the 3-D arm contradicts both.
+  const auto pointing = synth.pose(Motion::kArmPartwayOrPointing, 1.0, 0.0, true);
+  EXPECT_EQ(fuseTwoViews(pointing, 2, 0, true).gesture_id, 0);
+  const auto raise = synth.pose(Motion::kRaiseArmUp, 1.0, 0.0, true);
+  EXPECT_EQ(fuseTwoViews(raise, 2, 0, true).gesture_id, 0);
+  // Two-arm gestures are not tested in 3-D: one view's "cross arms" stays one vote short.
+  const auto cross = synth.pose(Motion::kCrossArms, 1.0, 0.0, true);
+  EXPECT_EQ(fuseTwoViews(cross, 1, 0, true).gesture_id, 0);
+  // Without skeletons, or with fewer 3-D frames than confirm_3d_min_frames (5), nothing is confirmed.
+  const auto extend = synth.pose(Motion::kExtendArmSide, 1.0, 0.0, true);
+  EXPECT_EQ(fuseTwoViews(extend, 2, 0, true, false).gesture_id, 0);
+  EXPECT_EQ(fuseTwoViews(extend, 2, 0, true, true, 4).gesture_id, 0);
+  EXPECT_EQ(fuseTwoViews(extend, 2, 0, true, true, 5).gesture_id, 2);
+}
+
+TEST(ViewFusion3DTest, ConfirmKeysAreValidatedAndRead) {
+  gf::gesture::ViewFusionConfig c;
+  c.confirm_3d_min_fraction = 0.0;
+  c.confirm_3d_min_frames = 0;
+  c.confirm_3d_max_dt_s = -1.0;
+  const auto e = c.validate();
+  ASSERT_EQ(e.size(), 3u);
+  EXPECT_NE(e[0].find("view_fusion.confirm_3d_min_fraction"), std::string::npos);
+  EXPECT_NE(e[1].find("view_fusion.confirm_3d_min_frames must be in [1, 1000], got 0"), std::string::npos);
+  EXPECT_NE(e[2].find("view_fusion.confirm_3d_max_dt_s"), std::string::npos);
+  using gf::common::ConfigReader;
+  ConfigReader ok = ConfigReader::fromString("view_fusion: {confirm_3d: true, confirm_3d_min_fraction: 0.7, "
+                                             "confirm_3d_min_frames: 8, confirm_3d_max_dt_s: 0.05}\n",
+                                             "ok.yaml", ConfigReader::MissingKeys::kUseDefaults);
+  const auto read = gf::gesture::readViewFusionConfig(ok);
+  EXPECT_TRUE(ok.ok()) << ok.errorReport();
+  EXPECT_TRUE(read.confirm_3d);
+  EXPECT_DOUBLE_EQ(read.confirm_3d_min_fraction, 0.7);
+  EXPECT_EQ(read.confirm_3d_min_frames, 8);
+  EXPECT_DOUBLE_EQ(read.confirm_3d_max_dt_s, 0.05);
+  ConfigReader bad = ConfigReader::fromString("view_fusion: {confirm_3d: maybe, confirm_3d_min_frames: 0}\n", "bad.yaml",
+                                              ConfigReader::MissingKeys::kUseDefaults);
+  (void)gf::gesture::readViewFusionConfig(bad);
+  EXPECT_FALSE(bad.ok());
+  for (const char* key : {"view_fusion.confirm_3d", "view_fusion.confirm_3d_min_frames"}) {
+    EXPECT_NE(bad.errorReport().find(key), std::string::npos) << key << " missing in:\n" << bad.errorReport();
   }
 }
