@@ -26,6 +26,10 @@
 ///    ≥ min_agreeing_views; otherwise 0 (none). "none" votes never outvote a gesture, so
 ///    a gesture seen by two of three views passes; a posture seen as a gesture by one view
 ///    does not.
+///  - with confirm_3d, a one-arm gesture (extend, raise) exactly one vote short still passes when
+///    the views' skeletons of the vote window, triangulated (gesture/view_triangulation.hpp), show
+///    the arm in that pose in at least confirm_3d_min_fraction of the 3-D frames: the geometry
+///    that no 2-D view can tell apart from a pointing arm (docs/gestures.md §6).
 /// min_agreeing_views = 1 with one view is the paper's single-camera pipeline.
 /// Thread safety: none; one instance per thread.
 
