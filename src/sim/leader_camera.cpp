@@ -160,7 +160,8 @@ LeaderCameraFrame LeaderCamera::frame(double t, const MultirotorState& leader, c
   }
   const std::vector<gesture::SynthFrame> skeletons = worker.skeletonsAt(t, cameras);
   out.skeleton = skeletons.front();
-  out.calibrated = worker.calibrated(0, out.skeleton.skeleton, ws);
+  const bool calibrate = cfg_.view_fusion.confirm_3d;  // the poses serve only the 3-D confirmation
+  if (calibrate) out.calibrated = worker.calibrated(0, out.skeleton.skeleton, ws);
   // A camera's FIFO: a gap breaks its temporal consistency. A full FIFO is classified below,
   // all cameras of the frame together (MissionClassifier::classifyAll).
   std::vector<const gesture::SkeletonWindow*> windows;
@@ -188,7 +189,7 @@ LeaderCameraFrame LeaderCamera::frame(double t, const MultirotorState& leader, c
     FollowerCamera& fc = follower_cams_[i];
     const SensorFrame seen = fc.sensors.observe(follower_poses[i], ws.feet_world, ws.p_world, cfg_.worker.height_m, false);
     v.visible = (i >= online.size() || online[i]) && seen.visible();
-    v.calibrated = worker.calibrated(i + 1, skeletons[i + 1].skeleton, ws);
+    if (calibrate && v.visible) v.calibrated = worker.calibrated(i + 1, skeletons[i + 1].skeleton, ws);
     if (v.visible) push(fc.window, fc.last_visible_s, skeletons[i + 1].skeleton, v.classification);
   }
   if (frame.visible()) push(window_, last_visible_s_, out.skeleton.skeleton, out.classification);

@@ -74,14 +74,14 @@ class StepSchedule {
 struct FollowerView {
   bool visible = false;  ///< the worker is in its field of view, not occluded, detected
   std::optional<gesture::Classification> classification;  ///< as LeaderCameraFrame::classification
-  gesture::CalibratedSkeleton calibrated;  ///< its skeleton with the true pose of the camera that rendered it
+  gesture::CalibratedSkeleton calibrated;  ///< its skeleton with the true pose of the camera that rendered it (visible, view_fusion.confirm_3d only)
 };
 
 /// \brief One frame of the leader's camera.
 struct LeaderCameraFrame {
   SensorFrame sensors;         ///< box (when visible) and ranges after the injected faults
   gesture::SynthFrame skeleton;  ///< what the worker looked like from the camera
-  gesture::CalibratedSkeleton calibrated;  ///< skeleton with the true pose of the camera that rendered it (WorkerModel::calibrated)
+  gesture::CalibratedSkeleton calibrated;  ///< skeleton with the true pose of the camera that rendered it (WorkerModel::calibrated; view_fusion.confirm_3d only)
   int range_outliers = 0;      ///< gross range errors injected into this frame
   /// The classifier's output: the worker was detected, the FIFO is full, a classifier was
   /// given and it succeeded.
