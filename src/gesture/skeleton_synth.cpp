@@ -272,8 +272,10 @@ Body3D SkeletonSynthesizer::pose(Motion motion, double s, double phase, bool lef
     case Motion::kBalanceLunge: {
       // Stepping across a gap or kicking something loose: the leading arm out and up 30–60°
       // above the horizontal (between "extend" and "raise"), the other out, low and back; the
-      // torso leans and the stance is wide (applied after the arms, below).
-      const double up = degToRad(30 + 30 * va), fwd = degToRad(-30 + 60 * vb);
+      // torso leans and the stance is wide (applied after the arms, below). The side kick
+      // (half of them since v8): the leading arm −10…+50° about the horizontal.
+      const bool kick = var_.variant < 0.5;
+      const double up = kick ? degToRad(-10 + 60 * va) : degToRad(30 + 30 * va), fwd = degToRad(-30 + 60 * vb);
       const Vector3d lead_dir(std::cos(up) * std::sin(fwd), std::cos(up) * std::cos(fwd), std::sin(up));
       const Vector3d trail_dir = Vector3d(-0.3, 0.7, -0.6).normalized();
       if (left_arm) {
@@ -306,7 +308,31 @@ Body3D SkeletonSynthesizer::pose(Motion motion, double s, double phase, bool lef
   pole_R = (pole_R.normalized() + w * (ppole_R.normalized() - pole_R.normalized()));
   solveArm(sL, target_L, b.upper_arm, b.forearm, pole_L, p[kLeftElbow], p[kLeftWrist]);
   solveArm(sR, target_R, b.upper_arm, b.forearm, pole_R, p[kRightElbow], p[kRightWrist]);
-  if (motion == Motion::kBalanceLunge) {
+  if (motion == Motion::kBalanceLunge && var_.variant < 0.5) {
+    // Side kick: the leg on the other side than the leading arm swings out sideways 0.20–0.45 H
+    // and up to 0.18 H high, the standing knee bends, the upper body leans 10–40° over the
+    // leading side and 0–20° forward about the hip centre.
+    const double sign = left_arm ? 1.0 : -1.0;  // +y: the leading side
+    const auto idx = [](int k) { return static_cast<std::size_t>(k); };
+    const std::size_t kick_ankle = idx(left_arm ? kRightAnkle : kLeftAnkle), kick_knee = idx(left_arm ? kRightKnee : kLeftKnee);
+    const std::size_t kick_hip = idx(left_arm ? kRightHip : kLeftHip), stand_knee = idx(left_arm ? kLeftKnee : kRightKnee);
+    const double out = s * (0.20 + 0.25 * vb) * H, lift = s * 0.18 * vc * H, drop = s * 0.03 * H;
+    p[kick_ankle] += Vector3d(0, -sign * out, lift);
+    p[kick_knee] = 0.5 * (p[kick_hip] + p[kick_ankle]) + Vector3d(0.02 * H * s, 0, 0);
+    p[stand_knee] += Vector3d(0.05 * H * s, 0, -0.5 * drop);
+    const Vector3d hip_c = 0.5 * (p[kLeftHip] + p[kRightHip]);
+    const Eigen::Matrix3d R = (Eigen::AngleAxisd(-sign * s * degToRad(10 + 30 * vd), Vector3d::UnitX()) *
+                               Eigen::AngleAxisd(s * degToRad(20 * vc), Vector3d::UnitY()))
+                                  .toRotationMatrix();
+    for (const int k : {kNose, kLeftEye, kRightEye, kLeftEar, kRightEar, kLeftShoulder, kRightShoulder, kLeftElbow,
+                        kRightElbow, kLeftWrist, kRightWrist}) {
+      auto& q = p[static_cast<std::size_t>(k)];
+      q = hip_c + R * (q - hip_c) - Vector3d(0, 0, drop);
+    }
+    body.head_top = hip_c + R * (body.head_top - hip_c) - Vector3d(0, 0, drop);
+    p[kLeftHip].z() -= drop;
+    p[kRightHip].z() -= drop;
+  } else if (motion == Motion::kBalanceLunge) {
     // Wide stance: the leading side's foot forward, the other back; hips lowered; the upper
     // body leans forward 15–40° and sideways ±15° about the hip centre.
     const double step = s * (0.22 + 0.12 * va) * H, drop = s * 0.06 * H;
@@ -407,6 +433,11 @@ std::vector<SynthSequence> SkeletonSynthesizer::renderViews(Motion motion, const
   drawShape();
   const Script script = drawScript(motion);
   const int id = next_id_++;
+  {
+    std::seed_seq ss{seed_, static_cast<std::uint64_t>(id), std::uint64_t{0x7a41a7u}};
+    std::mt19937_64 variant_rng(ss);
+    var_.variant = std::uniform_real_distribution<double>(0.0, 1.0)(variant_rng);
+  }
   std::vector<SynthSequence> out;
   out.reserve(views.size());
   out.push_back(project(script, id, views.front(), rng_));

@@ -8,7 +8,7 @@
 /// "none" motion — the near-misses of DESIGN §2 (reaching up to a bolt, arms folded low,
 /// a tool held at the waist, an arm raised part-way or pointing, walking, climbing a
 /// ladder, standing idle; since v3 also an object held or caught in front of the chest and a
-/// balancing lunge with the torso leaning and the arms out). Body frame: x forward, y left, z up, feet at z = 0. The body is
+/// balancing lunge with the torso leaning and the arms out — since v8 half of them a side kick). Body frame: x forward, y left, z up, feet at z = 0. The body is
 /// projected through a `CameraModel` from a viewpoint at distance d, elevation ε above the
 /// horizontal and azimuth ψ around the body (ψ = 0: in front), with keypoint noise,
 /// missing keypoints and box jitter. The simulator uses the same code with the leader's
@@ -126,6 +126,9 @@ class SkeletonSynthesizer {
   };
   struct Variation {  // per-sequence pose variation
     double a = 0.5, b = 0.5, c = 0.5, d = 0.5;
+    /// The motion's variant (the balancing lunge: a side kick when < 0.5), from a stream of
+    /// its own (seed, sequence id): the main stream, and so every other sequence, is unchanged.
+    double variant = 0.5;
   };
   /// The per-sequence draws that do not depend on the camera.
   struct Script {

@@ -182,6 +182,12 @@ Share share3D(Motion m, int id, int count, std::uint64_t seed) {
 // frame); pointing read as extend 0.0005; the balancing lunge, whose leading arm the generator puts
 // between "extend" and "raise" (30–60° above the horizontal), 0.014 / 0.037; every other motion 0.
 // The bounds leave room for other noise draws, not for a 2-D-like confusion.
+// Since the v8 generator (2026-12-03) half of the balancing lunges are side kicks whose leading arm
+// is −10…+50° about the horizontal: up to +27.5° that arm IS extended sideways in 3-D — the same arm
+// pose as the gesture, not a near-miss of it — so the lunge reads as "extend" in 0.19 of its frames
+// (measured; 0.014 before the kicks). Arm geometry alone does not reject it (an upright-stance test
+// would; docs/gestures.md §6); the 3-D rule only completes a vote one camera's LSTM already cast,
+// and the three-camera end-to-end test includes the lunge (test_gesture_classifier.cpp).
 TEST(ViewTriangulationTest, ThreeNoisyViewsTellExtendAndRaiseFromTheirNearMisses) {
   const int n = 40;
   EXPECT_GE(share3D(Motion::kExtendArmSide, gf::gesture::kExtendArmSide, n, 11).rate(), 0.85);
@@ -191,7 +197,8 @@ TEST(ViewTriangulationTest, ThreeNoisyViewsTellExtendAndRaiseFromTheirNearMisses
                    Motion::kWalking, Motion::kHoldObjectAtChest, Motion::kArmsFoldedLow, Motion::kToolAtWaist,
                    Motion::kIdle, Motion::kCrossArms, Motion::kPalmsTogether}) {
     const auto seed = static_cast<std::uint64_t>(m);
-    EXPECT_LE(share3D(m, gf::gesture::kExtendArmSide, n, 20 + seed).rate(), 0.05) << gf::gesture::toString(m);
+    const double extend_max = m == Motion::kBalanceLunge ? 0.25 : 0.05;  // the side kicks, above
+    EXPECT_LE(share3D(m, gf::gesture::kExtendArmSide, n, 20 + seed).rate(), extend_max) << gf::gesture::toString(m);
     EXPECT_LE(share3D(m, gf::gesture::kRaiseArmUp, n, 40 + seed).rate(), 0.06) << gf::gesture::toString(m);
   }
 }
