@@ -15,7 +15,8 @@ from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 from visualization_msgs.msg import MarkerArray
 
-WINDOW = (3.0, 8.0)      # sim seconds over which rates are measured
+WINDOW = [3.0, 8.0]      # sim seconds over which rates are measured (later if subscribing takes longer)
+LATEST_WINDOW_START = 10.0  # the mission's first request comes at 20 s
 # then a gesture is injected (operator commands come next; the mission's own first request is at t = 20 s)
 RATES = {                # topic: (type, expected Hz, tolerance factor)
     "/clock": (Clock, 100.0, 0.2),
@@ -44,8 +45,8 @@ def counter(topic):
 
 def main():
     rospy.init_node("sim_check")
-    for topic, (typ, _, _) in RATES.items():
-        rospy.Subscriber(topic, typ, counter(topic), queue_size=200)
+    rate_subs = {topic: rospy.Subscriber(topic, typ, counter(topic), queue_size=200)
+                 for topic, (typ, _, _) in RATES.items()}
     rospy.Subscriber("/uav1/formation_params", FormationParams, lambda m: state.__setitem__("params1", m))
     history = []  # the leader's estimate as follower 1 received it: (stamp, position, velocity)
     rospy.Subscriber("/uav1/worker_state", WorkerState, lambda m: history.append(
@@ -93,6 +94,23 @@ def main():
         return True
 
     wall0 = time.time()
+    # Count only once every rate subscription is connected: on a loaded machine connecting to a
+    # busy nodelet manager can take seconds, and a window before that measures the connection, not
+    # the rate. The window moves later by as much (its length stays), at most to 10 s.
+    while not rospy.is_shutdown() and time.time() - wall0 < 30:
+        unconnected = [t for t, sub in rate_subs.items() if sub.get_num_connections() == 0]
+        if not unconnected:
+            break
+        time.sleep(0.05)
+    if unconnected:
+        print("FAIL: no publisher connected within 30 s wall: %s" % unconnected)
+        return 1
+    start = max(WINDOW[0], rospy.Time.now().to_sec() + 0.2)
+    if start > LATEST_WINDOW_START:
+        print("FAIL: subscriptions connected only at sim %.1f s (window must start by %.0f s)" % (start, LATEST_WINDOW_START))
+        return 1
+    WINDOW[1] += start - WINDOW[0]
+    WINDOW[0] = start
     if not wait_until(WINDOW[0]):
         return 1
     # 1 of 3 (during the rate window: ~3 s wall, before the mission's first request at 20 s):

@@ -43,12 +43,16 @@ check(any(t >= 13.0 and x.startswith("search: worker not seen") for t, _, x in l
       "rviz label 'search: worker not seen ...' above the leader: %s" % sorted({x for _, _, x in lead}))
 for i in (1, 2):
     check(any(x.startswith("hold: worker estimate older") for _, j, x in rows if j == i), "rviz label 'hold: ...' above follower %d" % i)
-# Not tracking: the start's listening (docs/safety.md §2.4; its own label, before 1.5 s) and the blackout.
+# Not tracking: the start's listening (docs/safety.md §2.4; its own label) and the blackout. A planner
+# listens from its first replanning for at most max_plan_age_s (1 s) — when that first replanning
+# comes depends on the machine's load (nodelets loading, the map), so each UAV's listening is timed
+# from its own first listening label: at most 1 s + one replanning period (0.4 s) + a label tick.
 start = [r for r in rows if r[2].startswith("hold: listening:")]
-check(rows and all(t < 1.5 for t, _, _ in start) and
+listen = {i: (min(t for t, j, _ in start if j == i), max(t for t, j, _ in start if j == i)) for i in {j for _, j, _ in start}}
+check(rows and all(last - first <= 1.5 for first, last in listen.values()) and
       not any((t < 10.5 or t > 16.5) and not x.startswith("hold: listening:") for t, _, x in rows),
-      "labels only while not tracking (listening < 1.5 s: %s; the blackout 10.9-14.5 s: %s)"
-      % ([r[0] for r in start[-1:]], [r[0] for r in rows if not r[2].startswith("hold: listening:")][:1] +
+      "labels only while not tracking (listening per UAV, first - last label: %s, each <= 1.5 s; the blackout 10.9-14.5 s: %s)"
+      % ({i: "%.2f-%.2f" % v for i, v in sorted(listen.items())}, [r[0] for r in rows if not r[2].startswith("hold: listening:")][:1] +
          [r[0] for r in rows if not r[2].startswith("hold: listening:")][-1:]))
 sys.exit(bad)
 PY
