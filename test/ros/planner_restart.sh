@@ -47,7 +47,7 @@ rospy.spin()
 PY
 cat > "$T/inner.sh" <<INNER
 ip link set lo up && ip route add 224.0.0.0/4 dev lo || exit 1
-roslaunch -p $PORT gesture_formation simulation.launch key_file:=$T/keys output_dir:=$T/out duration:=30 \
+roslaunch -p $PORT gesture_formation simulation.launch key_file:=$T/keys output_dir:=$T/out duration:=36 \
   real_time_factor:=1.5 > "$T/launch.log" 2>&1 &
 launch=\$!
 for _ in \$(seq 50); do rosparam get /use_sim_time > /dev/null 2>&1 && break; sleep 0.2; done
@@ -74,13 +74,20 @@ def check(ok, what):
 m = json.load(open(out + "/metrics.json"))
 rows = [(float(r["t"]), r["mode"], r["reason"]) for r in csv.DictReader(open(out + "/modes.csv")) if r["uav"] == "2"]
 again = [r for r in rows if r[0] >= 16.0]
-# Loading takes a few seconds (the map's distance field: ~2.7 s of sim time here).
-check(len(again) >= 2 and again[0][1] == "hold" and again[0][2].startswith("listening:") and again[0][0] < 21.0,
+# Loading takes a few seconds (the map's distance field: ~2.3-2.7 s of sim time here, alone or beside
+# two unit-test binaries; up to 10 s allowed for a machine busier than that).
+check(len(again) >= 2 and again[0][1] == "hold" and again[0][2].startswith("listening:") and again[0][0] < 26.0,
       "follower 2 listens at its first plan after the restart: %s" % again[:1])
 check(len(again) >= 2 and again[1][1] == "track" and again[1][0] - again[0][0] <= 0.85,
       "then tracks within 2 replanning periods: %s" % again[1:2])
-check(not [r for r in rows if 1.5 < r[0] < 16.0 and r[1] != "track"], "no other mode change before the restart: %s" % rows)
-check(m["sim_time_s"] > 29.0, "the mission ran to its end (%.1f s)" % m["sim_time_s"])
+# Before the restart: the start's listening (its first plan comes later on a loaded machine), then
+# tracking until 16 s — nothing else.
+first_track = next((t for t, mode, _ in rows if mode == "track"), None)
+check(first_track is not None and first_track < 16.0 and
+      all(mode == "hold" and reason.startswith("listening:") for t, mode, reason in rows if t < first_track) and
+      not [r for r in rows if first_track < r[0] < 16.0 and r[1] != "track"],
+      "no other mode change before the restart (the start's listening, then tracking): %s" % rows)
+check(m["sim_time_s"] > 35.0, "the mission ran to its end (%.1f s)" % m["sim_time_s"])
 check(m["min_mutual_distance_m"] >= 2.5, "min mutual distance %.2f m >= 2.5" % m["min_mutual_distance_m"])
 check(m["collisions"] == 0, "collisions %d" % m["collisions"])
 sys.exit(bad)
