@@ -2,7 +2,7 @@
 /// \file
 /// \brief The worker's skeleton in 3-D from the formation's calibrated 2-D views, and the arm
 /// geometry of DESIGN §2's one-arm gestures measured in it (docs/gestures.md §6, "3-D fusion":
-/// the step after the 2-of-3 vote; not yet wired into the vote).
+/// the step after the 2-of-3 vote: gesture::ViewFusion with view_fusion.confirm_3d).
 ///
 /// One camera cannot tell an arm extended to the side from an arm pointing forward-outward seen
 /// from ~30° beside it: both project alike. Two cameras whose poses are known (the UAVs'
