@@ -308,55 +308,51 @@ Body3D SkeletonSynthesizer::pose(Motion motion, double s, double phase, bool lef
   pole_R = (pole_R.normalized() + w * (ppole_R.normalized() - pole_R.normalized()));
   solveArm(sL, target_L, b.upper_arm, b.forearm, pole_L, p[kLeftElbow], p[kLeftWrist]);
   solveArm(sR, target_R, b.upper_arm, b.forearm, pole_R, p[kRightElbow], p[kRightWrist]);
+  const auto idx = [](int k) { return static_cast<std::size_t>(k); };
+  // The balancing lunge's upper body (head, shoulders, arms) rotated by R about the hip centre and
+  // lowered by drop with the hips.
+  const auto leanUpperBody = [&](const Eigen::Matrix3d& R, double drop) {
+    const Vector3d hip_c = 0.5 * (p[kLeftHip] + p[kRightHip]);
+    for (const int k : {kNose, kLeftEye, kRightEye, kLeftEar, kRightEar, kLeftShoulder, kRightShoulder, kLeftElbow,
+                        kRightElbow, kLeftWrist, kRightWrist}) {
+      auto& q = p[idx(k)];
+      q = hip_c + R * (q - hip_c) - Vector3d(0, 0, drop);
+    }
+    body.head_top = hip_c + R * (body.head_top - hip_c) - Vector3d(0, 0, drop);
+    p[kLeftHip].z() -= drop;
+    p[kRightHip].z() -= drop;
+  };
   if (motion == Motion::kBalanceLunge && var_.variant < 0.5) {
     // Side kick: the leg on the other side than the leading arm swings out sideways 0.20–0.45 H
     // and up to 0.18 H high, the standing knee bends, the upper body leans 10–40° over the
     // leading side and 0–20° forward about the hip centre.
     const double sign = left_arm ? 1.0 : -1.0;  // +y: the leading side
-    const auto idx = [](int k) { return static_cast<std::size_t>(k); };
     const std::size_t kick_ankle = idx(left_arm ? kRightAnkle : kLeftAnkle), kick_knee = idx(left_arm ? kRightKnee : kLeftKnee);
     const std::size_t kick_hip = idx(left_arm ? kRightHip : kLeftHip), stand_knee = idx(left_arm ? kLeftKnee : kRightKnee);
     const double out = s * (0.20 + 0.25 * vb) * H, lift = s * 0.18 * vc * H, drop = s * 0.03 * H;
     p[kick_ankle] += Vector3d(0, -sign * out, lift);
     p[kick_knee] = 0.5 * (p[kick_hip] + p[kick_ankle]) + Vector3d(0.02 * H * s, 0, 0);
     p[stand_knee] += Vector3d(0.05 * H * s, 0, -0.5 * drop);
-    const Vector3d hip_c = 0.5 * (p[kLeftHip] + p[kRightHip]);
     const Eigen::Matrix3d R = (Eigen::AngleAxisd(-sign * s * degToRad(10 + 30 * vd), Vector3d::UnitX()) *
                                Eigen::AngleAxisd(s * degToRad(20 * vc), Vector3d::UnitY()))
                                   .toRotationMatrix();
-    for (const int k : {kNose, kLeftEye, kRightEye, kLeftEar, kRightEar, kLeftShoulder, kRightShoulder, kLeftElbow,
-                        kRightElbow, kLeftWrist, kRightWrist}) {
-      auto& q = p[static_cast<std::size_t>(k)];
-      q = hip_c + R * (q - hip_c) - Vector3d(0, 0, drop);
-    }
-    body.head_top = hip_c + R * (body.head_top - hip_c) - Vector3d(0, 0, drop);
-    p[kLeftHip].z() -= drop;
-    p[kRightHip].z() -= drop;
+    leanUpperBody(R, drop);
   } else if (motion == Motion::kBalanceLunge) {
     // Wide stance: the leading side's foot forward, the other back; hips lowered; the upper
     // body leans forward 15–40° and sideways ±15° about the hip centre.
     const double step = s * (0.22 + 0.12 * va) * H, drop = s * 0.06 * H;
     const double sign = left_arm ? 1.0 : -1.0;
-    const auto idx = [](int k) { return static_cast<std::size_t>(k); };
     const std::size_t front_ankle = idx(left_arm ? kLeftAnkle : kRightAnkle), back_ankle = idx(left_arm ? kRightAnkle : kLeftAnkle);
     const std::size_t front_knee = idx(left_arm ? kLeftKnee : kRightKnee), back_knee = idx(left_arm ? kRightKnee : kLeftKnee);
     p[front_ankle] += Vector3d(step, 0, 0);
     p[front_knee] += Vector3d(0.9 * step, 0, -0.3 * drop);
     p[back_ankle] += Vector3d(-0.8 * step, 0, 0);
     p[back_knee] += Vector3d(-0.4 * step, 0, -0.3 * drop);
-    const Vector3d hip_c = 0.5 * (p[kLeftHip] + p[kRightHip]);
     const Eigen::Matrix3d R =
         (Eigen::AngleAxisd(sign * s * degToRad(-15 + 30 * vd), Vector3d::UnitX()) *
          Eigen::AngleAxisd(s * degToRad(15 + 25 * vc), Vector3d::UnitY()))
             .toRotationMatrix();
-    for (const int k : {kNose, kLeftEye, kRightEye, kLeftEar, kRightEar, kLeftShoulder, kRightShoulder, kLeftElbow,
-                        kRightElbow, kLeftWrist, kRightWrist}) {
-      auto& q = p[static_cast<std::size_t>(k)];
-      q = hip_c + R * (q - hip_c) - Vector3d(0, 0, drop);
-    }
-    body.head_top = hip_c + R * (body.head_top - hip_c) - Vector3d(0, 0, drop);
-    p[kLeftHip].z() -= drop;
-    p[kRightHip].z() -= drop;
+    leanUpperBody(R, drop);
   }
   return body;
 }
