@@ -324,14 +324,108 @@ inline gesture_formation::WorkerState fromWire(const comm::WorkerStateMessage& w
 }
 
 // ---- gesture observations (the multi-view vote) ---------------------------------------------
+/// CameraInfo (plumb_bob or no distortion) → intrinsics; fails naming what is unusable.
+inline common::Result<estimation::CameraIntrinsics> toIntrinsics(const sensor_msgs::CameraInfo& m) {
+  using R = common::Result<estimation::CameraIntrinsics>;
+  estimation::CameraIntrinsics k;
+  k.fx = m.K[0];
+  k.fy = m.K[4];
+  k.cx = m.K[2];
+  k.cy = m.K[5];
+  k.width_px = static_cast<int>(m.width);
+  k.height_px = static_cast<int>(m.height);
+  if (!m.D.empty()) {
+    if (m.distortion_model != "plumb_bob" || m.D.size() != 5) {
+      return R::fail("CameraInfo: distortion model '" + m.distortion_model + "' with " + std::to_string(m.D.size()) +
+                     " coefficients: expected plumb_bob with 5");
+    }
+    for (std::size_t i = 0; i < 5; ++i) k.distortion[i] = m.D[i];
+  }
+  const auto errors = k.validate();
+  if (!errors.empty()) return R::fail("CameraInfo: " + errors.front());
+  return R::ok(k);
+}
+// ---- a skeleton with its camera (view_fusion.confirm_3d; Gesture / GestureObservation) -----
+/// The 17 keypoints as (u, v, confidence) triples.
+inline std::vector<double> toKeypoints(const gesture::Skeleton2D& s) {
+  std::vector<double> out;
+  out.reserve(3 * gesture::kNumKeypoints);
+  for (std::size_t k = 0; k < static_cast<std::size_t>(gesture::kNumKeypoints); ++k) {
+    out.insert(out.end(), {s.x[k], s.y[k], s.c[k]});
+  }
+  return out;
+}
+inline sensor_msgs::CameraInfo toCameraInfo(const estimation::CameraIntrinsics& k) {
+  sensor_msgs::CameraInfo m;
+  m.width = static_cast<std::uint32_t>(k.width_px);
+  m.height = static_cast<std::uint32_t>(k.height_px);
+  m.distortion_model = "plumb_bob";
+  m.D.assign(k.distortion.begin(), k.distortion.end());
+  m.K = {k.fx, 0.0, k.cx, 0.0, k.fy, k.cy, 0.0, 0.0, 1.0};
+  m.R = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
+  m.P = {k.fx, 0.0, k.cx, 0.0, 0.0, k.fy, k.cy, 0.0, 0.0, 0.0, 1.0, 0.0};
+  return m;
+}
+inline geometry_msgs::Pose toPose(const Eigen::Matrix3d& R_world_camera, const Eigen::Vector3d& p_world_camera) {
+  geometry_msgs::Pose m;
+  m.position.x = p_world_camera.x();
+  m.position.y = p_world_camera.y();
+  m.position.z = p_world_camera.z();
+  const Eigen::Quaterniond q(R_world_camera);
+  m.orientation.w = q.w();
+  m.orientation.x = q.x();
+  m.orientation.y = q.y();
+  m.orientation.z = q.z();
+  return m;
+}
+/// Keypoints (17 triples), the image's camera info and the camera's pose in the world → a
+/// calibrated skeleton; fails naming the field (wrong count, a quaternion of norm outside
+/// 1 ± 1e-3, and everything gesture::validate refuses).
+inline common::Result<gesture::CalibratedSkeleton> toCalibrated(const std::vector<double>& keypoints,
+                                                                const sensor_msgs::CameraInfo& camera,
+                                                                const geometry_msgs::Pose& pose) {
+  using R = common::Result<gesture::CalibratedSkeleton>;
+  if (keypoints.size() != 3 * static_cast<std::size_t>(gesture::kNumKeypoints)) {
+    return R::fail("keypoints: " + std::to_string(keypoints.size()) + " values, expected " +
+                   std::to_string(3 * gesture::kNumKeypoints));
+  }
+  gesture::CalibratedSkeleton c;
+  for (std::size_t k = 0; k < static_cast<std::size_t>(gesture::kNumKeypoints); ++k) {
+    c.skeleton.x[k] = keypoints[3 * k];
+    c.skeleton.y[k] = keypoints[3 * k + 1];
+    c.skeleton.c[k] = keypoints[3 * k + 2];
+  }
+  auto intrinsics = toIntrinsics(camera);
+  if (!intrinsics) return R::fail("camera: " + intrinsics.reason());
+  c.intrinsics = *intrinsics;
+  const auto& o = pose.orientation;
+  const Eigen::Quaterniond q(o.w, o.x, o.y, o.z);
+  if (!(std::abs(q.norm() - 1.0) <= 1e-3)) {
+    return R::fail("camera_pose.orientation: norm " + std::to_string(q.norm()) + ", expected 1");
+  }
+  c.R_world_camera = q.normalized().toRotationMatrix();
+  c.p_world_camera = Eigen::Vector3d(pose.position.x, pose.position.y, pose.position.z);
+  const std::vector<std::string> problems = gesture::validate(c);
+  if (!problems.empty()) return R::fail(problems.front());
+  return R::ok(std::move(c));
+}
+
 /// The vote's input; an unknown geometry becomes NaN (the view votes only without the envelope gate).
-inline gesture::ViewObservation toViewObservation(const gesture_formation::GestureObservation& m) {
+/// A skeleton that cannot be used (skeleton_problem set,
+/// when given) leaves the view out of the 3-D confirmation only; its 2-D vote stands.
+inline gesture::ViewObservation toViewObservation(const gesture_formation::GestureObservation& m,
+                                                  std::string* skeleton_problem = nullptr) {
   gesture::ViewObservation o;
   o.view = m.uav_index;
   o.t_s = m.header.stamp.toSec();
   o.gesture_id = m.gesture_id;
   o.distance_m = m.geometry_known ? m.distance_m : std::nan("");
   o.elevation_deg = m.geometry_known ? m.elevation_deg : std::nan("");
+  if (!m.keypoints.empty()) {
+    auto c = toCalibrated(m.keypoints, m.camera, m.camera_pose);
+    if (c) o.calibrated = std::move(*c);
+    else if (skeleton_problem) *skeleton_problem = c.reason();
+  }
   return o;
 }
 /// Fails naming the field on what the payload encoder or a peer's decoder would refuse.
@@ -349,6 +443,11 @@ inline common::Result<comm::GestureObservationMessage> toWire(const gesture_form
   w.geometry_known = m.geometry_known;
   w.distance_m = m.geometry_known ? m.distance_m : 0.0;
   w.elevation_deg = m.geometry_known ? m.elevation_deg : 0.0;
+  if (!m.keypoints.empty()) {
+    auto c = toCalibrated(m.keypoints, m.camera, m.camera_pose);
+    if (!c) return R::fail("GestureObservation skeleton: " + c.reason());
+    w.calibrated = std::move(*c);
+  }
   return R::ok(std::move(w));
 }
 inline gesture_formation::GestureObservation fromWire(const comm::GestureObservationMessage& w) {
@@ -360,6 +459,11 @@ inline gesture_formation::GestureObservation fromWire(const comm::GestureObserva
   m.geometry_known = w.geometry_known;
   m.distance_m = w.distance_m;
   m.elevation_deg = w.elevation_deg;
+  if (w.calibrated) {
+    m.keypoints = toKeypoints(w.calibrated->skeleton);
+    m.camera = toCameraInfo(w.calibrated->intrinsics);
+    m.camera_pose = toPose(w.calibrated->R_world_camera, w.calibrated->p_world_camera);
+  }
   return m;
 }
 
@@ -407,27 +511,6 @@ inline common::Result<cv::Mat> toDepth(const sensor_msgs::Image& m) {
   const cv::Mat view(static_cast<int>(m.height), static_cast<int>(m.width), type, const_cast<std::uint8_t*>(m.data.data()),
                      m.step);
   return R::ok(view.clone());
-}
-/// CameraInfo (plumb_bob or no distortion) → intrinsics; fails naming what is unusable.
-inline common::Result<estimation::CameraIntrinsics> toIntrinsics(const sensor_msgs::CameraInfo& m) {
-  using R = common::Result<estimation::CameraIntrinsics>;
-  estimation::CameraIntrinsics k;
-  k.fx = m.K[0];
-  k.fy = m.K[4];
-  k.cx = m.K[2];
-  k.cy = m.K[5];
-  k.width_px = static_cast<int>(m.width);
-  k.height_px = static_cast<int>(m.height);
-  if (!m.D.empty()) {
-    if (m.distortion_model != "plumb_bob" || m.D.size() != 5) {
-      return R::fail("CameraInfo: distortion model '" + m.distortion_model + "' with " + std::to_string(m.D.size()) +
-                     " coefficients: expected plumb_bob with 5");
-    }
-    for (std::size_t i = 0; i < 5; ++i) k.distortion[i] = m.D[i];
-  }
-  const auto errors = k.validate();
-  if (!errors.empty()) return R::fail("CameraInfo: " + errors.front());
-  return R::ok(k);
 }
 
 }  // namespace gesture_formation::nodelets

@@ -77,11 +77,7 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
                         << vcfg.min_agreeing_views << ", max_age_s " << vcfg.max_age_s << ", envelope "
                         << (vcfg.gate_envelope ? "on" : "off") << " [" << vcfg.distance_min_m << ", "
                         << vcfg.distance_max_m << "] m, [" << vcfg.elevation_min_deg << ", " << vcfg.elevation_max_deg
-                        << "] deg\n");
-    if (vcfg.confirm_3d) {
-      NODELET_WARN("GestureCommander: view_fusion.confirm_3d has no effect over ROS yet: the views' observations "
-                   "carry no skeletons (docs/gestures.md 6)");
-    }
+                        << "] deg, confirm_3d " << (vcfg.confirm_3d ? "on" : "off") << "\n");
     filter_.emplace(fcfg);
     fusion_.emplace(vcfg, views_, fcfg.max_gesture_id);
     sequence_ = static_cast<std::uint64_t>(ros::WallTime::now().toNSec() / 1000);
@@ -104,7 +100,12 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
   void onObservation(const gesture_formation::GestureObservation::ConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
     if (msg->uav_index >= views_) return;  // single camera: the followers do not vote
-    const gesture::ViewObservation o = toViewObservation(*msg);
+    std::string skeleton_problem;
+    const gesture::ViewObservation o = toViewObservation(*msg, &skeleton_problem);
+    if (!skeleton_problem.empty()) {
+      NODELET_WARN_STREAM_THROTTLE(5.0, "GestureCommander: skeleton of UAV " << int(msg->uav_index)
+                                            << " left out of the 3-D confirmation: " << skeleton_problem);
+    }
     std::string reason;
     const bool accepted = fusion_->observe(o, &reason);
     if (!accepted) {
@@ -149,6 +150,7 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
     st.reported_views = f.reported;
     st.voting_views = fused.voting_views;
     st.agreeing_views = fused.agreeing_views;
+    st.confirmed_3d = fused.confirmed_3d;
     if (!out.accepted) NODELET_WARN_STREAM_THROTTLE(1.0, "GestureCommander: measurement rejected: " << out.reason);
     if (out.fired) {
       const gesture::GestureAction* action = mapping_.find(out.dominant_id);
@@ -165,7 +167,8 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
                       (action->increment >= 0 ? "+" : "") + std::to_string(action->increment);
       }
       NODELET_INFO_STREAM("GestureCommander: fired " << last_fired_ << " (" << fused.agreeing_views << " of "
-                                                     << fused.voting_views << " voting views agreed)");
+                                                     << fused.voting_views << " voting views agreed"
+                                                     << (fused.confirmed_3d ? ", confirmed in 3-D" : "") << ")");
     }
     st.last_fired = last_fired_;
     status_pub_.publish(st);

@@ -9,7 +9,8 @@
 //   camera_info_in (sensor_msgs/CameraInfo of the colour camera; without it: no stereo range)
 //   → detection_out (WorkerDetection, one per image; frame_id = the image's),
 //   gesture_out (Gesture, one per image with a full skeleton window: this UAV's classifier output,
-//   the ViewObserver's input).
+//   the ViewObserver's input; with the image's skeleton and camera info once camera_info_in has
+//   delivered, for the formation's 3-D confirmation).
 // Parameters (required): ~models_root (third_party_models), ~gesture_model (the LSTM's .onnx),
 //   ~detector (movenet_multipose | blazepose), ~skeleton (movenet_lightning | blazepose_landmark),
 //   ~detect_every_k, ~min_depth_m, ~max_depth_m, ~depth_scale_m, ~max_depth_dt_s
@@ -84,8 +85,12 @@ class PerceptionNodelet : public nodelet::Nodelet {
     info_sub_ = nh.subscribe<sensor_msgs::CameraInfo>("camera_info_in", 2, [this](const sensor_msgs::CameraInfo::ConstPtr& m) {
       auto k = toIntrinsics(*m);
       std::lock_guard<std::mutex> lock(mutex_);
-      if (k) camera_.emplace(*k);
-      else NODELET_WARN_STREAM_THROTTLE(5.0, "Perception: " << k.reason());
+      if (k) {
+        camera_.emplace(*k);
+        camera_info_ = *m;
+      } else {
+        NODELET_WARN_STREAM_THROTTLE(5.0, "Perception: " << k.reason());
+      }
     });
     // On the multi-threaded handle with its own lock: a depth image is stored at once, also while a
     // colour image is being processed (on the single-threaded handle it would queue behind it and
@@ -148,6 +153,11 @@ class PerceptionNodelet : public nodelet::Nodelet {
     g.header = msg->header;
     g.gesture_id = c->gesture_id;
     g.probabilities.assign(c->probabilities.begin(), c->probabilities.end());
+    if (frame->has_skeleton && camera_info_) {  // the window's newest skeleton, in this image's pixels
+      g.keypoints.reserve(3 * frame->skeleton.size());
+      for (const perception::Keypoint& k : frame->skeleton) g.keypoints.insert(g.keypoints.end(), {k.x, k.y, k.c});
+      g.camera = *camera_info_;
+    }
     gesture_pub_.publish(g);
   }
 
@@ -183,6 +193,7 @@ class PerceptionNodelet : public nodelet::Nodelet {
   double max_depth_dt_s_ = 0.0;
   float last_score_ = 0.0f;
   std::optional<estimation::CameraModel> camera_;
+  std::optional<sensor_msgs::CameraInfo> camera_info_;  ///< the last usable one (its intrinsics are camera_'s)
   std::mutex depth_mutex_;                         ///< guards depths_ only
   std::condition_variable depth_arrived_;
   std::deque<sensor_msgs::Image::ConstPtr> depths_;  ///< the last kDepthBuffer depth images

@@ -10,7 +10,9 @@
 //
 // Publishes: /clock; worker_truth_out (nav_msgs/Odometry); detection_out (WorkerDetection in
 //   <leader>/camera_optical); uwb_out (sensor_msgs/Range); uav<i>/gesture_out (Gesture: UAV i's
-//   classifier output; followers only while online, i.e. not in a mission follower dropout);
+//   classifier output; followers only while online, i.e. not in a mission follower dropout; with
+//   view_fusion.confirm_3d the skeleton too, in uav<i>/gesture_camera, and tf uav<i>/camera_axis →
+//   uav<i>/gesture_camera);
 //   operator_command_out (FormationCommand, sender/sequence assigned by the OperatorInterface);
 //   done_out (latched, at the end).
 // Subscribes: uav<i>/ground_truth (true states), uav<i>/plan, leader_params_in (FormationParams
@@ -32,6 +34,7 @@
 #include <rosgraph_msgs/Clock.h>
 #include <sensor_msgs/Range.h>
 #include <std_msgs/Bool.h>
+#include <tf2_ros/transform_broadcaster.h>
 
 #include "config_sources.hpp"
 #include "conversions.hpp"
@@ -246,12 +249,38 @@ class SimWorldNodelet : public nodelet::Nodelet {
     return toEigen(estimate_->position) + (t_s - estimate_->header.stamp.toSec()) * toEigen(estimate_->velocity);
   }
 
-  void publishGesture(int uav, const gesture::Classification& c, const ros::Time& stamp) {
+  /// UAV `uav`'s classification, as its Perception nodelet would publish it. With the 3-D
+  /// confirmation (`skeleton` given) the skeleton goes along in the frame of the generator's camera
+  /// that rendered it, uav<i>/gesture_camera, sent on tf relative to the UAV's true camera axis: the
+  /// pose the ViewObserver looks up through the estimated axis (SimUav) is the rendering pose moved
+  /// by the odometry's error, as in `gfctl simulate`.
+  void publishGesture(int uav, const gesture::Classification& c, const ros::Time& stamp,
+                      const gesture::CalibratedSkeleton* skeleton) {
+    const std::string prefix = "uav" + std::to_string(uav);
     gesture_formation::Gesture g;
     g.header.stamp = stamp;
-    g.header.frame_id = "uav" + std::to_string(uav) + "/camera_optical";
+    g.header.frame_id = prefix + "/camera_optical";
     g.gesture_id = c.gesture_id;
     g.probabilities.assign(c.probabilities.begin(), c.probabilities.end());
+    const auto& truth = truth_[static_cast<std::size_t>(uav)];
+    if (skeleton != nullptr && truth) {
+      g.header.frame_id = prefix + "/gesture_camera";
+      g.keypoints = toKeypoints(skeleton->skeleton);
+      g.camera = toCameraInfo(skeleton->intrinsics);
+      const geometry_msgs::Quaternion axis = cameraAxisOrientation(truth->heading_rad, truth->pitch_rad);
+      const Eigen::Quaterniond q_axis_inv = Eigen::Quaterniond(axis.w, axis.x, axis.y, axis.z).conjugate();
+      const geometry_msgs::Pose rel = toPose(q_axis_inv * skeleton->R_world_camera,
+                                             q_axis_inv * (skeleton->p_world_camera - truth->p_world));
+      geometry_msgs::TransformStamped T;
+      T.header.stamp = stamp;
+      T.header.frame_id = prefix + "/camera_axis";
+      T.child_frame_id = g.header.frame_id;
+      T.transform.translation.x = rel.position.x;
+      T.transform.translation.y = rel.position.y;
+      T.transform.translation.z = rel.position.z;
+      T.transform.rotation = rel.orientation;
+      tf_.sendTransform(T);
+    }
     gesture_pubs_[static_cast<std::size_t>(uav)].publish(g);
   }
 
@@ -282,7 +311,10 @@ class SimWorldNodelet : public nodelet::Nodelet {
     // Each UAV's classifier output, as its Perception nodelet would publish it (the followers'
     // first: the leader's closes the frame at the GestureCommander only when all have reported).
     for (std::size_t i = 0; i < cf.followers.size(); ++i) {
-      if (cf.followers[i].classification) publishGesture(static_cast<int>(i) + 1, *cf.followers[i].classification, stamp);
+      if (cf.followers[i].classification) {
+        publishGesture(static_cast<int>(i) + 1, *cf.followers[i].classification, stamp,
+                       cfg_.view_fusion.confirm_3d && cf.followers[i].visible ? &cf.followers[i].calibrated : nullptr);
+      }
     }
     if (!cf.sensors.visible()) return;
     gesture_formation::WorkerDetection d;
@@ -296,7 +328,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
     d.confidence = 0.9f;
     d.stereo_distance_m = cf.sensors.d_stereo_m;
     detection_pub_.publish(d);
-    if (cf.classification) publishGesture(0, *cf.classification, stamp);
+    if (cf.classification) publishGesture(0, *cf.classification, stamp, cfg_.view_fusion.confirm_3d ? &cf.calibrated : nullptr);
   }
 
   void sample(const sim::WorkerState& ws, bool all_truths) {
@@ -371,6 +403,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
   std::optional<gesture_formation::WorkerState> estimate_;
   ros::WallTime wall0_;
   ros::Publisher clock_pub_, worker_pub_, detection_pub_, uwb_pub_, command_pub_, done_pub_;
+  tf2_ros::TransformBroadcaster tf_;  ///< the gesture cameras (3-D confirmation)
   std::vector<ros::Publisher> gesture_pubs_;  ///< per UAV (only the leader's without follower views)
   std::vector<ros::Subscriber> truth_subs_, plan_subs_;
   ros::Subscriber params_sub_, estimate_sub_, status_sub_;

@@ -5,19 +5,30 @@
 // received over LCM), predicted to the frame's time. The leader's GestureCommander fuses the
 // views; followers' observations reach it through the LcmBridge.
 //
+// A classification that carries its skeleton (Gesture.keypoints) gets the pose of its image's
+// optical frame (the Gesture's frame_id) in the world frame at the frame's time from tf — on a
+// UAV: its odometry and the camera's mounting — for the leader's 3-D confirmation
+// (view_fusion.confirm_3d, docs/gestures.md §4.1); without a pose within ~tf_timeout_s, or with a
+// skeleton or camera info that cannot be used, the observation goes without the skeleton (its
+// 2-D vote is unaffected).
+//
 // Topics: gesture_in (Gesture: this UAV's classifier, e.g. the Perception nodelet or SimWorld),
-//   odometry_in (nav_msgs/Odometry of this UAV), worker_state_in (WorkerState)
+//   odometry_in (nav_msgs/Odometry of this UAV), worker_state_in (WorkerState), tf
 //   → observation_out (GestureObservation, one per classifier output).
 // Parameters (required): ~uav_index, ~max_state_age_s (odometry and worker state older than this
-//   at the frame's time, or a lost worker: geometry unknown, the view does not vote).
+//   at the frame's time, or a lost worker: geometry unknown, the view does not vote),
+//   ~world_frame, ~tf_timeout_s (how long to wait for the camera's pose at the frame's time).
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <mutex>
 #include <optional>
 
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
 #include <ros/ros.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
 
 #include "conversions.hpp"
 #include "gesture_formation/Gesture.h"
@@ -33,11 +44,15 @@ class ViewObserverNodelet : public nodelet::Nodelet {
     ParamLoader params(getPrivateNodeHandle());
     params.load("uav_index", uav_index_, 0, comm::kMaxUavIndex);
     params.load("max_state_age_s", max_state_age_s_, 0.01, 10.0);
+    params.load("world_frame", world_frame_);
+    params.load("tf_timeout_s", tf_timeout_s_, 0.0, 1.0);
+    if (world_frame_.empty()) params.addError("world_frame: must be non-empty");
     if (!params.ok()) {
       NODELET_ERROR_STREAM("ViewObserver refuses to start; fix these parameters:\n" << params.report());
       return;
     }
     NODELET_INFO_STREAM("ViewObserver loaded:\n" << params.loaded());
+    tf_listener_ = std::make_unique<tf2_ros::TransformListener>(tf_buffer_);
     observation_pub_ = nh.advertise<gesture_formation::GestureObservation>("observation_out", 20);
     odometry_sub_ = nh.subscribe<nav_msgs::Odometry>("odometry_in", 5, [this](const nav_msgs::Odometry::ConstPtr& m) {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -57,6 +72,7 @@ class ViewObserverNodelet : public nodelet::Nodelet {
     o.uav_index = static_cast<std::uint8_t>(uav_index_);
     o.gesture_id = g->gesture_id;
     o.probabilities = g->probabilities;
+    if (!g->keypoints.empty()) attachSkeleton(*g, o);
     {
       std::lock_guard<std::mutex> lock(mutex_);
       const double t = g->header.stamp.toSec();
@@ -77,9 +93,36 @@ class ViewObserverNodelet : public nodelet::Nodelet {
     observation_pub_.publish(o);
   }
 
+  /// The skeleton with its camera's pose at the frame's time, when both can be used.
+  void attachSkeleton(const gesture_formation::Gesture& g, gesture_formation::GestureObservation& o) {
+    geometry_msgs::TransformStamped T_world_camera;
+    try {
+      T_world_camera = tf_buffer_.lookupTransform(world_frame_, g.header.frame_id, g.header.stamp, ros::Duration(tf_timeout_s_));
+    } catch (const tf2::TransformException& e) {
+      NODELET_WARN_STREAM_THROTTLE(5.0, "ViewObserver: no camera pose for the skeleton (3-D confirmation): " << e.what());
+      return;
+    }
+    geometry_msgs::Pose pose;
+    pose.position.x = T_world_camera.transform.translation.x;
+    pose.position.y = T_world_camera.transform.translation.y;
+    pose.position.z = T_world_camera.transform.translation.z;
+    pose.orientation = T_world_camera.transform.rotation;
+    const auto c = toCalibrated(g.keypoints, g.camera, pose);
+    if (!c) {
+      NODELET_WARN_STREAM_THROTTLE(5.0, "ViewObserver: skeleton not usable for the 3-D confirmation: " << c.reason());
+      return;
+    }
+    o.keypoints = g.keypoints;
+    o.camera = g.camera;
+    o.camera_pose = pose;
+  }
+
   std::mutex mutex_;
   int uav_index_ = 0;
-  double max_state_age_s_ = 0.0;
+  double max_state_age_s_ = 0.0, tf_timeout_s_ = 0.0;
+  std::string world_frame_;
+  tf2_ros::Buffer tf_buffer_;
+  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
   std::optional<nav_msgs::Odometry> odometry_;
   std::optional<gesture_formation::WorkerState> worker_;
   ros::Publisher observation_pub_;

@@ -4,6 +4,8 @@
 #include <initializer_list>
 #include <set>
 
+#include <Eigen/Geometry>
+
 #include "gesture_formation/comm/byte_io.hpp"
 
 namespace gesture_formation::comm {
@@ -401,7 +403,73 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, formation
 }
 
 // ---- gesture observation: u16 uav_index, f64 t_s, u8 gesture_id, u8 count, count × f64
-//      probability, u8 flags (bit0 geometry_known), f64 distance_m, f64 elevation_deg -------------
+//      probability, u8 flags (bit0 geometry_known, bit1 skeleton), f64 distance_m, f64 elevation_deg,
+//      with bit1: 17 × (f64 x, f64 y, f64 confidence), f64 q_world_camera w x y z (unit within 1e-6),
+//      f64 p_world_camera x y z, f64 fx fy cx cy, 5 × f64 distortion, u16 width, u16 height ----------
+
+namespace {
+
+constexpr double kUnitQuaternionTolerance = 1e-6;
+
+void putCalibrated(ByteWriter& w, const gesture::CalibratedSkeleton& c) {
+  for (std::size_t k = 0; k < static_cast<std::size_t>(gesture::kNumKeypoints); ++k) {
+    w.f64(c.skeleton.x[k]);
+    w.f64(c.skeleton.y[k]);
+    w.f64(c.skeleton.c[k]);
+  }
+  const Eigen::Quaterniond q(c.R_world_camera);
+  w.f64(q.w());
+  w.f64(q.x());
+  w.f64(q.y());
+  w.f64(q.z());
+  w.f64(c.p_world_camera.x());
+  w.f64(c.p_world_camera.y());
+  w.f64(c.p_world_camera.z());
+  const estimation::CameraIntrinsics& k = c.intrinsics;
+  w.f64(k.fx);
+  w.f64(k.fy);
+  w.f64(k.cx);
+  w.f64(k.cy);
+  for (double d : k.distortion) w.f64(d);
+  w.u16(static_cast<std::uint16_t>(k.width_px));
+  w.u16(static_cast<std::uint16_t>(k.height_px));
+}
+
+/// Reads what putCalibrated wrote; the caller validates the result.
+void getCalibrated(Decoder& d, gesture::CalibratedSkeleton& c) {
+  const std::string f = "gesture_observation.skeleton";
+  for (std::size_t k = 0; d.ok() && k < static_cast<std::size_t>(gesture::kNumKeypoints); ++k) {
+    const std::string kp = f + ".keypoints[" + std::to_string(k) + "]";
+    d.f64(c.skeleton.x[k], kp + ".x");
+    d.f64(c.skeleton.y[k], kp + ".y");
+    d.f64(c.skeleton.c[k], kp + ".confidence");
+  }
+  double q[4] = {1.0, 0.0, 0.0, 0.0};
+  for (int i = 0; i < 4; ++i) d.f64(q[i], f + ".q_world_camera");
+  const Eigen::Quaterniond quat(q[0], q[1], q[2], q[3]);
+  if (d.ok() && !(std::abs(quat.norm() - 1.0) <= kUnitQuaternionTolerance)) {
+    d.fail(PayloadError::kOutOfRange, f + ".q_world_camera (norm " + std::to_string(quat.norm()) + ")");
+  }
+  if (d.ok()) c.R_world_camera = quat.normalized().toRotationMatrix();
+  d.vec3(c.p_world_camera, f + ".p_world_camera");
+  estimation::CameraIntrinsics& k = c.intrinsics;
+  d.f64(k.fx, f + ".fx");
+  d.f64(k.fy, f + ".fy");
+  d.f64(k.cx, f + ".cx");
+  d.f64(k.cy, f + ".cy");
+  for (double& x : k.distortion) d.f64(x, f + ".distortion");
+  std::uint16_t width = 0, height = 0;
+  d.u16(width, "gesture_observation.skeleton.width");
+  d.u16(height, "gesture_observation.skeleton.height");
+  k.width_px = width;
+  k.height_px = height;
+  if (d.ok()) {
+    const std::vector<std::string> problems = gesture::validate(c);
+    if (!problems.empty()) d.fail(PayloadError::kOutOfRange, f + ": " + problems.front());
+  }
+}
+
+}  // namespace
 
 EncodeResult encodePayload(const GestureObservationMessage& m) {
   if (!validUavIndex(m.uav_index)) return EncodeResult::fail("gesture_observation.uav_index " + std::to_string(m.uav_index) + " outside [0, " + std::to_string(kMaxUavIndex) + "]");
@@ -413,15 +481,24 @@ EncodeResult encodePayload(const GestureObservationMessage& m) {
   }
   if (!(m.distance_m >= 0.0 && m.distance_m <= kMaxObservationDistanceM)) return EncodeResult::fail("gesture_observation.distance_m outside [0, 1000]");
   if (!(m.elevation_deg >= -90.0 && m.elevation_deg <= 90.0)) return EncodeResult::fail("gesture_observation.elevation_deg outside [-90, 90]");
+  if (m.calibrated) {
+    const std::vector<std::string> problems = gesture::validate(*m.calibrated);
+    if (!problems.empty()) return EncodeResult::fail("gesture_observation.skeleton: " + problems.front());
+    if (m.calibrated->intrinsics.width_px > 65535 || m.calibrated->intrinsics.height_px > 65535) {
+      return EncodeResult::fail("gesture_observation.skeleton: image size " + std::to_string(m.calibrated->intrinsics.width_px) +
+                                " x " + std::to_string(m.calibrated->intrinsics.height_px) + " above 65535");
+    }
+  }
   ByteWriter w;
   w.u16(m.uav_index);
   w.f64(m.t_s);
   w.u8(m.gesture_id);
   w.u8(static_cast<std::uint8_t>(m.probabilities.size()));
   for (double p : m.probabilities) w.f64(p);
-  w.u8(m.geometry_known ? 1 : 0);
+  w.u8(static_cast<std::uint8_t>((m.geometry_known ? 1u : 0u) | (m.calibrated ? 2u : 0u)));
   w.f64(m.distance_m);
   w.f64(m.elevation_deg);
+  if (m.calibrated) putCalibrated(w, *m.calibrated);
   return EncodeResult::ok(w.release());
 }
 
@@ -445,12 +522,16 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, GestureOb
     if (d.f64(p, field) && !(p >= 0.0 && p <= 1.0)) d.fail(PayloadError::kOutOfRange, field);
     m.probabilities.push_back(p);
   }
-  if (d.u8(flags, "gesture_observation.flags") && (flags & ~1u) != 0) d.fail(PayloadError::kOutOfRange, "gesture_observation.flags");
+  if (d.u8(flags, "gesture_observation.flags") && (flags & ~3u) != 0) d.fail(PayloadError::kOutOfRange, "gesture_observation.flags");
   if (d.f64(m.distance_m, "gesture_observation.distance_m") && !(m.distance_m >= 0.0 && m.distance_m <= kMaxObservationDistanceM)) {
     d.fail(PayloadError::kOutOfRange, "gesture_observation.distance_m");
   }
   if (d.f64(m.elevation_deg, "gesture_observation.elevation_deg") && !(m.elevation_deg >= -90.0 && m.elevation_deg <= 90.0)) {
     d.fail(PayloadError::kOutOfRange, "gesture_observation.elevation_deg");
+  }
+  if (d.ok() && (flags & 2u) != 0) {
+    m.calibrated.emplace();
+    getCalibrated(d, *m.calibrated);
   }
   if (d.finish()) {
     m.geometry_known = (flags & 1u) != 0;

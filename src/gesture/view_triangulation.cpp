@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
@@ -31,6 +32,34 @@ CalibratedSkeleton cameraAround(double distance_m, double elevation_deg, double 
   const Eigen::Vector3d yc = zc.cross(xc);
   c.R_world_camera << xc, yc, zc;
   return c;
+}
+
+std::vector<std::string> validate(const CalibratedSkeleton& c) {
+  std::vector<std::string> e = c.intrinsics.validate();
+  const Eigen::Matrix3d& R = c.R_world_camera;
+  if (!R.allFinite() || !((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <= 1e-6) ||
+      !(R.determinant() > 0.0)) {
+    std::ostringstream m;
+    m << "R_world_camera: not a rotation (orthonormal within 1e-6, det +1): [" << R.format(Eigen::IOFormat(6, 0, ", ", "; "))
+      << "]";
+    e.push_back(m.str());
+  }
+  if (!(c.p_world_camera.allFinite() && c.p_world_camera.norm() <= 1e4)) {
+    e.push_back("p_world_camera: expected finite within 10 km, got (" + std::to_string(c.p_world_camera.x()) + ", " +
+                std::to_string(c.p_world_camera.y()) + ", " + std::to_string(c.p_world_camera.z()) + ")");
+  }
+  for (int k = 0; k < kNumKeypoints; ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    const Skeleton2D& s = c.skeleton;
+    if (!(std::isfinite(s.x[i]) && std::isfinite(s.y[i]))) {
+      e.push_back("keypoint " + std::to_string(k) + ": position not finite (" + std::to_string(s.x[i]) + ", " +
+                  std::to_string(s.y[i]) + ")");
+    }
+    if (!(s.c[i] >= 0.0 && s.c[i] <= 1.0)) {
+      e.push_back("keypoint " + std::to_string(k) + ": confidence expected [0, 1], got " + std::to_string(s.c[i]));
+    }
+  }
+  return e;
 }
 
 std::vector<std::string> TriangulationConfig::validate() const {

@@ -3,14 +3,17 @@
 # (min_agreeing_views 2) and on a copy with min_agreeing_views 1 (the paper's single camera),
 # fed GestureObservation messages directly (test/ros/gesture_commander_check.py): one camera fires
 # with 1 and never with 2; two cameras outside the classifier's envelope never fire; two inside
-# fire once with 2 agreeing views.
+# fire once with 2 agreeing views; with view_fusion.confirm_3d (a third copy) one camera's "extend"
+# fires when the three views' skeletons show the arm extended in 3-D, not when it points forward.
 set -o pipefail
 source "$(dirname "$0")/common.bash"
 start_master
 CFG=$SRC/config
 sed 's/^\( *min_agreeing_views:\) .*/\1 1/' "$CFG/gestures.yaml" > "$T/gestures_single.yaml"
 grep -q "min_agreeing_views: 1" "$T/gestures_single.yaml" || fail "could not set min_agreeing_views 1 in a copy"
-for v in single:$T/gestures_single.yaml voted:$CFG/gestures.yaml; do
+sed 's/^\( *confirm_3d:\) .*/\1 true/' "$CFG/gestures.yaml" > "$T/gestures_3d.yaml"
+grep -q "confirm_3d: true" "$T/gestures_3d.yaml" || fail "could not set confirm_3d true in a copy"
+for v in single:$T/gestures_single.yaml voted:$CFG/gestures.yaml confirm3d:$T/gestures_3d.yaml; do
   name=${v%%:*} file=${v#*:}
   timeout 60 rosrun nodelet nodelet standalone gesture_formation/GestureCommander __name:=gc_$name \
     _uav_count:=3 _sender_name:=gesture _frame_wait_s:=0.1 _gesture_config:="$file" \
@@ -19,9 +22,9 @@ for v in single:$T/gestures_single.yaml voted:$CFG/gestures.yaml; do
     > "$T/gc_$name.log" 2>&1 & pids+=($!)
 done
 for _ in $(seq 100); do
-  [ "$(rostopic list 2>/dev/null | grep -c 'gesture_status$')" -ge 2 ] && break; sleep 0.3
+  [ "$(rostopic list 2>/dev/null | grep -c 'gesture_status$')" -ge 3 ] && break; sleep 0.3
 done
 timeout 60 python3 "$SRC/test/ros/gesture_commander_check.py" || fails=$((fails + $?))
 grep -q "refuses to start" "$T"/gc_*.log && fail "a GestureCommander refused to start: $(grep -h -A4 refuses "$T"/gc_*.log)"
-[ $fails -eq 0 ] && echo "PASS: the GestureCommander fires on 2 of 3 cameras inside the envelope, on 1 only with min_agreeing_views 1"
+[ $fails -eq 0 ] && echo "PASS: the GestureCommander fires on 2 of 3 cameras inside the envelope, on 1 only with min_agreeing_views 1 or confirmed in 3-D"
 exit $fails

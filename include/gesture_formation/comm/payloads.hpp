@@ -12,6 +12,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -22,6 +23,7 @@
 #include "gesture_formation/common/result.hpp"
 #include "gesture_formation/formation/formation_commands.hpp"
 #include "gesture_formation/formation/formation_params.hpp"
+#include "gesture_formation/gesture/view_triangulation.hpp"
 #include "gesture_formation/planning/uav_planner.hpp"
 
 namespace gesture_formation::comm {
@@ -69,6 +71,10 @@ struct GestureObservationMessage {
   bool geometry_known = false;      ///< false: no worker estimate / odometry (the view cannot vote)
   double distance_m = 0.0;          ///< camera → worker estimate [m], [0, kMaxObservationDistanceM]
   double elevation_deg = 0.0;       ///< camera above the worker estimate [deg], [−90, 90]
+  /// The frame's skeleton with the pose (world ← optical frame) and intrinsics of the camera that
+  /// saw it, for view_fusion.confirm_3d; absent: the view takes no part in the 3-D confirmation.
+  /// Valid per gesture::validate(CalibratedSkeleton); the box is not sent.
+  std::optional<gesture::CalibratedSkeleton> calibrated;
 };
 /// Largest gesture id and number of class probabilities on the wire.
 constexpr int kMaxGestureId = 15;

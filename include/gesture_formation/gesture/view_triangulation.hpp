@@ -35,6 +35,13 @@ struct CalibratedSkeleton {
   estimation::CameraIntrinsics intrinsics;
 };
 
+/// \brief Every problem of a calibrated skeleton received from outside (another UAV, a ROS
+/// topic), each naming the field and the value; empty when valid: intrinsics valid
+/// (CameraIntrinsics::validate), R_world_camera a rotation (orthonormal within 1e-6, det +1),
+/// p_world_camera finite and within 10 km, keypoints finite, confidences in [0, 1]. The box is
+/// not checked (the triangulation does not use it).
+std::vector<std::string> validate(const CalibratedSkeleton& c);
+
 /// \brief A camera distance_m from the point (0, 0, aim_height_m) of a body frame (x forward, y left,
 /// z up, feet at 0), elevation_deg above the horizontal and azimuth_deg around z from x, looking at
 /// that point with its image rows horizontal — the viewpoints of gesture/skeleton_synth.hpp without

@@ -11,6 +11,7 @@
 using namespace gesture_formation::comm;
 namespace formation = gesture_formation::formation;
 namespace planning = gesture_formation::planning;
+namespace gesture = gesture_formation::gesture;
 
 namespace {
 
@@ -343,7 +344,9 @@ TEST(CommPayloadsTest, GestureObservationRoundTripAndRefusals) {
       {prob0, -1, 1.5, PayloadError::kOutOfRange, "gesture_observation.probabilities[0]"},
       {prob0, -1, -0.1, PayloadError::kOutOfRange, "gesture_observation.probabilities[0]"},
       {prob0, -1, kNaN, PayloadError::kNonFinite, "gesture_observation.probabilities[0]"},
-      {flags, 2, 0, PayloadError::kOutOfRange, "gesture_observation.flags"},
+      {flags, 4, 0, PayloadError::kOutOfRange, "gesture_observation.flags"},
+      // bit 1 announces a skeleton this payload does not carry
+      {flags, 3, 0, PayloadError::kTruncated, "gesture_observation.skeleton.keypoints[0].x"},
       {distance, -1, -1.0, PayloadError::kOutOfRange, "gesture_observation.distance_m"},
       {distance, -1, 1e6, PayloadError::kOutOfRange, "gesture_observation.distance_m"},
       {elevation, -1, 90.5, PayloadError::kOutOfRange, "gesture_observation.elevation_deg"},
@@ -375,6 +378,98 @@ TEST(CommPayloadsTest, GestureObservationRoundTripAndRefusals) {
   EXPECT_FALSE(encodePayload(e));
   e = m;
   e.uav_index = kMaxUavIndex + 1;
+  EXPECT_FALSE(encodePayload(e));
+}
+
+TEST(CommPayloadsTest, GestureObservationWithSkeletonRoundTripAndRefusals) {
+  GestureObservationMessage m;
+  m.uav_index = 1;
+  m.t_s = 12.5;
+  m.gesture_id = 2;
+  m.probabilities = {0.1, 0.1, 0.6, 0.1, 0.1};
+  m.geometry_known = true;
+  m.distance_m = 8.0;
+  m.elevation_deg = 20.0;
+  gesture::CalibratedSkeleton c = gesture::cameraAround(8.0, 20.0, 35.0, 1.0);
+  c.p_world_camera += Eigen::Vector3d(3.0, -4.0, 0.5);
+  c.intrinsics.distortion = {0.01, -0.02, 0.001, 0.0, 0.003};
+  for (int k = 0; k < gesture::kNumKeypoints; ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    c.skeleton.x[i] = 300.0 + 3.25 * k;
+    c.skeleton.y[i] = 150.0 + 7.5 * k;
+    c.skeleton.c[i] = k == 5 ? 0.0 : 0.05 * k;
+  }
+  m.calibrated = c;
+  const auto b = encoded(m);
+  // the observation without a skeleton, then 17 × 3 f64, q (4 f64), p (3 f64), fx fy cx cy, 5 distortion, 2 × u16
+  const std::size_t base = 2 + 8 + 1 + 1 + 5 * 8 + 1 + 2 * 8u;
+  ASSERT_EQ(b.size(), base + 17 * 3 * 8 + 4 * 8 + 3 * 8 + 4 * 8 + 5 * 8 + 2 * 2u);
+  EXPECT_EQ(b[base - 17], 3);  // flags: geometry_known | skeleton
+  GestureObservationMessage d;
+  ASSERT_EQ(decode(b, d), PayloadError::kNone);
+  ASSERT_TRUE(d.calibrated.has_value());
+  EXPECT_EQ(d.calibrated->skeleton.x, c.skeleton.x);
+  EXPECT_EQ(d.calibrated->skeleton.y, c.skeleton.y);
+  EXPECT_EQ(d.calibrated->skeleton.c, c.skeleton.c);
+  EXPECT_LT((d.calibrated->R_world_camera - c.R_world_camera).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_EQ(d.calibrated->p_world_camera, c.p_world_camera);
+  EXPECT_EQ(d.calibrated->intrinsics.fx, c.intrinsics.fx);
+  EXPECT_EQ(d.calibrated->intrinsics.cy, c.intrinsics.cy);
+  EXPECT_EQ(d.calibrated->intrinsics.distortion, c.intrinsics.distortion);
+  EXPECT_EQ(d.calibrated->intrinsics.width_px, 640);
+  EXPECT_EQ(d.calibrated->intrinsics.height_px, 480);
+  EXPECT_TRUE(gesture::validate(*d.calibrated).empty());
+  // Bad values on the wire: refused naming the field, the output untouched.
+  const std::size_t kp0 = base, q = base + 17 * 24, p = q + 32, fx = p + 24, width = fx + 9 * 8;
+  struct Case {
+    std::size_t offset;
+    double value;
+    PayloadError error;
+    const char* field;
+  };
+  const Case cases[] = {
+      {kp0, kNaN, PayloadError::kNonFinite, "gesture_observation.skeleton.keypoints[0].x"},
+      {kp0 + 3 * 24 + 16, 1.5, PayloadError::kOutOfRange, "keypoint 3: confidence expected [0, 1], got 1.5"},
+      {kp0 + 16, -0.2, PayloadError::kOutOfRange, "keypoint 0: confidence"},
+      {q, 2.0, PayloadError::kOutOfRange, "gesture_observation.skeleton.q_world_camera (norm"},
+      {q + 8, kInf, PayloadError::kNonFinite, "gesture_observation.skeleton.q_world_camera"},
+      {p + 8, 2e4, PayloadError::kOutOfRange, "p_world_camera: expected finite within 10 km"},
+      {fx, -615.0, PayloadError::kOutOfRange, "camera.fx must be > 0"},
+      {fx + 4 * 8, kNaN, PayloadError::kNonFinite, "gesture_observation.skeleton.distortion"},
+  };
+  for (const Case& cs : cases) {
+    auto bad = b;
+    putDouble(bad, cs.offset, cs.value);
+    GestureObservationMessage untouched = d;
+    std::string reason;
+    EXPECT_EQ(decode(bad, untouched, &reason), cs.error) << cs.field;
+    EXPECT_NE(reason.find(cs.field), std::string::npos) << reason;
+    EXPECT_EQ(untouched.calibrated->skeleton.x, d.calibrated->skeleton.x);
+  }
+  auto zero_width = b;
+  zero_width[width] = 0;
+  zero_width[width + 1] = 0;
+  std::string reason;
+  EXPECT_EQ(decode(zero_width, d, &reason), PayloadError::kOutOfRange);
+  EXPECT_NE(reason.find("camera.width must be > 0, got 0"), std::string::npos) << reason;
+  auto shorter = b;
+  shorter.pop_back();
+  EXPECT_EQ(decode(shorter, d, &reason), PayloadError::kTruncated);
+  EXPECT_NE(reason.find("gesture_observation.skeleton.height"), std::string::npos) << reason;
+  auto longer = b;
+  longer.push_back(0);
+  EXPECT_EQ(decode(longer, d), PayloadError::kTrailingBytes);
+  // The encoder refuses what a decoder would, naming the problem.
+  auto e = m;
+  e.calibrated->R_world_camera(0, 0) += 0.01;
+  const auto not_rotation = encodePayload(e);
+  ASSERT_FALSE(not_rotation);
+  EXPECT_NE(not_rotation.reason().find("R_world_camera: not a rotation"), std::string::npos) << not_rotation.reason();
+  e = m;
+  e.calibrated->skeleton.c[4] = 1.01;
+  EXPECT_FALSE(encodePayload(e));
+  e = m;
+  e.calibrated->intrinsics.width_px = 70000;
   EXPECT_FALSE(encodePayload(e));
 }
 
