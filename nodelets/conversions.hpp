@@ -411,8 +411,8 @@ inline common::Result<gesture::CalibratedSkeleton> toCalibrated(const std::vecto
 }
 
 /// The vote's input; an unknown geometry becomes NaN (the view votes only without the envelope gate).
-/// A skeleton that cannot be used (skeleton_problem set,
-/// when given) leaves the view out of the 3-D confirmation only; its 2-D vote stands.
+/// A skeleton that cannot be used (skeleton_problem set, when given) leaves the view out of the
+/// 3-D confirmation only; its 2-D vote stands.
 inline gesture::ViewObservation toViewObservation(const gesture_formation::GestureObservation& m,
                                                   std::string* skeleton_problem = nullptr) {
   gesture::ViewObservation o;
