@@ -4,7 +4,8 @@ sim-time window; then the formation's cameras vote (docs/gestures.md §4.1, 2 of
 injected at the leader's classifier alone (1 of 3 UAVs) fires nothing and changes nothing; the
 same gesture injected at both followers' classifiers (2 of 3; their votes reach the leader over
 LCM) fires once, and the followers' formation parameters (received over LCM) and their planned
-references change accordingly.
+references change accordingly; SimWorld's own classifications carry their skeletons (the mission's
+view_fusion.confirm_3d).
 Prints one line per check; exit code = number of failures."""
 import math
 import sys
@@ -65,6 +66,11 @@ def main():
     corridor_points = []  # per "corridors" marker (the planners' stage-3 corridors, LINE_LIST)
     rospy.Subscriber("/visualization/markers", MarkerArray, lambda a: corridor_points.extend(
         len(m.points) for m in a.markers if m.ns == "corridors"), queue_size=50)
+    # SimWorld's own classifications (the launch sends them to /world/unused: the test injects its
+    # own): the power-tower mission has view_fusion.confirm_3d, so each carries its skeleton.
+    sim_gestures = []
+    rospy.Subscriber("/world/unused/uav1/perception/gesture", Gesture, lambda m: sim_gestures.append(
+        (len(m.keypoints), m.header.frame_id, m.camera.K[0])), queue_size=200)
     gesture_pubs = [rospy.Publisher("/uav%d/perception/gesture" % i, Gesture, queue_size=50) for i in range(3)]
     statuses = []
     rospy.Subscriber("/uav0/gesture_status", GestureStatus, lambda m: statuses.append(m), queue_size=200)
@@ -183,6 +189,11 @@ def main():
     ok = bool(corridor_points) and max(corridor_points) >= 24 and all(n % 2 == 0 for n in corridor_points)
     print("%s: corridors drawn: %d markers, up to %d points (expected >= 24, pairs)" % (
         "PASS" if ok else "FAIL", len(corridor_points), max(corridor_points or [0])))
+    fails += 0 if ok else 1
+    with_skeleton = [g for g in sim_gestures if g[0] == 51 and g[1] == "uav1/gesture_camera" and g[2] > 0]
+    ok = len(sim_gestures) >= 100 and len(with_skeleton) == len(sim_gestures)
+    print("%s: SimWorld's classifications of follower 1: %d, %d with 17 keypoints, camera info and frame "
+          "uav1/gesture_camera (confirm_3d; expected >= 100, all)" % ("PASS" if ok else "FAIL", len(sim_gestures), len(with_skeleton)))
     fails += 0 if ok else 1
     return fails
 
