@@ -49,11 +49,25 @@ int main(int argc, char** argv) {
   cmd.target = formation::CommandTarget::list({1, 2});
   cmd.parameter = formation::Parameter::kGamma;
   cmd.amount = 5;
+  GestureObservationMessage obs;  // with a skeleton (view_fusion.confirm_3d)
+  obs.uav_index = 1;
+  obs.gesture_id = 2;
+  obs.probabilities = {0.1, 0.1, 0.6, 0.1, 0.1};
+  obs.geometry_known = true;
+  obs.distance_m = 9.0;
+  obs.skeleton.emplace();
+  for (std::size_t k = 0; k < obs.skeleton->skeleton.x.size(); ++k) {
+    obs.skeleton->skeleton.x[k] = 300.0 + 4.0 * static_cast<double>(k);
+    obs.skeleton->skeleton.y[k] = 200.0 + 6.0 * static_cast<double>(k);
+    obs.skeleton->skeleton.c[k] = 0.8;
+  }
+  obs.skeleton->p_world_camera = {8.0, 1.0, 3.0};
+  // in the order of MessageType (1..6); fuzz_payloads: prefix i % 5 for the first five, 255 for the observation
   const std::vector<std::vector<std::uint8_t>> payloads = {
       encodePayload(hb).value(), encodePayload(ws).value(), encodePayload(plan).value(),
-      encodePayload(params).value(), encodePayload(cmd).value()};
+      encodePayload(params).value(), encodePayload(cmd).value(), encodePayload(obs).value()};
   for (std::size_t i = 0; i < payloads.size(); ++i) {
-    write(dir + "/payloads/seed_" + std::to_string(i), withPrefix(static_cast<std::uint8_t>(i), payloads[i]));
+    write(dir + "/payloads/seed_" + std::to_string(i), withPrefix(static_cast<std::uint8_t>(i < 5 ? i : 255), payloads[i]));
   }
   KeyEntry k;
   k.id = 2;

@@ -446,7 +446,13 @@ inline common::Result<comm::GestureObservationMessage> toWire(const gesture_form
   if (!m.keypoints.empty()) {
     auto c = toCalibrated(m.keypoints, m.camera, m.camera_pose);
     if (!c) return R::fail("GestureObservation skeleton: " + c.reason());
-    w.calibrated = std::move(*c);
+    comm::ObservedSkeleton s;
+    s.skeleton = c->skeleton;
+    const auto& q = m.camera_pose.orientation;
+    s.q_world_camera = Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized();
+    s.p_world_camera = c->p_world_camera;
+    s.intrinsics = c->intrinsics;
+    w.skeleton = std::move(s);
   }
   return R::ok(std::move(w));
 }
@@ -459,10 +465,16 @@ inline gesture_formation::GestureObservation fromWire(const comm::GestureObserva
   m.geometry_known = w.geometry_known;
   m.distance_m = w.distance_m;
   m.elevation_deg = w.elevation_deg;
-  if (w.calibrated) {
-    m.keypoints = toKeypoints(w.calibrated->skeleton);
-    m.camera = toCameraInfo(w.calibrated->intrinsics);
-    m.camera_pose = toPose(w.calibrated->R_world_camera, w.calibrated->p_world_camera);
+  if (w.skeleton) {
+    m.keypoints = toKeypoints(w.skeleton->skeleton);
+    m.camera = toCameraInfo(w.skeleton->intrinsics);
+    m.camera_pose.position.x = w.skeleton->p_world_camera.x();
+    m.camera_pose.position.y = w.skeleton->p_world_camera.y();
+    m.camera_pose.position.z = w.skeleton->p_world_camera.z();
+    m.camera_pose.orientation.w = w.skeleton->q_world_camera.w();
+    m.camera_pose.orientation.x = w.skeleton->q_world_camera.x();
+    m.camera_pose.orientation.y = w.skeleton->q_world_camera.y();
+    m.camera_pose.orientation.z = w.skeleton->q_world_camera.z();
   }
   return m;
 }

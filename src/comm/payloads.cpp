@@ -407,25 +407,48 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, formation
 //      with bit1: 17 × (f64 x, f64 y, f64 confidence), f64 q_world_camera w x y z (unit within 1e-6),
 //      f64 p_world_camera x y z, f64 fx fy cx cy, 5 × f64 distortion, u16 width, u16 height ----------
 
-namespace {
-
 constexpr double kUnitQuaternionTolerance = 1e-6;
 
-void putCalibrated(ByteWriter& w, const gesture::CalibratedSkeleton& c) {
-  for (std::size_t k = 0; k < static_cast<std::size_t>(gesture::kNumKeypoints); ++k) {
-    w.f64(c.skeleton.x[k]);
-    w.f64(c.skeleton.y[k]);
-    w.f64(c.skeleton.c[k]);
+gesture::CalibratedSkeleton ObservedSkeleton::calibrated() const {
+  gesture::CalibratedSkeleton c;
+  c.skeleton = skeleton;
+  c.R_world_camera = q_world_camera.normalized().toRotationMatrix();
+  c.p_world_camera = p_world_camera;
+  c.intrinsics = intrinsics;
+  return c;
+}
+
+std::vector<std::string> ObservedSkeleton::validate() const {
+  std::vector<std::string> e;
+  const double n = q_world_camera.norm();
+  if (!(std::abs(n - 1.0) <= kUnitQuaternionTolerance)) {
+    e.push_back("q_world_camera: norm " + std::to_string(n) + ", expected 1 +- 1e-6");
+    return e;  // calibrated() would be meaningless
   }
-  const Eigen::Quaterniond q(c.R_world_camera);
-  w.f64(q.w());
-  w.f64(q.x());
-  w.f64(q.y());
-  w.f64(q.z());
-  w.f64(c.p_world_camera.x());
-  w.f64(c.p_world_camera.y());
-  w.f64(c.p_world_camera.z());
-  const estimation::CameraIntrinsics& k = c.intrinsics;
+  if (intrinsics.width_px > 65535 || intrinsics.height_px > 65535) {
+    e.push_back("image size " + std::to_string(intrinsics.width_px) + " x " + std::to_string(intrinsics.height_px) +
+                " above 65535");
+  }
+  for (auto& p : gesture::validate(calibrated())) e.push_back(std::move(p));
+  return e;
+}
+
+namespace {
+
+void putSkeleton(ByteWriter& w, const ObservedSkeleton& o) {
+  for (std::size_t k = 0; k < static_cast<std::size_t>(gesture::kNumKeypoints); ++k) {
+    w.f64(o.skeleton.x[k]);
+    w.f64(o.skeleton.y[k]);
+    w.f64(o.skeleton.c[k]);
+  }
+  w.f64(o.q_world_camera.w());
+  w.f64(o.q_world_camera.x());
+  w.f64(o.q_world_camera.y());
+  w.f64(o.q_world_camera.z());
+  w.f64(o.p_world_camera.x());
+  w.f64(o.p_world_camera.y());
+  w.f64(o.p_world_camera.z());
+  const estimation::CameraIntrinsics& k = o.intrinsics;
   w.f64(k.fx);
   w.f64(k.fy);
   w.f64(k.cx);
@@ -435,24 +458,21 @@ void putCalibrated(ByteWriter& w, const gesture::CalibratedSkeleton& c) {
   w.u16(static_cast<std::uint16_t>(k.height_px));
 }
 
-/// Reads what putCalibrated wrote; the caller validates the result.
-void getCalibrated(Decoder& d, gesture::CalibratedSkeleton& c) {
+/// Reads what putSkeleton wrote and validates it.
+void getSkeleton(Decoder& d, ObservedSkeleton& o) {
   const std::string f = "gesture_observation.skeleton";
   for (std::size_t k = 0; d.ok() && k < static_cast<std::size_t>(gesture::kNumKeypoints); ++k) {
     const std::string kp = f + ".keypoints[" + std::to_string(k) + "]";
-    d.f64(c.skeleton.x[k], kp + ".x");
-    d.f64(c.skeleton.y[k], kp + ".y");
-    d.f64(c.skeleton.c[k], kp + ".confidence");
+    d.f64(o.skeleton.x[k], kp + ".x");
+    d.f64(o.skeleton.y[k], kp + ".y");
+    d.f64(o.skeleton.c[k], kp + ".confidence");
   }
-  double q[4] = {1.0, 0.0, 0.0, 0.0};
-  for (int i = 0; i < 4; ++i) d.f64(q[i], f + ".q_world_camera");
-  const Eigen::Quaterniond quat(q[0], q[1], q[2], q[3]);
-  if (d.ok() && !(std::abs(quat.norm() - 1.0) <= kUnitQuaternionTolerance)) {
-    d.fail(PayloadError::kOutOfRange, f + ".q_world_camera (norm " + std::to_string(quat.norm()) + ")");
-  }
-  if (d.ok()) c.R_world_camera = quat.normalized().toRotationMatrix();
-  d.vec3(c.p_world_camera, f + ".p_world_camera");
-  estimation::CameraIntrinsics& k = c.intrinsics;
+  d.f64(o.q_world_camera.w(), f + ".q_world_camera");
+  d.f64(o.q_world_camera.x(), f + ".q_world_camera");
+  d.f64(o.q_world_camera.y(), f + ".q_world_camera");
+  d.f64(o.q_world_camera.z(), f + ".q_world_camera");
+  d.vec3(o.p_world_camera, f + ".p_world_camera");
+  estimation::CameraIntrinsics& k = o.intrinsics;
   d.f64(k.fx, f + ".fx");
   d.f64(k.fy, f + ".fy");
   d.f64(k.cx, f + ".cx");
@@ -464,7 +484,7 @@ void getCalibrated(Decoder& d, gesture::CalibratedSkeleton& c) {
   k.width_px = width;
   k.height_px = height;
   if (d.ok()) {
-    const std::vector<std::string> problems = gesture::validate(c);
+    const std::vector<std::string> problems = o.validate();
     if (!problems.empty()) d.fail(PayloadError::kOutOfRange, f + ": " + problems.front());
   }
 }
@@ -481,13 +501,9 @@ EncodeResult encodePayload(const GestureObservationMessage& m) {
   }
   if (!(m.distance_m >= 0.0 && m.distance_m <= kMaxObservationDistanceM)) return EncodeResult::fail("gesture_observation.distance_m outside [0, 1000]");
   if (!(m.elevation_deg >= -90.0 && m.elevation_deg <= 90.0)) return EncodeResult::fail("gesture_observation.elevation_deg outside [-90, 90]");
-  if (m.calibrated) {
-    const std::vector<std::string> problems = gesture::validate(*m.calibrated);
+  if (m.skeleton) {
+    const std::vector<std::string> problems = m.skeleton->validate();
     if (!problems.empty()) return EncodeResult::fail("gesture_observation.skeleton: " + problems.front());
-    if (m.calibrated->intrinsics.width_px > 65535 || m.calibrated->intrinsics.height_px > 65535) {
-      return EncodeResult::fail("gesture_observation.skeleton: image size " + std::to_string(m.calibrated->intrinsics.width_px) +
-                                " x " + std::to_string(m.calibrated->intrinsics.height_px) + " above 65535");
-    }
   }
   ByteWriter w;
   w.u16(m.uav_index);
@@ -495,10 +511,10 @@ EncodeResult encodePayload(const GestureObservationMessage& m) {
   w.u8(m.gesture_id);
   w.u8(static_cast<std::uint8_t>(m.probabilities.size()));
   for (double p : m.probabilities) w.f64(p);
-  w.u8(static_cast<std::uint8_t>((m.geometry_known ? 1u : 0u) | (m.calibrated ? 2u : 0u)));
+  w.u8(static_cast<std::uint8_t>((m.geometry_known ? 1u : 0u) | (m.skeleton ? 2u : 0u)));
   w.f64(m.distance_m);
   w.f64(m.elevation_deg);
-  if (m.calibrated) putCalibrated(w, *m.calibrated);
+  if (m.skeleton) putSkeleton(w, *m.skeleton);
   return EncodeResult::ok(w.release());
 }
 
@@ -530,8 +546,8 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, GestureOb
     d.fail(PayloadError::kOutOfRange, "gesture_observation.elevation_deg");
   }
   if (d.ok() && (flags & 2u) != 0) {
-    m.calibrated.emplace();
-    getCalibrated(d, *m.calibrated);
+    m.skeleton.emplace();
+    getSkeleton(d, *m.skeleton);
   }
   if (d.finish()) {
     m.geometry_known = (flags & 1u) != 0;

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "gesture_formation/comm/envelope.hpp"
 #include "gesture_formation/common/result.hpp"
@@ -60,6 +61,20 @@ struct WorkerStateMessage {
   bool lost = false;  ///< estimator reports the worker lost (prediction only, timed out)
 };
 
+/// \brief A skeleton with its camera as it travels: the orientation as a quaternion, sent as
+/// given, so that decode and encode are inverse (the codec is a bijection on valid input).
+struct ObservedSkeleton {
+  gesture::Skeleton2D skeleton;  ///< keypoints [px] and confidences; the box is not sent
+  Eigen::Quaterniond q_world_camera = Eigen::Quaterniond::Identity();  ///< optical frame → world, norm 1 ± 1e-6
+  Eigen::Vector3d p_world_camera = Eigen::Vector3d::Zero();            ///< optical centre [m]
+  estimation::CameraIntrinsics intrinsics;                              ///< width, height ≤ 65535
+
+  /// As the triangulation takes it (R from the normalised quaternion).
+  gesture::CalibratedSkeleton calibrated() const;
+  /// Every problem (quaternion norm, image size, and gesture::validate of calibrated()).
+  std::vector<std::string> validate() const;
+};
+
 /// \brief One UAV's gesture classification of one camera frame with that camera's geometry to
 /// the worker estimate (the multi-view vote, gesture::ViewObservation; docs/gestures.md §4.1).
 /// The sender's id, sequence and send stamp are the envelope's.
@@ -71,11 +86,11 @@ struct GestureObservationMessage {
   bool geometry_known = false;      ///< false: no worker estimate / odometry (the view cannot vote)
   double distance_m = 0.0;          ///< camera → worker estimate [m], [0, kMaxObservationDistanceM]
   double elevation_deg = 0.0;       ///< camera above the worker estimate [deg], [−90, 90]
-  /// The frame's skeleton with the pose (world ← optical frame) and intrinsics of the camera that
-  /// saw it, for view_fusion.confirm_3d; absent: the view takes no part in the 3-D confirmation.
-  /// Valid per gesture::validate(CalibratedSkeleton); the box is not sent.
-  std::optional<gesture::CalibratedSkeleton> calibrated;
+  /// The frame's skeleton with the camera that saw it, for view_fusion.confirm_3d; absent: the
+  /// view takes no part in the 3-D confirmation.
+  std::optional<ObservedSkeleton> skeleton;
 };
+
 /// Largest gesture id and number of class probabilities on the wire.
 constexpr int kMaxGestureId = 15;
 constexpr std::size_t kMaxGestureClasses = 16;

@@ -390,8 +390,10 @@ TEST(CommPayloadsTest, GestureObservationWithSkeletonRoundTripAndRefusals) {
   m.geometry_known = true;
   m.distance_m = 8.0;
   m.elevation_deg = 20.0;
-  gesture::CalibratedSkeleton c = gesture::cameraAround(8.0, 20.0, 35.0, 1.0);
-  c.p_world_camera += Eigen::Vector3d(3.0, -4.0, 0.5);
+  const gesture::CalibratedSkeleton cam = gesture::cameraAround(8.0, 20.0, 35.0, 1.0);
+  ObservedSkeleton c;
+  c.q_world_camera = Eigen::Quaterniond(cam.R_world_camera);
+  c.p_world_camera = cam.p_world_camera + Eigen::Vector3d(3.0, -4.0, 0.5);
   c.intrinsics.distortion = {0.01, -0.02, 0.001, 0.0, 0.003};
   for (int k = 0; k < gesture::kNumKeypoints; ++k) {
     const auto i = static_cast<std::size_t>(k);
@@ -399,7 +401,7 @@ TEST(CommPayloadsTest, GestureObservationWithSkeletonRoundTripAndRefusals) {
     c.skeleton.y[i] = 150.0 + 7.5 * k;
     c.skeleton.c[i] = k == 5 ? 0.0 : 0.05 * k;
   }
-  m.calibrated = c;
+  m.skeleton = c;
   const auto b = encoded(m);
   // the observation without a skeleton, then 17 × 3 f64, q (4 f64), p (3 f64), fx fy cx cy, 5 distortion, 2 × u16
   const std::size_t base = 2 + 8 + 1 + 1 + 5 * 8 + 1 + 2 * 8u;
@@ -407,18 +409,20 @@ TEST(CommPayloadsTest, GestureObservationWithSkeletonRoundTripAndRefusals) {
   EXPECT_EQ(b[base - 17], 3);  // flags: geometry_known | skeleton
   GestureObservationMessage d;
   ASSERT_EQ(decode(b, d), PayloadError::kNone);
-  ASSERT_TRUE(d.calibrated.has_value());
-  EXPECT_EQ(d.calibrated->skeleton.x, c.skeleton.x);
-  EXPECT_EQ(d.calibrated->skeleton.y, c.skeleton.y);
-  EXPECT_EQ(d.calibrated->skeleton.c, c.skeleton.c);
-  EXPECT_LT((d.calibrated->R_world_camera - c.R_world_camera).cwiseAbs().maxCoeff(), 1e-12);
-  EXPECT_EQ(d.calibrated->p_world_camera, c.p_world_camera);
-  EXPECT_EQ(d.calibrated->intrinsics.fx, c.intrinsics.fx);
-  EXPECT_EQ(d.calibrated->intrinsics.cy, c.intrinsics.cy);
-  EXPECT_EQ(d.calibrated->intrinsics.distortion, c.intrinsics.distortion);
-  EXPECT_EQ(d.calibrated->intrinsics.width_px, 640);
-  EXPECT_EQ(d.calibrated->intrinsics.height_px, 480);
-  EXPECT_TRUE(gesture::validate(*d.calibrated).empty());
+  ASSERT_TRUE(d.skeleton.has_value());
+  EXPECT_EQ(d.skeleton->skeleton.x, c.skeleton.x);
+  EXPECT_EQ(d.skeleton->skeleton.y, c.skeleton.y);
+  EXPECT_EQ(d.skeleton->skeleton.c, c.skeleton.c);
+  EXPECT_EQ(d.skeleton->q_world_camera.coeffs(), c.q_world_camera.coeffs());  // sent as given: exact
+  EXPECT_EQ(d.skeleton->p_world_camera, c.p_world_camera);
+  EXPECT_EQ(d.skeleton->intrinsics.fx, c.intrinsics.fx);
+  EXPECT_EQ(d.skeleton->intrinsics.cy, c.intrinsics.cy);
+  EXPECT_EQ(d.skeleton->intrinsics.distortion, c.intrinsics.distortion);
+  EXPECT_EQ(d.skeleton->intrinsics.width_px, 640);
+  EXPECT_EQ(d.skeleton->intrinsics.height_px, 480);
+  EXPECT_EQ(encoded(d), b);  // decode and encode are inverse
+  EXPECT_LT((d.skeleton->calibrated().R_world_camera - cam.R_world_camera).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_TRUE(gesture::validate(d.skeleton->calibrated()).empty());
   // Bad values on the wire: refused naming the field, the output untouched.
   const std::size_t kp0 = base, q = base + 17 * 24, p = q + 32, fx = p + 24, width = fx + 9 * 8;
   struct Case {
@@ -431,7 +435,7 @@ TEST(CommPayloadsTest, GestureObservationWithSkeletonRoundTripAndRefusals) {
       {kp0, kNaN, PayloadError::kNonFinite, "gesture_observation.skeleton.keypoints[0].x"},
       {kp0 + 3 * 24 + 16, 1.5, PayloadError::kOutOfRange, "keypoint 3: confidence expected [0, 1], got 1.5"},
       {kp0 + 16, -0.2, PayloadError::kOutOfRange, "keypoint 0: confidence"},
-      {q, 2.0, PayloadError::kOutOfRange, "gesture_observation.skeleton.q_world_camera (norm"},
+      {q, 2.0, PayloadError::kOutOfRange, "gesture_observation.skeleton: q_world_camera: norm"},
       {q + 8, kInf, PayloadError::kNonFinite, "gesture_observation.skeleton.q_world_camera"},
       {p + 8, 2e4, PayloadError::kOutOfRange, "p_world_camera: expected finite within 10 km"},
       {fx, -615.0, PayloadError::kOutOfRange, "camera.fx must be > 0"},
@@ -444,7 +448,7 @@ TEST(CommPayloadsTest, GestureObservationWithSkeletonRoundTripAndRefusals) {
     std::string reason;
     EXPECT_EQ(decode(bad, untouched, &reason), cs.error) << cs.field;
     EXPECT_NE(reason.find(cs.field), std::string::npos) << reason;
-    EXPECT_EQ(untouched.calibrated->skeleton.x, d.calibrated->skeleton.x);
+    EXPECT_EQ(untouched.skeleton->skeleton.x, d.skeleton->skeleton.x);
   }
   auto zero_width = b;
   zero_width[width] = 0;
@@ -461,15 +465,15 @@ TEST(CommPayloadsTest, GestureObservationWithSkeletonRoundTripAndRefusals) {
   EXPECT_EQ(decode(longer, d), PayloadError::kTrailingBytes);
   // The encoder refuses what a decoder would, naming the problem.
   auto e = m;
-  e.calibrated->R_world_camera(0, 0) += 0.01;
-  const auto not_rotation = encodePayload(e);
-  ASSERT_FALSE(not_rotation);
-  EXPECT_NE(not_rotation.reason().find("R_world_camera: not a rotation"), std::string::npos) << not_rotation.reason();
+  e.skeleton->q_world_camera.w() += 0.01;
+  const auto not_unit = encodePayload(e);
+  ASSERT_FALSE(not_unit);
+  EXPECT_NE(not_unit.reason().find("q_world_camera: norm"), std::string::npos) << not_unit.reason();
   e = m;
-  e.calibrated->skeleton.c[4] = 1.01;
+  e.skeleton->skeleton.c[4] = 1.01;
   EXPECT_FALSE(encodePayload(e));
   e = m;
-  e.calibrated->intrinsics.width_px = 70000;
+  e.skeleton->intrinsics.width_px = 70000;
   EXPECT_FALSE(encodePayload(e));
 }
 
