@@ -366,17 +366,32 @@ inline sensor_msgs::CameraInfo toCameraInfo(const estimation::CameraIntrinsics& 
   m.P = {k.fx, 0.0, k.cx, 0.0, 0.0, k.fy, k.cy, 0.0, 0.0, 0.0, 1.0, 0.0};
   return m;
 }
-inline geometry_msgs::Pose toPose(const Eigen::Matrix3d& R_world_camera, const Eigen::Vector3d& p_world_camera) {
+inline geometry_msgs::Pose toPose(const Eigen::Quaterniond& q, const Eigen::Vector3d& p) {
   geometry_msgs::Pose m;
-  m.position.x = p_world_camera.x();
-  m.position.y = p_world_camera.y();
-  m.position.z = p_world_camera.z();
-  const Eigen::Quaterniond q(R_world_camera);
+  m.position.x = p.x();
+  m.position.y = p.y();
+  m.position.z = p.z();
   m.orientation.w = q.w();
   m.orientation.x = q.x();
   m.orientation.y = q.y();
   m.orientation.z = q.z();
   return m;
+}
+inline geometry_msgs::Pose toPose(const geometry_msgs::Transform& t) {
+  geometry_msgs::Pose m;
+  m.position.x = t.translation.x;
+  m.position.y = t.translation.y;
+  m.position.z = t.translation.z;
+  m.orientation = t.rotation;
+  return m;
+}
+inline geometry_msgs::Transform toTransform(const geometry_msgs::Pose& p) {
+  geometry_msgs::Transform t;
+  t.translation.x = p.position.x;
+  t.translation.y = p.position.y;
+  t.translation.z = p.position.z;
+  t.rotation = p.orientation;
+  return t;
 }
 /// Keypoints (17 triples), the image's camera info and the camera's pose in the world → a
 /// calibrated skeleton; fails naming the field (wrong count, a quaternion of norm outside
@@ -468,13 +483,7 @@ inline gesture_formation::GestureObservation fromWire(const comm::GestureObserva
   if (w.skeleton) {
     m.keypoints = toKeypoints(w.skeleton->skeleton);
     m.camera = toCameraInfo(w.skeleton->intrinsics);
-    m.camera_pose.position.x = w.skeleton->p_world_camera.x();
-    m.camera_pose.position.y = w.skeleton->p_world_camera.y();
-    m.camera_pose.position.z = w.skeleton->p_world_camera.z();
-    m.camera_pose.orientation.w = w.skeleton->q_world_camera.w();
-    m.camera_pose.orientation.x = w.skeleton->q_world_camera.x();
-    m.camera_pose.orientation.y = w.skeleton->q_world_camera.y();
-    m.camera_pose.orientation.z = w.skeleton->q_world_camera.z();
+    m.camera_pose = toPose(w.skeleton->q_world_camera, w.skeleton->p_world_camera);
   }
   return m;
 }

@@ -269,16 +269,12 @@ class SimWorldNodelet : public nodelet::Nodelet {
       g.camera = toCameraInfo(skeleton->intrinsics);
       const geometry_msgs::Quaternion axis = cameraAxisOrientation(truth->heading_rad, truth->pitch_rad);
       const Eigen::Quaterniond q_axis_inv = Eigen::Quaterniond(axis.w, axis.x, axis.y, axis.z).conjugate();
-      const geometry_msgs::Pose rel = toPose(q_axis_inv * skeleton->R_world_camera,
-                                             q_axis_inv * (skeleton->p_world_camera - truth->p_world));
       geometry_msgs::TransformStamped T;
       T.header.stamp = stamp;
       T.header.frame_id = prefix + "/camera_axis";
       T.child_frame_id = g.header.frame_id;
-      T.transform.translation.x = rel.position.x;
-      T.transform.translation.y = rel.position.y;
-      T.transform.translation.z = rel.position.z;
-      T.transform.rotation = rel.orientation;
+      T.transform = toTransform(toPose(q_axis_inv * Eigen::Quaterniond(skeleton->R_world_camera),
+                                       q_axis_inv * (skeleton->p_world_camera - truth->p_world)));
       tf_.sendTransform(T);
     }
     gesture_pubs_[static_cast<std::size_t>(uav)].publish(g);

@@ -102,11 +102,7 @@ class ViewObserverNodelet : public nodelet::Nodelet {
       NODELET_WARN_STREAM_THROTTLE(5.0, "ViewObserver: no camera pose for the skeleton (3-D confirmation): " << e.what());
       return;
     }
-    geometry_msgs::Pose pose;
-    pose.position.x = T_world_camera.transform.translation.x;
-    pose.position.y = T_world_camera.transform.translation.y;
-    pose.position.z = T_world_camera.transform.translation.z;
-    pose.orientation = T_world_camera.transform.rotation;
+    const geometry_msgs::Pose pose = toPose(T_world_camera.transform);
     const auto c = toCalibrated(g.keypoints, g.camera, pose);
     if (!c) {
       NODELET_WARN_STREAM_THROTTLE(5.0, "ViewObserver: skeleton not usable for the 3-D confirmation: " << c.reason());
