@@ -332,6 +332,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     msg.planned_at = ros::Time(t);
     msg.formation = toMsg(params_, 0).uavs;
     for (int k = 0; k < req.reference.steps(); ++k) msg.reference.push_back(toPoint(req.reference.p_world.col(k)));
+    for (int k = 0; k < in.worker.steps(); ++k) msg.worker.push_back(toPoint(in.worker.p_world.col(k)));
     plan_pub_.publish(msg);
     traj_pub_.publish(toMultiDof(msg, "uav" + std::to_string(uav_index_)));
   }
