@@ -1,7 +1,8 @@
 // SimUav nodelet: one simulated UAV of the mission (the sim core of `gfctl simulate`:
 // sim::Multirotor plant + sim::TrackingController + sim::Odometry, in the same wind field, with
 // the same seeds), stepping at the mission's step_s in sim time. It executes the plans of its
-// FormationPlanner exactly as received (an empty plan: brake to hover).
+// FormationPlanner exactly as received (an empty plan: brake to hover). Its callbacks run on its
+// own thread, not the nodelet manager's workers; odometry and tf carry the state at the clock.
 //
 // Topics: plan_in (PlannedTrajectory) → odometry_out (nav_msgs/Odometry, the noisy estimate the
 //   planner and estimator use; orientation = camera axis, docs/ros.md), ground_truth_out (the
@@ -17,6 +18,7 @@
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
 #include <geometry_msgs/TwistWithCovarianceStamped.h>
+#include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <tf2_ros/transform_broadcaster.h>
 
@@ -36,9 +38,21 @@
 namespace gesture_formation::nodelets {
 
 class SimUavNodelet : public nodelet::Nodelet {
+ public:
+  ~SimUavNodelet() override {
+    if (spinner_) spinner_->stop();
+    step_timer_.stop();
+    publish_timer_.stop();
+  }
+
  private:
   void onInit() override {
-    ros::NodeHandle& nh = getNodeHandle();
+    // The flight stack's own thread: the plant, its odometry and the camera tf must not wait for the
+    // nodelet manager's workers, which the planner and blocking tf lookups (ViewObserver,
+    // WorkerEstimator: up to tf_timeout_s) can all hold at once — as a flight controller does not
+    // wait for the onboard computer.
+    ros::NodeHandle nh(getNodeHandle());
+    nh.setCallbackQueue(&queue_);
     ParamLoader params(getPrivateNodeHandle());
     std::string mission_file;
     int seed = 0;
@@ -91,6 +105,8 @@ class SimUavNodelet : public nodelet::Nodelet {
     plan_sub_ = nh.subscribe("plan_in", 5, &SimUavNodelet::onPlan, this);
     step_timer_ = nh.createTimer(ros::Duration(step_s_), &SimUavNodelet::onStep, this);
     publish_timer_ = nh.createTimer(ros::Duration(1.0 / rate_hz), &SimUavNodelet::onPublish, this);
+    spinner_.emplace(1, &queue_);
+    spinner_->start();
   }
 
   void onPlan(const gesture_formation::PlannedTrajectory::ConstPtr& msg) {
@@ -105,7 +121,11 @@ class SimUavNodelet : public nodelet::Nodelet {
 
   void onStep(const ros::TimerEvent&) {
     std::lock_guard<std::mutex> lock(mutex_);
-    const double now = ros::Time::now().toSec();
+    advanceTo(ros::Time::now().toSec());
+  }
+
+  /// Steps the plant up to `now` (caller holds mutex_).
+  void advanceTo(double now) {
     if (t_ < 0.0) t_ = now;
     // Catch up in fixed steps (the clock may advance by more than one step between calls).
     for (int n = 0; t_ + step_s_ <= now + 1e-9 && n < 1000; ++n) {
@@ -133,6 +153,7 @@ class SimUavNodelet : public nodelet::Nodelet {
   void onPublish(const ros::TimerEvent&) {
     std::lock_guard<std::mutex> lock(mutex_);
     if (t_ < 0.0) return;
+    advanceTo(ros::Time::now().toSec());  // the state at the clock, not at the last step timer's call
     const ros::Time stamp(t_);
     const auto& s = plant_->state();
     odom_pub_.publish(odometry(stamp, est_.p_world, est_.v_world, est_.heading_rad, est_.pitch_rad));
@@ -174,8 +195,10 @@ class SimUavNodelet : public nodelet::Nodelet {
   sim::EstimatedState est_;
   tf2_ros::TransformBroadcaster tf_;
   ros::Publisher odom_pub_, truth_pub_, wind_pub_;
+  ros::CallbackQueue queue_;  ///< served by spinner_ (declared before what it serves, destroyed after)
   ros::Subscriber plan_sub_;
   ros::Timer step_timer_, publish_timer_;
+  std::optional<ros::AsyncSpinner> spinner_;
 };
 
 }  // namespace gesture_formation::nodelets
