@@ -78,6 +78,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
       return;
     }
     NODELET_INFO_STREAM("SimWorld loaded:\n" << params.loaded());
+    for (const auto& w : sim::gestureReadabilityWarnings(cfg_)) NODELET_WARN_STREAM("SimWorld: " << w);
     if (duration_s_ <= 0.0) duration_s_ = cfg_.duration_s;
     const auto s = static_cast<std::uint64_t>(seed);
     worker_.emplace(cfg_.worker, sim::mixSeed(s ^ static_cast<std::uint64_t>(sim::Stream::kWorker)));

@@ -127,11 +127,15 @@ int ViewFusion::viewVote(std::size_t i, double t_now) const {
   return best_count > 0 && best_count >= config_.vote_min_fraction * total ? best : 0;
 }
 
-bool ViewFusion::inEnvelope(double distance_m, double elevation_deg) const {
-  if (!config_.gate_envelope) return true;
+bool ViewFusionConfig::inEnvelope(double distance_m, double elevation_deg) const {
+  if (!gate_envelope) return true;
   if (!(std::isfinite(distance_m) && distance_m >= 0.0 && std::isfinite(elevation_deg))) return false;  // unknown
-  return distance_m >= config_.distance_min_m && distance_m <= config_.distance_max_m &&
-         elevation_deg >= config_.elevation_min_deg && elevation_deg <= config_.elevation_max_deg;
+  return distance_m >= distance_min_m && distance_m <= distance_max_m && elevation_deg >= elevation_min_deg &&
+         elevation_deg <= elevation_max_deg;
+}
+
+bool ViewFusion::inEnvelope(double distance_m, double elevation_deg) const {
+  return config_.inEnvelope(distance_m, elevation_deg);
 }
 
 FusedGesture ViewFusion::fuse(double t_now) const {

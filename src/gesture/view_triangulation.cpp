@@ -83,6 +83,10 @@ std::vector<std::string> ArmGestureThresholds::validate() const {
   if (!(min_reach_ratio > 0.0 && min_reach_ratio <= 1.0)) {
     e.push_back("min_reach_ratio: expected (0, 1], got " + std::to_string(min_reach_ratio));
   }
+  angle("max_trunk_tilt_deg", max_trunk_tilt_deg);
+  if (!(max_foot_offset_torso > 0.0 && max_foot_offset_torso <= 5.0)) {
+    e.push_back("max_foot_offset_torso: expected (0, 5], got " + std::to_string(max_foot_offset_torso));
+  }
   return e;
 }
 
@@ -161,6 +165,24 @@ std::optional<BodyFrame> bodyFrameOf(const Skeleton3D& s) {
   return f;
 }
 
+Stance stanceOf(const Skeleton3D& s) {
+  Stance st;
+  for (int k : {kLeftShoulder, kRightShoulder, kLeftHip, kRightHip, kLeftAnkle, kRightAnkle}) {
+    if (!s.valid[static_cast<std::size_t>(k)]) return st;
+  }
+  const Eigen::Vector3d mid_hip = 0.5 * (s.p_world[kLeftHip] + s.p_world[kRightHip]);
+  const Eigen::Vector3d trunk = 0.5 * (s.p_world[kLeftShoulder] + s.p_world[kRightShoulder]) - mid_hip;
+  const double torso = trunk.norm();
+  if (!(torso >= 0.2)) return st;
+  st.valid = true;
+  st.trunk_tilt_deg = angleDeg(trunk, Eigen::Vector3d::UnitZ());
+  for (int k : {kLeftAnkle, kRightAnkle}) {
+    const Eigen::Vector3d d = s.p_world[static_cast<std::size_t>(k)] - mid_hip;
+    st.foot_offset_torso = std::max(st.foot_offset_torso, std::hypot(d.x(), d.y()) / torso);
+  }
+  return st;
+}
+
 ArmGeometry armGeometry(const Skeleton3D& s, bool left_arm) {
   ArmGeometry g;
   const auto shoulder = static_cast<std::size_t>(left_arm ? kLeftShoulder : kRightShoulder);
@@ -183,6 +205,10 @@ ArmGeometry armGeometry(const Skeleton3D& s, bool left_arm) {
 }
 
 int oneArmGesture3D(const Skeleton3D& s, const ArmGestureThresholds& t) {
+  const Stance stance = stanceOf(s);
+  if (!stance.valid || stance.trunk_tilt_deg > t.max_trunk_tilt_deg || stance.foot_offset_torso > t.max_foot_offset_torso) {
+    return kNone;
+  }
   int best = kNone;
   for (bool left : {true, false}) {
     const ArmGeometry g = armGeometry(s, left);

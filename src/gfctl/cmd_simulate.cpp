@@ -264,6 +264,7 @@ int cmdSimulate(const Args& args) {
   } else {
     std::cerr << "gfctl simulate: warning: no mission.gesture_model: gestures are not recognised\n";
   }
+  for (const auto& w : sim::gestureReadabilityWarnings(L.mission)) std::cerr << "gfctl simulate: warning: " << w << "\n";
   const auto t0 = std::chrono::steady_clock::now();
   auto map = planning::OccupancyMap::fromScenario(L.scenario);
   if (!map) return badInput(args, path + ": map: " + map.reason());

@@ -1,12 +1,15 @@
 #include "gesture_formation/sim/mission_config.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
 
 #include <yaml-cpp/yaml.h>
 
+#include "gesture_formation/common/angles.hpp"
 #include "gesture_formation/common/config_reader.hpp"
+#include "gesture_formation/formation/formation_geometry.hpp"
 #include "validate_util.hpp"
 
 namespace gesture_formation::sim {
@@ -594,6 +597,43 @@ common::Result<MissionConfig> loadMissionConfig(const std::string& scenario_path
   const auto slash = scenario_path.find_last_of('/');
   const std::string dir = slash == std::string::npos ? "." : scenario_path.substr(0, slash);
   return parseMissionConfig(emitter.c_str(), scenario_path + " + " + faults_path, dir);
+}
+
+std::vector<std::string> gestureReadabilityWarnings(const MissionConfig& m) {
+  const gesture::ViewFusionConfig& vf = m.view_fusion;
+  if (m.gesture_model.empty() || !vf.gate_envelope) return {};
+  const formation::FormationParams& fp = m.formation.params;
+  const formation::UavReference lref = formation::leaderReference(Eigen::Vector3d::Zero(), 0.0, fp.leader);
+  std::vector<formation::UavReference> refs{lref};
+  for (const auto& f : fp.followers) {
+    refs.push_back(formation::followerReference(Eigen::Vector3d::Zero(), lref.heading_rad, lref.pitch_rad, f));
+  }
+  // Followers' cameras vote only when they are views of the fusion (min_agreeing_views > 1).
+  const std::size_t cameras = vf.min_agreeing_views > 1 ? refs.size() : 1;
+  int inside = 0;
+  std::string outside;
+  for (std::size_t i = 0; i < cameras; ++i) {
+    const double d = refs[i].p_world.norm();
+    const double e = d > 0.0 ? common::radToDeg(std::asin(std::clamp(refs[i].p_world.z() / d, -1.0, 1.0))) : 0.0;
+    if (vf.inEnvelope(d, e)) {
+      ++inside;
+      continue;
+    }
+    std::ostringstream o;
+    o.precision(3);
+    o << (outside.empty() ? "" : ", ") << (i == 0 ? std::string("the leader") : "follower " + std::to_string(i)) << " at "
+      << d << " m, " << e << " deg";
+    outside += o.str();
+  }
+  if (inside >= vf.min_agreeing_views) return {};
+  std::ostringstream w;
+  w << "gestures: " << inside << " of " << cameras << " cameras inside the classifier's validated envelope ("
+    << vf.distance_min_m << "-" << vf.distance_max_m << " m, " << vf.elevation_min_deg << "-" << vf.elevation_max_deg
+    << " deg above the worker; view_fusion) at the mission's start, " << vf.min_agreeing_views
+    << " needed to accept a gesture (min_agreeing_views): " << outside << " do not vote"
+    << (vf.confirm_3d && inside + 1 == vf.min_agreeing_views ? " (a one-arm gesture may still pass the 3-D confirmation)" : "")
+    << " (docs/gestures.md 4.1)";
+  return {w.str()};
 }
 
 }  // namespace gesture_formation::sim

@@ -66,6 +66,9 @@ struct ViewFusionConfig {
 
   /// \brief Every problem, each naming the key; empty when valid.
   std::vector<std::string> validate() const;
+  /// \brief Whether a camera at this distance and elevation from the worker may vote (always with
+  /// gate_envelope off; never with an unknown geometry).
+  bool inEnvelope(double distance_m, double elevation_deg) const;
 };
 
 /// \brief Reads `view_fusion.{min_agreeing_views, max_age_s, gate_envelope, distance_min_m,

@@ -151,6 +151,13 @@ common::Result<MissionConfig> loadMissionConfig(const std::string& scenario_path
 common::Result<MissionConfig> parseMissionConfig(const std::string& yaml, const std::string& source_name,
                                                  const std::string& base_dir);
 
+/// \brief What keeps the mission's formation, as configured at its start, from reading gestures:
+/// with view_fusion.gate_envelope, the UAVs whose reference lies outside the validated envelope
+/// (distance and elevation from the worker) when fewer than min_agreeing_views stay inside — one
+/// message naming each such UAV, its distance and elevation and the envelope. Empty when enough
+/// cameras are inside, or without a gesture model. For gfctl simulate and SimWorld to warn with.
+std::vector<std::string> gestureReadabilityWarnings(const MissionConfig& m);
+
 /// \brief Parses a request target: all | leader | followers | follower<i> | a list of UAV
 /// indices [0, 2] (0 = leader).
 common::Result<formation::CommandTarget> parseTarget(const std::string& text);

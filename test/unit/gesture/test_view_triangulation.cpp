@@ -71,7 +71,57 @@ TEST(ViewTriangulationTest, ExactViewsRecoverTheBodyAndItsFrame) {
   EXPECT_LE(left.from_outward_deg, 25.5);
   EXPECT_GT(left.reach_ratio, 0.99);
   EXPECT_GT(right.from_up_deg, 150.0);
+  // It stands upright, feet under the hips.
+  const gf::gesture::Stance stance = gf::gesture::stanceOf(s);
+  ASSERT_TRUE(stance.valid);
+  EXPECT_LT(stance.trunk_tilt_deg, 5.0);
+  EXPECT_LT(stance.foot_offset_torso, 0.5);
   EXPECT_EQ(gf::gesture::oneArmGesture3D(s), gf::gesture::kExtendArmSide);
+}
+
+// A side kick or a lunge can hold an arm exactly where "extend" holds it (docs/gestures.md §6):
+// the arm test alone says "extend"; the stance says no. Exact views, so the numbers are the body's.
+TEST(ViewTriangulationTest, TheArmOfTheGestureWithoutAnUprightStanceIsNoGesture) {
+  SkeletonSynthesizer synth(SynthConfig{}, 3);
+  const gf::gesture::Body3D upright = synth.pose(Motion::kExtendArmSide, 1.0, 0.0, true);
+  const auto seen = [](const gf::gesture::Body3D& body) {
+    std::vector<CalibratedSkeleton> views{cameraAt(10.0, 20.0, 0.0, 1.0), cameraAt(9.0, 30.0, 60.0, 1.0),
+                                          cameraAt(12.0, 15.0, -60.0, 1.0)};
+    for (auto& v : views) projectInto(body, v);
+    return gf::gesture::triangulate(views, TriangulationConfig{});
+  };
+  const auto i = [](int k) { return static_cast<std::size_t>(k); };
+  const Eigen::Vector3d hip = 0.5 * (upright.p[i(gf::gesture::kLeftHip)] + upright.p[i(gf::gesture::kRightHip)]);
+  const double torso = (0.5 * (upright.p[i(gf::gesture::kLeftShoulder)] + upright.p[i(gf::gesture::kRightShoulder)]) - hip).norm();
+  // The right foot kicked out sideways (the arm is the left one): 1.0 torso lengths from the hips.
+  gf::gesture::Body3D kick = upright;
+  kick.p[i(gf::gesture::kRightAnkle)] = hip + Eigen::Vector3d(0.0, -1.0 * torso, 0.15);
+  const Skeleton3D sk = seen(kick);
+  EXPECT_LT(gf::gesture::armGeometry(sk, true).from_outward_deg, 25.5);  // the arm is the gesture's
+  EXPECT_NEAR(gf::gesture::stanceOf(sk).foot_offset_torso, 1.0, 1e-6);
+  EXPECT_EQ(gf::gesture::oneArmGesture3D(sk), gf::gesture::kNone);
+  // The whole body leaning 30° sideways about the hips (arm and all: still "extended" in the body frame).
+  gf::gesture::Body3D lean = upright;
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(degToRad(30.0), Eigen::Vector3d::UnitX()).toRotationMatrix();
+  for (int k : {gf::gesture::kNose, gf::gesture::kLeftEye, gf::gesture::kRightEye, gf::gesture::kLeftEar,
+                gf::gesture::kRightEar, gf::gesture::kLeftShoulder, gf::gesture::kRightShoulder, gf::gesture::kLeftElbow,
+                gf::gesture::kRightElbow, gf::gesture::kLeftWrist, gf::gesture::kRightWrist}) {
+    lean.p[i(k)] = hip + R * (upright.p[i(k)] - hip);
+  }
+  const Skeleton3D sl = seen(lean);
+  EXPECT_LT(gf::gesture::armGeometry(sl, true).from_outward_deg, 25.5);
+  EXPECT_NEAR(gf::gesture::stanceOf(sl).trunk_tilt_deg, gf::gesture::stanceOf(seen(upright)).trunk_tilt_deg + 30.0, 1.0);
+  EXPECT_EQ(gf::gesture::oneArmGesture3D(sl), gf::gesture::kNone);
+  // Just inside both limits it counts; feet unseen (no ankles): stance unknown, no gesture.
+  gf::gesture::ArmGestureThresholds loose;
+  loose.max_foot_offset_torso = 1.05;
+  EXPECT_EQ(gf::gesture::oneArmGesture3D(sk, loose), gf::gesture::kExtendArmSide);
+  loose.max_trunk_tilt_deg = 35.0;
+  EXPECT_EQ(gf::gesture::oneArmGesture3D(sl, loose), gf::gesture::kExtendArmSide);
+  Skeleton3D no_feet = seen(upright);
+  no_feet.valid[i(gf::gesture::kLeftAnkle)] = false;
+  EXPECT_FALSE(gf::gesture::stanceOf(no_feet).valid);
+  EXPECT_EQ(gf::gesture::oneArmGesture3D(no_feet), gf::gesture::kNone);
 }
 
 TEST(ViewTriangulationTest, OneViewOrNearlyParallelRaysGiveNoPoint) {
@@ -129,6 +179,13 @@ TEST(ViewTriangulationTest, ConfigErrorsNameTheFieldAndValue) {
   EXPECT_NE(et[0].find("extend_max_deg"), std::string::npos);
   EXPECT_NE(et[0].find("95"), std::string::npos);
   EXPECT_NE(et[1].find("min_reach_ratio"), std::string::npos);
+  gf::gesture::ArmGestureThresholds st;
+  st.max_trunk_tilt_deg = 90.0;
+  st.max_foot_offset_torso = std::nan("");
+  const auto es = st.validate();
+  ASSERT_EQ(es.size(), 2u);
+  EXPECT_NE(es[0].find("max_trunk_tilt_deg: expected (0, 90) deg, got 90"), std::string::npos) << es[0];
+  EXPECT_NE(es[1].find("max_foot_offset_torso: expected (0, 5], got nan"), std::string::npos) << es[1];
 }
 
 namespace {
@@ -184,21 +241,23 @@ Share share3D(Motion m, int id, int count, std::uint64_t seed) {
 // The bounds leave room for other noise draws, not for a 2-D-like confusion.
 // Since the v8 generator (2026-12-03) half of the balancing lunges are side kicks whose leading arm
 // is −10…+50° about the horizontal: up to +27.5° that arm IS extended sideways in 3-D — the same arm
-// pose as the gesture, not a near-miss of it — so the lunge reads as "extend" in 0.19 of its frames
-// (measured; 0.014 before the kicks). Arm geometry alone does not reject it (an upright-stance test
-// would; docs/gestures.md §6); the 3-D rule only completes a vote one camera's LSTM already cast,
-// and the three-camera end-to-end test includes the lunge (test_gesture_classifier.cpp).
+// pose as the gesture, not a near-miss of it — and by arm geometry alone the lunge read as "extend"
+// in 0.19 of its frames (0.014 before the kicks). The upright-stance test (stanceOf, same day) takes
+// that to 0 of 3770 frames (80 performances), the gestures from 0.916 / 0.920 of their frames to
+// 0.909 / 0.910 (extend / raise).
 TEST(ViewTriangulationTest, ThreeNoisyViewsTellExtendAndRaiseFromTheirNearMisses) {
   const int n = 40;
   EXPECT_GE(share3D(Motion::kExtendArmSide, gf::gesture::kExtendArmSide, n, 11).rate(), 0.85);
   EXPECT_GE(share3D(Motion::kRaiseArmUp, gf::gesture::kRaiseArmUp, n, 12).rate(), 0.85);
   EXPECT_LE(share3D(Motion::kArmPartwayOrPointing, gf::gesture::kExtendArmSide, n, 27).rate(), 0.01);
+  // The side kicks and lunges: their arm may be the gesture's, their stance is not (above).
+  EXPECT_LE(share3D(Motion::kBalanceLunge, gf::gesture::kExtendArmSide, n, 21).rate(), 0.005);
+  EXPECT_LE(share3D(Motion::kBalanceLunge, gf::gesture::kRaiseArmUp, n, 22).rate(), 0.005);
   for (Motion m : {Motion::kArmPartwayOrPointing, Motion::kBalanceLunge, Motion::kReachUpBolt, Motion::kClimbingLadder,
                    Motion::kWalking, Motion::kHoldObjectAtChest, Motion::kArmsFoldedLow, Motion::kToolAtWaist,
                    Motion::kIdle, Motion::kCrossArms, Motion::kPalmsTogether}) {
     const auto seed = static_cast<std::uint64_t>(m);
-    const double extend_max = m == Motion::kBalanceLunge ? 0.25 : 0.05;  // the side kicks, above
-    EXPECT_LE(share3D(m, gf::gesture::kExtendArmSide, n, 20 + seed).rate(), extend_max) << gf::gesture::toString(m);
+    EXPECT_LE(share3D(m, gf::gesture::kExtendArmSide, n, 20 + seed).rate(), 0.05) << gf::gesture::toString(m);
     EXPECT_LE(share3D(m, gf::gesture::kRaiseArmUp, n, 40 + seed).rate(), 0.06) << gf::gesture::toString(m);
   }
 }

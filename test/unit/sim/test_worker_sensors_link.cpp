@@ -202,6 +202,37 @@ TEST(MissionConfigTest, ShippedScenariosLoad) {
   EXPECT_DOUBLE_EQ(pt->formation.limits.safety_distance_m, 2.5);
 }
 
+// A formation whose cameras sit outside the classifier's validated envelope cannot accept a
+// gesture (docs/gestures.md 4.1): gfctl simulate and SimWorld say so at the start.
+TEST(MissionConfigTest, WarnsWhenTooFewCamerasAreInsideTheGestureEnvelope) {
+  const auto pt = gf::sim::loadMissionConfig(std::string(GF_SOURCE_DIR) + "/config/scenarios/power_towers.yaml");
+  ASSERT_TRUE(pt) << pt.reason();
+  EXPECT_TRUE(gf::sim::gestureReadabilityWarnings(*pt).empty());  // Table II: 10 m at 11 deg, followers 8 m
+  gf::sim::MissionConfig close = *pt;
+  close.formation.params.followers[0].distance_m = 4.5;
+  EXPECT_TRUE(gf::sim::gestureReadabilityWarnings(close).empty());  // leader + follower 2: 2 of 3, enough
+  close.formation.params.followers[1].distance_m = 4.5;
+  const auto w = gf::sim::gestureReadabilityWarnings(close);
+  ASSERT_EQ(w.size(), 1u);
+  for (const char* want : {"1 of 3 cameras", "follower 1 at 4.5 m, 11 deg", "follower 2 at 4.5 m", "5-20 m",
+                           "2 needed", "3-D confirmation"}) {
+    EXPECT_NE(w[0].find(want), std::string::npos) << "missing '" << want << "' in " << w[0];
+  }
+  close.view_fusion.gate_envelope = false;  // every camera votes: nothing to say
+  EXPECT_TRUE(gf::sim::gestureReadabilityWarnings(close).empty());
+  gf::sim::MissionConfig single = *pt;      // the paper's single camera: only the leader's counts
+  single.view_fusion.min_agreeing_views = 1;
+  single.formation.params.followers[0].distance_m = 4.5;
+  EXPECT_TRUE(gf::sim::gestureReadabilityWarnings(single).empty());
+  single.formation.params.leader.gamma_deg = 50.0;
+  const auto ws = gf::sim::gestureReadabilityWarnings(single);
+  ASSERT_EQ(ws.size(), 1u);
+  EXPECT_NE(ws[0].find("0 of 1 cameras"), std::string::npos) << ws[0];
+  EXPECT_NE(ws[0].find("the leader at 10 m, 50 deg"), std::string::npos) << ws[0];
+  single.gesture_model.clear();             // no gestures read at all: nothing to say
+  EXPECT_TRUE(gf::sim::gestureReadabilityWarnings(single).empty());
+}
+
 TEST(MissionConfigTest, ListsEveryProblem) {
   const std::string yaml = R"(
 mission:
