@@ -204,18 +204,22 @@ std::optional<PlannedTrajectory> UavPlanner::separateHoldPoint(const PlanRequest
   // predicted positions (worker_safety_distance_m), each plus the QP's buffer.
   struct Keep {
     std::function<Eigen::Vector3d(double)> at;
-    double distance;
+    double distance;  ///< the stop point's target distance
+    double floor;     ///< a move must not enter it where the unmoved plan is outside (the verifier's requirement + buffer)
     std::string name;
   };
   std::vector<Keep> keep;
   for (const auto& other : req.higher_priority_plans) {
     if (other.empty()) continue;
+    const double age = std::isfinite(req.t_now_s) ? std::max(0.0, req.t_now_s - other.t0_s) : 0.0;
     keep.push_back({[&other](double t) { return evaluateTrajectory(other, t).p; },
-                    config_.mutual_distance_m + config_.qp_distance_buffer_m, "UAV " + std::to_string(other.uav_index)});
+                    config_.mutual_distance_m + config_.qp_distance_buffer_m,
+                    config_.mutual_distance_m + config_.age_margin_speed_mps * age + config_.qp_distance_buffer_m,
+                    "UAV " + std::to_string(other.uav_index)});
   }
   if (req.worker.steps() > 0 && req.worker.p_world.allFinite()) {
-    keep.push_back({[&req](double t) { return workerPositionAt(req.worker, req.t_now_s, req.dt_s, t); },
-                    config_.worker_safety_distance_m + config_.qp_distance_buffer_m, "the worker"});
+    const double d = config_.worker_safety_distance_m + config_.qp_distance_buffer_m;
+    keep.push_back({[&req](double t) { return workerPositionAt(req.worker, req.t_now_s, req.dt_s, t); }, d, d, "the worker"});
   }
   if (keep.empty()) return std::nullopt;
   // First sample from which the plan stands still (the stop point).
@@ -241,7 +245,6 @@ std::optional<PlannedTrajectory> UavPlanner::separateHoldPoint(const PlanRequest
     if (kp.distance - d_min > deficit) deficit = kp.distance - d_min, closest = kp.name;
   }
   if (!(away.norm() > 1e-6) || !(deficit > 1e-3)) return std::nullopt;
-  const Eigen::Vector3d dir = away.normalized();
   const double D = std::min(deficit, config_.fallback_max_deviation_m);
   // s(τ) = D (1 − cos(πτ/T)) / 2: peak speed Dπ/2T and acceleration Dπ²/2T² within the recovery
   // pace; T a whole number of samples, so that the move ends on a sample (no overshoot in between).
@@ -249,28 +252,46 @@ std::optional<PlannedTrajectory> UavPlanner::separateHoldPoint(const PlanRequest
                                                   M_PI * std::sqrt(D / (2.0 * config_.recovery_acceleration_mps2))) /
                                          hold.dt_s - 1e-9);
   if (static_cast<double>(n - 1 - k_stop) * hold.dt_s < T) return std::nullopt;  // the move must end inside the plan
-  PlannedTrajectory moved = hold;
-  for (int k = k_stop; k < n; ++k) {
-    const double tau = (k - k_stop) * hold.dt_s;
-    const double ph = tau < T ? M_PI * tau / T : M_PI;
-    TrajectorySample& s = moved.samples[static_cast<std::size_t>(k)];
-    s.p_world = p_hold + dir * (D * 0.5 * (1.0 - std::cos(ph)));
-    s.v_world = tau < T ? Eigen::Vector3d(dir * (D * M_PI / (2.0 * T) * std::sin(ph))) : Eigen::Vector3d::Zero();
-    s.a_world = tau < T ? Eigen::Vector3d(dir * (D * M_PI * M_PI / (2.0 * T * T) * std::cos(ph))) : Eigen::Vector3d::Zero();
-  }
-  aimCamera(req, moved);
-  // Obstacles and limits: the verifier alone; the UAVs and the worker: never closer than the hold.
-  const VerificationReport rep = verifier_->verify(moved, req.t_now_s, {}, formation::WorkerHorizon{}, req.t_now_s, hold.dt_s);
-  if (!rep.ok) return std::nullopt;
-  for (const auto& kp : keep) {
-    for (double t = hold.t0_s; t <= hold.tEnd() + 1e-9; t += hold.dt_s / 4.0) {
-      const Eigen::Vector3d q = kp.at(t);
-      if ((evaluateTrajectory(moved, t).p - q).norm() < (evaluateTrajectory(hold, t).p - q).norm() - 1e-6) return std::nullopt;
+  const auto moveAlong = [&](const Eigen::Vector3d& dir) -> std::optional<PlannedTrajectory> {
+    PlannedTrajectory moved = hold;
+    for (int k = k_stop; k < n; ++k) {
+      const double tau = (k - k_stop) * hold.dt_s;
+      const double ph = tau < T ? M_PI * tau / T : M_PI;
+      TrajectorySample& s = moved.samples[static_cast<std::size_t>(k)];
+      s.p_world = p_hold + dir * (D * 0.5 * (1.0 - std::cos(ph)));
+      s.v_world = tau < T ? Eigen::Vector3d(dir * (D * M_PI / (2.0 * T) * std::sin(ph))) : Eigen::Vector3d::Zero();
+      s.a_world = tau < T ? Eigen::Vector3d(dir * (D * M_PI * M_PI / (2.0 * T * T) * std::cos(ph))) : Eigen::Vector3d::Zero();
     }
+    aimCamera(req, moved);
+    // Obstacles and limits: the verifier alone; the UAVs and the worker: never closer than the hold
+    // where that is within their floor, never inside the floor where the hold is not.
+    const VerificationReport rep = verifier_->verify(moved, req.t_now_s, {}, formation::WorkerHorizon{}, req.t_now_s, hold.dt_s);
+    if (!rep.ok) return std::nullopt;
+    for (const auto& kp : keep) {
+      for (double t = hold.t0_s; t <= hold.tEnd() + 1e-9; t += hold.dt_s / 4.0) {
+        const Eigen::Vector3d q = kp.at(t);
+        // Closer only where it stays beyond the floor (a UAV 5 m off must not block a move by a
+        // millimetre: dense pillars seed 3).
+        const double d_hold = (evaluateTrajectory(hold, t).p - q).norm();
+        if ((evaluateTrajectory(moved, t).p - q).norm() < std::min(d_hold, kp.floor) - 1e-6) return std::nullopt;
+      }
+    }
+    return moved;
+  };
+  // Away from what it is too close to; when that is blocked (a pillar behind the UAV, another UAV
+  // on the far side), straight up: among pillars and towers the way up is usually free, and it
+  // leaves a worker on the ground below (dense pillars seed 3: a follower braked between a pillar
+  // and the worker walking up to it, 1.89 m).
+  const char* how = "away from ";
+  std::optional<PlannedTrajectory> moved = moveAlong(away.normalized());
+  if (!moved && away.normalized().z() < 1.0 - 1e-9) {
+    moved = moveAlong(Eigen::Vector3d::UnitZ());
+    how = "up, away from ";
   }
+  if (!moved) return std::nullopt;
   std::ostringstream os;
   os.precision(3);
-  os << "; moving the brake point " << D << " m away from " << closest;
+  os << "; moving the brake point " << D << " m " << how << closest;
   why = os.str();
   return moved;
 }
