@@ -180,7 +180,7 @@ with open(report, "w") as f:
                 + ". See [safety.md](safety.md) §4.5 for missions that hung.\n\n")
     if violations:
         f.write(f"**Safety violations ({len(violations)} of {total} missions):**\n\n" + "\n".join(f"- {v}" for v in violations)
-                + "\n\nCauses and reproduction: [safety.md](safety.md) §4.4.\n")
+                + "\n\nCauses and reproduction: [safety.md](safety.md) §4 (each violation found has its subsection there, e.g. §4.4, §4.11).\n")
     else:
         f.write(f"**No safety violation in the {total} missions** (no min mutual < 2.5 m, no obstacle distance < 0.5 m, "
                 "no collision).\n")
