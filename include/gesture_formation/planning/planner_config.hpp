@@ -75,8 +75,8 @@ struct PlannerConfig {
   /// a weather report's gust figure is the peak of its window. No estimate: no wind allowance.
   /// (from ≥ 0, m_per_mps ≥ 0, max ≥ 0, window > 0.)
   double wind_allowance_from_mps = 5.0;
-  double wind_allowance_m_per_mps = 0.05;
-  double wind_allowance_max_m = 0.3;
+  double wind_allowance_m_per_mps = 0.2;
+  double wind_allowance_max_m = 1.0;
   double wind_window_s = 120.0;
   /// Largest distance (m) a reference may be moved by the projection; > 0.
   double max_projection_m = 6.0;
