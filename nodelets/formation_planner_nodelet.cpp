@@ -202,12 +202,8 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
       last_status_ = formation::toString(formation::CommandStatus::kRejected);
     } else {
       const auto out = state_->apply(*cmd);
-      last_outcome_ = formation::toString(out.status);
-      last_status_ = last_outcome_;
-      if (!out.reason.empty()) last_outcome_ += ": " + out.reason;
-      for (const auto& c : out.changes) {
-        if (c.clamped) last_outcome_ += " (clamped by " + c.clamp_rule + ")";
-      }
+      last_outcome_ = out.describe();
+      last_status_ = formation::toString(out.status);
       if (out.status == formation::CommandStatus::kApplied) {
         ++version_;
         params_ = state_->params();

@@ -17,6 +17,15 @@ const char* parameterName(Parameter p) {
 
 const char* toString(CommandSource s) { return s == CommandSource::kOperator ? "operator" : "gesture"; }
 
+std::string CommandOutcome::describe() const {
+  std::string text = toString(status);
+  if (!reason.empty()) text += ": " + reason;
+  for (const auto& c : changes) {
+    if (c.clamped) text += " (clamped by " + c.clamp_rule + ")";
+  }
+  return text;
+}
+
 const char* toString(CommandStatus s) {
   switch (s) {
     case CommandStatus::kApplied: return "applied";

@@ -121,6 +121,9 @@ struct CommandOutcome {
     }
     return false;
   }
+  /// One line for operators and logs: the status, ": reason" when there is one, and
+  /// " (clamped by <rule>)" per clamped change (FormationParams.last_outcome).
+  std::string describe() const;
 };
 
 /// \brief Bounds of the duplicate-id memory.

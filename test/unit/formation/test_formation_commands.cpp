@@ -67,6 +67,16 @@ TEST(FormationCommandsTest, LeaderGammaClampedAndReported) {
   EXPECT_EQ(s.params().leader.gamma_deg, 60.0);
 }
 
+TEST(FormationCommandsTest, OutcomeDescribesStatusReasonAndClamps) {
+  FormationState s = tableII();
+  EXPECT_EQ(s.apply(cmd(1, CommandTarget::leader(), Parameter::kGamma, 100.0)).describe(),
+            "applied (clamped by limits.gamma_max_deg)");
+  EXPECT_EQ(s.apply(cmd(2, CommandTarget::leader(), Parameter::kGamma, -1.0)).describe(), "applied");
+  CommandOutcome rejected;
+  rejected.reason = "unknown UAV 7";
+  EXPECT_EQ(rejected.describe(), "rejected: unknown UAV 7");
+}
+
 TEST(FormationCommandsTest, LeaderGammaClampedByFollowerElevation) {
   FormationParams p;
   p.followers[1].gamma_deg = 10.0;  // follower 2 sits 10° above the leader's pitch
