@@ -91,7 +91,8 @@ bool segmentClear(const DistanceField& field, double res, const Eigen::Vector3d&
 
 common::Result<std::vector<Eigen::Vector3d>> GridPathSearch::search(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                                                     double clearance_m, double shortcut_clearance_m,
-                                                                    double margin_m, int max_expansions, Stats* stats) const {
+                                                                    double margin_m, int max_expansions, Stats* stats,
+                                                                    const KeepOutTube& keep_out) const {
   using R = common::Result<std::vector<Eigen::Vector3d>>;
   if (!a.allFinite() || !b.allFinite()) return R::fail("A*: non-finite start or goal");
   const double res = map_.resolution();
@@ -108,6 +109,11 @@ common::Result<std::vector<Eigen::Vector3d>> GridPathSearch::search(const Eigen:
   const auto inBox = [&](int x, int y, int z) { return x >= lx && y >= ly && z >= lz && x <= hx && y <= hy && z <= hz; };
   if (!inBox(va.x(), va.y(), va.z()) || !inBox(vb.x(), vb.y(), vb.z())) return R::fail("A*: start or goal outside the map grid");
   const int nx = hx - lx + 1, ny = hy - ly + 1, nz = hz - lz + 1;
+  // A voxel the search may enter: clear of obstacles and outside the keep-out tube.
+  const auto enterable = [&](int x, int y, int z) {
+    if (field_.atLocal(x, y, z) < clearance_m) return false;
+    return !keep_out.active() || !keep_out.contains(map_.centerOf(VoxelIndex(x, y, z) + origin));
+  };
   const std::size_t total = static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny) * static_cast<std::size_t>(nz);
   if (total > 20'000'000) return R::fail("A*: search box too large (" + std::to_string(total) + " voxels)");
   const auto lin = [&](int x, int y, int z) { return static_cast<std::int32_t>((x - lx) + nx * ((y - ly) + ny * (z - lz))); };
@@ -171,7 +177,7 @@ common::Result<std::vector<Eigen::Vector3d>> GridPathSearch::search(const Eigen:
             const std::int32_t ni = lin(x, y, z);
             if (flood_stamp_[static_cast<std::size_t>(ni)] == fg) continue;
             if (ni == start) return 0;  // connected
-            if (field_.atLocal(x, y, z) < clearance_m) continue;
+            if (!enterable(x, y, z)) continue;
             flood_stamp_[static_cast<std::size_t>(ni)] = fg;
             flood_queue_.push_back(ni);
             if (flood_queue_.size() > static_cast<std::size_t>(kPocketMaxVoxels)) return 0;  // too large to tell
@@ -203,7 +209,7 @@ common::Result<std::vector<Eigen::Vector3d>> GridPathSearch::search(const Eigen:
           const std::int32_t ni = lin(x, y, z);
           touch(ni);
           if (closed_[static_cast<std::size_t>(ni)]) continue;
-          if (ni != goal && field_.atLocal(x, y, z) < clearance_m) continue;
+          if (ni != goal && !enterable(x, y, z)) continue;
           const float ng = gc + static_cast<float>(std::sqrt(static_cast<double>(dx * dx + dy * dy + dz * dz)));
           if (ng < g_[static_cast<std::size_t>(ni)]) {
             g_[static_cast<std::size_t>(ni)] = ng;
@@ -237,7 +243,10 @@ common::Result<std::vector<Eigen::Vector3d>> GridPathSearch::search(const Eigen:
   std::size_t i = 0;
   while (i + 1 < raw.size()) {
     std::size_t j = raw.size() - 1;
-    while (j > i + 1 && !segmentClear(field_, res, raw[i], raw[j], shortcut_clearance_m)) --j;
+    while (j > i + 1 && !(segmentClear(field_, res, raw[i], raw[j], shortcut_clearance_m) &&
+                          keep_out.segmentOutside(raw[i], raw[j]))) {
+      --j;
+    }
     out.push_back(raw[j]);
     i = j;
   }

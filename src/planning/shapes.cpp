@@ -58,4 +58,59 @@ Eigen::Matrix3d rotationFromRpy(double roll_rad, double pitch_rad, double yaw_ra
       .toRotationMatrix();
 }
 
+Eigen::Vector3d closestPointOnSegment(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& x) {
+  const Eigen::Vector3d ab = b - a;
+  const double L2 = ab.squaredNorm();
+  if (!(L2 > 1e-18)) return a;
+  return a + std::clamp((x - a).dot(ab) / L2, 0.0, 1.0) * ab;
+}
+
+double distanceToPolyline(const std::vector<Eigen::Vector3d>& poly, const Eigen::Vector3d& x) {
+  double d = std::numeric_limits<double>::infinity();
+  if (poly.size() == 1) return (x - poly.front()).norm();
+  for (std::size_t i = 0; i + 1 < poly.size(); ++i) d = std::min(d, (x - closestPointOnSegment(poly[i], poly[i + 1], x)).norm());
+  return d;
+}
+
+double distanceToPolyline(const std::vector<Eigen::Vector3d>& poly, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  if (poly.size() == 1) return (poly.front() - closestPointOnSegment(a, b, poly.front())).norm();
+  double d = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i + 1 < poly.size(); ++i) d = std::min(d, segmentSegmentDistance(a, b, poly[i], poly[i + 1]));
+  return d;
+}
+
+double segmentSegmentDistance(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                              const Eigen::Vector3d& d) {
+  // Closest points: minimise |a + s·u − c − t·v| over s, t ∈ [0, 1] — the unconstrained optimum
+  // clamped, then each parameter re-optimised for the other's (clamped) value.
+  const Eigen::Vector3d u = b - a, v = d - c, w = a - c;
+  const double uu = u.squaredNorm(), vv = v.squaredNorm();
+  if (!(uu > 1e-18)) return (a - closestPointOnSegment(c, d, a)).norm();
+  if (!(vv > 1e-18)) return (c - closestPointOnSegment(a, b, c)).norm();
+  const double uv = u.dot(v), uw = u.dot(w), vw = v.dot(w);
+  const double den = uu * vv - uv * uv;  // ≥ 0; 0: parallel
+  double s = den > 1e-12 * uu * vv ? std::clamp((uv * vw - vv * uw) / den, 0.0, 1.0) : 0.0;
+  const double t = std::clamp((uv * s + vw) / vv, 0.0, 1.0);
+  s = std::clamp((uv * t - uw) / uu, 0.0, 1.0);
+  return (a + s * u - c - t * v).norm();
+}
+
+std::vector<Eigen::Vector3d> simplifyPolyline(const std::vector<Eigen::Vector3d>& p, double tolerance) {
+  if (p.size() < 3) return p;
+  std::vector<Eigen::Vector3d> out{p.front()};
+  std::size_t i = 0;
+  while (i + 1 < p.size()) {
+    std::size_t j = i + 1;
+    while (j + 1 < p.size()) {
+      bool ok = true;
+      for (std::size_t m = i + 1; m <= j && ok; ++m) ok = (p[m] - closestPointOnSegment(p[i], p[j + 1], p[m])).norm() <= tolerance;
+      if (!ok) break;
+      ++j;
+    }
+    out.push_back(p[j]);
+    i = j;
+  }
+  return out;
+}
+
 }  // namespace gesture_formation::planning

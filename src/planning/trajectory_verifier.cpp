@@ -102,20 +102,6 @@ std::vector<Eigen::Vector3d> keptBrakeEnvelope(const PlannedTrajectory& other, i
   return {};
 }
 
-Eigen::Vector3d closestPointOnSegment(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& x) {
-  const Eigen::Vector3d ab = b - a;
-  const double L2 = ab.squaredNorm();
-  if (!(L2 > 1e-18)) return a;
-  return a + std::clamp((x - a).dot(ab) / L2, 0.0, 1.0) * ab;
-}
-
-double distanceToPolyline(const std::vector<Eigen::Vector3d>& poly, const Eigen::Vector3d& x) {
-  double d = std::numeric_limits<double>::infinity();
-  if (poly.size() == 1) return (x - poly.front()).norm();
-  for (std::size_t i = 0; i + 1 < poly.size(); ++i) d = std::min(d, (x - closestPointOnSegment(poly[i], poly[i + 1], x)).norm());
-  return d;
-}
-
 TrajectoryVerifier::TrajectoryVerifier(const OccupancyMap& map, const DistanceField& field, const PlannerConfig& config)
     : map_(map), field_(field), config_(config), fcl_(map) {}
 

@@ -42,26 +42,6 @@ double supportAlong(const NormPolygon& poly, const Eigen::Vector3d& d) {
   return s;
 }
 
-/// Greedy simplification: every dropped point lies within `tolerance` of the segment that
-/// replaces it, so the simplified polyline is within `tolerance` of every original point.
-std::vector<Eigen::Vector3d> simplifyPolyline(const std::vector<Eigen::Vector3d>& p, double tolerance) {
-  if (p.size() < 3) return p;
-  std::vector<Eigen::Vector3d> out{p.front()};
-  std::size_t i = 0;
-  while (i + 1 < p.size()) {
-    std::size_t j = i + 1;
-    while (j + 1 < p.size()) {
-      bool ok = true;
-      for (std::size_t m = i + 1; m <= j && ok; ++m) ok = (p[m] - closestPointOnSegment(p[i], p[j + 1], p[m])).norm() <= tolerance;
-      if (!ok) break;
-      ++j;
-    }
-    out.push_back(p[j]);
-    i = j;
-  }
-  return out;
-}
-
 std::string checkRequest(const PlanRequest& r) {
   std::ostringstream e;
   const auto& s = r.state;
@@ -514,20 +494,42 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
   // Waypoints: the current position, then the projected references (duplicates dropped),
   // with A* detours where the straight segment is not clear.
   const double start_clear = field.clearance(p0);
+  // The worker's keep-out for the path: a tube around his predicted positions over the horizon
+  // (a ball for a standing worker). A straight segment to a reference far away may pass right by
+  // him, and where obstacles make the corridor around that segment a sliver the QP cannot bend
+  // around him (harsh seed 65: the leader stuck for 180 s beside the tower he climbed, every
+  // replanning infeasible; docs/planning.md §5). Shrunk per segment so that neither end lies
+  // inside it (a worker who walked up to the UAV; a reference on his track that he will have
+  // passed when the UAV gets there): the QP's half-spaces keep the full distance in time.
+  KeepOutTube worker_tube;
+  if (has_worker) {
+    std::vector<Eigen::Vector3d> track;
+    for (int k = 0; k < req.worker.steps(); ++k) track.push_back(req.worker.p_world.col(k));
+    worker_tube.polyline_world = simplifyPolyline(track, 0.05);  // within 5 cm of every step
+  }
+  const auto keepOutFor = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    KeepOutTube tube = worker_tube;
+    if (tube.polyline_world.empty()) return tube;
+    tube.radius_m = std::min({worker_keep, tube.distance(a) - res, tube.distance(b) - res});
+    return tube;
+  };
   std::vector<Eigen::Vector3d> raw{p0};
-  bool truncated = false;
+  bool truncated = false, path_around_worker = false;
   for (int k = 1; k <= N && !truncated; ++k) {
     const Eigen::Vector3d& target = ref[static_cast<std::size_t>(k)];
     if ((target - raw.back()).norm() < 1e-3) continue;
     const bool from_start = raw.size() == 1;
     const double need = from_start ? std::min(seg_clear, start_clear - res) : seg_clear;
-    if (segmentClear(field, res, raw.back(), target, need)) {
+    const KeepOutTube tube = keepOutFor(raw.back(), target);
+    const bool outside = tube.segmentOutside(raw.back(), target);
+    if (segmentClear(field, res, raw.back(), target, need) && outside) {
       raw.push_back(target);
       continue;
     }
+    path_around_worker = path_around_worker || !outside;
     ++result.path_searches;
     const auto detour = search_->search(raw.back(), target, path_clear, seg_clear, config_.search_margin_m,
-                                        config_.search_max_expansions);
+                                        config_.search_max_expansions, nullptr, tube);
     if (!detour) {
       truncated = true;  // the rest of the reference is unreachable for now
       break;
@@ -552,7 +554,7 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
           close = (raw[m] - (a + s * ab)).norm() <= config_.path_merge_tolerance_m;
         }
         const double need = i == 0 ? std::min(seg_clear, start_clear - res) : seg_clear;
-        if (!close || !segmentClear(field, res, a, b, need)) break;
+        if (!close || !segmentClear(field, res, a, b, need) || !keepOutFor(a, b).segmentOutside(a, b)) break;
         j = c;
       }
       path.push_back(raw[j]);
@@ -702,10 +704,12 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
   const auto linPoint = [&](int k) {
     return have_prev ? evaluateTrajectory(last_verified_, req.t_now_s + k * dt).p : p0;
   };
-  // Half-space keeping x_k at least `margin` from o, linearised at the last plan.
-  const auto addSeparation = [&](int k, const Eigen::Vector3d& o, double margin, PositionConstraint::Kind kind) {
+  // Half-space keeping x_k at least `margin` from o, linearised at the last plan (at_guide: at
+  // the guide point on this path).
+  const auto addSeparation = [&](int k, const Eigen::Vector3d& o, double margin, PositionConstraint::Kind kind,
+                                  bool at_guide = false) {
     if ((o - p0).norm() - margin > vmax * k * dt) return;  // cannot get that close by t_k
-    Eigen::Vector3d n = linPoint(k) - o;
+    Eigen::Vector3d n = (at_guide ? guide[static_cast<std::size_t>(k)] : linPoint(k)) - o;
     if (n.norm() < 1e-6) n = guide[static_cast<std::size_t>(k)] - o;
     if (n.norm() < 1e-6) n = Eigen::Vector3d::UnitZ();
     n.normalize();
@@ -754,8 +758,12 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
     const double d0 = (p0 - req.worker.p_world.col(0)).norm();
     const double margin = config_.worker_safety_distance_m + config_.qp_distance_buffer_m;
     for (int k = 1; k <= N; ++k) {
-      // Already inside at t0 (the worker walked up): recover (recoveringDistance).
-      addSeparation(k, req.worker.p_world.col(k), recoveringDistance(config_, margin, d0, k * dt, true), PositionConstraint::Kind::kWorker);
+      // Already inside at t0 (the worker walked up): recover (recoveringDistance). When the path
+      // goes around him, the half-spaces turn with it (through the guide point: on the path,
+      // outside his keep-out); a previous plan that did not go around him would keep them a wall
+      // between the UAV and its reference.
+      addSeparation(k, req.worker.p_world.col(k), recoveringDistance(config_, margin, d0, k * dt, true),
+                    PositionConstraint::Kind::kWorker, path_around_worker);
     }
   }
   // Warm start: the last verified plan re-timed (primal only; the constraint set changes).

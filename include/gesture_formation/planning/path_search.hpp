@@ -19,6 +19,7 @@
 #include "gesture_formation/common/result.hpp"
 #include "gesture_formation/planning/distance_field.hpp"
 #include "gesture_formation/planning/occupancy_map.hpp"
+#include "gesture_formation/planning/shapes.hpp"
 
 namespace gesture_formation::planning {
 
@@ -39,6 +40,24 @@ bool segmentClear(const DistanceField& field, double resolution_m, const Eigen::
 /// \brief Smallest field clearance (m) along a → b sampled every resolution/2.
 double segmentClearance(const DistanceField& field, double resolution_m, const Eigen::Vector3d& a, const Eigen::Vector3d& b);
 
+/// \brief A tube the path must not enter besides the obstacles: every point within radius_m of
+/// the polyline — the worker's keep-out along his predicted positions (`worker_safety_distance_m`
+/// + the QP buffer). radius_m ≤ 0 or no points: none.
+struct KeepOutTube {
+  std::vector<Eigen::Vector3d> polyline_world;
+  double radius_m = 0.0;
+  bool active() const { return radius_m > 0.0 && !polyline_world.empty(); }
+  /// Distance from p to the polyline (infinity without points).
+  double distance(const Eigen::Vector3d& p) const { return distanceToPolyline(polyline_world, p); }
+  /// Distance from the segment a → b to the polyline (infinity without points).
+  double distance(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const { return distanceToPolyline(polyline_world, a, b); }
+  bool contains(const Eigen::Vector3d& p) const { return active() && distance(p) < radius_m; }
+  /// True when the segment a → b stays outside the tube (inactive: always).
+  bool segmentOutside(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const {
+    return !active() || distance(a, b) >= radius_m;
+  }
+};
+
 /// \brief Weighted A* (ε = 1.5) between two points on the voxel grid inside a box around them.
 class GridPathSearch {
  public:
@@ -57,10 +76,12 @@ class GridPathSearch {
   /// the goal (at most kPocketMaxVoxels voxels, same connectivity) checks whether the goal lies
   /// in a closed pocket that does not hold the start — e.g. inside a tower's lattice — and
   /// fails at once if so, instead of spending the whole budget on the start's side: the result
-  /// is the same (no path exists), only cheaper (docs/planning.md §10).
+  /// is the same (no path exists), only cheaper (docs/planning.md §10). With `keep_out`, voxel
+  /// centres inside the tube are not free either (the goal's voxel still counts as free) and
+  /// shortcuts stay outside it; the caller shrinks the tube when a or b lies inside it.
   common::Result<std::vector<Eigen::Vector3d>> search(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double clearance_m,
                                                       double shortcut_clearance_m, double margin_m, int max_expansions,
-                                                      Stats* stats = nullptr) const;
+                                                      Stats* stats = nullptr, const KeepOutTube& keep_out = {}) const;
 
  private:
   const OccupancyMap& map_;

@@ -66,6 +66,27 @@ struct PrimitiveSet {
   double distance(const Eigen::Vector3d& p_world) const;
 };
 
+// ---- segments and polylines (the planner's envelopes and keep-outs) ----
+
+/// \brief The point of segment [a, b] nearest to x (a when a == b).
+Eigen::Vector3d closestPointOnSegment(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& x);
+
+/// \brief Distance between the segments [a, b] and [c, d] (exact; either may be a point).
+double segmentSegmentDistance(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                              const Eigen::Vector3d& d);
+
+/// \brief Distance (m) from x to a polyline (a single point: to that point; +inf when empty).
+double distanceToPolyline(const std::vector<Eigen::Vector3d>& polyline, const Eigen::Vector3d& x);
+
+/// \brief Distance (m) from the segment [a, b] to a polyline (a single point: to that point;
+/// +inf when empty).
+double distanceToPolyline(const std::vector<Eigen::Vector3d>& polyline, const Eigen::Vector3d& a, const Eigen::Vector3d& b);
+
+/// \brief Greedy simplification: every dropped point lies within `tolerance` of the segment that
+/// replaces it, so the simplified polyline is within `tolerance` of every original point (fewer
+/// than three points: unchanged; a point repeated n times: that point twice).
+std::vector<Eigen::Vector3d> simplifyPolyline(const std::vector<Eigen::Vector3d>& points, double tolerance);
+
 /// \brief Rotation from roll, pitch, yaw in radians (R = Rz(yaw) Ry(pitch) Rx(roll)).
 Eigen::Matrix3d rotationFromRpy(double roll_rad, double pitch_rad, double yaw_rad);
 

@@ -29,6 +29,7 @@
 #include "gesture_formation/planning/distance_field.hpp"
 #include "gesture_formation/planning/occupancy_map.hpp"
 #include "gesture_formation/planning/planner_config.hpp"
+#include "gesture_formation/planning/shapes.hpp"  // closestPointOnSegment, distanceToPolyline
 #include "gesture_formation/planning/uav_planner.hpp"
 
 namespace gesture_formation::planning {
@@ -76,12 +77,6 @@ std::vector<Eigen::Vector3d> brakeEnvelope(const PlannedTrajectory& plan, double
 /// take it from here.
 std::vector<Eigen::Vector3d> keptBrakeEnvelope(const PlannedTrajectory& other, int own_index, double t_now_s,
                                                const PlannerConfig& config);
-
-/// \brief The point of segment [a, b] nearest to x (a when a == b).
-Eigen::Vector3d closestPointOnSegment(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& x);
-
-/// \brief Distance (m) from x to a polyline (a single point: to that point; +inf when empty).
-double distanceToPolyline(const std::vector<Eigen::Vector3d>& polyline, const Eigen::Vector3d& x);
 
 struct VerificationReport {
   bool ok = false;

@@ -3,11 +3,14 @@
 // check ran (it must not refuse a reachable goal).
 #include <gtest/gtest.h>
 
+#include <array>
+#include <limits>
 #include <string>
 
 #include "gesture_formation/planning/distance_field.hpp"
 #include "gesture_formation/planning/occupancy_map.hpp"
 #include "gesture_formation/planning/path_search.hpp"
+#include "gesture_formation/planning/shapes.hpp"
 
 using namespace gesture_formation::planning;
 
@@ -87,4 +90,89 @@ TEST(GridPathSearchTest, GoalBehindALargeWallWithAGapIsFoundAfterThePocketCheck)
     }
   }
   EXPECT_TRUE(through_gap) << "the path crosses x = 0 through the gap";
+}
+
+TEST(GridPathSearchTest, KeepOutTubeIsGoneAroundAndNeverEntered) {
+  // Free space (no obstacles): a → b straight through the tube. Without it the path is the
+  // straight segment; with it, every piece of the path stays outside the tube.
+  const OccupancyMap map = OccupancyMap::fromPrimitives(mapConfig(), PrimitiveSet{}, GroundSpec{});
+  const DistanceField field(map);
+  const GridPathSearch search(map, field);
+  const Eigen::Vector3d a(-6, 0.1, 0.1), b(6, 0.1, 0.1);
+  KeepOutTube tube;
+  tube.polyline_world = {Eigen::Vector3d(0, 0, -1), Eigen::Vector3d(0, 0, 1)};  // a vertical piece
+  tube.radius_m = 3.15;
+  EXPECT_FALSE(tube.segmentOutside(a, b));
+  EXPECT_NEAR(tube.distance(a, b), 0.1, 1e-12);
+  const auto straight = search.search(a, b, 0.3, 0.3, 6.0, 200'000);
+  ASSERT_TRUE(straight.has_value()) << straight.reason();
+  EXPECT_EQ(straight.value().size(), 2u);
+  const auto around = search.search(a, b, 0.3, 0.3, 6.0, 200'000, nullptr, tube);
+  ASSERT_TRUE(around.has_value()) << around.reason();
+  const auto& path = around.value();
+  EXPECT_EQ(path.front(), a);
+  EXPECT_EQ(path.back(), b);
+  ASSERT_GE(path.size(), 3u);
+  for (std::size_t i = 0; i + 1 < path.size(); ++i) {
+    EXPECT_GE(tube.distance(path[i], path[i + 1]), tube.radius_m)
+        << "piece " << i << ": " << path[i].transpose() << " → " << path[i + 1].transpose();
+  }
+  // A tube the search cannot get around inside its box: no path (not one through the tube).
+  KeepOutTube wall = tube;
+  wall.radius_m = 5.5;
+  const auto blocked =
+      search.search(Eigen::Vector3d(-5.9, 0, 0), Eigen::Vector3d(5.9, 0, 0), 0.3, 0.3, 0.4, 200'000, nullptr, wall);
+  EXPECT_FALSE(blocked.has_value());
+}
+
+TEST(SegmentGeometryTest, SegmentDistancesAgainstBruteForce) {
+  // Exact segment–segment distance against dense sampling of both segments, in every
+  // configuration (crossing, parallel, collinear, skew, degenerate to points).
+  const std::vector<std::array<Eigen::Vector3d, 4>> cases = {
+      {Eigen::Vector3d(-1, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, -1, 1), Eigen::Vector3d(0, 1, 1)},
+      {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(2, 0, 0), Eigen::Vector3d(1, 1, 0), Eigen::Vector3d(3, 1, 0)},
+      {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(2, 0, 0), Eigen::Vector3d(3, 0, 0)},
+      {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 2, 3), Eigen::Vector3d(4, -1, 2), Eigen::Vector3d(-2, 3, 0.5)},
+      {Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(2, 0, 0)},
+      {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(5, 0, 0), Eigen::Vector3d(6, 1, 0), Eigen::Vector3d(9, 4, 0)},
+  };
+  for (std::size_t n = 0; n < cases.size(); ++n) {
+    const auto& [a, b, c, d] = cases[n];
+    double brute = std::numeric_limits<double>::infinity();
+    for (int i = 0; i <= 400; ++i) {
+      for (int j = 0; j <= 400; ++j) {
+        brute = std::min(brute, ((a + (b - a) * (i / 400.0)) - (c + (d - c) * (j / 400.0))).norm());
+      }
+    }
+    const double exact = segmentSegmentDistance(a, b, c, d);
+    EXPECT_LE(exact, brute + 1e-12) << "case " << n;
+    EXPECT_NEAR(exact, brute, 0.02) << "case " << n;
+    EXPECT_NEAR(segmentSegmentDistance(c, d, a, b), exact, 1e-12) << "case " << n << " (symmetric)";
+  }
+}
+
+TEST(SegmentGeometryTest, SimplifiedPolylineDropsStandingAndStraightPoints) {
+  const std::vector<Eigen::Vector3d> standing(41, Eigen::Vector3d(1, 2, 3));
+  const auto still = simplifyPolyline(standing, 0.05);
+  ASSERT_EQ(still.size(), 2u);
+  EXPECT_EQ(still.front(), still.back());
+  std::vector<Eigen::Vector3d> walk, turn;
+  for (int k = 0; k <= 40; ++k) walk.push_back(Eigen::Vector3d(0.22 * k, 0, 1));
+  EXPECT_EQ(simplifyPolyline(walk, 0.05).size(), 2u);
+  // Walks 20 steps east, then 20 north: three points, the corner kept; every input point within
+  // the tolerance of the simplified polyline.
+  for (int k = 0; k <= 20; ++k) turn.push_back(Eigen::Vector3d(0.2 * k, 0, 1));
+  for (int k = 1; k <= 20; ++k) turn.push_back(Eigen::Vector3d(4, 0.2 * k, 1));
+  KeepOutTube tube;
+  tube.polyline_world = simplifyPolyline(turn, 0.05);
+  EXPECT_EQ(tube.polyline_world.size(), 3u);
+  for (const auto& p : turn) EXPECT_LE(tube.distance(p), 0.05 + 1e-12) << p.transpose();
+  // Standing, then walking away: the start and the end, the standing points merged.
+  std::vector<Eigen::Vector3d> start_walk(10, Eigen::Vector3d::Zero());
+  for (int k = 1; k <= 10; ++k) start_walk.push_back(Eigen::Vector3d(0, 0.2 * k, 0));
+  EXPECT_EQ(simplifyPolyline(start_walk, 0.05).size(), 2u);
+  // A single point is a polyline too: the distances are to that point.
+  tube.polyline_world = {Eigen::Vector3d(0, 0, 0)};
+  EXPECT_DOUBLE_EQ(tube.distance(Eigen::Vector3d(3, 4, 0)), 5.0);
+  EXPECT_DOUBLE_EQ(tube.distance(Eigen::Vector3d(-1, 2, 0), Eigen::Vector3d(1, 2, 0)), 2.0);
 }

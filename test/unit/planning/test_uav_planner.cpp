@@ -11,6 +11,7 @@
 #include "gesture_formation/common/angles.hpp"
 #include "gesture_formation/planning/distance_field.hpp"
 #include "gesture_formation/planning/occupancy_map.hpp"
+#include "gesture_formation/planning/path_search.hpp"
 #include "gesture_formation/planning/scenario.hpp"
 #include "gesture_formation/planning/trajectory_verifier.hpp"
 #include "gesture_formation/planning/uav_planner.hpp"
@@ -529,6 +530,51 @@ TEST(UavPlannerTest, StartCloserThanCorridorClearanceMovesAway) {
     s = advance(r.trajectory, t);
   }
   EXPECT_GE(w.field->clearance(s.p_world), cfg.obstacle_clearance_m - 0.05) << "from " << c0 << " m at " << start.transpose();
+}
+
+TEST(UavPlannerTest, PathGoesAroundTheWorkerWhereTheCorridorIsTooNarrowToBendAround) {
+  // harsh seed 65 at 250 s (fault matrix, docs/safety.md §4.12): the leader hovers 2.5 m from the
+  // east tower's west face, 5 m from the worker who climbs the tower, its reference 14 m away on
+  // the far side, climbing with him. The straight segment to it passed 2.6 m from him and the
+  // tower made the corridor around it a sliver; the QP (3.15 m from him, half-spaces through the
+  // previous plan: a wall) was infeasible at every replanning, and the UAV stayed there for 180 s.
+  // The path must go around his keep-out, and the plans must get round him to the reference.
+  const World& w = towers();
+  PlannerConfig cfg = testConfig();
+  UavPlanner planner(cfg, w.map, w.field);
+  const Eigen::Vector3d start(44.03, 4.33, 2.71), worker(49.1, 3.5, 2.4), goal(57.2, 8.2, 5.8);
+  ASSERT_LT((worker - closestPointOnSegment(start, goal, worker)).norm(), cfg.worker_safety_distance_m);  // 2.6 m
+  UavKinematicState s = stateAt(start);
+  double t = 0.0, closest = std::numeric_limits<double>::infinity();
+  int optimized = 0;
+  for (int cycle = 0; cycle < 40; ++cycle) {
+    PlanRequest req = straightRequest(0, t, s, goal, goal, 0.0, worker);
+    for (int k = 0; k < req.reference.steps(); ++k) {  // he climbs at 0.35 m/s, the reference with him
+      const double up = 0.35 * (t + k * req.dt_s);
+      req.worker.p_world(2, k) += up;
+      req.reference.p_world(2, k) += up;
+    }
+    const PlanResult r = planner.plan(req);
+    ASSERT_TRUE(r.verified) << "cycle " << cycle << ": " << r.reason;
+    optimized += r.status == PlanStatus::kOptimized ? 1 : 0;
+    if (cycle == 0) {
+      ASSERT_EQ(r.status, PlanStatus::kOptimized) << r.reason;
+      for (std::size_t i = 0; i + 1 < r.path_world.size(); ++i) {
+        EXPECT_GE(distanceToPolyline({worker}, r.path_world[i], r.path_world[i + 1]),
+                  cfg.worker_safety_distance_m + cfg.qp_distance_buffer_m - 1e-9) << "piece " << i;
+      }
+    }
+    expectSafe(r.trajectory, *w.map, cfg);
+    for (double tt = r.trajectory.t0_s; tt <= r.trajectory.tEnd(); tt += 0.05) {
+      closest = std::min(closest, (evaluateTrajectory(r.trajectory, tt).p - (worker + Eigen::Vector3d(0, 0, 0.35 * tt))).norm());
+    }
+    t += 0.4;
+    s = advance(r.trajectory, t);
+  }
+  EXPECT_GE(optimized, 36) << "of 40 replannings";
+  EXPECT_GE(closest, cfg.worker_safety_distance_m - 1e-3);
+  const Eigen::Vector3d reference_now = goal + Eigen::Vector3d(0, 0, 0.35 * t);
+  EXPECT_LT((s.p_world - reference_now).norm(), 1.0) << "ended at " << s.p_world.transpose();
 }
 
 // brakeEnvelope: where a UAV following the plan stops if it brakes at a sample time in
