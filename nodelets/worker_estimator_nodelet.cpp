@@ -83,8 +83,8 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
       return;
     }
     const auto outcome = filter_.step(t, *m);
-    if (!filter_.initialized()) return;
     if (estimation::accepted(outcome)) last_fused_ = msg->header.stamp;
+    if (!filter_.confirmed()) return;  // a tentative track is not published (docs/estimation.md)
     auto out = toWorkerState(filter_.state(), filter_.covariance());
     out.header.stamp = ros::Time(filter_.time());
     out.header.frame_id = world_frame_;
@@ -98,7 +98,7 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
 
   void onTimer(const ros::TimerEvent& event) {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!filter_.initialized()) return;
+    if (!filter_.confirmed()) return;
     const double t = event.current_real.toSec();
     const auto s = filter_.predicted(t);
     estimation::Vector6d x;

@@ -99,6 +99,7 @@ EstimatorConfig readEstimatorConfig(ConfigReader& r) {
   r.readDouble("gate_chi2", c.filter.gate_chi2, Range::positive());
   r.readInt("max_consecutive_rejections", c.filter.max_consecutive_rejections, Range::atLeast(1));
   r.readDouble("lost_timeout_s", c.filter.lost_timeout_s, Range::positive());
+  r.readInt("confirm_measurements", c.filter.confirm_measurements, Range::atLeast(1));
   r.readDouble("stereo.min_depth_m", c.stereo.min_depth_m, Range::nonNegative());
   r.readDouble("stereo.max_depth_m", c.stereo.max_depth_m, Range::positive());
   r.readInt("stereo.min_valid_pixels", c.stereo.min_valid_pixels, Range::atLeast(1));

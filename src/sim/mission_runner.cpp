@@ -236,7 +236,10 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
     bool worker_lost = false;
     std::string hold;  // non-empty: hold a safe position (docs/safety.md), the reason
     if (i == 0) {
-      if (!kf.initialized()) {
+      // Nothing to plan on before the first estimate, nor on a tentative track (initialised from
+      // one measurement that may be a gross range error: range_outliers / harsh seed 97): fly the
+      // last plan, as the ROS leader does while its WorkerEstimator publishes nothing new.
+      if (!kf.confirmed()) {
         ++M.plans_skipped;
         return;
       }
@@ -419,7 +422,7 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
       // and each UAV's odometry: a view votes only inside the classifier's envelope) → filter.
       bool classified = false;
       const std::optional<Eigen::Vector3d> worker_est =
-          kf.initialized() ? std::optional<Eigen::Vector3d>(kf.predicted(t).p_world) : std::nullopt;
+          kf.confirmed() ? std::optional<Eigen::Vector3d>(kf.predicted(t).p_world) : std::nullopt;
       const auto observation = [&](int view, const gesture::Classification& c, const gesture::CalibratedSkeleton& cal) {
         gesture::ViewObservation o;
         o.view = view;
@@ -471,9 +474,10 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
           }
         }
       }
+      // The estimate the system acts on (a tentative track is not published: docs/estimation.md).
       Eigen::Vector3d estimate = Eigen::Vector3d::Zero();
-      if (kf.initialized()) estimate = kf.predicted(t).p_world;
-      metrics.cameraFrame(frame.visible(), kf.initialized() ? &estimate : nullptr, ws.p_world);
+      if (kf.confirmed()) estimate = kf.predicted(t).p_world;
+      metrics.cameraFrame(frame.visible(), kf.confirmed() ? &estimate : nullptr, ws.p_world);
     }
 
     // Replanning, staggered, in priority order within a step.
@@ -495,7 +499,7 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
       TimelineInput in;
       in.t_s = t;
       in.worker = ws;
-      if (kf.initialized()) in.estimate_world = kf.predicted(t).p_world;
+      if (kf.confirmed()) in.estimate_world = kf.predicted(t).p_world;
       in.visible = camera.lastVisibleS() > t - 0.2 ? 1 : 0;
       in.gesture_true = worker.performingAt(t);
       in.gesture_class = last_class;

@@ -52,6 +52,23 @@ print(("ok   " if ok else "FAIL ") + f"dup_reorder seed 32 to 295 s: mutual {m['
 sys.exit(0 if ok else 1)
 PY
 
+# Regression (docs/safety.md §4.12): range_outliers seed 97 — the first UWB ranges were gross
+# errors (1.15, 0.10, 0.45 m for a worker 10 m away); the leader planned on the track they
+# initialised, turned its camera away from the worker and lost him for the whole mission (estimate
+# error 42.6 m RMS). The leader now acts on a confirmed track only.
+"$GFCTL" simulate --scenario "$SRC/config/scenarios/power_towers.yaml" --fault-profile range_outliers --seed 97 \
+  --duration 30 --threads 1 --out "$TMP/r97" --no-plot > "$TMP/r97.log" 2>&1 || { echo "FAIL range_outliers 97: gfctl exited $?"; cat "$TMP/r97.log"; exit 1; }
+python3 - "$TMP/r97" <<'PY' || fail=1
+import csv, json, sys
+m = json.load(open(sys.argv[1] + "/metrics.json"))
+rows = list(csv.DictReader(open(sys.argv[1] + "/timeline.csv")))
+seen_late = sum(int(r["visible"]) for r in rows if float(r["t"]) >= 20.0)
+ok = m["human_estimate_error_rms_m"] < 1.0 and seen_late > 0 and m["range_outliers"] > 0
+print(("ok   " if ok else "FAIL ") + f"range_outliers seed 97 to 30 s: estimate error {m['human_estimate_error_rms_m']:.2f} m RMS (< 1), "
+      f"worker in view in {seen_late} timeline rows after 20 s (> 0), outliers {m['range_outliers']}")
+sys.exit(0 if ok else 1)
+PY
+
 # Bad fault files: exit 2, every problem listed with its field and value.
 cat > "$TMP/bad.yaml" <<'YAML'
 faults:

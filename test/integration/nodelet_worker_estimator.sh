@@ -1,7 +1,8 @@
 #!/bin/bash
 # The WorkerEstimator nodelet end to end under a private ROS master: it refuses to start
-# (listing every missing parameter) without parameters, and with the shipped config turns a
-# WorkerDetection + a static camera tf into a WorkerState at the expected position.
+# (listing every missing parameter) without parameters, and with the shipped config turns
+# WorkerDetections (three confirm the track) + a static camera tf into a WorkerState at the
+# expected position.
 set -o pipefail  # not -u: devel/setup.bash reads unset variables
 GFCTL=$1
 SRC=$2
@@ -45,9 +46,11 @@ rosrun nodelet nodelet standalone gesture_formation/WorkerEstimator __name:=est 
   _config_file:="$SRC/config/estimator.yaml" _world_frame:=world _uwb_max_age_s:=0.2 _tf_timeout_s:=0.5 \
   _publish_rate_hz:=5.0 detection_in:=det worker_state_out:=state > "$T/est.log" 2>&1 & pids+=($!)
 sleep 2
-timeout 10 rostopic echo -n 1 /state > "$T/state.txt" 2>&1 & echo_pid=$!
+timeout 25 rostopic echo -n 1 /state > "$T/state.txt" 2>&1 & echo_pid=$!
 sleep 1
-for i in 1 2 3; do
+# The estimator publishes a track once confirm_measurements (3) detections were accepted
+# (docs/estimation.md); five, in case one is lost while a publisher connects.
+for i in 1 2 3 4 5; do
   rostopic pub -1 /det gesture_formation/WorkerDetection \
     "{header: {stamp: now, frame_id: cam_optical}, detected: true, u: 300, v: 190, w: 40, h: 100, confidence: 0.9, stereo_distance_m: 10.0}" > /dev/null 2>&1
 done

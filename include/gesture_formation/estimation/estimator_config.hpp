@@ -32,6 +32,7 @@ struct EstimatorConfig {
 /// `process_noise.{sigma_p_m,sigma_v_mps}`,
 /// `measurement_noise.{sigma_xy_m,sigma_z_uwb_m,sigma_z_stereo_m,sigma_z_apparent_m}`,
 /// `initial_velocity_std_mps`, `gate_chi2`, `max_consecutive_rejections`, `lost_timeout_s`,
+/// `confirm_measurements`,
 /// `stereo.{min_depth_m,max_depth_m,min_valid_pixels,min_valid_fraction,depth_scale_m}`.
 /// `camera` may instead be a ROS camera_info YAML (image_width, camera_matrix, ...) given by
 /// `camera_info_file`. When `camera.width/height` are absent they default to 2·cx, 2·cy.

@@ -10,7 +10,11 @@
 /// Beyond the paper: Mahalanobis gating (χ²₃) with re-initialisation after more than
 /// `max_consecutive_rejections` rejections in a row, measurements older than the filter's
 /// time dropped and counted, non-finite input rejected, a "lost" flag after a timeout, after
-/// which the velocity is no longer extrapolated (see predict()).
+/// which the velocity is no longer extrapolated (see predict()), and track confirmation: a track
+/// (re-)initialised from one measurement is *tentative* until `confirm_measurements` of its
+/// measurements (the initialising one included) were accepted — consumers act only on a
+/// confirmed track, so that a gross range error at the start does not steer the formation
+/// (docs/estimation.md, docs/safety.md §4.12).
 /// A rejected input never changes the state.
 /// Thread safety: none; one filter per thread (the nodelet guards it with a mutex).
 
@@ -38,6 +42,7 @@ struct HumanKalmanConfig {
   double gate_chi2 = 16.27;               ///< Mahalanobis gate, χ²₃ at 0.999, > 0
   int max_consecutive_rejections = 10;    ///< at most this many gated-out measurements in a row, ≥ 1
   double lost_timeout_s = 5.0;            ///< no fused measurement for this long → lost, and no more extrapolation [s], > 0
+  int confirm_measurements = 3;           ///< accepted measurements (the initialising one included) that confirm a track, ≥ 1
 
   std::vector<std::string> validate() const {
     std::vector<std::string> e;
@@ -51,6 +56,9 @@ struct HumanKalmanConfig {
     pos(lost_timeout_s, "lost_timeout_s");
     if (max_consecutive_rejections < 1) {
       e.push_back("max_consecutive_rejections must be >= 1, got " + std::to_string(max_consecutive_rejections));
+    }
+    if (confirm_measurements < 1) {
+      e.push_back("confirm_measurements must be >= 1, got " + std::to_string(confirm_measurements));
     }
     return e;
   }
@@ -116,6 +124,11 @@ class HumanKalman {
   /// Mahalanobis distance² of the last gated measurement (NaN before any).
   double lastMahalanobis2() const { return last_d2_; }
   int consecutiveRejections() const { return consecutive_rejections_; }
+  /// \brief True when initialised and at least `confirm_measurements` measurements were accepted
+  /// since the last (re-)initialisation (the initialising one included). A tentative track's
+  /// state is not for acting on: the WorkerEstimator does not publish it, the simulated leader
+  /// does not plan on it.
+  bool confirmed() const { return initialized_ && accepted_since_init_ >= config_.confirm_measurements; }
 
   /// \brief True when initialised and no measurement was fused for more than lost_timeout_s
   /// before `t_s`.
@@ -233,6 +246,7 @@ class HumanKalman {
     P_ = P;
     consecutive_rejections_ = 0;
     t_last_fused_ = t_;
+    ++accepted_since_init_;
     ++counters_.fused;
     return UpdateOutcome::kFused;
   }
@@ -286,6 +300,7 @@ class HumanKalman {
     t_last_fused_ = t_s;
     initialized_ = true;
     consecutive_rejections_ = 0;
+    accepted_since_init_ = 1;
   }
 
   HumanKalmanConfig config_;
@@ -295,6 +310,7 @@ class HumanKalman {
   Vector6d x_ = Vector6d::Zero();
   Matrix6d P_ = Matrix6d::Identity();
   int consecutive_rejections_ = 0;
+  int accepted_since_init_ = 0;
   double last_d2_ = std::nan("");
   HumanKalmanCounters counters_;
 };

@@ -42,11 +42,12 @@ TEST(EstimatorConfigTest, EveryProblemListedAtOnce) {
   const auto path = writeTemp("est_bad.yaml",
                               "camera: {fx: -615, distortion: [0, 0, 0]}\nhuman_height_m: 7\n"
                               "process_noise: {sigma_p_m: 0}\nmeasurement_noise: {sigma_xy_m: nan}\n"
-                              "max_consecutive_rejections: 0\nstereo: {min_depth_m: 5, max_depth_m: 4}\n");
+                              "max_consecutive_rejections: 0\nconfirm_measurements: 0\nstereo: {min_depth_m: 5, max_depth_m: 4}\n");
   const auto c = estimation::loadEstimatorConfig(path, ConfigReader::MissingKeys::kUseDefaults);
   ASSERT_FALSE(c);
   for (const char* key : {"camera.fx", "camera.distortion", "human_height_m", "process_noise.sigma_p_m",
-                          "measurement_noise.sigma_xy_m", "max_consecutive_rejections", "stereo.max_depth_m"}) {
+                          "measurement_noise.sigma_xy_m", "max_consecutive_rejections", "confirm_measurements",
+                          "stereo.max_depth_m"}) {
     EXPECT_NE(c.reason().find(key), std::string::npos) << key << " not named in:\n" << c.reason();
   }
 }

@@ -107,6 +107,42 @@ TEST(HumanKalmanTest, ReinitialisesAfterMaxConsecutiveRejections) {
   EXPECT_EQ(kf.consecutiveRejections(), 1);
 }
 
+TEST(HumanKalmanTest, TrackIsConfirmedAfterConfirmMeasurementsAcceptedAndAgainAfterReinitialisation) {
+  HumanKalmanConfig cfg;
+  cfg.max_consecutive_rejections = 2;
+  cfg.confirm_measurements = 3;
+  HumanKalman kf(cfg);
+  EXPECT_FALSE(kf.confirmed());
+  double t = 0.0;
+  EXPECT_EQ(kf.step(t, meas(Eigen::Vector3d(0, 0, 0), 0.05)), UpdateOutcome::kInitialized);
+  EXPECT_FALSE(kf.confirmed());  // one measurement: tentative
+  EXPECT_EQ(kf.step(t += 0.1, meas(Eigen::Vector3d(30, 0, 0), 0.05)), UpdateOutcome::kGated);
+  EXPECT_FALSE(kf.confirmed());  // a gated one does not count
+  EXPECT_EQ(kf.step(t += 0.1, meas(Eigen::Vector3d(0, 0, 0), 0.05)), UpdateOutcome::kFused);
+  EXPECT_FALSE(kf.confirmed());
+  EXPECT_EQ(kf.step(t += 0.1, meas(Eigen::Vector3d(0, 0, 0), 0.05)), UpdateOutcome::kFused);
+  EXPECT_TRUE(kf.confirmed());   // initialising + 2 fused
+  // Re-initialisation starts a new, tentative track.
+  for (int i = 0; i < 2; ++i) EXPECT_EQ(kf.step(t += 0.1, meas(Eigen::Vector3d(30, 0, 0), 0.05)), UpdateOutcome::kGated);
+  EXPECT_TRUE(kf.confirmed());   // gated measurements do not unconfirm the track
+  EXPECT_EQ(kf.step(t += 0.1, meas(Eigen::Vector3d(30, 0, 0), 0.05)), UpdateOutcome::kReinitialized);
+  EXPECT_FALSE(kf.confirmed());
+  kf.step(t += 0.1, meas(Eigen::Vector3d(30, 0, 0), 0.05));
+  kf.step(t += 0.1, meas(Eigen::Vector3d(30, 0, 0), 0.05));
+  EXPECT_TRUE(kf.confirmed());
+  kf.reset();
+  EXPECT_FALSE(kf.confirmed());
+  // confirm_measurements 1: the initialising measurement confirms (the behaviour without the rule).
+  cfg.confirm_measurements = 1;
+  HumanKalman at_once(cfg);
+  at_once.step(0.0, meas(Eigen::Vector3d(0, 0, 0)));
+  EXPECT_TRUE(at_once.confirmed());
+  cfg.confirm_measurements = 0;
+  const auto errors = cfg.validate();
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_NE(errors.front().find("confirm_measurements must be >= 1, got 0"), std::string::npos) << errors.front();
+}
+
 TEST(HumanKalmanTest, OutOfOrderAndInvalidMeasurementsChangeNothing) {
   HumanKalman kf;
   kf.step(1.0, meas(Eigen::Vector3d(1, 1, 1)));

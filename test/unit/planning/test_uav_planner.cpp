@@ -533,7 +533,7 @@ TEST(UavPlannerTest, StartCloserThanCorridorClearanceMovesAway) {
 }
 
 TEST(UavPlannerTest, PathGoesAroundTheWorkerWhereTheCorridorIsTooNarrowToBendAround) {
-  // harsh seed 65 at 250 s (fault matrix, docs/safety.md §4.12): the leader hovers 2.5 m from the
+  // harsh seed 65 at 250 s (fault matrix, docs/planning.md §8.2): the leader hovers 2.5 m from the
   // east tower's west face, 5 m from the worker who climbs the tower, its reference 14 m away on
   // the far side, climbing with him. The straight segment to it passed 2.6 m from him and the
   // tower made the corridor around it a sliver; the QP (3.15 m from him, half-spaces through the

@@ -557,6 +557,27 @@ TEST(FaultSafetyTest, RangeDropoutsAndOutliersKeepTheEstimateUsable) {
   EXPECT_EQ(r.out->metrics.collisions, 0);
 }
 
+// §2.5 / §4.12: the leader plans only on a confirmed track — a track initialised from one
+// measurement (possibly a gross range error) is tentative until confirm_measurements of its
+// measurements were accepted; the leader's first request comes that much later.
+TEST(FaultSafetyTest, LeaderPlansOnlyOnAConfirmedTrack) {
+  const auto firstLeaderCall = [](int confirm) {
+    auto cfg = stationaryWorkerMission();
+    cfg.estimator.filter.confirm_measurements = confirm;
+    const Flight r = fly(cfg, 3.0);
+    EXPECT_TRUE(r.out) << r.out.reason();
+    for (const Call& c : *r.calls) {
+      if (c.uav == 0) return c.t_s;
+    }
+    return std::numeric_limits<double>::infinity();
+  };
+  const double at_once = firstLeaderCall(1), after_four = firstLeaderCall(4);
+  const double camera_period = 1.0 / stationaryWorkerMission().camera.rate_hz;
+  ASSERT_TRUE(std::isfinite(at_once));
+  ASSERT_TRUE(std::isfinite(after_four)) << "the leader never planned";
+  EXPECT_GE(after_four, at_once + 3 * camera_period - 1e-9) << "at once " << at_once << " s, after four " << after_four;
+}
+
 // §1 rule 1 / §2.1: with faults.avoid_all_plans (default) every UAV, the leader too, plans around
 // every other UAV's last plan; without it a higher-priority UAV avoids a lower-priority one only
 // when that one fell back, holds or went silent for max_plan_age_s.
