@@ -195,6 +195,7 @@ void MetricsAccumulator::plan(int uav, double t_s, std::uint64_t params_version,
   plan_ms_.push_back(total_ms);
   if (uav >= 0 && uav < n_) last_status_[static_cast<std::size_t>(uav)] = static_cast<int>(status);
   plan_events_.push_back(PlanEvent{uav, t_s, params_version});
+  plan_log_.push_back(PlanRecord{t_s, uav, params_version, status, total_ms, reason});
 }
 
 int MetricsAccumulator::lastPlanStatus(int uav) const {
@@ -328,6 +329,7 @@ MissionOutput MetricsAccumulator::finish(const std::vector<GestureEpisode>& gest
   M.real_time_factor = M.wall_time_s > 0 ? M.sim_time_s / M.wall_time_s : nan;
   out.metrics = M;
   out.timeline = std::move(timeline_);
+  out.plans = std::move(plan_log_);
   out.requests = std::move(requests_);
   return out;
 }
@@ -492,10 +494,32 @@ bool writeModesCsv(const std::string& path, const MissionOutput& out, std::strin
   return true;
 }
 
+bool writePlansCsv(const std::string& path, const MissionOutput& out, std::string* error) {
+  std::ofstream f(path);
+  if (!f) {
+    if (error) *error = path + ": cannot open for writing";
+    return false;
+  }
+  f << "t,uav,status,params_version,planning_ms,reason\n";
+  for (const auto& p : out.plans) {
+    std::string why = p.reason;
+    std::replace(why.begin(), why.end(), ',', ';');
+    std::replace(why.begin(), why.end(), '\n', ' ');
+    f << formatDouble(p.t_s) << ',' << formation::uavLabel(p.uav) << ',' << planning::toString(p.status) << ','
+      << p.params_version << ',' << formatDouble(p.planning_ms) << ',' << why << '\n';
+  }
+  f.flush();
+  if (!f) {
+    if (error) *error = path + ": write failed";
+    return false;
+  }
+  return true;
+}
+
 bool writeMissionFiles(const std::string& dir, const MissionOutput& out, int uav_count, bool with_modes,
                        std::string* error) {
   if (!writeTimelineCsv(dir + "/timeline.csv", out, uav_count, error) || !writeEventsCsv(dir + "/events.csv", out, error) ||
-      (with_modes && !writeModesCsv(dir + "/modes.csv", out, error))) {
+      (with_modes && !writeModesCsv(dir + "/modes.csv", out, error)) || !writePlansCsv(dir + "/plans.csv", out, error)) {
     return false;
   }
   const std::string tmp = dir + "/metrics.json.tmp", path = dir + "/metrics.json";

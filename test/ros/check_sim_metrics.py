@@ -81,6 +81,11 @@ def main():
     tl = list(csv.DictReader(open(f"{out}/timeline.csv")))
     check(len(tl) > 350 and "est_x" in tl[0] and "L_plan_status" in tl[0] and not math.isnan(num(tl[-1]["est_x"])),
           f"timeline.csv in gfctl simulate's columns at 10 Hz ({len(tl)} rows)")
+    pl = list(csv.DictReader(open(f"{out}/plans.csv")))
+    check(len(pl) > 100 and {r["uav"] for r in pl} == {"L", "1", "2"} and
+          all(r["status"] in ("optimized", "fallback_previous", "fallback_brake") for r in pl) and
+          all(r["reason"] for r in pl if r["status"] != "optimized"),
+          f"plans.csv: every UAV's replannings with status and, when not optimized, the reason ({len(pl)} rows)")
     return fails
 
 

@@ -141,10 +141,21 @@ struct ModeChange {
   std::string reason;
 };
 
+/// \brief One replanning of one UAV (plans.csv): what became of it and why.
+struct PlanRecord {
+  double t_s = 0.0;
+  int uav = 0;
+  std::uint64_t params_version = 0;
+  planning::PlanStatus status = planning::PlanStatus::kOptimized;
+  double planning_ms = 0.0;  ///< wall clock: the one column that differs between two runs of a seed
+  std::string reason;        ///< empty when optimised
+};
+
 /// \brief Everything a mission produces (the files of docs/simulation.md §3).
 struct MissionOutput {
   MissionMetrics metrics;
   std::vector<ModeChange> modes;
+  std::vector<PlanRecord> plans;  ///< every replanning, in the order fed (plans.csv)
   std::vector<TimelineRow> timeline;
   std::vector<RequestRecord> requests;
   std::vector<GestureEpisode> gestures;  ///< performed by the worker
@@ -299,6 +310,7 @@ class MetricsAccumulator {
   std::vector<RequestRecord> requests_;
   std::vector<CommandOutcome> unmatched_;
   std::vector<PlanEvent> plan_events_;
+  std::vector<PlanRecord> plan_log_;
   std::vector<double> plan_ms_;
   std::vector<int> last_status_;
   std::vector<bool> in_obstacle_, in_worker_;
@@ -315,8 +327,11 @@ bool writeTimelineCsv(const std::string& path, const MissionOutput& out, int uav
 bool writeEventsCsv(const std::string& path, const MissionOutput& out, std::string* error);
 /// \brief Writes modes.csv: `t,uav,mode,reason`, one row per ModeChange.
 bool writeModesCsv(const std::string& path, const MissionOutput& out, std::string* error);
+/// \brief Writes plans.csv: `t,uav,status,params_version,planning_ms,reason`, one row per
+/// replanning (commas in the reason become ';').
+bool writePlansCsv(const std::string& path, const MissionOutput& out, std::string* error);
 /// \brief Writes a mission's files into `dir`: timeline.csv, events.csv, modes.csv (if
-/// `with_modes`) and metrics.json last, atomically (written to a temporary name, then renamed:
+/// `with_modes`), plans.csv and metrics.json last, atomically (written to a temporary name, then renamed:
 /// its appearance tells a watching script that the files are complete).
 bool writeMissionFiles(const std::string& dir, const MissionOutput& out, int uav_count, bool with_modes,
                        std::string* error);
