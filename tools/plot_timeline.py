@@ -5,7 +5,8 @@ In the style of the paper's simulation timeline (Kratky et al., RA-L 2025, Fig. 
 timeline"): per UAV the distance to the worker d_t, the pairwise UAV distances d_m, the
 distance to the nearest obstacle d_o and the observation angle, with the references as
 transparent lines and vertical markers when a command was applied (operator: red, worker's
-gesture: blue); plus a top and a side view of the trajectories with the towers, conductor
+gesture: blue), and ticks where a UAV's replanning failed (plans.csv: previous plan flown, or a
+brake); plus a top and a side view of the trajectories with the towers, conductor
 lines and other obstacles (scene.json).
 
 Usage: /opt/gesture_formation/venv/bin/python tools/plot_timeline.py DIR [--out FILE]
@@ -106,6 +107,20 @@ def main():
         for ax in (ax_dt, ax_dm, ax_do, ax_phi, ax_el):
             ax.axvline(ta, color=col, lw=0.7, alpha=0.6)
 
+    # Failed replannings (plans.csv): per UAV a row of ticks along the bottom of the d_t panel —
+    # "|" the previous verified plan flown, "x" a brake plan — where a UAV fell behind and why is
+    # then read in plans.csv.
+    plans_path = os.path.join(d, "plans.csv")
+    if os.path.exists(plans_path):
+        plans = read_csv(plans_path)
+        for k, lab in enumerate(labels):
+            c = COLORS[k % len(COLORS)]
+            y = 0.4 + 0.5 * k
+            for status, marker, size in (("fallback_previous", "|", 20), ("fallback_brake", "x", 14)):
+                ts = [float(r["t"]) for r in plans if r["uav"] == lab and r["status"] == status]
+                if ts:
+                    ax_dt.scatter(ts, [y] * len(ts), marker=marker, s=size, color=c, lw=0.8)
+    ax_dt.set_ylim(bottom=0.0)
     ax_dt.set_ylabel(r"$d_t$ [m]")
     ax_dm.set_ylabel(r"$d_m$ [m]")
     ax_do.set_ylabel(r"$d_o$ [m]")
@@ -115,7 +130,8 @@ def main():
     ax_dt.legend(loc="upper right", fontsize=7, ncol=3)
     ax_dm.legend(loc="upper right", fontsize=7, ncol=4)
     ax_do.legend(loc="upper right", fontsize=7)
-    ax_dt.set_title("thin: actual, wide transparent: reference; vertical lines: operator (red) / gesture (blue) commands",
+    ax_dt.set_title("thin: actual, wide transparent: reference; vertical lines: operator (red) / gesture (blue) commands;\n"
+                    "ticks at the bottom: failed replannings per UAV (| previous plan flown, x brake; plans.csv)",
                     fontsize=8)
 
     # Top and side views.
