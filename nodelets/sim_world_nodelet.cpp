@@ -20,7 +20,8 @@
 //   (WorkerState of the leader), gesture_status_in (the leader's gesture filter).
 // Sim time starts when every UAV's FormationPlanner is up. At the end (~duration_s, ≤ 0: the
 // mission's) writes ~output_dir/{metrics.json, timeline.csv, events.csv, modes.csv (the planners'
-// mode changes, from the plans' mode field)} and stops the clock.
+// mode changes, from the plans' mode field), plans.csv (every plan's status and reason)} and stops
+// the clock.
 // Parameters (required): ~mission_file, ~seed, ~real_time_factor, ~clock_step_s,
 //   ~duration_s, ~output_dir, ~world_frame, ~leader_camera_frame; optional ~faults_file (a fault
 //   profile merged into the mission: camera blackouts, sensor dropouts, range outliers, wind).
