@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <regex>
 #include <sstream>
 
@@ -393,127 +394,111 @@ std::string metricsJson(const MissionMetrics& m) {
   return os.str();
 }
 
-bool writeTimelineCsv(const std::string& path, const MissionOutput& out, int uav_count, std::string* error) {
+namespace {
+
+/// Writes `path` with `body`; false and `error` naming the file when it cannot be opened or written.
+bool writeTextFile(const std::string& path, std::string* error, const std::function<void(std::ostream&)>& body) {
   std::ofstream f(path);
   if (!f) {
     if (error) *error = path + ": cannot open for writing";
     return false;
   }
-  f << "t,worker_x,worker_y,worker_z,est_x,est_y,est_z,visible,gesture_true,gesture_class,dominant_ratio";
-  for (int i = 0; i < uav_count; ++i) {
-    const std::string u = formation::uavLabel(i) + "_";
-    for (const char* c : {"x", "y", "z", "d_t", "d_ref", "d_o", "phi_deg", "phi_ref_deg", "elev_deg", "elev_ref_deg",
-                          "heading_deg", "pitch_deg", "speed", "plan_status"}) {
-      f << ',' << u << c;
-    }
-  }
-  for (int i = 0; i < uav_count; ++i) {
-    for (int j = i + 1; j < uav_count; ++j) f << ",d_m_" << formation::uavLabel(i) << '_' << formation::uavLabel(j);
-  }
-  f << '\n';
-  for (const auto& r : out.timeline) {
-    f << formatDouble(r.t_s);
-    for (int k = 0; k < 3; ++k) f << ',' << formatDouble(r.worker_world(k));
-    for (int k = 0; k < 3; ++k) f << ',' << formatDouble(r.estimate_world(k));
-    f << ',' << r.visible << ',' << r.gesture_true << ',' << r.gesture_class << ',' << formatDouble(r.dominant_ratio);
-    for (const auto& u : r.uavs) {
-      for (int k = 0; k < 3; ++k) f << ',' << formatDouble(u.p_world(k));
-      for (double v : {u.d_t, u.d_ref, u.d_o, u.phi_deg, u.phi_ref_deg, u.elev_deg, u.elev_ref_deg, u.heading_deg,
-                       u.pitch_deg, u.speed_mps}) {
-        f << ',' << formatDouble(v);
-      }
-      f << ',' << u.plan_status;
-    }
-    for (double d : r.mutual_m) f << ',' << formatDouble(d);
-    f << '\n';
-  }
+  body(f);
   f.flush();
   if (!f) {
     if (error) *error = path + ": write failed";
     return false;
   }
   return true;
+}
+
+/// Free text as one CSV field: commas become ';', line breaks spaces.
+std::string csvText(std::string s) {
+  std::replace(s.begin(), s.end(), ',', ';');
+  std::replace(s.begin(), s.end(), '\n', ' ');
+  return s;
+}
+
+}  // namespace
+
+bool writeTimelineCsv(const std::string& path, const MissionOutput& out, int uav_count, std::string* error) {
+  return writeTextFile(path, error, [&](std::ostream& f) {
+    f << "t,worker_x,worker_y,worker_z,est_x,est_y,est_z,visible,gesture_true,gesture_class,dominant_ratio";
+    for (int i = 0; i < uav_count; ++i) {
+      const std::string u = formation::uavLabel(i) + "_";
+      for (const char* c : {"x", "y", "z", "d_t", "d_ref", "d_o", "phi_deg", "phi_ref_deg", "elev_deg", "elev_ref_deg",
+                            "heading_deg", "pitch_deg", "speed", "plan_status"}) {
+        f << ',' << u << c;
+      }
+    }
+    for (int i = 0; i < uav_count; ++i) {
+      for (int j = i + 1; j < uav_count; ++j) f << ",d_m_" << formation::uavLabel(i) << '_' << formation::uavLabel(j);
+    }
+    f << '\n';
+    for (const auto& r : out.timeline) {
+      f << formatDouble(r.t_s);
+      for (int k = 0; k < 3; ++k) f << ',' << formatDouble(r.worker_world(k));
+      for (int k = 0; k < 3; ++k) f << ',' << formatDouble(r.estimate_world(k));
+      f << ',' << r.visible << ',' << r.gesture_true << ',' << r.gesture_class << ',' << formatDouble(r.dominant_ratio);
+      for (const auto& u : r.uavs) {
+        for (int k = 0; k < 3; ++k) f << ',' << formatDouble(u.p_world(k));
+        for (double v : {u.d_t, u.d_ref, u.d_o, u.phi_deg, u.phi_ref_deg, u.elev_deg, u.elev_ref_deg, u.heading_deg,
+                         u.pitch_deg, u.speed_mps}) {
+          f << ',' << formatDouble(v);
+        }
+        f << ',' << u.plan_status;
+      }
+      for (double d : r.mutual_m) f << ',' << formatDouble(d);
+      f << '\n';
+    }
+  });
 }
 
 bool writeEventsCsv(const std::string& path, const MissionOutput& out, std::string* error) {
-  std::ofstream f(path);
-  if (!f) {
-    if (error) *error = path + ": cannot open for writing";
-    return false;
-  }
-  f << "t,source,description,status,applied_t,adaptation_start_t,gesture_id,gesture_start_t,gesture_end_t,uavs\n";
-  for (const auto& r : out.requests) {
-    std::string uavs;
-    for (std::size_t i = 0; i < r.uavs.size(); ++i) uavs += (i ? ";" : "") + formation::uavLabel(r.uavs[i]);
-    double gs = std::numeric_limits<double>::quiet_NaN(), ge = gs;
-    if (r.matched_episode >= 0) {
-      gs = out.gestures[static_cast<std::size_t>(r.matched_episode)].start_s;
-      ge = out.gestures[static_cast<std::size_t>(r.matched_episode)].end_s;
+  return writeTextFile(path, error, [&](std::ostream& f) {
+    f << "t,source,description,status,applied_t,adaptation_start_t,gesture_id,gesture_start_t,gesture_end_t,uavs\n";
+    for (const auto& r : out.requests) {
+      std::string uavs;
+      for (std::size_t i = 0; i < r.uavs.size(); ++i) uavs += (i ? ";" : "") + formation::uavLabel(r.uavs[i]);
+      double gs = std::numeric_limits<double>::quiet_NaN(), ge = gs;
+      if (r.matched_episode >= 0) {
+        gs = out.gestures[static_cast<std::size_t>(r.matched_episode)].start_s;
+        ge = out.gestures[static_cast<std::size_t>(r.matched_episode)].end_s;
+      }
+      f << formatDouble(r.t_s) << ',' << r.source << ',' << csvText(r.description) << ',' << r.status << ',' << formatDouble(r.applied_s)
+        << ',' << formatDouble(r.adaptation_start_s) << ',' << r.gesture_id << ',' << formatDouble(gs) << ','
+        << formatDouble(ge) << ',' << uavs << '\n';
     }
-    std::string desc = r.description;
-    std::replace(desc.begin(), desc.end(), ',', ';');
-    f << formatDouble(r.t_s) << ',' << r.source << ',' << desc << ',' << r.status << ',' << formatDouble(r.applied_s)
-      << ',' << formatDouble(r.adaptation_start_s) << ',' << r.gesture_id << ',' << formatDouble(gs) << ','
-      << formatDouble(ge) << ',' << uavs << '\n';
-  }
-  // Performed gestures that never fired anything.
-  for (std::size_t e = 0; e < out.gestures.size(); ++e) {
-    bool matched = false;
-    for (const auto& r : out.requests) matched = matched || r.matched_episode == static_cast<int>(e);
-    if (!matched) {
-      const auto& g = out.gestures[e];
-      f << formatDouble(g.start_s) << ",worker,gesture " << g.gesture_id << " not recognised,missed,nan,nan,"
-        << g.gesture_id << ',' << formatDouble(g.start_s) << ',' << formatDouble(g.end_s) << ",\n";
+    // Performed gestures that never fired anything.
+    for (std::size_t e = 0; e < out.gestures.size(); ++e) {
+      bool matched = false;
+      for (const auto& r : out.requests) matched = matched || r.matched_episode == static_cast<int>(e);
+      if (!matched) {
+        const auto& g = out.gestures[e];
+        f << formatDouble(g.start_s) << ",worker,gesture " << g.gesture_id << " not recognised,missed,nan,nan,"
+          << g.gesture_id << ',' << formatDouble(g.start_s) << ',' << formatDouble(g.end_s) << ",\n";
+      }
     }
-  }
-  f.flush();
-  if (!f) {
-    if (error) *error = path + ": write failed";
-    return false;
-  }
-  return true;
+  });
 }
 
 bool writeModesCsv(const std::string& path, const MissionOutput& out, std::string* error) {
-  std::ofstream f(path);
-  if (!f) {
-    if (error) *error = path + ": cannot open for writing";
-    return false;
-  }
-  f << "t,uav,mode,reason\n";
-  for (const auto& m : out.modes) {
-    std::string why = m.reason;
-    std::replace(why.begin(), why.end(), ',', ';');
-    f << formatDouble(m.t_s) << ',' << formation::uavLabel(m.uav) << ',' << m.mode << ',' << why << '\n';
-  }
-  f.flush();
-  if (!f) {
-    if (error) *error = path + ": write failed";
-    return false;
-  }
-  return true;
+  return writeTextFile(path, error, [&](std::ostream& f) {
+    f << "t,uav,mode,reason\n";
+    for (const auto& m : out.modes) {
+      f << formatDouble(m.t_s) << ',' << formation::uavLabel(m.uav) << ',' << m.mode << ',' << csvText(m.reason) << '\n';
+    }
+  });
 }
 
 bool writePlansCsv(const std::string& path, const MissionOutput& out, std::string* error) {
-  std::ofstream f(path);
-  if (!f) {
-    if (error) *error = path + ": cannot open for writing";
-    return false;
-  }
-  f << "t,uav,status,params_version,planning_ms,reason\n";
-  for (const auto& p : out.plans) {
-    std::string why = p.reason;
-    std::replace(why.begin(), why.end(), ',', ';');
-    std::replace(why.begin(), why.end(), '\n', ' ');
-    f << formatDouble(p.t_s) << ',' << formation::uavLabel(p.uav) << ',' << planning::toString(p.status) << ','
-      << p.params_version << ',' << formatDouble(p.planning_ms) << ',' << why << '\n';
-  }
-  f.flush();
-  if (!f) {
-    if (error) *error = path + ": write failed";
-    return false;
-  }
-  return true;
+  return writeTextFile(path, error, [&](std::ostream& f) {
+    f << "t,uav,status,params_version,planning_ms,reason\n";
+    for (const auto& p : out.plans) {
+      f << formatDouble(p.t_s) << ',' << formation::uavLabel(p.uav) << ',' << planning::toString(p.status) << ','
+        << p.params_version << ',' << formatDouble(p.planning_ms) << ',' << csvText(p.reason) << '\n';
+    }
+  });
 }
 
 bool writeMissionFiles(const std::string& dir, const MissionOutput& out, int uav_count, bool with_modes,
