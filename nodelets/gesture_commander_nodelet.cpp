@@ -6,7 +6,9 @@
 //
 // Frames: observations are grouped by their stamp (the frame's time). A frame is fused and given
 // to the filter once every view has reported it, or ~frame_wait_s after its stamp (a view that
-// did not classify it, or an offline follower); a frame none of whose observations was accepted
+// did not classify it, or an offline follower) — view_fusion.fusion_lag_s after it when that is
+// longer (a delayed link: the views are compared at the frame's time, docs/gestures.md §4.1);
+// a frame none of whose observations was accepted
 // is not given to the filter (as `gfctl simulate`). With view_fusion.min_agreeing_views 1 the
 // leader's own classification goes to the filter unchanged (the paper's single camera) and the
 // followers' observations are ignored.
@@ -18,6 +20,7 @@
 //   or ~mission_file (a scenario's mission.gestures), ~uav_count, ~sender_name, ~frame_wait_s.
 //   Command sequence numbers start at the wall clock in microseconds, so a restarted commander
 //   is never taken for a duplicate.
+#include <algorithm>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -72,12 +75,14 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
       return;
     }
     views_ = vcfg.min_agreeing_views > 1 ? uav_count : 1;
+    close_after_s_ = std::max(frame_wait_s_, views_ > 1 ? vcfg.fusion_lag_s : 0.0);
     NODELET_INFO_STREAM("GestureCommander loaded:\n"
                         << params.loaded() << "  view_fusion: " << views_ << " camera(s), min_agreeing_views "
                         << vcfg.min_agreeing_views << ", max_age_s " << vcfg.max_age_s << ", envelope "
                         << (vcfg.gate_envelope ? "on" : "off") << " [" << vcfg.distance_min_m << ", "
                         << vcfg.distance_max_m << "] m, [" << vcfg.elevation_min_deg << ", " << vcfg.elevation_max_deg
-                        << "] deg, confirm_3d " << (vcfg.confirm_3d ? "on" : "off") << "\n");
+                        << "] deg, confirm_3d " << (vcfg.confirm_3d ? "on" : "off") << ", frames closed "
+                        << close_after_s_ << " s after their stamp\n");
     filter_.emplace(fcfg);
     fusion_.emplace(vcfg, views_, fcfg.max_gesture_id);
     sequence_ = static_cast<std::uint64_t>(ros::WallTime::now().toNSec() / 1000);
@@ -87,7 +92,7 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
     peer_sub_ = nh.subscribe("peer_observations_in", 100, &GestureCommanderNodelet::onObservation, this);
     timer_ = nh.createTimer(ros::Duration(0.01), [this](const ros::TimerEvent&) {
       std::lock_guard<std::mutex> lock(mutex_);
-      closeFrames(ros::Time::now().toSec() - frame_wait_s_);
+      closeFrames(ros::Time::now().toSec() - close_after_s_);
     });
   }
 
@@ -177,6 +182,7 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
   std::mutex mutex_;
   std::string sender_;
   double frame_wait_s_ = 0.0;
+  double close_after_s_ = 0.0;  ///< max(frame_wait_s, view_fusion.fusion_lag_s)
   int views_ = 1;
   std::optional<gesture::GestureFilter> filter_;
   std::optional<gesture::ViewFusion> fusion_;

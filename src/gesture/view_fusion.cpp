@@ -45,6 +45,9 @@ std::vector<std::string> ViewFusionConfig::validate() const {
   if (!(std::isfinite(confirm_3d_max_dt_s) && confirm_3d_max_dt_s > 0.0 && confirm_3d_max_dt_s <= 1.0)) {
     e.push_back("view_fusion.confirm_3d_max_dt_s must be in (0, 1], got " + num(confirm_3d_max_dt_s));
   }
+  if (!(std::isfinite(fusion_lag_s) && fusion_lag_s >= 0.0 && fusion_lag_s <= 2.0)) {
+    e.push_back("view_fusion.fusion_lag_s must be in [0, 2], got " + num(fusion_lag_s));
+  }
   return e;
 }
 
@@ -64,6 +67,7 @@ ViewFusionConfig readViewFusionConfig(ConfigReader& r) {
   r.readDouble(k + "confirm_3d_min_fraction", c.confirm_3d_min_fraction, Range::closed(1e-9, 1.0));
   r.readInt(k + "confirm_3d_min_frames", c.confirm_3d_min_frames, Range::closed(1, 1000));
   r.readDouble(k + "confirm_3d_max_dt_s", c.confirm_3d_max_dt_s, Range::closed(1e-9, 1.0));
+  r.readDouble(k + "fusion_lag_s", c.fusion_lag_s, Range::closed(0.0, 2.0));
   if (c.distance_max_m <= c.distance_min_m) {
     r.addError(k + "distance_max_m", "value " + common::formatDouble(c.distance_max_m) + " must exceed distance_min_m " +
                                          common::formatDouble(c.distance_min_m));
@@ -97,18 +101,31 @@ bool ViewFusion::observe(const ViewObservation& o, std::string* reason) {
   }
   const auto i = static_cast<std::size_t>(o.view);
   auto& h = history_[i];
-  if (!h.empty() && o.t_s < h.back().t_s) {
+  if (!h.empty() && o.t_s < h.back().t_s - config_.fusion_lag_s) {
     return fail("view " + std::to_string(o.view) + ": t " + common::formatDouble(o.t_s) + " older than the stored " +
-                common::formatDouble(h.back().t_s));
+                common::formatDouble(h.back().t_s) + " by more than fusion_lag_s " +
+                common::formatDouble(config_.fusion_lag_s));
   }
-  h.push_back(o);
-  const double keep_s = config_.vote_window_s + config_.max_age_s;
-  while (!h.empty() && h.front().t_s < o.t_s - keep_s) h.pop_front();
+  // After every stored observation of the same or an earlier time (arrival order among equals).
+  const auto at = std::upper_bound(h.begin(), h.end(), o.t_s,
+                                   [](double t, const ViewObservation& stored) { return t < stored.t_s; });
+  h.insert(at, o);
+  const double keep_s = config_.vote_window_s + config_.max_age_s + config_.fusion_lag_s;
+  const double newest_s = h.back().t_s;
+  while (!h.empty() && h.front().t_s < newest_s - keep_s) h.pop_front();
   return true;
 }
 
-int ViewFusion::viewVote(std::size_t i, double t_now) const {
-  if (!(config_.vote_window_s > 0.0)) return history_[i].back().gesture_id;
+const ViewObservation* ViewFusion::newestAt(std::size_t i, double t_now) const {
+  const auto& h = history_[i];
+  for (auto it = h.rbegin(); it != h.rend(); ++it) {
+    if (it->t_s <= t_now + config_.max_age_s) return &*it;
+  }
+  return nullptr;
+}
+
+int ViewFusion::viewVote(std::size_t i, const ViewObservation& newest, double t_now) const {
+  if (!(config_.vote_window_s > 0.0)) return newest.gesture_id;
   std::vector<int> count(static_cast<std::size_t>(max_gesture_id_ + 1), 0);
   int total = 0;
   for (const ViewObservation& o : history_[i]) {
@@ -142,12 +159,11 @@ FusedGesture ViewFusion::fuse(double t_now) const {
   FusedGesture out;
   std::vector<int> votes(static_cast<std::size_t>(max_gesture_id_ + 1), 0);
   for (std::size_t i = 0; i < history_.size(); ++i) {
-    if (history_[i].empty()) continue;
-    const ViewObservation& o = history_[i].back();
-    if (!(t_now - o.t_s <= config_.max_age_s) || o.t_s > t_now + config_.max_age_s) continue;
-    if (!inEnvelope(o.distance_m, o.elevation_deg)) continue;
+    const ViewObservation* o = newestAt(i, t_now);
+    if (o == nullptr || !(t_now - o->t_s <= config_.max_age_s)) continue;
+    if (!inEnvelope(o->distance_m, o->elevation_deg)) continue;
     ++out.voting_views;
-    ++votes[static_cast<std::size_t>(viewVote(i, t_now))];
+    ++votes[static_cast<std::size_t>(viewVote(i, *o, t_now))];
   }
   int best = 0, best_votes = 0;
   bool unique = false;

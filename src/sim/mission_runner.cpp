@@ -450,8 +450,9 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
         return o;
       };
       if (cf.classification) classified = fusion.observe(observation(0, *cf.classification, cf.calibrated));
-      // The followers' votes travel the link; those that arrived by now are counted (older ones
-      // age out of the vote: view_fusion.max_age_s).
+      // The followers' votes travel the link; those that arrived by now are counted. The views are
+      // compared view_fusion.fusion_lag_s in the past (the link's delay budget): a vote that is
+      // older than max_age_s at that moment, or arrives later than the lag, does not count.
       for (std::size_t i = 0; i < cf.followers.size(); ++i) {
         if (cf.followers[i].classification) {
           vote_links[i + 1]->send(t, observation(static_cast<int>(i) + 1, *cf.followers[i].classification,
@@ -462,9 +463,10 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
         for (const auto& o : vote_links[static_cast<std::size_t>(i)]->receive(t)) classified = fusion.observe(o) || classified;
       }
       if (classified) {
-        const int fused = follower_views ? fusion.fuse(t).gesture_id : cf.classification->gesture_id;
+        const double t_fused = follower_views ? t - cfg.view_fusion.fusion_lag_s : t;
+        const int fused = follower_views ? fusion.fuse(t_fused).gesture_id : cf.classification->gesture_id;
         last_class = fused;
-        const auto fo = filter.update(t, fused);
+        const auto fo = filter.update(t_fused, fused);
         last_ratio = fo.dominant_ratio;
         if (fo.fired) {
           const std::size_t record = metrics.addRequest(firedGestureRecord(t, fo.dominant_id, cfg.gesture_mapping));

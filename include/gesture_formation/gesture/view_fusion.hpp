@@ -31,6 +31,14 @@
 ///    the arm in that pose in at least confirm_3d_min_fraction of the 3-D frames: the geometry
 ///    that no 2-D view can tell apart from a pointing arm (docs/gestures.md §6).
 /// min_agreeing_views = 1 with one view is the paper's single-camera pipeline.
+///
+/// Link delay (fusion_lag_s, docs/gestures.md §4.1): the followers' classifications reach the
+/// leader over the radio, 0.1–0.4 s late under load — older than max_age_s by the time they
+/// arrive, so fused at the newest frame they would never vote. A caller that fuses at
+/// t_now − fusion_lag_s compares the views at one past moment that every view's report has
+/// reached: "a view's newest classification" is then its newest at or before that moment
+/// (+ max_age_s, the clock tolerance), and observations may arrive up to fusion_lag_s out of
+/// order (they are inserted in time order). fusion_lag_s = 0: fused at the newest frame.
 /// Thread safety: none; one instance per thread.
 
 #include <cstddef>
@@ -63,6 +71,9 @@ struct ViewFusionConfig {
   double confirm_3d_min_fraction = 0.5;  ///< (0, 1]
   int confirm_3d_min_frames = 5;         ///< ≥ 1
   double confirm_3d_max_dt_s = 0.034;    ///< views' frames at most this apart form one 3-D frame [s], > 0
+  /// [0, 2] s: callers fuse at t_now − fusion_lag_s (the links' delay budget); observations may
+  /// arrive this much out of order and the history is kept this much longer. 0: no lag.
+  double fusion_lag_s = 0.0;
 
   /// \brief Every problem, each naming the key; empty when valid.
   std::vector<std::string> validate() const;
@@ -73,7 +84,7 @@ struct ViewFusionConfig {
 
 /// \brief Reads `view_fusion.{min_agreeing_views, max_age_s, gate_envelope, distance_min_m,
 /// distance_max_m, elevation_min_deg, elevation_max_deg, vote_window_s, vote_min_fraction, confirm_3d,
-/// confirm_3d_min_fraction, confirm_3d_min_frames, confirm_3d_max_dt_s}` (missing keys: the defaults above
+/// confirm_3d_min_fraction, confirm_3d_min_frames, confirm_3d_max_dt_s, fusion_lag_s}` (missing keys: the defaults above
 /// unless the reader requires every key).
 ViewFusionConfig readViewFusionConfig(common::ConfigReader& reader);
 
@@ -103,11 +114,13 @@ class ViewFusion {
   /// config first; an invalid config is clamped to something safe (min_agreeing_views ≥ 1).
   ViewFusion(const ViewFusionConfig& config, int views, int max_gesture_id);
 
-  /// Stores `o` as its view's newest observation. Rejected (false, `reason` set, nothing
-  /// changed): unknown view id, t not finite or older than that view's stored observation,
-  /// gesture id outside 0..max_gesture_id.
+  /// Stores `o` in its view's history (in time order). Rejected (false, `reason` set, nothing
+  /// changed): unknown view id, t not finite or older than that view's newest stored observation
+  /// by more than fusion_lag_s, gesture id outside 0..max_gesture_id.
   bool observe(const ViewObservation& o, std::string* reason = nullptr);
-  /// The fused id at t_now from the stored observations.
+  /// The fused id at t_now from the stored observations: each view's newest observation at or
+  /// before t_now + max_age_s must be fresh (t_now − t ≤ max_age_s). With a lag, call it with
+  /// t_now − fusion_lag_s.
   FusedGesture fuse(double t_now) const;
   /// Whether a view's geometry lies inside the validated envelope.
   bool inEnvelope(double distance_m, double elevation_deg) const;
@@ -118,10 +131,13 @@ class ViewFusion {
  private:
   ViewFusionConfig config_;
   int max_gesture_id_;
-  /// Per view: its observations of the last vote_window_s (+ max_age_s) up to its newest (back()).
+  /// Per view: its observations of the last vote_window_s + max_age_s + fusion_lag_s up to its
+  /// newest (back()), in time order.
   std::vector<std::deque<ViewObservation>> history_;
-  /// The vote of view i at t_now (0: none), its newest observation being fresh and inside the envelope.
-  int viewVote(std::size_t i, double t_now) const;
+  /// View i's newest observation at or before t_now + max_age_s (nullptr: none).
+  const ViewObservation* newestAt(std::size_t i, double t_now) const;
+  /// The vote of view i at t_now (0: none), `newest` (its newestAt) being fresh and inside the envelope.
+  int viewVote(std::size_t i, const ViewObservation& newest, double t_now) const;
   /// Whether the triangulated frames of the vote window show one-arm gesture g (confirm_3d).
   bool confirmedIn3D(int g, double t_now) const;
 };

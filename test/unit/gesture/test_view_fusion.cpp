@@ -228,3 +228,69 @@ TEST(ViewFusionTest, VoteWindowKeysAreValidated) {
   EXPECT_NE(problems[0].find("vote_window_s"), std::string::npos) << problems[0];
   EXPECT_NE(problems[1].find("vote_min_fraction"), std::string::npos) << problems[1];
 }
+
+// Link delay (docs/gestures.md §4.1, safety.md §2.1): a follower's classifications arrive 0.35 s
+// after their frame, older than max_age_s (0.25 s) by then. Fused at the newest frame that view never
+// votes and a gesture seen by the leader and that follower does not pass; fused fusion_lag_s (0.4 s)
+// in the past, both views are compared at one moment every report has reached.
+TEST(ViewFusionTest, DelayedFollowerVotesCountWhenTheViewsAreFusedAtALag) {
+  for (const double lag : {0.0, 0.4}) {
+    ViewFusionConfig c;  // two agreeing views needed
+    c.fusion_lag_s = lag;
+    ViewFusion f(c, 3, 4);
+    int fused_gestures = 0, frames = 0;
+    for (int k = 0; k <= 30; ++k) {  // 10 Hz frames 0..3 s, the worker extends an arm throughout
+      const double t = 0.1 * k;
+      ASSERT_TRUE(f.observe(obs(0, t, 2)));
+      const int late = k - 4;  // the follower frame stamped 0.35 s ago arrived by now (0.4 s ago: 0.05 s)
+      if (late >= 0) {
+        ASSERT_TRUE(f.observe(obs(1, 0.1 * late, 2)));
+        ASSERT_TRUE(f.observe(obs(2, 0.1 * late, 0)));  // the third view reads none
+      }
+      if (t < 1.5) continue;
+      ++frames;
+      const FusedGesture g = f.fuse(t - c.fusion_lag_s);
+      fused_gestures += g.gesture_id == 2 ? 1 : 0;
+      EXPECT_EQ(g.voting_views, lag > 0.0 ? 3 : 1) << "t " << t << " lag " << lag;
+    }
+    EXPECT_EQ(fused_gestures, lag > 0.0 ? frames : 0) << "lag " << lag;
+  }
+}
+
+TEST(ViewFusionTest, ObservationsArriveOutOfOrderOnlyWithinTheLag) {
+  ViewFusionConfig c;
+  c.min_agreeing_views = 1;
+  c.fusion_lag_s = 0.4;
+  ViewFusion f(c, 1, 4);
+  ASSERT_TRUE(f.observe(obs(0, 1.0, 0)));
+  ASSERT_TRUE(f.observe(obs(0, 0.8, 3)));  // reordered by the link: inserted before 1.0
+  ASSERT_TRUE(f.observe(obs(0, 0.9, 3)));
+  // The newest at 0.6 (+ max_age_s 0.25) is the frame of 0.8, not the last to arrive.
+  EXPECT_EQ(f.fuse(0.6).voting_views, 1);
+  EXPECT_EQ(f.fuse(1.0).gesture_id, 3);  // two of the window's three frames read 3
+  std::string why;
+  EXPECT_FALSE(f.observe(obs(0, 0.5, 1), &why));  // 0.5 s before the newest: beyond the lag
+  EXPECT_NE(why.find("fusion_lag_s"), std::string::npos) << why;
+  EXPECT_EQ(f.fuse(1.0).gesture_id, 3);  // nothing changed
+  ViewFusion strict(ViewFusionConfig{}, 1, 4);  // no lag: an older frame is rejected, as before
+  ASSERT_TRUE(strict.observe(obs(0, 1.0, 0)));
+  EXPECT_FALSE(strict.observe(obs(0, 0.9, 3), &why));
+  EXPECT_NE(why.find("older"), std::string::npos) << why;
+}
+
+TEST(ViewFusionTest, FusionLagIsValidated) {
+  ConfigReader r = ConfigReader::fromString("view_fusion: {fusion_lag_s: 3.5}\n", "test.yaml",
+                                            ConfigReader::MissingKeys::kUseDefaults);
+  (void)readViewFusionConfig(r);
+  EXPECT_FALSE(r.ok());
+  EXPECT_NE(r.errorReport().find("view_fusion.fusion_lag_s"), std::string::npos) << r.errorReport();
+  ConfigReader ok = ConfigReader::fromString("view_fusion: {fusion_lag_s: 0.4}\n", "test.yaml",
+                                             ConfigReader::MissingKeys::kUseDefaults);
+  EXPECT_DOUBLE_EQ(readViewFusionConfig(ok).fusion_lag_s, 0.4);
+  EXPECT_TRUE(ok.ok()) << ok.errorReport();
+  ViewFusionConfig bad;
+  bad.fusion_lag_s = -0.1;
+  const std::vector<std::string> problems = bad.validate();
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_NE(problems[0].find("fusion_lag_s must be in [0, 2], got -0.1"), std::string::npos) << problems[0];
+}

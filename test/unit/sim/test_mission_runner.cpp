@@ -138,3 +138,26 @@ TEST(MissionRunnerTest, FollowerGestureVotesTravelTheLossyLink) {
   EXPECT_EQ(fired_lost, 0);
   EXPECT_GT(lost_all, 0);
 }
+
+// A slow link (safety.md §2.1): every follower vote arrives 0.35 s after its frame, older than
+// view_fusion.max_age_s (0.25 s). Fused at the newest frame only the leader's view votes and no
+// gesture fires; fused view_fusion.fusion_lag_s (0.4 s) in the past the same readings fire.
+TEST(MissionRunnerTest, DelayedFollowerVotesCountWhenTheViewsAreFusedAtALag) {
+  World w;
+  auto cfg = gf::sim::test::openFieldWithoutRequests();
+  ASSERT_EQ(cfg.view_fusion.min_agreeing_views, 2);
+  cfg.link.delay_s = 0.35;
+  gf::sim::MissionWorld world{&w.map, &w.field, 0.0};
+  const gf::sim::PlannerFactory factory = [](int) { return std::make_unique<ReferencePlanner>(false); };
+  AlwaysExtendArm classifier;
+  const auto fired = [&](double lag) {
+    cfg.view_fusion.fusion_lag_s = lag;
+    const auto out = gf::sim::runMission(cfg, world, factory, &classifier, 3, 20.0);
+    EXPECT_TRUE(out) << out.reason();
+    int n = 0;
+    for (const auto& r : out->requests) n += r.source == "gesture" ? 1 : 0;
+    return n;
+  };
+  EXPECT_EQ(fired(0.0), 0);
+  EXPECT_GE(fired(0.4), 1);
+}
