@@ -21,7 +21,8 @@
 //   scenario's mission) or ~formation_config + ~planner_config, ~replanning_period_s,
 //   ~horizon_dt_s, ~horizon_steps, ~max_share_age_s, ~params_rate_hz, ~max_wind_estimate_age_s; without ~mission_file
 //   also ~avoid_all_plans, ~max_plan_age_s, ~max_worker_age_s, ~brake_accel_mps2,
-//   ~search_timeout_s, ~search_height_m, ~search_vertical_speed_mps, ~search_period_s (with it: the mission's faults.* of the
+//   ~search_timeout_s, ~search_height_m, ~search_vertical_speed_mps, ~search_period_s,
+//   ~search_horizontal_speed_mps (with it: the mission's faults.* of the
 //   same names and controller.brake_accel_mps2, as gfctl simulate); optional ~faults_file (a fault
 //   profile merged into the mission, as `gfctl simulate --faults`).
 // Listen before moving (docs/safety.md §2.4, planning::listeningReason — gfctl simulate's rule for a
@@ -99,6 +100,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
       params.load("search_height_m", search_.height_m, 0.1, 100.0);
       params.load("search_vertical_speed_mps", search_.vertical_speed_mps, 0.01, 10.0);
       params.load("search_period_s", search_.period_s, 0.5, 120.0);
+      params.load("search_horizontal_speed_mps", search_.horizontal_speed_mps, 0.0, 10.0);
       if (!formation_file.empty()) loadFormation(formation_file, params, fcfg);
       if (!planner_file.empty()) loadPlanner(planner_file, params, pcfg);
     }

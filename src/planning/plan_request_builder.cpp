@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Geometry>
+
 #include "gesture_formation/common/csv.hpp"
 
 namespace gesture_formation::planning {
@@ -95,6 +97,9 @@ std::vector<std::string> SearchConfig::validate(const std::string& prefix) const
     e.push_back(prefix + "search_vertical_speed_mps must be > 0, got " + num(vertical_speed_mps));
   }
   if (!(std::isfinite(period_s) && period_s > 0.0)) e.push_back(prefix + "search_period_s must be > 0, got " + num(period_s));
+  if (!(std::isfinite(horizontal_speed_mps) && horizontal_speed_mps >= 0.0)) {
+    e.push_back(prefix + "search_horizontal_speed_mps must be >= 0, got " + num(horizontal_speed_mps));
+  }
   return e;
 }
 
@@ -104,17 +109,29 @@ bool searching(int uav_index, const std::string& hold_reason, double t_s, double
          std::isfinite(worker_stamp_s) && t_s - worker_stamp_s <= limits.max_worker_age_s + config.timeout_s;
 }
 
-formation::HorizonPoints searchTargets(const Eigen::Vector3d& worker_world, double t_s, double dt_s, int steps,
-                                       double worker_stamp_s, double sweep_begin_s, const SearchConfig& config) {
+formation::HorizonPoints searchTargets(const Eigen::Vector3d& worker_world, const Eigen::Vector3d& camera_world,
+                                       double t_s, double dt_s, int steps, double worker_stamp_s, double sweep_begin_s,
+                                       const SearchConfig& config) {
   formation::HorizonPoints out(3, std::max(0, steps));
   const double period = config.period_s > 0.0 ? config.period_s : 1.0;
+  const auto triangle = [](double phase) {  // 0 → 1 → 0 → −1 → 0 per unit of phase
+    const double f = phase - std::floor(phase);
+    return f < 0.25 ? 4.0 * f : (f < 0.75 ? 2.0 - 4.0 * f : 4.0 * f - 4.0);
+  };
+  const Eigen::Vector2d rel = (worker_world - camera_world).head<2>();
+  const double horizontal = rel.norm();
+  const bool turn = config.horizontal_speed_mps > 0.0 && horizontal > 1e-6;
   for (int k = 0; k < out.cols(); ++k) {
     const double t = t_s + k * dt_s;
     const double phase = std::max(0.0, t - sweep_begin_s) / period;
-    const double f = phase - std::floor(phase);
-    const double w = f < 0.25 ? 4.0 * f : (f < 0.75 ? 2.0 - 4.0 * f : 4.0 * f - 4.0);  // 0 → 1 → 0 → −1 → 0
-    const double amplitude = std::min(config.height_m, config.vertical_speed_mps * std::max(0.0, t - worker_stamp_s));
-    out.col(k) = worker_world + Eigen::Vector3d(0.0, 0.0, amplitude * w);
+    const double age = std::max(0.0, t - worker_stamp_s);
+    const double amplitude = std::min(config.height_m, config.vertical_speed_mps * age);
+    Eigen::Vector3d target = worker_world;
+    if (turn) {
+      const double angle = std::atan2(config.horizontal_speed_mps * age, horizontal) * triangle(0.5 * phase);
+      target.head<2>() = camera_world.head<2>() + Eigen::Rotation2Dd(angle) * rel;
+    }
+    out.col(k) = target + Eigen::Vector3d(0.0, 0.0, amplitude * triangle(phase));
   }
   return out;
 }
@@ -153,7 +170,8 @@ HoldPlanner::Decision HoldPlanner::decide(const Situation& s) {
   }
   if (!std::isfinite(sweep_begin_s_)) sweep_begin_s_ = s.t_s;
   d.mode = "search";
-  d.camera_target = searchTargets(s.worker_world, s.t_s, s.dt_s, s.steps, s.worker_stamp_s, sweep_begin_s_, search_);
+  d.camera_target =
+      searchTargets(s.worker_world, *hold_p_, s.t_s, s.dt_s, s.steps, s.worker_stamp_s, sweep_begin_s_, search_);
   return d;
 }
 

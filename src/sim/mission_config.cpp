@@ -393,6 +393,7 @@ common::Result<MissionConfig> parseMissionConfig(const std::string& yaml, const 
   r.readDouble(fk + "search_height_m", c.faults.search.height_m, Range::positive());
   r.readDouble(fk + "search_vertical_speed_mps", c.faults.search.vertical_speed_mps, Range::positive());
   r.readDouble(fk + "search_period_s", c.faults.search.period_s, Range::positive());
+  r.readDouble(fk + "search_horizontal_speed_mps", c.faults.search.horizontal_speed_mps, Range::nonNegative());
   r.readDouble(fk + "max_command_age_s", c.faults.max_command_age_s, Range::positive());
   r.readDouble(fk + "max_plan_age_s", c.faults.max_plan_age_s, Range::positive());
   r.readBool(fk + "avoid_all_plans", c.faults.avoid_all_plans);

@@ -105,15 +105,22 @@ Eigen::Vector3d brakingPoint(const Eigen::Vector3d& p_world, const Eigen::Vector
 /// its lost_timeout_s) the camera follows that prediction, as in a plain hold; once the estimator
 /// has lost him (the position is held where the model left it) the camera sweeps along the
 /// vertical through that estimate, as far up and down as he could have climbed since he was last
-/// seen — a worker on a tower climbs out of a camera that keeps looking where he was. Followers
+/// seen — a worker on a tower climbs out of a camera that keeps looking where he was. With
+/// horizontal_speed_mps > 0 the sweep also turns the camera left and right about the vertical
+/// through the hold point, as far as a worker walking at that speed could have gone sideways
+/// since he was last seen — a worker walking on the ground leaves the view sideways. Followers
 /// hold as before.
 struct SearchConfig {
   double timeout_s = 60.0;           ///< search for at most this long after the hold began, then look at the estimate; 0: never
   double height_m = 15.0;            ///< the sweep's largest offset above / below the estimate [m], > 0
   double vertical_speed_mps = 0.5;   ///< assumed climbing speed: the offset grows by this × the estimate's age, > 0
   double period_s = 8.0;             ///< up, back, down, back once [s], > 0
+  /// Assumed walking speed for the sideways sweep [m/s], ≥ 0 (0: vertical sweep only): the
+  /// camera turns ± atan(this × the estimate's age / horizontal distance to the estimate), left,
+  /// back, right, back once every 2 × period_s.
+  double horizontal_speed_mps = 0.0;
   /// Every problem, each naming the key under `prefix` (search_timeout_s, search_height_m,
-  /// search_vertical_speed_mps, search_period_s); empty when valid.
+  /// search_vertical_speed_mps, search_period_s, search_horizontal_speed_mps); empty when valid.
   std::vector<std::string> validate(const std::string& prefix) const;
 };
 
@@ -126,9 +133,13 @@ bool searching(int uav_index, const std::string& hold_reason, double t_s, double
 /// \brief The search's camera targets for steps k = 0..steps−1 at t_k = t_s + k·dt_s: the
 /// estimate raised by A(t_k)·w(phase), A = min(height_m, vertical_speed × (t_k − worker_stamp_s)),
 /// w a triangle wave 0 → 1 → 0 → −1 → 0 per period_s, phase 0 at sweep_begin_s (when the sweep
-/// began): close to the estimate first, wider the longer he is lost.
-formation::HorizonPoints searchTargets(const Eigen::Vector3d& worker_world, double t_s, double dt_s, int steps,
-                                       double worker_stamp_s, double sweep_begin_s, const SearchConfig& config);
+/// began): close to the estimate first, wider the longer he is lost. With horizontal_speed_mps > 0
+/// the estimate is first turned about the vertical through `camera_world` by Θ(t_k)·w(phase / 2),
+/// Θ = atan2(horizontal_speed × (t_k − worker_stamp_s), horizontal distance camera → estimate)
+/// (≤ 90°; nothing turns when the camera is straight above or below the estimate).
+formation::HorizonPoints searchTargets(const Eigen::Vector3d& worker_world, const Eigen::Vector3d& camera_world,
+                                       double t_s, double dt_s, int steps, double worker_stamp_s, double sweep_begin_s,
+                                       const SearchConfig& config);
 
 /// \brief The hold reference: every step at `hold_world`, camera heading and pitch towards
 /// `worker_world` (the worker estimate; `heading_rad` when straight above/below).

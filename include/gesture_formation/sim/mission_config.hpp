@@ -98,7 +98,7 @@ struct FaultConfig {
   /// late or lost fallback flag makes unsafe (docs/safety.md §2.1).
   bool avoid_all_plans = true;
   /// The leader's camera search for a worker it lost (keys search_timeout_s, search_height_m,
-  /// search_vertical_speed_mps, search_period_s; docs/safety.md §2.2).
+  /// search_vertical_speed_mps, search_period_s, search_horizontal_speed_mps; docs/safety.md §2.2).
   planning::SearchConfig search;
   std::vector<std::string> validate(const std::string& prefix = "") const;
   /// \brief Whether follower `uav`'s computer is down at `t_s` (a follower_dropouts window).
