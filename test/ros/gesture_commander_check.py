@@ -5,7 +5,9 @@ messages of gesture 2 at 15 Hz for 2 s (30 frames: 20 agreeing ones fill the fil
 f_d = 1 > 0.8) and checks which fire. For the 3-D confirmation the observations carry the skeleton
 of a worker projected through three calibrated cameras (pinhole, the commander's pose convention:
 optical frame in the world): the one view that reads "extend" fires only when the skeleton's arm
-is extended in 3-D, not when it points forward.
+is extended in 3-D, not when it points forward. A slow link: /voted and /lagged (fusion_lag_s 0.8)
+get the leader's observations at once and follower 1's 0.47 s late (7 frames; stamped with their
+frame): only /lagged fires.
 Exit code = number of failures."""
 import math
 import sys
@@ -86,7 +88,7 @@ def skeleton_fields(azimuth_deg, arm):
 def main():
     rospy.init_node("gesture_commander_check")
     pubs, commands, statuses = {}, {}, {}
-    for name in ("single", "voted", "confirm3d"):
+    for name in ("single", "voted", "confirm3d", "lagged"):
         pubs[name] = (rospy.Publisher("/%s/observation" % name, GestureObservation, queue_size=50),
                       rospy.Publisher("/%s/peer_observations" % name, GestureObservation, queue_size=50))
         commands[name], statuses[name] = [], []
@@ -110,6 +112,27 @@ def main():
                 pubs[name][0 if uav == 0 else 1].publish(o)
             rate.sleep()
         time.sleep(0.5)
+
+    def inject_late_follower(names, delay_frames=7):
+        """The leader reads gesture 2 at once; follower 1 reads it too, its observations published
+        delay_frames frames (at 15 Hz) after their stamp."""
+        rate = rospy.Rate(15)
+        stamps = []
+        for k in range(40 + delay_frames):
+            stamps.append(rospy.Time.now())
+            for name in names:
+                if k < 40:
+                    o = GestureObservation(uav_index=0, gesture_id=2, probabilities=[0, 0, 1.0, 0, 0], geometry_known=True,
+                                           distance_m=IN_ENVELOPE[0], elevation_deg=IN_ENVELOPE[1])
+                    o.header.stamp = stamps[-1]
+                    pubs[name][0].publish(o)
+                if k >= delay_frames:
+                    o = GestureObservation(uav_index=1, gesture_id=2, probabilities=[0, 0, 1.0, 0, 0], geometry_known=True,
+                                           distance_m=IN_ENVELOPE[0], elevation_deg=IN_ENVELOPE[1])
+                    o.header.stamp = stamps[k - delay_frames]
+                    pubs[name][1].publish(o)
+            rate.sleep()
+        time.sleep(1.0)
 
     fails = 0
 
@@ -156,6 +179,17 @@ def main():
           "confirm_3d on, 1 of 3 cameras, the arm extended in 3-D: %d command(s)%s (expected 1, confirmed in 3-D, "
           "1 agreeing)" % (len(commands["confirm3d"]), ", fired confirmed_3d %s with %d agreeing" % (
               fired[0].confirmed_3d, fired[0].agreeing_views) if fired else ""))
+    before = len(commands["voted"])
+    del statuses["voted"][:]
+    inject_late_follower(["voted", "lagged"])
+    agree = max([m.agreeing_views for m in statuses["voted"]] or [0])
+    check(len(commands["voted"]) == before and agree == 1,
+          "no lag, follower 1 0.47 s late: %d new command(s), at most %d agreeing view(s) (expected 0, 1)" % (
+              len(commands["voted"]) - before, agree))
+    fired = [m for m in statuses["lagged"] if m.fired]
+    check(len(commands["lagged"]) == 1 and len(fired) == 1 and fired[0].agreeing_views == 2,
+          "fusion_lag_s 0.8, follower 1 0.47 s late: %d command(s)%s (expected 1, 2 agreeing)" % (
+              len(commands["lagged"]), ", fired with %d agreeing" % fired[0].agreeing_views if fired else ""))
     return fails
 
 
