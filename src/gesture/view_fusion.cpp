@@ -84,6 +84,7 @@ ViewFusion::ViewFusion(const ViewFusionConfig& config, int views, int max_gestur
       max_gesture_id_(std::max(1, max_gesture_id)),
       history_(static_cast<std::size_t>(std::max(1, views))) {
   config_.min_agreeing_views = std::max(1, config_.min_agreeing_views);
+  config_.fusion_lag_s = std::isfinite(config_.fusion_lag_s) ? std::clamp(config_.fusion_lag_s, 0.0, 2.0) : 0.0;
 }
 
 bool ViewFusion::observe(const ViewObservation& o, std::string* reason) {

@@ -111,7 +111,8 @@ struct FusedGesture {
 class ViewFusion {
  public:
   /// `views` cameras (ids 0..views−1), gesture ids 0..max_gesture_id. Call validate() on the
-  /// config first; an invalid config is clamped to something safe (min_agreeing_views ≥ 1).
+  /// config first; an invalid config is clamped to something safe (min_agreeing_views ≥ 1,
+  /// fusion_lag_s into [0, 2], not finite: 0).
   ViewFusion(const ViewFusionConfig& config, int views, int max_gesture_id);
 
   /// Stores `o` in its view's history (in time order). Rejected (false, `reason` set, nothing

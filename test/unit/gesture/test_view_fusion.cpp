@@ -276,6 +276,11 @@ TEST(ViewFusionTest, ObservationsArriveOutOfOrderOnlyWithinTheLag) {
   ASSERT_TRUE(strict.observe(obs(0, 1.0, 0)));
   EXPECT_FALSE(strict.observe(obs(0, 0.9, 3), &why));
   EXPECT_NE(why.find("older"), std::string::npos) << why;
+  ViewFusionConfig nan_lag;  // not validated: clamped to no lag, not "accept anything"
+  nan_lag.fusion_lag_s = std::nan("");
+  ViewFusion clamped(nan_lag, 1, 4);
+  ASSERT_TRUE(clamped.observe(obs(0, 1.0, 0)));
+  EXPECT_FALSE(clamped.observe(obs(0, 0.9, 3)));
 }
 
 TEST(ViewFusionTest, FusionLagIsValidated) {
