@@ -111,53 +111,51 @@ class AlwaysExtendArm : public gf::sim::MissionClassifier {
   }
 };
 
+/// The 20-s mission of `cfg` with every camera reading "extend arm" and reference-following
+/// planners: the gesture commands it fired, and the inter-UAV messages the links lost.
+struct ExtendArmRun {
+  int gestures_fired = 0;
+  long messages_lost = 0;
+};
+ExtendArmRun runEveryCameraReadingExtendArm(const gf::sim::MissionConfig& cfg) {
+  World w;
+  gf::sim::MissionWorld world{&w.map, &w.field, 0.0};
+  const gf::sim::PlannerFactory factory = [](int) { return std::make_unique<ReferencePlanner>(false); };
+  AlwaysExtendArm classifier;
+  const auto out = gf::sim::runMission(cfg, world, factory, &classifier, 3, 20.0);
+  EXPECT_TRUE(out) << out.reason();
+  ExtendArmRun run;
+  if (!out) return run;
+  for (const auto& r : out->requests) run.gestures_fired += r.source == "gesture" ? 1 : 0;
+  run.messages_lost = out->metrics.messages_lost;
+  return run;
+}
+
 }  // namespace
 
 // The followers' gesture votes reach the leader over the inter-UAV link (as over LCM in the ROS
 // system), so they share its faults: with every message lost, the leader's own view is 1 of the
 // 2 agreeing views the vote needs and nothing fires; with a working link the same readings fire.
 TEST(MissionRunnerTest, FollowerGestureVotesTravelTheLossyLink) {
-  World w;
   auto cfg = gf::sim::test::openFieldWithoutRequests();
   ASSERT_EQ(cfg.view_fusion.min_agreeing_views, 2);
-  gf::sim::MissionWorld world{&w.map, &w.field, 0.0};
-  const gf::sim::PlannerFactory factory = [](int) { return std::make_unique<ReferencePlanner>(false); };
-  AlwaysExtendArm classifier;
-  const auto fired = [&](double loss) {
-    cfg.link.loss = loss;
-    const auto out = gf::sim::runMission(cfg, world, factory, &classifier, 3, 20.0);
-    EXPECT_TRUE(out) << out.reason();
-    int n = 0;
-    for (const auto& r : out->requests) n += r.source == "gesture" ? 1 : 0;
-    return std::make_pair(n, out->metrics.messages_lost);
-  };
-  const auto [fired_ok, lost_ok] = fired(0.0);
-  EXPECT_GE(fired_ok, 1);
-  EXPECT_EQ(lost_ok, 0);
-  const auto [fired_lost, lost_all] = fired(1.0);
-  EXPECT_EQ(fired_lost, 0);
-  EXPECT_GT(lost_all, 0);
+  const ExtendArmRun ok = runEveryCameraReadingExtendArm(cfg);
+  EXPECT_GE(ok.gestures_fired, 1);
+  EXPECT_EQ(ok.messages_lost, 0);
+  cfg.link.loss = 1.0;
+  const ExtendArmRun lost = runEveryCameraReadingExtendArm(cfg);
+  EXPECT_EQ(lost.gestures_fired, 0);
+  EXPECT_GT(lost.messages_lost, 0);
 }
 
 // A slow link (safety.md §2.1): every follower vote arrives 0.35 s after its frame, older than
 // view_fusion.max_age_s (0.25 s). Fused at the newest frame only the leader's view votes and no
 // gesture fires; fused view_fusion.fusion_lag_s (0.4 s) in the past the same readings fire.
 TEST(MissionRunnerTest, DelayedFollowerVotesCountWhenTheViewsAreFusedAtALag) {
-  World w;
   auto cfg = gf::sim::test::openFieldWithoutRequests();
   ASSERT_EQ(cfg.view_fusion.min_agreeing_views, 2);
   cfg.link.delay_s = 0.35;
-  gf::sim::MissionWorld world{&w.map, &w.field, 0.0};
-  const gf::sim::PlannerFactory factory = [](int) { return std::make_unique<ReferencePlanner>(false); };
-  AlwaysExtendArm classifier;
-  const auto fired = [&](double lag) {
-    cfg.view_fusion.fusion_lag_s = lag;
-    const auto out = gf::sim::runMission(cfg, world, factory, &classifier, 3, 20.0);
-    EXPECT_TRUE(out) << out.reason();
-    int n = 0;
-    for (const auto& r : out->requests) n += r.source == "gesture" ? 1 : 0;
-    return n;
-  };
-  EXPECT_EQ(fired(0.0), 0);
-  EXPECT_GE(fired(0.4), 1);
+  EXPECT_EQ(runEveryCameraReadingExtendArm(cfg).gestures_fired, 0);
+  cfg.view_fusion.fusion_lag_s = 0.4;
+  EXPECT_GE(runEveryCameraReadingExtendArm(cfg).gestures_fired, 1);
 }
