@@ -77,6 +77,38 @@ Eigen::Vector3d brakeStop(const Eigen::Vector3d& p, const Eigen::Vector3d& v, co
   return p + 0.5 * b.speed_mps * b.t_stop_s * b.dir;
 }
 
+PlannedTrajectory retimeThenBrake(const PlannedTrajectory& plan, double t0, double dt, int n, const DynamicLimits& limits) {
+  PlannedTrajectory out;
+  out.uav_index = plan.uav_index;
+  out.t0_s = t0;
+  out.dt_s = dt;
+  if (plan.samples.empty()) return out;
+  const double t_end = plan.tEnd();
+  const TrajectorySample& last = plan.samples.back();
+  const BrakeProfile b = brakeProfile(last.v_world, limits, dt);
+  for (int k = 0; k < n; ++k) {
+    const double t = t0 + k * dt;
+    TrajectorySample s;
+    const double tau = t - t_end;
+    if (tau > 1e-9 && b.speed_mps > 0.0) {  // braking after the end (a stop on a sample of the end's grid)
+      const double tb = std::min(tau, b.t_stop_s);
+      s.p_world = last.p_world + (b.speed_mps * tb - 0.5 * b.decel_mps2 * tb * tb) * b.dir;
+      s.v_world = (b.speed_mps - b.decel_mps2 * tb) * b.dir;
+      s.a_world = tau < b.t_stop_s ? Eigen::Vector3d(-b.decel_mps2 * b.dir) : Eigen::Vector3d::Zero();
+    } else {
+      const TrajectoryPoint x = evaluateTrajectory(plan, t);
+      s.p_world = x.p;
+      s.v_world = x.v;
+      s.a_world = x.a;
+    }
+    const TrajectorySample angles = plan.sampleAt(t);
+    s.heading_rad = angles.heading_rad;
+    s.pitch_rad = angles.pitch_rad;
+    out.samples.push_back(s);
+  }
+  return out;
+}
+
 std::vector<Eigen::Vector3d> brakeEnvelope(const PlannedTrajectory& plan, double t_until, const DynamicLimits& limits) {
   std::vector<Eigen::Vector3d> out;
   if (plan.samples.empty()) return out;

@@ -42,6 +42,28 @@ double supportAlong(const NormPolygon& poly, const Eigen::Vector3d& d) {
   return s;
 }
 
+/// Least value of d·p_k (k = 1..N, index 0 unused) that the QP's model can reach from (p0, v0, a0):
+/// acceleration along −d at `accel_share` of the acceleration set's support (the first interval
+/// ramps from a0, as in the QP), speed along −d within the velocity set's support. A position row
+/// d·p_k ≤ b with b below it cannot be met — the UAV's momentum carries it over the plane (a state
+/// that deviates from the plan it flew, a corridor rebuilt around a new path).
+std::vector<double> leastReach(const Eigen::Vector3d& d, const Eigen::Vector3d& p0, const Eigen::Vector3d& v0,
+                               const Eigen::Vector3d& a0, const NormPolygon& velocity, const NormPolygon& acceleration,
+                               double accel_share, double dt, int N) {
+  std::vector<double> out(static_cast<std::size_t>(N) + 1, d.dot(p0));
+  const double A = accel_share * supportAlong(acceleration, d), V = supportAlong(velocity, d);
+  double s = d.dot(p0), v = d.dot(v0), acc = d.dot(a0);
+  for (int k = 1; k <= N; ++k) {
+    double next = -A;
+    next = std::min(std::max(next, 2.0 * (-V - v) / dt - acc), A);  // not faster than V along −d
+    s += v * dt + acc * dt * dt / 3.0 + next * dt * dt / 6.0;
+    v += (acc + next) * dt / 2.0;
+    acc = next;
+    out[static_cast<std::size_t>(k)] = s;
+  }
+  return out;
+}
+
 std::string checkRequest(const PlanRequest& r) {
   std::ostringstream e;
   const auto& s = r.state;
@@ -325,22 +347,8 @@ PlanResult UavPlanner::fallback(const PlanRequest& req, PlanResult result, const
       os << "previous plan is " << deviation << " m from the state";
       why_not = os.str();
     } else {
-      PlannedTrajectory prev;
+      PlannedTrajectory prev = retimeThenBrake(last_verified_, req.t_now_s, dt, n, config_.limits);
       prev.uav_index = req.uav_index;
-      prev.t0_s = req.t_now_s;
-      prev.dt_s = dt;
-      for (int k = 0; k < n; ++k) {
-        const double t = req.t_now_s + k * dt;
-        const TrajectoryPoint x = evaluateTrajectory(last_verified_, t);
-        const TrajectorySample angles = last_verified_.sampleAt(t);
-        TrajectorySample s;
-        s.p_world = x.p;
-        s.v_world = x.v;
-        s.a_world = x.a;
-        s.heading_rad = angles.heading_rad;
-        s.pitch_rad = angles.pitch_rad;
-        prev.samples.push_back(s);
-      }
       const VerificationReport rep =
           verifier_ ? verifier_->verify(prev, req.t_now_s, req.higher_priority_plans, req.worker, req.t_now_s, dt)
                     : VerificationReport{};
@@ -580,8 +588,32 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
     inflated = std::make_unique<CorridorBuilder>(cc);
   }
   const CorridorBuilder& builder = inflated ? *inflated : *corridors_;
+  // A start closer to an obstacle than the corridor clearance (flying low over the ground, a
+  // gust): the first corridor is asked for a little less than the start has — its exact distance
+  // to the nearest voxel centre − the builder's seed margin (the ends lie that far inside every
+  // plane) − kFirstCorridorGap — not less than the verifier's clearance. Asked for more, the builder
+  // shrinks its planes point by point around the start — a fan of ~100 planes for a start near
+  // flat ground, whose QP rows (× 40 samples) made single replannings take seconds; within ~1 cm of
+  // that distance the fan appears too (tangent planes through points just beyond the start). Not
+  // less: the corridor must not let the UAV much closer than it is (the move-away rows below ask
+  // it to recover).
+  std::unique_ptr<CorridorBuilder> first_builder;
+  if (start_clear < seg_clear) {
+    constexpr double kFirstCorridorGap = 0.03;
+    std::vector<Eigen::Vector3d> near;
+    map.pointsInBox(Aabb{p0 - Eigen::Vector3d::Constant(seg_clear), p0 + Eigen::Vector3d::Constant(seg_clear)}, near);
+    double d_exact = std::numeric_limits<double>::infinity();
+    for (const auto& q : near) d_exact = std::min(d_exact, (q - p0).norm());
+    CorridorConfig cc = corridors_->config();
+    const double first_clear = std::clamp(d_exact - cc.seed_margin_m - kFirstCorridorGap,
+                                          config_.verify_clearance_m + OccupancyMap::rasterInflation(res), seg_clear);  // to centres
+    if (first_clear < seg_clear - 1e-9) {
+      cc.clearance_m = first_clear;
+      first_builder = std::make_unique<CorridorBuilder>(cc);
+    }
+  }
   for (std::size_t i = 0; i + 1 < path.size(); ++i) {
-    auto c = builder.buildSegment(path[i], path[i + 1], map);
+    auto c = (i == 0 && first_builder ? *first_builder : builder).buildSegment(path[i], path[i + 1], map);
     if (!c) {
       result.timings.corridor_ms = msSince(t_stage);
       return finish(fallback(req, result, "corridor " + std::to_string(i) + ": " + c.reason()));
@@ -659,17 +691,38 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
       guide[static_cast<std::size_t>(k)] = path[static_cast<std::size_t>(s)] + local * tangent(s);
     }
   }
-  // Corridor rows, pruned when the sample cannot reach them (‖x_k − p0‖ ≤ v_max t_k).
+  // Corridor rows, pruned when the sample cannot reach them (‖x_k − p0‖ ≤ v_max t_k). A row the
+  // UAV cannot meet (with a 2 cm cushion) even braking with all its acceleration — its momentum
+  // carries it over the plane (leastReach) — is moved out to where it can braking at 70 %, by at
+  // most the tracking allowance: the part
+  // of the corridor clearance that is there to absorb deviations from the plan, and never closer
+  // to the obstacle points behind it than the verifier's clearance (catch-up 18–34 m low over the
+  // ground: the plan flown descended towards its floor, the new corridor's floor was 2 cm too high
+  // for the state; docs/planning.md §12). Rows it can meet are not touched (plans unchanged); a row
+  // still out of reach after the allowance leaves the QP infeasible: the planner falls back.
   const double vmax = config_.limits.max_speed_mps;
+  constexpr double kMomentumAccelShare = 0.7, kMomentumCushion = 0.02;
+  const double verify_clear = config_.verify_clearance_m + OccupancyMap::rasterInflation(res);  // to voxel centres
+  std::vector<std::vector<std::vector<double>>> least(corridors.size());  // [corridor][row][k], lazily
   for (int k = 1; k <= N; ++k) {
     const double reach = vmax * k * dt;
     const int s_prev = seg[static_cast<std::size_t>(k) - 1], s_cur = seg[static_cast<std::size_t>(k)];
     for (int s : {s_prev, s_cur}) {
       const Polytope& P = corridors[static_cast<std::size_t>(s)].polytope;
+      const double cap = std::min(allowance, corridors[static_cast<std::size_t>(s)].clearance_m - verify_clear);
+      auto& rows_least = least[static_cast<std::size_t>(s)];
+      if (rows_least.empty()) rows_least.resize(static_cast<std::size_t>(P.rows()));
       for (int r = 0; r < P.rows(); ++r) {
         const Eigen::Vector3d a = P.A.row(r).transpose();
-        const double b = P.b(r) - config_.corridor_margin_m;
+        double b = P.b(r) - config_.corridor_margin_m;
         if (a.dot(p0) + reach < b) continue;  // unreachable plane
+        auto& lr = rows_least[static_cast<std::size_t>(r)];
+        if (lr.empty()) lr = leastReach(a, p0, qp.v0, qp.a0, qp.velocity, qp.acceleration, 1.0, dt, N);
+        if (lr[static_cast<std::size_t>(k)] + kMomentumCushion > b && cap > 0.0) {
+          const std::vector<double> soft = leastReach(a, p0, qp.v0, qp.a0, qp.velocity, qp.acceleration, kMomentumAccelShare, dt, N);
+          b = std::min(soft[static_cast<std::size_t>(k)] + kMomentumCushion, b + cap);
+          ++result.momentum_relaxed_rows;
+        }
         qp.constraints.push_back(PositionConstraint{k, a, b, PositionConstraint::Kind::kCorridor});
       }
       if (s_prev == s_cur) break;
@@ -689,10 +742,22 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
       }
       if (g.allFinite() && g.norm() > 1e-6) {
         const Eigen::Vector3d away = g.normalized();
+        // Not faster than the UAV can turn round: moving towards the obstacle it first has to stop.
+        // Largest away·(x_k − p0) braking fully / at 70 %, less the cushion:
+        const auto most = [&](double share) {
+          std::vector<double> m = leastReach(-away, p0, qp.v0, qp.a0, qp.velocity, qp.acceleration, share, dt, N);
+          for (double& x : m) x = -(x + kMomentumCushion) - away.dot(p0);
+          return m;
+        };
+        const std::vector<double> most_full = most(1.0), most_soft = most(kMomentumAccelShare);
         for (int k = 1; k <= N; ++k) {
-          const double gain = std::min(seg_clear - d_start,
-                                       -0.5 * config_.recovery_slack_m + 1.2 * recoveryAllowance(config_, k * dt));
+          double gain = std::min(seg_clear - d_start,
+                                 -0.5 * config_.recovery_slack_m + 1.2 * recoveryAllowance(config_, k * dt));
           // away·(x_k − p0) ≥ gain  ⇔  (−away)·x_k ≤ −away·p0 − gain
+          if (gain > most_full[static_cast<std::size_t>(k)]) {
+            gain = most_soft[static_cast<std::size_t>(k)];
+            ++result.momentum_relaxed_rows;
+          }
           qp.constraints.push_back(PositionConstraint{k, -away, -away.dot(p0) - gain, PositionConstraint::Kind::kCorridor});
         }
       }

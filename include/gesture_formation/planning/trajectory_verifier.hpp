@@ -63,6 +63,14 @@ BrakeProfile brakeProfile(const Eigen::Vector3d& v_world, const DynamicLimits& l
 Eigen::Vector3d brakeStop(const Eigen::Vector3d& p_world, const Eigen::Vector3d& v_world, const DynamicLimits& limits,
                           double dt_s);
 
+/// \brief `plan` re-timed to n samples t0_s + k·dt_s: the exact Hermite evaluation while within it
+/// (camera angles from PlannedTrajectory::sampleAt); after its end, braking to hover from its end
+/// velocity by brakeProfile() — not a jump to rest, which a plan that ends moving would otherwise
+/// make (a velocity step of several m/s within one interval: tens of m/s² that no verifier passes).
+/// A plan that ends at rest re-times exactly as evaluateTrajectory (hover at its end).
+PlannedTrajectory retimeThenBrake(const PlannedTrajectory& plan, double t0_s, double dt_s, int n,
+                                  const DynamicLimits& limits);
+
 /// \brief The braking envelope of another UAV's plan at t_until_s (PlannerConfig::brake_envelope_age_s,
 /// brake_envelope_lead_s): brakeStop() of the plan's state at each of its sample times in
 /// [t0, min(t_until, tEnd)] and at that end time, in time order — a polyline of ≥ 1 point (empty

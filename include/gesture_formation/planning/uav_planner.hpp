@@ -140,6 +140,9 @@ struct PlanResult {
   int corridor_count = 0;
   int projected_references = 0;  ///< reference steps moved out of obstacles / the worker zone
   int path_searches = 0;         ///< A* searches run for blocked segments
+  /// Corridor rows moved out because the UAV's momentum carries it over them (at most the tracking
+  /// allowance), and move-away rows lowered to what it can reach (docs/planning.md §6.3).
+  int momentum_relaxed_rows = 0;
   /// Tracking allowance (m) this replanning added to the planning clearances
   /// (PlannerConfig::tracking_allowance_*): the largest recent deviation of the state from the
   /// plan being flown.

@@ -318,6 +318,102 @@ TEST(UavPlannerTest, NanReferenceFallsBackToPreviousPlanThenBrake) {
   EXPECT_NE(n.reason.find("state.p_world"), std::string::npos) << n.reason;
 }
 
+// A catch-up plan ends moving (the reference is far; the terminal velocity is only penalised).
+// Re-timed for a fallback it used to hover after its end — a velocity step of ~4 m/s within one
+// interval, which failed verification ("acceleration 26 m/s^2"), so a failed replanning braked
+// instead of flying the verified plan (found in the sideways-search catch-up, docs/planning.md §12).
+// Now it brakes to hover after its end, within the limits, and verifies.
+TEST(UavPlannerTest, PreviousPlanThatEndsMovingBrakesAfterItsEndWhenReused) {
+  const World& w = towers();
+  const PlannerConfig cfg = testConfig();
+  UavPlanner planner(cfg, w.map, w.field);
+  const Eigen::Vector3d from(6, -12, 10), to(46, -12, 10), worker(-5, -3, 1);
+  const PlanResult first = planner.plan(straightRequest(0, 0.0, stateAt(from), from, to, 4.0, worker));
+  ASSERT_EQ(first.status, PlanStatus::kOptimized) << first.reason;
+  const TrajectorySample& end = first.trajectory.samples.back();
+  ASSERT_GT(end.v_world.norm(), 2.0) << "the first plan should end moving: " << end.v_world.transpose();
+  PlanRequest bad = straightRequest(0, 0.4, advance(first.trajectory, 0.4), from, to, 4.0, worker);
+  bad.reference.p_world(1, 7) = std::numeric_limits<double>::quiet_NaN();
+  const PlanResult r = planner.plan(bad);
+  ASSERT_EQ(r.status, PlanStatus::kFallbackPrevious) << r.reason;
+  EXPECT_TRUE(r.verified);
+  ASSERT_EQ(r.trajectory.samples.size(), first.trajectory.samples.size());
+  const double t_end = first.trajectory.tEnd();
+  // The same curve up to the old end, then a straight stop along the end velocity.
+  for (double t = 0.4; t <= t_end + 1e-9; t += 0.1) {
+    EXPECT_LT((evaluateTrajectory(r.trajectory, t).p - evaluateTrajectory(first.trajectory, t).p).norm(), 1e-9) << t;
+  }
+  const Eigen::Vector3d dir = end.v_world.normalized();
+  for (double t = t_end; t <= r.trajectory.tEnd() + 1e-9; t += 0.05) {
+    const TrajectoryPoint x = evaluateTrajectory(r.trajectory, t);
+    const Eigen::Vector3d off = x.p - end.p_world;
+    EXPECT_LT((off - off.dot(dir) * dir).norm(), 1e-9) << t;  // on the line of the end velocity
+    EXPECT_GE(off.dot(dir), -1e-9) << t;
+    EXPECT_LE(x.a.norm(), cfg.limits.max_acceleration_mps2 + 1e-6) << t;
+    EXPECT_LE(x.v.dot(dir), end.v_world.norm() + 1e-9) << t;  // slowing down
+  }
+  EXPECT_LT(r.trajectory.samples.back().v_world.norm(), end.v_world.norm());
+  expectSafe(r.trajectory, *w.map, cfg);
+  // A previous plan that ends at rest re-times as before: hover at its end.
+  PlannedTrajectory rest = hoveringPlan(0, 0.0, from);
+  const PlannedTrajectory again = retimeThenBrake(rest, 1.0, 0.2, 41, cfg.limits);
+  ASSERT_EQ(again.samples.size(), 41u);
+  for (const auto& smp : again.samples) {
+    EXPECT_EQ(smp.p_world, from);
+    EXPECT_EQ(smp.v_world, Eigen::Vector3d::Zero());
+  }
+}
+
+// Low over flat ground, descending towards the corridor's floor faster than it can stop above it
+// (a state that deviates from the plan it flew; the sideways-search catch-up of
+// docs/planning.md §12 at ~1.5 m): the QP was infeasible ("feasible without the corridors
+// constraints") and the UAV fell back. Rows its momentum carries it over are moved out by at most
+// the tracking allowance, so it plans, verifies and keeps the verifier's clearance.
+TEST(UavPlannerTest, DescendingTowardsTheCorridorFloorStillPlans) {
+  const World& w = towers();
+  const PlannerConfig cfg = testConfig();
+  const Eigen::Vector3d worker(-5, -3, 1);
+  int relaxed_runs = 0;
+  for (const double vz : {-0.6, -0.9, -1.2}) {
+    UavPlanner planner(cfg, w.map, w.field);
+    const Eigen::Vector3d from(6, -12, 1.5), to(36, -12, 1.45);
+    UavKinematicState st = stateAt(from);
+    st.v_world = Eigen::Vector3d(3.0, 0.0, vz);
+    const PlanResult r = planner.plan(straightRequest(0, 0.0, st, from, to, 4.0, worker));
+    ASSERT_EQ(r.status, PlanStatus::kOptimized) << "v_z " << vz << ": " << r.reason;
+    EXPECT_TRUE(r.verified);
+    expectSafe(r.trajectory, *w.map, cfg);
+    relaxed_runs += r.momentum_relaxed_rows > 0 ? 1 : 0;
+    std::printf("v_z %.1f: relaxed rows %d, lowest %.3f m\n", vz, r.momentum_relaxed_rows, [&] {
+      double z = 1e9;
+      for (const auto& smp : r.trajectory.samples) z = std::min(z, smp.p_world.z());
+      return z;
+    }());
+  }
+  EXPECT_GE(relaxed_runs, 1);
+}
+
+// A start closer to the ground than the corridor clearance (0.8 m + the tracking allowance): asked
+// for the full clearance, the corridor builder shrank its planes point by point around the start —
+// ~100 planes, ~4000 QP rows, replannings of seconds in the sideways-search catch-up. The first
+// corridor now keeps the clearance stage 2 checked its segment with.
+TEST(UavPlannerTest, StartNearTheGroundKeepsTheFirstCorridorSmall) {
+  const World& w = towers();
+  const PlannerConfig cfg = testConfig();
+  UavPlanner planner(cfg, w.map, w.field);
+  const Eigen::Vector3d from(8, -12, 1.05), to(38, -12, 1.9), worker(-5, -3, 1);
+  UavKinematicState st = stateAt(from);
+  st.v_world = Eigen::Vector3d(3.0, 0.0, 0.0);
+  const PlanResult r = planner.plan(straightRequest(0, 0.0, st, from, to, 4.0, worker));
+  ASSERT_EQ(r.status, PlanStatus::kOptimized) << r.reason;
+  ASSERT_FALSE(r.corridors.empty());
+  EXPECT_LE(r.corridors.front().polytope.rows(), 30) << "planes of the first corridor";
+  EXPECT_LT(r.qp_constraints, 2000);
+  expectSafe(r.trajectory, *w.map, cfg);
+  std::printf("first corridor %d planes, %d QP constraints, %.1f ms\n", static_cast<int>(r.corridors.front().polytope.rows()),
+              r.qp_constraints, r.timings.total_ms);
+}
+
 // An infeasible QP names its cause by re-solving without each constraint family (docs/planning.md
 // §7.1) — but not beyond the time budget: the fallback must not wait for the diagnosis.
 TEST(UavPlannerTest, InfeasibleQpNamesItsCauseWithinTheTimeBudgetOnly) {
