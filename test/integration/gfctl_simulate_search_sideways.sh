@@ -13,7 +13,7 @@ GFCTL=$1
 SRC=$2
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
-printf 'faults:\n  camera_blackouts: [[210, 230]]\n' > "$TMP/vertical.yaml"
+printf 'faults:\n  camera_blackouts: [[210, 230]]\n  search_horizontal_speed_mps: 0\n' > "$TMP/vertical.yaml"
 printf 'faults:\n  camera_blackouts: [[210, 230]]\n  search_horizontal_speed_mps: 1.5\n' > "$TMP/sideways.yaml"
 for f in vertical sideways; do
   "$GFCTL" simulate --scenario "$SRC/config/scenarios/power_towers.yaml" --faults "$TMP/$f.yaml" --out "$TMP/$f" \

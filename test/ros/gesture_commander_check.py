@@ -5,9 +5,9 @@ messages of gesture 2 at 15 Hz for 2 s (30 frames: 20 agreeing ones fill the fil
 f_d = 1 > 0.8) and checks which fire. For the 3-D confirmation the observations carry the skeleton
 of a worker projected through three calibrated cameras (pinhole, the commander's pose convention:
 optical frame in the world): the one view that reads "extend" fires only when the skeleton's arm
-is extended in 3-D, not when it points forward. A slow link: /voted and /lagged (fusion_lag_s 0.8)
-get the leader's observations at once and follower 1's 0.47 s late (7 frames; stamped with their
-frame): only /lagged fires.
+is extended in 3-D, not when it points forward. A slow link: /nolag (fusion_lag_s 0), /voted (the shipped 0.4 s) and
+/lagged (0.8 s) get the leader's observations at once and follower 1's 0.47 s late (7 frames;
+stamped with their frame): /voted and /lagged fire, /nolag does not.
 Exit code = number of failures."""
 import math
 import sys
@@ -88,7 +88,7 @@ def skeleton_fields(azimuth_deg, arm):
 def main():
     rospy.init_node("gesture_commander_check")
     pubs, commands, statuses = {}, {}, {}
-    for name in ("single", "voted", "confirm3d", "lagged"):
+    for name in ("single", "voted", "confirm3d", "lagged", "nolag"):
         pubs[name] = (rospy.Publisher("/%s/observation" % name, GestureObservation, queue_size=50),
                       rospy.Publisher("/%s/peer_observations" % name, GestureObservation, queue_size=50))
         commands[name], statuses[name] = [], []
@@ -181,11 +181,15 @@ def main():
               fired[0].confirmed_3d, fired[0].agreeing_views) if fired else ""))
     before = len(commands["voted"])
     del statuses["voted"][:]
-    inject_late_follower(["voted", "lagged"])
-    agree = max([m.agreeing_views for m in statuses["voted"]] or [0])
-    check(len(commands["voted"]) == before and agree == 1,
-          "no lag, follower 1 0.47 s late: %d new command(s), at most %d agreeing view(s) (expected 0, 1)" % (
-              len(commands["voted"]) - before, agree))
+    inject_late_follower(["nolag", "voted", "lagged"])
+    agree = max([m.agreeing_views for m in statuses["nolag"]] or [0])
+    check(not commands["nolag"] and agree == 1,
+          "no lag, follower 1 0.47 s late: %d command(s), at most %d agreeing view(s) (expected 0, 1)" % (
+              len(commands["nolag"]), agree))
+    fired = [m for m in statuses["voted"] if m.fired]
+    check(len(commands["voted"]) == before + 1 and len(fired) == 1 and fired[0].agreeing_views == 2,
+          "shipped fusion_lag_s 0.4, follower 1 0.47 s late: %d new command(s)%s (expected 1, 2 agreeing)" % (
+              len(commands["voted"]) - before, ", fired with %d agreeing" % fired[0].agreeing_views if fired else ""))
     fired = [m for m in statuses["lagged"] if m.fired]
     check(len(commands["lagged"]) == 1 and len(fired) == 1 and fired[0].agreeing_views == 2,
           "fusion_lag_s 0.8, follower 1 0.47 s late: %d command(s)%s (expected 1, 2 agreeing)" % (

@@ -73,7 +73,8 @@ struct ViewFusionConfig {
   double confirm_3d_max_dt_s = 0.034;    ///< views' frames at most this apart form one 3-D frame [s], > 0
   /// [0, 2] s: callers fuse at t_now − fusion_lag_s (the links' delay budget); observations may
   /// arrive this much out of order and the history is kept this much longer. 0: no lag.
-  double fusion_lag_s = 0.0;
+  /// Default 0.4 s (since 2026-12-03): the fault matrix's delay budget (0.1 s + up to 0.3 s).
+  double fusion_lag_s = 0.4;
 
   /// \brief Every problem, each naming the key; empty when valid.
   std::vector<std::string> validate() const;

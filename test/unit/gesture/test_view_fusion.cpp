@@ -272,7 +272,9 @@ TEST(ViewFusionTest, ObservationsArriveOutOfOrderOnlyWithinTheLag) {
   EXPECT_FALSE(f.observe(obs(0, 0.5, 1), &why));  // 0.5 s before the newest: beyond the lag
   EXPECT_NE(why.find("fusion_lag_s"), std::string::npos) << why;
   EXPECT_EQ(f.fuse(1.0).gesture_id, 3);  // nothing changed
-  ViewFusion strict(ViewFusionConfig{}, 1, 4);  // no lag: an older frame is rejected, as before
+  ViewFusionConfig no_lag;  // (the default is 0.4 s since 2026-12-03)
+  no_lag.fusion_lag_s = 0.0;
+  ViewFusion strict(no_lag, 1, 4);  // no lag: an older frame is rejected, as before
   ASSERT_TRUE(strict.observe(obs(0, 1.0, 0)));
   EXPECT_FALSE(strict.observe(obs(0, 0.9, 3), &why));
   EXPECT_NE(why.find("older"), std::string::npos) << why;

@@ -213,9 +213,12 @@ TEST(SearchTest, OnlyTheLeaderSearchesForALostWorkerForABoundedTime) {
   EXPECT_FALSE(gf::planning::searching(0, lost, 10.0, 5.0, lim, cfg));
   EXPECT_FALSE(gf::planning::searching(0, lost, 10.0, std::numeric_limits<double>::quiet_NaN(), lim, gf::planning::SearchConfig{}));
   // The sweep: from the estimate when the sweep began (here 8 s), up, back, down, back every 8 s,
-  // as far as 0.5 m/s × the estimate's age (last fused at 5 s).
+  // as far as 0.5 m/s × the estimate's age (last fused at 5 s). The vertical sweep alone here (the
+  // sideways one, on by default, is the next test).
+  gf::planning::SearchConfig vertical_only;
+  vertical_only.horizontal_speed_mps = 0.0;
   const Eigen::Vector3d last(1, 2, 3);
-  const auto tg = gf::planning::searchTargets(last, Eigen::Vector3d(11, 2, 8), 8.0, 1.0, 10, 5.0, 8.0, gf::planning::SearchConfig{});
+  const auto tg = gf::planning::searchTargets(last, Eigen::Vector3d(11, 2, 8), 8.0, 1.0, 10, 5.0, 8.0, vertical_only);
   ASSERT_EQ(tg.cols(), 10);
   const double want[] = {0, 1.0, 2.5, 1.5, 0, -2.0, -4.5, -2.5, 0, 3.0};
   for (int k = 0; k < 10; ++k) {
@@ -232,7 +235,7 @@ TEST(SearchTest, OnlyTheLeaderSearchesForALostWorkerForABoundedTime) {
   EXPECT_NE(problems[3].find("faults.search_period_s"), std::string::npos);
   EXPECT_NE(problems[4].find("faults.search_horizontal_speed_mps must be >= 0, got -0.5"), std::string::npos) << problems[4];
   // The amplitude stops at height_m.
-  const auto late = gf::planning::searchTargets(last, Eigen::Vector3d(11, 2, 8), 70.0, 1.0, 8, 5.0, 8.0, gf::planning::SearchConfig{});
+  const auto late = gf::planning::searchTargets(last, Eigen::Vector3d(11, 2, 8), 70.0, 1.0, 8, 5.0, 8.0, vertical_only);
   EXPECT_LE(late.row(2).maxCoeff(), 3.0 + 15.0 + 1e-9);
   EXPECT_NEAR(late.row(2).maxCoeff() - 3.0, 15.0, 1e-9);  // the top of the cycle at 74 s (phase 8.25)
 }
@@ -242,11 +245,14 @@ TEST(SearchTest, OnlyTheLeaderSearchesForALostWorkerForABoundedTime) {
 // while the vertical sweep goes on as before; the distance from the camera stays that of the estimate.
 TEST(SearchTest, TheSidewaysSweepTurnsAsFarAsHeCouldHaveWalked) {
   gf::planning::SearchConfig cfg;  // period 8 s
+  EXPECT_EQ(cfg.horizontal_speed_mps, 1.5);  // on by default since 2026-12-03
   cfg.horizontal_speed_mps = 1.0;
+  gf::planning::SearchConfig vertical_only;
+  vertical_only.horizontal_speed_mps = 0.0;
   const Eigen::Vector3d camera(0, 0, 10), est(10, 0, 1);
   // Last fused at 0 s, the sweep began at 10 s; steps every 2 s from 10 s.
   const auto tg = gf::planning::searchTargets(est, camera, 10.0, 2.0, 9, 0.0, 10.0, cfg);
-  const auto vertical = gf::planning::searchTargets(est, camera, 10.0, 2.0, 9, 0.0, 10.0, gf::planning::SearchConfig{});
+  const auto vertical = gf::planning::searchTargets(est, camera, 10.0, 2.0, 9, 0.0, 10.0, vertical_only);
   ASSERT_EQ(tg.cols(), 9);
   const double w_h[] = {0, 0.5, 1, 0.5, 0, -0.5, -1, -0.5, 0};  // triangle wave over 16 s, sampled every 2 s
   for (int k = 0; k < 9; ++k) {
@@ -256,7 +262,7 @@ TEST(SearchTest, TheSidewaysSweepTurnsAsFarAsHeCouldHaveWalked) {
     EXPECT_NEAR((tg.col(k) - camera).head<2>().norm(), 10.0, 1e-9) << k;
     EXPECT_NEAR(tg(2, k), vertical(2, k), 1e-12) << k;  // the vertical sweep unchanged
   }
-  // Off (the default), or straight above the estimate: no turn.
+  // Off (0), or straight above the estimate: no turn.
   for (int k = 0; k < 9; ++k) EXPECT_EQ(vertical.col(k).head<2>(), est.head<2>());
   const auto above = gf::planning::searchTargets(est, Eigen::Vector3d(10, 0, 12), 10.0, 2.0, 9, 0.0, 10.0, cfg);
   for (int k = 0; k < 9; ++k) EXPECT_EQ(above.col(k).head<2>(), est.head<2>());

@@ -155,6 +155,7 @@ TEST(MissionRunnerTest, DelayedFollowerVotesCountWhenTheViewsAreFusedAtALag) {
   auto cfg = gf::sim::test::openFieldWithoutRequests();
   ASSERT_EQ(cfg.view_fusion.min_agreeing_views, 2);
   cfg.link.delay_s = 0.35;
+  cfg.view_fusion.fusion_lag_s = 0.0;  // fused at the newest frame (the default is 0.4 s)
   EXPECT_EQ(runEveryCameraReadingExtendArm(cfg).gestures_fired, 0);
   cfg.view_fusion.fusion_lag_s = 0.4;
   EXPECT_GE(runEveryCameraReadingExtendArm(cfg).gestures_fired, 1);
