@@ -14,7 +14,9 @@
 # from that file: the ~1400 missions (≈ 4–10 CPU-hours) can be spread over sessions and machines. A
 # (profile, seed) already in the file is skipped, so the script resumes; start afresh after a change
 # that can move the figures (planner, simulator, model) by removing the file (the report lists the
-# commits its rows come from). Seeds are the outer loop, so a run stopped early covers every profile
+# commits its rows come from; older runs files kept as docs/data/fault_matrix_runs_<commit>.csv are
+# listed, and a newer matrix still running, kept as docs/data/fault_matrix_runs_next*.csv, is
+# reported by its safety figures so far, not in the tables). Seeds are the outer loop, so a run stopped early covers every profile
 # evenly. GF_JOBS missions run at once (default: the number of cores), each classifying its camera
 # views on one thread when the jobs fill the cores (gfctl simulate --threads; results do not depend
 # on it); GFCTL overrides the binary,
@@ -168,7 +170,21 @@ with open(report, "w") as f:
             "leader learned it too late over the delayed link. Cause and fix (every UAV avoids every plan, now the "
             "default): [safety.md](safety.md) §4. The tables above are with the fix.\n\n")
     import glob
-    archived = sorted(glob.glob(os.path.join(os.path.dirname(runs_file) or ".", "fault_matrix_runs_*.csv")))
+    runs_dir = os.path.dirname(runs_file) or "."
+    pending = sorted(glob.glob(os.path.join(runs_dir, "fault_matrix_runs_next*.csv")))
+    archived = sorted(a for a in glob.glob(os.path.join(runs_dir, "fault_matrix_runs_*.csv")) if a not in pending)
+    for a in pending:  # the matrix of newer defaults, still running: its safety figures so far
+        rows = list(csv.DictReader(open(a)))
+        if not rows:
+            continue
+        worst_m = min(float(r["min_mutual_distance_m"]) for r in rows)
+        worst_o = min(float(r["min_obstacle_distance_m"]) for r in rows)
+        coll = sum(int(float(r["collisions"])) for r in rows)
+        f.write(f"**In progress, not in the tables:** `{os.path.relpath(a)}` — {len(rows)} missions of commit(s) "
+                + ", ".join(sorted({f"`{r['commit']}`" for r in rows})) + f" (seeds up to {max(int(r['seed']) for r in rows)}): "
+                f"min mutual {worst_m:.2f} m, min obstacle {worst_o:.3f} m, {coll} collisions"
+                + (" — no safety violation so far." if worst_m >= 2.5 and worst_o >= 0.5 and coll == 0 else
+                   " — **a safety violation: see safety.md §4.**") + "\n\n")
     if archived:
         f.write("Runs of earlier commits (kept, not in the tables): " + ", ".join(
             f"`{os.path.relpath(a)}` ({sum(1 for _ in open(a)) - 1} missions)" for a in archived) + ".\n\n")
