@@ -30,6 +30,12 @@ P
   row nominal 2 6.10 0.98 0 1
   row loss50 1 2.40 1.00 0 0
 } > "$TMP/runs.csv"
+# A newer matrix in progress next to the runs file: reported by its safety figures, not in the tables.
+{
+  echo "$H"
+  row nominal 1 5.90 0.91 0 0
+  row loss50 1 3.20 0.88 0 0
+} > "$TMP/fault_matrix_runs_next.csv"
 GF_RUNS="$TMP/runs.csv" GF_REPORT="$TMP/reliability.md" GF_PROFILES="nominal loss50" tools/run_fault_matrix.sh --report-only \
   > "$TMP/out.txt"
 R="$TMP/reliability.md"
@@ -41,6 +47,8 @@ check "the violation is counted" 'Safety violations (1 of 3 missions)' "$R"
 check "false adaptations counted and named" 'False adaptations: 1 in the 3 missions** (`nominal` seed 2)' "$R"
 check "missing seed listed" '`loss50` seed 2' "$R"
 check "the summary line" '3 missions, 1 with a safety violation' "$TMP/out.txt"
+check "the matrix in progress: its safety figures" 'fault_matrix_runs_next.csv` — 2 missions of commit(s) `abc1234567` (seeds up to 1): min mutual 3.20 m, min obstacle 0.880 m, 0 collisions — no safety violation so far.' "$R"
+grep -q "fault_matrix_runs_next.csv\` (2 missions)" "$R" && { echo "FAIL: the matrix in progress is listed as an earlier commit's"; fails=$((fails + 1)); } || echo "PASS: not listed as an earlier commit's runs"
 if [ -x /opt/gesture_formation/venv/bin/python ]; then
   [ -s "$TMP/images/fault_matrix.png" ] && echo "PASS: figure drawn" || { echo "FAIL: no $TMP/images/fault_matrix.png"; fails=$((fails + 1)); }
   check "figure linked" '](images/fault_matrix.png)' "$R"
