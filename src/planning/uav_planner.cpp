@@ -694,16 +694,19 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
   // Corridor rows, pruned when the sample cannot reach them (‖x_k − p0‖ ≤ v_max t_k). A row the
   // UAV cannot meet (with a 2 cm cushion) even braking with all its acceleration — its momentum
   // carries it over the plane (leastReach) — is moved out to where it can braking at 70 %, by at
-  // most the tracking allowance: the part
-  // of the corridor clearance that is there to absorb deviations from the plan, and never closer
-  // to the obstacle points behind it than the verifier's clearance (catch-up 18–34 m low over the
+  // most the tracking allowance: the part of the corridor clearance that is there to absorb
+  // deviations from the plan, and never closer to the obstacle points behind it than the
+  // verifier's clearance (catch-up 18–34 m low over the
   // ground: the plan flown descended towards its floor, the new corridor's floor was 2 cm too high
   // for the state; docs/planning.md §12). Rows it can meet are not touched (plans unchanged); a row
   // still out of reach after the allowance leaves the QP infeasible: the planner falls back.
   const double vmax = config_.limits.max_speed_mps;
   constexpr double kMomentumAccelShare = 0.7, kMomentumCushion = 0.02;
   const double verify_clear = config_.verify_clearance_m + OccupancyMap::rasterInflation(res);  // to voxel centres
-  std::vector<std::vector<std::vector<double>>> least(corridors.size());  // [corridor][row][k], lazily
+  struct Reach {
+    std::vector<double> full, soft;  // leastReach braking fully / at kMomentumAccelShare, per k
+  };
+  std::vector<std::vector<Reach>> least(corridors.size());  // [corridor][row], computed lazily
   for (int k = 1; k <= N; ++k) {
     const double reach = vmax * k * dt;
     const int s_prev = seg[static_cast<std::size_t>(k) - 1], s_cur = seg[static_cast<std::size_t>(k)];
@@ -716,11 +719,11 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
         const Eigen::Vector3d a = P.A.row(r).transpose();
         double b = P.b(r) - config_.corridor_margin_m;
         if (a.dot(p0) + reach < b) continue;  // unreachable plane
-        auto& lr = rows_least[static_cast<std::size_t>(r)];
-        if (lr.empty()) lr = leastReach(a, p0, qp.v0, qp.a0, qp.velocity, qp.acceleration, 1.0, dt, N);
-        if (lr[static_cast<std::size_t>(k)] + kMomentumCushion > b && cap > 0.0) {
-          const std::vector<double> soft = leastReach(a, p0, qp.v0, qp.a0, qp.velocity, qp.acceleration, kMomentumAccelShare, dt, N);
-          b = std::min(soft[static_cast<std::size_t>(k)] + kMomentumCushion, b + cap);
+        Reach& lr = rows_least[static_cast<std::size_t>(r)];
+        if (lr.full.empty()) lr.full = leastReach(a, p0, qp.v0, qp.a0, qp.velocity, qp.acceleration, 1.0, dt, N);
+        if (lr.full[static_cast<std::size_t>(k)] + kMomentumCushion > b && cap > 0.0) {
+          if (lr.soft.empty()) lr.soft = leastReach(a, p0, qp.v0, qp.a0, qp.velocity, qp.acceleration, kMomentumAccelShare, dt, N);
+          b = std::min(lr.soft[static_cast<std::size_t>(k)] + kMomentumCushion, b + cap);
           ++result.momentum_relaxed_rows;
         }
         qp.constraints.push_back(PositionConstraint{k, a, b, PositionConstraint::Kind::kCorridor});
