@@ -2,7 +2,8 @@
 // Where a nodelet's algorithm configs come from (docs/ros.md): onboard, the product files
 // (config/formation.yaml, config/planner.yaml, config/gestures.yaml, every key required);
 // in simulation, the `mission` section of a scenario file, so that the ROS simulation runs
-// with exactly the parameters of `gfctl simulate` (parameter `mission_file`).
+// with exactly the parameters of `gfctl simulate` (parameter `mission_file`; the mission file's
+// values win over every other parameter source, and the nodelet's "loaded" report says so).
 #include <memory>
 #include <string>
 
@@ -14,13 +15,13 @@
 #include "gesture_formation/planning/occupancy_map.hpp"
 #include "gesture_formation/planning/planner_config.hpp"
 #include "gesture_formation/planning/scenario.hpp"
-#include "gesture_formation/sim/mission_config.hpp"
+#include "gesture_formation/onboard/onboard_settings.hpp"
 #include "param_loader.hpp"
 
 namespace gesture_formation::nodelets {
 
 /// The scenario's map and distance field (built once per process that loads it), and its
-/// exact solids and ground height (the obstacle-distance metric, sim::ObstacleDistance).
+/// exact solids and ground height (the obstacle-distance metric of the simulation).
 struct WorldMap {
   std::shared_ptr<const planning::OccupancyMap> map;
   std::shared_ptr<const planning::DistanceField> field;
@@ -47,13 +48,14 @@ inline bool loadWorldMap(const std::string& scenario_file, ParamLoader& params, 
   return true;
 }
 
-/// Loads the mission of `mission_file` (every problem into `params`), with the fault profile of
+/// Loads the product settings of `mission_file`'s `mission` section (onboard::OnboardSettings:
+/// the very parse gfctl simulate uses; every problem into `params`), with the fault profile of
 /// the optional ~faults_file merged in (as `gfctl simulate --faults FILE`; every nodelet of a
 /// simulation gets the same pair).
-inline bool loadMission(const std::string& mission_file, ParamLoader& params, sim::MissionConfig& out) {
+inline bool loadOnboard(const std::string& mission_file, ParamLoader& params, onboard::OnboardSettings& out) {
   std::string faults_file;
   params.loadOptional("faults_file", faults_file, "");
-  auto m = faults_file.empty() ? sim::loadMissionConfig(mission_file) : sim::loadMissionConfig(mission_file, faults_file);
+  auto m = onboard::loadOnboardSettings(mission_file, faults_file);
   if (!m) {
     params.addError((faults_file.empty() ? "mission_file: " : "mission_file + faults_file: ") + m.reason());
     return false;

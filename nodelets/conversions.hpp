@@ -27,9 +27,8 @@
 #include "gesture_formation/formation/formation_params.hpp"
 #include "gesture_formation/gesture/view_fusion.hpp"
 #include "gesture_formation/planning/polytope_edges.hpp"
+#include "gesture_formation/planning/replan_step.hpp"
 #include "gesture_formation/planning/uav_planner.hpp"
-#include "gesture_formation/sim/mission_config.hpp"
-#include "gesture_formation/sim/multirotor.hpp"
 
 namespace gesture_formation::nodelets {
 
@@ -103,18 +102,6 @@ inline planning::UavKinematicState toKinematicState(const nav_msgs::Odometry& od
   s.p_world = toEigen(odom.pose.pose.position);
   s.v_world = toEigen(odom.twist.twist.linear);  // world frame (child_frame_id = world_frame)
   cameraHeadingPitch(odom.pose.pose.orientation, s.heading_rad, s.pitch_rad);
-  return s;
-}
-
-/// A true state (ground truth odometry) as the sim core's plant state: position, velocity,
-/// camera heading and pitch.
-inline sim::MultirotorState toMultirotorState(const nav_msgs::Odometry& odom) {
-  const planning::UavKinematicState k = toKinematicState(odom);
-  sim::MultirotorState s;
-  s.p_world = k.p_world;
-  s.v_world = k.v_world;
-  s.heading_rad = k.heading_rad;
-  s.pitch_rad = k.pitch_rad;
   return s;
 }
 
@@ -279,7 +266,7 @@ inline common::Result<formation::FormationCommand> fromMsg(const gesture_formati
   if (m.target == "list") {
     c.target = formation::CommandTarget::list(std::vector<formation::UavIndex>(m.uavs.begin(), m.uavs.end()));
   } else {
-    auto t = sim::parseTarget(m.target);
+    auto t = formation::parseTarget(m.target);
     if (!t) return R::fail("FormationCommand.target: " + t.reason());
     c.target = *t;
   }
@@ -321,6 +308,17 @@ inline gesture_formation::WorkerState fromWire(const comm::WorkerStateMessage& w
   s.predicted = true;
   s.source = "lcm";
   return s;
+}
+
+/// WorkerState → what the replanning step knows of the worker (last_fused 0: never fused).
+inline planning::WorkerKnowledge toWorkerKnowledge(const gesture_formation::WorkerState& s) {
+  planning::WorkerKnowledge w;
+  w.stamp_s = s.header.stamp.toSec();
+  w.fused_s = s.last_fused.isZero() ? std::nan("") : s.last_fused.toSec();
+  w.p_world = toEigen(s.position);
+  w.v_world = toEigen(s.velocity);
+  w.lost = s.lost != 0;
+  return w;
 }
 
 // ---- gesture observations (the multi-view vote) ---------------------------------------------

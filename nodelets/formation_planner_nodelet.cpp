@@ -52,7 +52,7 @@
 #include "conversions.hpp"
 #include "gesture_formation/formation/formation_geometry.hpp"
 #include "gesture_formation/formation/worker_heading.hpp"
-#include "gesture_formation/planning/plan_request_builder.hpp"
+#include "gesture_formation/planning/replan_step.hpp"
 #include "gesture_formation/planning/trajectory_qp.hpp"
 #include "param_loader.hpp"
 
@@ -69,27 +69,34 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     std::string scenario_file, mission_file, formation_file, planner_file;
     params.load("scenario_file", scenario_file);
     params.loadOptional("mission_file", mission_file, "");
-    params.load("replanning_period_s", period_s_, 0.05, 5.0);
-    params.load("horizon_dt_s", horizon_dt_s_, 0.02, 1.0);
-    params.load("horizon_steps", horizon_steps_, 2, formation::kMaxHorizonSteps);
-    params.load("max_share_age_s", max_share_age_s_, 0.1, 10.0);
-    freshness_.max_share_age_s = max_share_age_s_;
     params.load("max_wind_estimate_age_s", max_wind_age_s_, 0.1, 60.0);
     double params_rate_hz = 0.0;
     params.load("params_rate_hz", params_rate_hz, 0.1, 50.0);
     formation::FormationConfig fcfg;
     planning::PlannerConfig pcfg;
     if (!mission_file.empty()) {
-      sim::MissionConfig mission;
-      if (loadMission(mission_file, params, mission)) {
+      // Simulation: the mission file's settings — the very values gfctl simulate runs with —
+      // win over every parameter; the replanning parameters below are not read.
+      onboard::OnboardSettings mission;
+      if (loadOnboard(mission_file, params, mission)) {
         fcfg = mission.formation;
         pcfg = mission.planner;
-        rule_ = planning::AvoidanceRule{mission.faults.avoid_all_plans, mission.faults.max_plan_age_s};
-        freshness_.max_worker_age_s = mission.faults.max_worker_age_s;
-        search_ = mission.faults.search;
-        brake_accel_mps2_ = mission.controller.brake_accel_mps2;
+        period_s_ = mission.replanning_period_s;
+        horizon_dt_s_ = mission.horizon_dt_s;
+        horizon_steps_ = mission.horizon_steps;
+        freshness_ = mission.freshness;
+        rule_ = mission.rule;
+        search_ = mission.search;
+        brake_accel_mps2_ = mission.brake_accel_mps2;
+        params.note("from mission_file: replanning_period_s " + std::to_string(period_s_) + ", horizon_dt_s " +
+                    std::to_string(horizon_dt_s_) + ", horizon_steps " + std::to_string(horizon_steps_) +
+                    ", faults.* limits, controller.brake_accel_mps2, formation, planner");
       }
     } else {
+      params.load("replanning_period_s", period_s_, 0.05, 5.0);
+      params.load("horizon_dt_s", horizon_dt_s_, 0.02, 1.0);
+      params.load("horizon_steps", horizon_steps_, 2, formation::kMaxHorizonSteps);
+      params.load("max_share_age_s", freshness_.max_share_age_s, 0.1, 10.0);
       params.load("formation_config", formation_file);
       params.load("planner_config", planner_file);
       params.load("avoid_all_plans", rule_.avoid_all_plans);
@@ -117,13 +124,21 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     }
     NODELET_INFO_STREAM("FormationPlanner (UAV " << uav_index_ << ") loaded:\n" << params.loaded());
     params_ = fcfg.params;
-    hold_ = planning::HoldPlanner(freshness_, search_, brake_accel_mps2_);
-    heading_.emplace(fcfg.worker_heading);
     if (uav_index_ == formation::kLeader) {
       auto st = formation::FormationState::create(fcfg.params, fcfg.limits, fcfg.duplicates);
       state_.emplace(std::move(*st));  // the config was validated by its loader
     }
-    planner_ = std::make_unique<planning::UavPlanner>(pcfg, world.map, world.field);
+    planning::ReplanConfig rc;
+    rc.uav_index = uav_index_;
+    rc.dt_s = horizon_dt_s_;
+    rc.steps = horizon_steps_;
+    rc.freshness = freshness_;
+    rc.rule = rule_;
+    rc.search = search_;
+    rc.brake_accel_mps2 = brake_accel_mps2_;
+    rc.worker_heading = fcfg.worker_heading;
+    step_ = std::make_unique<planning::ReplanStep>(
+        rc, std::make_unique<planning::UavPlannerAdapter>(std::make_unique<planning::UavPlanner>(pcfg, world.map, world.field)));
     received_.resize(static_cast<std::size_t>(uav_count_));
 
     plan_pub_ = nh.advertise<gesture_formation::PlannedTrajectory>("plan_out", 5);
@@ -239,77 +254,32 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   }
 
   void replan(double t) {
-    if (!odom_ || !worker_) return;
-    // Rule 2: never follow data older than its age limit — hold instead (the same decision as
-    // gfctl simulate). A WorkerState without a fusion time (last_fused 0) counts as never fused.
-    const double fused_s = worker_->last_fused.isZero() ? std::nan("") : worker_->last_fused.toSec();
-    std::string hold = planning::holdReason(uav_index_, t, worker_->header.stamp.toSec(), fused_s, freshness_);
-    // Listen before moving (docs/safety.md §2.4): a (re)started planner knows no other UAV's plan;
-    // it holds until every other follower's plan made since its first replanning has arrived, or
-    // for at most max_plan_age_s (a UAV not heard from by then has right of way, as a silent one).
-    if (!std::isfinite(listen_since_s_)) listen_since_s_ = t;
-    if (hold.empty() && listening_) {
-      const std::vector<int> unheard = planning::unheardFollowers(uav_index_, listen_since_s_, received_, nullptr);
-      if (unheard.empty() || t - listen_since_s_ > rule_.max_plan_age_s) {
-        listening_ = false;
-        if (!unheard.empty()) {
-          std::string list;
-          for (int j : unheard) list += " " + std::to_string(j);
-          NODELET_WARN_STREAM("FormationPlanner UAV " << uav_index_ << ": no plan since the start from UAV(s)" << list
-                                                      << " after max_plan_age_s; tracking without them");
-        }
-      } else {
-        hold = planning::listeningReason(uav_index_, listen_since_s_, received_, nullptr);
-      }
-    }
-    const double age = std::max(0.0, t - worker_->header.stamp.toSec());
-    const bool stale = !hold.empty();
-    const Eigen::Vector3d v0 = stale || worker_->lost ? Eigen::Vector3d::Zero() : toEigen(worker_->velocity);
-    const Eigen::Vector3d p0 = toEigen(worker_->position) + age * v0;
-    const double hphi = stale ? heading_->heading() : heading_->update(v0);
-    // Hold: plan to the point where braking ends (latched until it tracks again), camera on the
-    // worker estimate; the old estimate serves only as obstacle and camera target. The leader that
-    // lost the worker searches with its camera (the decision gfctl simulate makes, same code).
-    planning::HoldPlanner::Situation situation;
-    situation.uav_index = uav_index_;
-    situation.t_s = t;
-    situation.dt_s = horizon_dt_s_;
-    situation.steps = horizon_steps_;
-    situation.hold_reason = hold;
-    situation.worker_stamp_s = fused_s;
-    situation.worker_lost = worker_->lost != 0;
-    situation.p_world = odom_->p_world;
-    situation.v_world = odom_->v_world;
-    situation.heading_rad = odom_->heading_rad;
-    situation.worker_world = p0;
-    const planning::HoldPlanner::Decision decision = hold_.decide(situation);
-    const std::string& mode = decision.mode;
+    if (!odom_) return;
+    // The replanning step gfctl simulate's UAVs run too (planning::ReplanStep): freshness and
+    // hold, listen before moving, the worker's extrapolation, hold / search, the request.
+    std::optional<planning::WorkerKnowledge> worker;
+    if (worker_) worker = toWorkerKnowledge(*worker_);
+    planning::ReplanInputs in;
+    in.t_s = t;
+    in.state = *odom_;
+    if (wind_ && t - wind_stamp_s_ <= max_wind_age_s_) in.wind_estimate_mps = *wind_;
+    in.worker = worker ? &*worker : nullptr;
+    in.params = &params_;
+    in.leader_plan = received_[0] ? &received_[0]->plan : nullptr;
+    in.received = &received_;
+    const planning::ReplanOutcome out = step_->step(in);
+    if (!out.planned()) return;
+    if (!out.note.empty()) NODELET_WARN_STREAM("FormationPlanner UAV " << uav_index_ << ": " << out.note);
+    const std::string mode = planning::toString(out.mode);
     if (mode != mode_) {
-      if (stale) {
-        NODELET_WARN_STREAM("FormationPlanner UAV " << uav_index_ << ": " << mode << ": " << hold);
+      if (out.holding()) {
+        NODELET_WARN_STREAM("FormationPlanner UAV " << uav_index_ << ": " << mode << ": " << out.reason);
       } else {
         NODELET_INFO_STREAM("FormationPlanner UAV " << uav_index_ << ": track: fresh data");
       }
       mode_ = mode;
     }
-    planning::PlanRequestInputs in;
-    in.uav_index = uav_index_;
-    in.t_s = t;
-    in.dt_s = horizon_dt_s_;
-    in.state = *odom_;
-    if (wind_ && t - wind_stamp_s_ <= max_wind_age_s_) in.wind_estimate_mps = *wind_;
-    const auto& last = planner_->lastVerifiedPlan();
-    if (!last.empty()) in.state.a_world = last.sampleAt(t).a_world;
-    in.worker = formation::constantVelocityHorizon(p0, v0, hphi, horizon_steps_, horizon_dt_s_);
-    in.params = &params_;
-    const auto& leader = received_[0];
-    if (leader && t - leader->plan.t0_s <= max_share_age_s_) in.leader_plan = &leader->plan;
-    in.received = &received_;
-    in.rule = rule_;
-    in.hold_reference = decision.holding() ? &decision.reference : nullptr;
-    if (decision.camera_target.cols() > 0) in.camera_target = &decision.camera_target;
-    const planning::PlanRequest req = planning::buildPlanRequest(in);
-    const planning::PlanResult res = planner_->plan(req);
+    const planning::PlanResult& res = out.result;
     if (res.status != planning::PlanStatus::kOptimized) {
       NODELET_WARN_STREAM_THROTTLE(2.0, "FormationPlanner UAV " << uav_index_ << ": " << planning::toString(res.status)
                                                                 << ": " << res.reason);
@@ -321,16 +291,16 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
                                                    << " abandoned solve(s) still running in this process, docs/safety.md 4.5)");
     }
     auto msg = toMsg(res);
-    msg.fallback = msg.fallback || stale;  // a holding UAV has right of way (rule 3)
+    msg.fallback = out.fallback;  // a holding UAV or a fallback plan has right of way (rule 3)
     msg.mode = mode;
-    msg.mode_reason = hold;
+    msg.mode_reason = out.reason;
     msg.header.frame_id = world_frame_;
     msg.uav_index = uav_index_;
     msg.params_version = uav_index_ == formation::kLeader ? version_ : received_version_;
     msg.planned_at = ros::Time(t);
     msg.formation = toMsg(params_, 0).uavs;
-    for (int k = 0; k < req.reference.steps(); ++k) msg.reference.push_back(toPoint(req.reference.p_world.col(k)));
-    for (int k = 0; k < in.worker.steps(); ++k) msg.worker.push_back(toPoint(in.worker.p_world.col(k)));
+    for (int k = 0; k < out.reference.steps(); ++k) msg.reference.push_back(toPoint(out.reference.p_world.col(k)));
+    for (int k = 0; k < out.worker.steps(); ++k) msg.worker.push_back(toPoint(out.worker.p_world.col(k)));
     plan_pub_.publish(msg);
     traj_pub_.publish(toMultiDof(msg, "uav" + std::to_string(uav_index_)));
   }
@@ -338,28 +308,24 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   std::mutex mutex_;
   int uav_index_ = 0, uav_count_ = 0, horizon_steps_ = 0;
   std::string world_frame_;
-  double period_s_ = 0.0, horizon_dt_s_ = 0.0, max_share_age_s_ = 0.0, offset_s_ = 0.0, next_plan_s_ = -1.0;
+  double period_s_ = 0.0, horizon_dt_s_ = 0.0, offset_s_ = 0.0, next_plan_s_ = -1.0;
   static constexpr double kMaxWindMps = 60.0;  ///< a larger wind estimate is garbage
   double max_wind_age_s_ = 0.0, wind_stamp_s_ = 0.0;
   std::optional<Eigen::Vector3d> wind_;
   std::uint64_t wind_rejected_ = 0;
   formation::FormationParams params_;
-  std::optional<formation::WorkerHeading> heading_;
   std::optional<formation::FormationState> state_;
   std::uint64_t version_ = 0;           ///< leader: the parameters' version
   std::uint64_t received_version_ = 0;  ///< followers: the version received (0 over LCM: not carried)
   planning::AvoidanceRule rule_;
   planning::FreshnessLimits freshness_;
   double brake_accel_mps2_ = 0.0;
-  planning::HoldPlanner hold_;             ///< hold / search decision, latched braking point
   planning::SearchConfig search_;
   std::string mode_ = "track";             ///< track | hold | search (logged on change)
-  double listen_since_s_ = std::nan("");   ///< the first replanning (planning::listeningReason)
-  bool listening_ = true;
   std::string last_command_, last_outcome_, last_source_, last_status_;
   ros::Time last_stamp_;
   std::vector<int> last_uavs_;
-  std::unique_ptr<planning::UavPlanner> planner_;
+  std::unique_ptr<planning::ReplanStep> step_;  ///< planner, hold / search, listening (shared with gfctl simulate)
   std::optional<planning::UavKinematicState> odom_;
   std::optional<gesture_formation::WorkerState> worker_;
   std::vector<std::optional<planning::ReceivedPlan>> received_;  ///< by sender; [0] the leader's plan

@@ -61,6 +61,8 @@ class ParamLoader {
     if (!nh_.getParam(name, value)) value = fallback;
     loaded_ << "  " << name << " = " << value << "\n";
   }
+  /// \brief A line for the "loaded" report (e.g. a value taken from a file, not a parameter).
+  void note(const std::string& line) { loaded_ << "  " << line << "\n"; }
   void addError(const std::string& error) { errors_.push_back(error); }
   void addErrors(const std::vector<std::string>& errors) { errors_.insert(errors_.end(), errors.begin(), errors.end()); }
 

@@ -22,8 +22,8 @@
 #include <ros/ros.h>
 #include <tf2_ros/transform_broadcaster.h>
 
-#include "config_sources.hpp"
-#include "conversions.hpp"
+#include "sim_config_sources.hpp"
+#include "sim_conversions.hpp"
 #include "gesture_formation/formation/formation_geometry.hpp"
 #include "gesture_formation/formation/worker_heading.hpp"
 #include "gesture_formation/sim/multirotor.hpp"

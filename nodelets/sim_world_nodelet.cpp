@@ -37,8 +37,8 @@
 #include <std_msgs/Bool.h>
 #include <tf2_ros/transform_broadcaster.h>
 
-#include "config_sources.hpp"
-#include "conversions.hpp"
+#include "sim_config_sources.hpp"
+#include "sim_conversions.hpp"
 #include "gesture_formation/Gesture.h"
 #include "gesture_formation/GestureStatus.h"
 #include "gesture_formation/formation/worker_heading.hpp"
@@ -248,7 +248,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
   /// The leader's estimate predicted to t_s (nullopt before the first one).
   std::optional<Eigen::Vector3d> estimateAt(double t_s) const {
     if (!estimate_) return std::nullopt;
-    return toEigen(estimate_->position) + (t_s - estimate_->header.stamp.toSec()) * toEigen(estimate_->velocity);
+    return toWorkerKnowledge(*estimate_).positionAt(t_s);
   }
 
   /// UAV `uav`'s classification, as its Perception nodelet would publish it. With the 3-D

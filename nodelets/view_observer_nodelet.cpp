@@ -79,14 +79,12 @@ class ViewObserverNodelet : public nodelet::Nodelet {
       const auto fresh = [&](const ros::Time& s) { return std::abs(t - s.toSec()) <= max_state_age_s_; };
       if (odometry_ && worker_ && !worker_->lost && fresh(odometry_->header.stamp) && fresh(worker_->header.stamp)) {
         // The camera's distance and elevation from the worker estimate predicted to the frame.
-        const Eigen::Vector3d p_worker =
-            toEigen(worker_->position) + (t - worker_->header.stamp.toSec()) * toEigen(worker_->velocity);
-        const Eigen::Vector3d rel = toEigen(odometry_->pose.pose.position) - p_worker;
-        const double d = rel.norm();
-        if (std::isfinite(d) && d > 1e-9) {
+        const Eigen::Vector3d p_worker = toWorkerKnowledge(*worker_).positionAt(t);
+        const formation::ViewGeometry g = formation::viewGeometry(toEigen(odometry_->pose.pose.position), p_worker);
+        if (std::isfinite(g.distance_m) && g.distance_m > 1e-9) {
           o.geometry_known = true;
-          o.distance_m = d;
-          o.elevation_deg = common::radToDeg(std::asin(std::clamp(rel.z() / d, -1.0, 1.0)));
+          o.distance_m = g.distance_m;
+          o.elevation_deg = g.elevation_deg;
         }
       }
     }

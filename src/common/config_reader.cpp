@@ -275,14 +275,18 @@ void ConfigReader::readDoubleList(const std::string& key, std::vector<double>& v
   if (good) value = out;
 }
 
-std::vector<std::string> ConfigReader::unusedKeys() const {
+std::vector<std::string> ConfigReader::unusedKeys() const { return unusedLeaves(false); }
+
+std::vector<std::string> ConfigReader::unusedKeysOfWholeDocument() const { return unusedLeaves(true); }
+
+std::vector<std::string> ConfigReader::unusedLeaves(bool whole_document) const {
   std::set<std::string> sections;
   for (const auto& k : used_) sections.insert(topSection(k));
   std::vector<std::string> leaves;
   collectLeaves(root_, "", leaves);
   std::vector<std::string> unused;
   for (const auto& leaf : leaves) {
-    if (sections.count(topSection(leaf)) == 0) continue;
+    if (!whole_document && sections.count(topSection(leaf)) == 0) continue;
     bool consumed = false;
     for (const auto& u : used_) {
       // A key is consumed when it was read itself or lies under a node read as a whole.
@@ -301,6 +305,35 @@ std::string ConfigReader::errorReport() const {
   std::string s;
   for (const auto& e : errors_) s += e + "\n";
   return s;
+}
+
+void withSubReader(ConfigReader& r, const std::string& key, ConfigReader::MissingKeys mode,
+                   const std::function<void(ConfigReader&)>& fn) {
+  const YAML::Node n = r.node(key);
+  std::string text = "{}";
+  if (n.IsDefined() && !n.IsNull()) {
+    if (!n.IsMap()) {
+      r.addError(key, "must be a mapping");
+      return;
+    }
+    YAML::Emitter em;
+    em << n;
+    text = em.c_str();
+  }
+  ConfigReader sub = ConfigReader::fromString(text, r.source() + " " + key, mode);
+  fn(sub);
+  const std::string sub_prefix = sub.source() + ": ";
+  for (const auto& e : sub.errors()) {
+    // "<file> <key>: field: message" → "<file>: <key>.field: message"
+    const std::string rest = e.rfind(sub_prefix, 0) == 0 ? e.substr(sub_prefix.size()) : e;
+    const auto colon = rest.find(": ");
+    if (colon == std::string::npos || rest.find(' ') < colon) {
+      r.addError(key, rest);
+    } else {
+      r.addError(key + "." + rest.substr(0, colon), rest.substr(colon + 2));
+    }
+  }
+  for (const auto& u : sub.unusedKeysOfWholeDocument()) r.addError(key + "." + u, "unknown key");
 }
 
 }  // namespace gesture_formation::common

@@ -259,4 +259,19 @@ CommandOutcome FormationState::apply(const FormationCommand& command) {
   return out;
 }
 
+common::Result<CommandTarget> parseTarget(const std::string& text) {
+  using R = common::Result<CommandTarget>;
+  if (text == "all") return R::ok(CommandTarget::all());
+  if (text == "leader") return R::ok(CommandTarget::leader());
+  if (text == "followers") return R::ok(CommandTarget::followers());
+  if (text.rfind("follower", 0) == 0 && text.size() > 8) {
+    const std::string n = text.substr(8);
+    if (n.find_first_not_of("0123456789") == std::string::npos && n.size() < 4) {
+      const int i = std::stoi(n);
+      if (i >= 1) return R::ok(CommandTarget::list({i}));
+    }
+  }
+  return R::fail("target must be all | leader | followers | follower<i> | a list of UAV indices, got '" + text + "'");
+}
+
 }  // namespace gesture_formation::formation

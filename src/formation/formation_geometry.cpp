@@ -1,5 +1,6 @@
 #include "gesture_formation/formation/formation_geometry.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "gesture_formation/common/angles.hpp"
@@ -101,6 +102,15 @@ void formationHorizon(const WorkerHorizon& worker, const FormationParams& params
   for (std::size_t i = 0; i < params.followers.size(); ++i) {
     followerHorizon(worker, params.leader, plan, params.followers[i], out[i + 1]);
   }
+}
+
+ViewGeometry viewGeometry(const Eigen::Vector3d& camera_world, const Eigen::Vector3d& worker_world) {
+  const Eigen::Vector3d rel = camera_world - worker_world;
+  ViewGeometry g;
+  g.distance_m = rel.norm();
+  g.elevation_deg = g.distance_m > 1e-9 ? common::radToDeg(std::asin(std::clamp(rel.z() / g.distance_m, -1.0, 1.0)))
+                                        : (std::isfinite(g.distance_m) ? 0.0 : g.distance_m);
+  return g;
 }
 
 }  // namespace gesture_formation::formation

@@ -9,6 +9,15 @@
 
 namespace gesture_formation::planning {
 
+const char* toString(HoldMode mode) {
+  switch (mode) {
+    case HoldMode::kTrack: return "track";
+    case HoldMode::kHold: return "hold";
+    case HoldMode::kSearch: return "search";
+  }
+  return "unknown";
+}
+
 PlanRequest buildPlanRequest(const PlanRequestInputs& in) {
   PlanRequest req;
   const int i = in.uav_index;
@@ -23,6 +32,7 @@ PlanRequest buildPlanRequest(const PlanRequestInputs& in) {
   if (in.camera_target != nullptr) req.camera_target = *in.camera_target;
   const bool hold = in.hold_reference != nullptr;
   const bool has_leader_plan = i != 0 && in.leader_plan != nullptr && !in.leader_plan->empty();
+  const bool leader_plan_fresh = has_leader_plan && in.t_s - in.leader_plan->t0_s <= in.leader_plan_max_age_s;
   if (hold) {
     req.reference = *in.hold_reference;
     if (has_leader_plan) req.higher_priority_plans.push_back(*in.leader_plan);
@@ -30,7 +40,7 @@ PlanRequest buildPlanRequest(const PlanRequestInputs& in) {
     formation::leaderHorizon(in.worker, in.params->leader, req.reference);
   } else {
     formation::LeaderPlan lp;
-    if (has_leader_plan) {
+    if (leader_plan_fresh) {
       lp.heading_rad.resize(1, steps);
       lp.pitch_rad.resize(1, steps);
       for (int k = 0; k < steps; ++k) {
@@ -39,7 +49,7 @@ PlanRequest buildPlanRequest(const PlanRequestInputs& in) {
         lp.pitch_rad(k) = s.pitch_rad;
       }
     }
-    formation::followerHorizon(in.worker, in.params->leader, has_leader_plan ? &lp : nullptr,
+    formation::followerHorizon(in.worker, in.params->leader, leader_plan_fresh ? &lp : nullptr,
                                in.params->followers[static_cast<std::size_t>(i - 1)], req.reference);
     if (has_leader_plan) req.higher_priority_plans.push_back(*in.leader_plan);
   }
@@ -165,11 +175,11 @@ HoldPlanner::Decision HoldPlanner::decide(const Situation& s) {
       s.worker_lost && searching(s.uav_index, s.hold_reason, s.t_s, s.worker_stamp_s, limits_, search_);
   if (!search) {
     sweep_begin_s_ = std::numeric_limits<double>::quiet_NaN();
-    d.mode = "hold";
+    d.mode = HoldMode::kHold;
     return d;
   }
   if (!std::isfinite(sweep_begin_s_)) sweep_begin_s_ = s.t_s;
-  d.mode = "search";
+  d.mode = HoldMode::kSearch;
   d.camera_target =
       searchTargets(s.worker_world, *hold_p_, s.t_s, s.dt_s, s.steps, s.worker_stamp_s, sweep_begin_s_, search_);
   return d;

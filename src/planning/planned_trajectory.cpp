@@ -2,6 +2,7 @@
 #include <cmath>
 
 #include "gesture_formation/common/angles.hpp"
+#include "gesture_formation/planning/planned_trajectory.hpp"
 #include "gesture_formation/planning/uav_planner.hpp"
 
 namespace gesture_formation::planning {
@@ -36,6 +37,18 @@ TrajectorySample PlannedTrajectory::sampleAt(double t_s) const {
   out.a_world = (1.0 - w) * a.a_world + w * b.a_world;
   out.heading_rad = common::wrapAngle(a.heading_rad + w * common::wrapAngle(b.heading_rad - a.heading_rad));
   out.pitch_rad = (1.0 - w) * a.pitch_rad + w * b.pitch_rad;
+  return out;
+}
+
+UavKinematicState PlannedTrajectory::stateAt(double t_s) const {
+  const TrajectorySample s = sampleAt(t_s);
+  UavKinematicState out;
+  out.t_s = t_s;
+  out.p_world = s.p_world;
+  out.v_world = s.v_world;
+  out.a_world = s.a_world;
+  out.heading_rad = s.heading_rad;
+  out.pitch_rad = s.pitch_rad;
   return out;
 }
 

@@ -10,6 +10,7 @@
 #include "gesture_formation/common/angles.hpp"
 #include "gesture_formation/common/config_reader.hpp"
 #include "gesture_formation/formation/formation_geometry.hpp"
+#include "gesture_formation/onboard/onboard_settings.hpp"
 #include "validate_util.hpp"
 
 namespace gesture_formation::sim {
@@ -81,21 +82,6 @@ bool inWindow(const std::vector<std::pair<double, double>>& windows, double t_s)
   return false;
 }
 
-common::Result<formation::CommandTarget> parseTarget(const std::string& text) {
-  using R = common::Result<formation::CommandTarget>;
-  if (text == "all") return R::ok(formation::CommandTarget::all());
-  if (text == "leader") return R::ok(formation::CommandTarget::leader());
-  if (text == "followers") return R::ok(formation::CommandTarget::followers());
-  if (text.rfind("follower", 0) == 0 && text.size() > 8) {
-    const std::string n = text.substr(8);
-    if (n.find_first_not_of("0123456789") == std::string::npos && n.size() < 4) {
-      const int i = std::stoi(n);
-      if (i >= 1) return R::ok(formation::CommandTarget::list({i}));
-    }
-  }
-  return R::fail("target must be all | leader | followers | follower<i> | a list of UAV indices, got '" + text + "'");
-}
-
 namespace {
 
 /// The keys of one link (mission.links.* and their mission.faults.* overlays) under `k`.
@@ -119,37 +105,6 @@ Eigen::Vector3d vec3(ConfigReader& r, const std::string& key, const Eigen::Vecto
   r.readDoubleList(key, v, 3, 3, Range::any());
   if (v.size() != 3) return def;
   return Eigen::Vector3d(v[0], v[1], v[2]);
-}
-
-/// Runs `fn` on a sub-reader over the node at `key` (a top-level-keyed reader for the other
-/// modules' loaders) and copies its errors (named "<file> <key>: field: message").
-template <class Fn>
-void withSubReader(ConfigReader& r, const std::string& key, ConfigReader::MissingKeys mode, Fn fn) {
-  const YAML::Node n = r.node(key);
-  std::string text = "{}";
-  if (n.IsDefined() && !n.IsNull()) {
-    if (!n.IsMap()) {
-      r.addError(key, "must be a mapping");
-      return;
-    }
-    YAML::Emitter em;
-    em << n;
-    text = em.c_str();
-  }
-  ConfigReader sub = ConfigReader::fromString(text, r.source() + " " + key, mode);
-  fn(sub);
-  const std::string sub_prefix = sub.source() + ": ";
-  for (const auto& e : sub.errors()) {
-    // "<file> <key>: field: message" → "<file>: <key>.field: message"
-    const std::string rest = e.rfind(sub_prefix, 0) == 0 ? e.substr(sub_prefix.size()) : e;
-    const auto colon = rest.find(": ");
-    if (colon == std::string::npos || rest.find(' ') < colon) {
-      r.addError(key, rest);
-    } else {
-      r.addError(key + "." + rest.substr(0, colon), rest.substr(colon + 2));
-    }
-  }
-  for (const auto& u : sub.unusedKeys()) r.addError(key + "." + u, "unknown key");
 }
 
 const std::vector<std::pair<std::string, gesture::Motion>>& motionNames() {
@@ -243,9 +198,6 @@ common::Result<MissionConfig> parseMissionConfig(const std::string& yaml, const 
   }
   const std::string m = "mission.";
   r.readDouble(m + "step_s", c.step_s, Range::openClosed(0.0, 0.05));
-  r.readDouble(m + "replanning_period_s", c.replanning_period_s, Range::openClosed(0.0, 5.0));
-  r.readDouble(m + "horizon_dt_s", c.horizon_dt_s, Range::openClosed(0.0, 2.0));
-  r.readInt(m + "horizon_steps", c.horizon_steps, Range::closed(2, formation::kMaxHorizonSteps));
   r.readDouble(m + "timeline_rate_hz", c.timeline_rate_hz, Range::openClosed(0.0, 100.0));
   r.readDouble(m + "gesture_match_window_s", c.gesture_match_window_s, Range::positive());
   if (r.has(m + "gesture_model")) {
@@ -327,9 +279,29 @@ common::Result<MissionConfig> parseMissionConfig(const std::string& yaml, const 
            {"ki_xy", &ct.ki_xy}, {"ki_z", &ct.ki_z}, {"integral_limit_mps2", &ct.integral_limit_mps2},
            {"integral_zone_m", &ct.integral_zone_m}, {"integral_zone_mps", &ct.integral_zone_mps},
            {"max_accel_mps2", &ct.max_accel_mps2}, {"k_heading", &ct.k_heading}, {"k_pitch", &ct.k_pitch},
-           {"brake_accel_mps2", &ct.brake_accel_mps2}, {"hover_speed_mps", &ct.hover_speed_mps}}) {
+           {"hover_speed_mps", &ct.hover_speed_mps}}) {
     r.readDouble(ck + name, *v, Range::nonNegative());
   }
+  // The product's settings (replanning, safety limits, formation, gestures, planner, estimator):
+  // one parse with the onboard nodelets (onboard::readOnboardSettings).
+  onboard::OnboardSettings onboard;
+  onboard::readOnboardSettings(r, m, onboard);
+  c.replanning_period_s = onboard.replanning_period_s;
+  c.horizon_dt_s = onboard.horizon_dt_s;
+  c.horizon_steps = onboard.horizon_steps;
+  ct.brake_accel_mps2 = onboard.brake_accel_mps2;
+  c.faults.max_share_age_s = onboard.freshness.max_share_age_s;
+  c.faults.max_worker_age_s = onboard.freshness.max_worker_age_s;
+  c.faults.search = onboard.search;
+  c.faults.max_command_age_s = onboard.max_command_age_s;
+  c.faults.max_plan_age_s = onboard.rule.max_plan_age_s;
+  c.faults.avoid_all_plans = onboard.rule.avoid_all_plans;
+  c.formation = onboard.formation;
+  c.gesture_filter = onboard.gesture_filter;
+  c.gesture_mapping = onboard.gesture_mapping;
+  c.view_fusion = onboard.view_fusion;
+  c.planner = onboard.planner;
+  c.estimator = onboard.estimator;
   for (const auto& e : ct.validate()) r.addError(m + "controller", e);
 
   auto& od = c.odometry;
@@ -387,16 +359,6 @@ common::Result<MissionConfig> parseMissionConfig(const std::string& yaml, const 
     r.readDouble(k + "gust_peak_mps", wd.gust_peak_mps, Range::nonNegative());
     r.readDouble(k + "gust_duration_s", wd.gust_duration_s, Range::positive());
   }
-  r.readDouble(fk + "max_share_age_s", c.faults.max_share_age_s, Range::positive());
-  r.readDouble(fk + "max_worker_age_s", c.faults.max_worker_age_s, Range::positive());
-  r.readDouble(fk + "search_timeout_s", c.faults.search.timeout_s, Range::nonNegative());
-  r.readDouble(fk + "search_height_m", c.faults.search.height_m, Range::positive());
-  r.readDouble(fk + "search_vertical_speed_mps", c.faults.search.vertical_speed_mps, Range::positive());
-  r.readDouble(fk + "search_period_s", c.faults.search.period_s, Range::positive());
-  r.readDouble(fk + "search_horizontal_speed_mps", c.faults.search.horizontal_speed_mps, Range::nonNegative());
-  r.readDouble(fk + "max_command_age_s", c.faults.max_command_age_s, Range::positive());
-  r.readDouble(fk + "max_plan_age_s", c.faults.max_plan_age_s, Range::positive());
-  r.readBool(fk + "avoid_all_plans", c.faults.avoid_all_plans);
   auto readWindows = [&](const char* name, std::vector<std::pair<double, double>>& out) {
     const YAML::Node bl = r.node(fk + name);
     if (!bl.IsDefined()) return;
@@ -448,29 +410,9 @@ common::Result<MissionConfig> parseMissionConfig(const std::string& yaml, const 
   }
   for (const auto& e : c.faults.validate()) r.addError(m + "faults", e);
 
-  // --- other modules' configs (their own loaders on sub-readers) -----------------------
-  withSubReader(r, m + "formation", ConfigReader::MissingKeys::kUseDefaults,
-                [&](ConfigReader& s) { c.formation = formation::readFormationConfig(s); });
-  withSubReader(r, m + "gestures", ConfigReader::MissingKeys::kUseDefaults, [&](ConfigReader& s) {
-    c.gesture_filter = gesture::readGestureFilterConfig(s);
-    gesture::readGestureMapping(s, c.gesture_filter.max_gesture_id,
-                                static_cast<int>(c.formation.params.followers.size()), c.gesture_mapping);
-    c.view_fusion = gesture::readViewFusionConfig(s);
-  });
-  for (const auto& e : c.view_fusion.validate()) r.addError(m + "gestures", e);
-  if (c.view_fusion.min_agreeing_views > c.formation.params.uavCount()) {
-    r.addError(m + "gestures.view_fusion.min_agreeing_views",
-               "value " + std::to_string(c.view_fusion.min_agreeing_views) + " exceeds the number of UAVs (cameras) " +
-                   std::to_string(c.formation.params.uavCount()) + ": no gesture could ever be accepted");
-  }
-  withSubReader(r, m + "planner", ConfigReader::MissingKeys::kUseDefaults,
-                [&](ConfigReader& s) { c.planner = planning::readPlannerConfig(s); });
-  withSubReader(r, m + "estimator", ConfigReader::MissingKeys::kUseDefaults,
-                [&](ConfigReader& s) { c.estimator = estimation::readEstimatorConfig(s); });
   c.camera.camera = c.estimator.camera;  // one camera: what the sensor sees is what the estimator models
   c.worker.synth.camera = c.estimator.camera;
   c.worker.synth.fps = c.camera.rate_hz;
-  for (const auto& e : c.formation.validate()) r.addError(m + "formation", e);
 
   const int n_uavs = c.formation.params.uavCount();
   if (!c.uavs.empty() && static_cast<int>(c.uavs.size()) != n_uavs) {
@@ -515,7 +457,7 @@ common::Result<MissionConfig> parseMissionConfig(const std::string& yaml, const 
         q.target_text = text + "]";
       } else {
         q.target_text = tn.IsScalar() ? tn.Scalar() : "";
-        const auto t = parseTarget(q.target_text);
+        const auto t = formation::parseTarget(q.target_text);
         if (!t) {
           r.addError(k + "target", t.reason());
         } else {
@@ -549,55 +491,15 @@ common::Result<MissionConfig> parseMissionConfig(const std::string& yaml, const 
 }
 
 common::Result<MissionConfig> loadMissionConfig(const std::string& scenario_path) {
-  std::ifstream in(scenario_path);
-  if (!in) return common::Result<MissionConfig>::fail(scenario_path + ": cannot open file\n");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const auto slash = scenario_path.find_last_of('/');
-  const std::string dir = slash == std::string::npos ? "." : scenario_path.substr(0, slash);
-  return parseMissionConfig(ss.str(), scenario_path, dir);
+  return loadMissionConfig(scenario_path, "");
 }
 
 common::Result<MissionConfig> loadMissionConfig(const std::string& scenario_path, const std::string& faults_path) {
-  using R = common::Result<MissionConfig>;
-  std::ifstream in(scenario_path);
-  if (!in) return R::fail(scenario_path + ": cannot open file\n");
-  std::ifstream fin(faults_path);
-  if (!fin) return R::fail(faults_path + ": cannot open file\n");
-  std::stringstream ss, fs;
-  ss << in.rdbuf();
-  fs << fin.rdbuf();
-  YAML::Node root, faults;
-  try {
-    root = YAML::Load(ss.str());
-  } catch (const YAML::Exception& e) {
-    return R::fail(scenario_path + ": YAML: " + e.what() + "\n");
-  }
-  try {
-    faults = YAML::Load(fs.str());
-  } catch (const YAML::Exception& e) {
-    return R::fail(faults_path + ": YAML: " + e.what() + "\n");
-  }
-  std::string problems;
-  if (!faults.IsMap() || !faults["faults"].IsDefined()) {
-    problems += faults_path + ": faults: missing (a fault file has one top-level key, faults)\n";
-  } else {
-    for (const auto& kv : faults) {
-      const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : std::string("?");
-      if (key != "faults") problems += faults_path + ": " + key + ": unknown key (a fault file has only faults)\n";
-    }
-    if (!faults["faults"].IsMap() && !faults["faults"].IsNull()) {
-      problems += faults_path + ": faults: must be a mapping of mission.faults keys\n";
-    }
-  }
-  if (!root.IsMap() || !root["mission"].IsMap()) problems += scenario_path + ": mission: missing\n";
-  if (!problems.empty()) return R::fail(problems);
-  root["mission"]["faults"] = faults["faults"].IsNull() ? YAML::Node(YAML::NodeType::Map) : faults["faults"];
-  YAML::Emitter emitter;
-  emitter << root;
+  auto yaml = onboard::loadMissionYaml(scenario_path, faults_path);
+  if (!yaml) return common::Result<MissionConfig>::fail(yaml.reason());
   const auto slash = scenario_path.find_last_of('/');
   const std::string dir = slash == std::string::npos ? "." : scenario_path.substr(0, slash);
-  return parseMissionConfig(emitter.c_str(), scenario_path + " + " + faults_path, dir);
+  return parseMissionConfig(*yaml, faults_path.empty() ? scenario_path : scenario_path + " + " + faults_path, dir);
 }
 
 std::vector<std::string> gestureReadabilityWarnings(const MissionConfig& m) {
@@ -614,8 +516,8 @@ std::vector<std::string> gestureReadabilityWarnings(const MissionConfig& m) {
   int inside = 0;
   std::string outside;
   for (std::size_t i = 0; i < cameras; ++i) {
-    const double d = refs[i].p_world.norm();
-    const double e = d > 0.0 ? common::radToDeg(std::asin(std::clamp(refs[i].p_world.z() / d, -1.0, 1.0))) : 0.0;
+    const formation::ViewGeometry g = formation::viewGeometry(refs[i].p_world, Eigen::Vector3d::Zero());
+    const double d = g.distance_m, e = g.elevation_deg;
     if (vf.inEnvelope(d, e)) {
       ++inside;
       continue;

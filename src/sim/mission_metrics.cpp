@@ -153,12 +153,13 @@ void MetricsAccumulator::sampleTimeline(const TimelineInput& in) {
     UavSample us;
     us.p_world = s.p_world;
     const Eigen::Vector3d to_worker = w - s.p_world;
-    us.d_t = to_worker.norm();
+    const formation::ViewGeometry view = formation::viewGeometry(s.p_world, w);
+    us.d_t = view.distance_m;
     us.d_ref = P.uav(i).distance_m;
     us.d_o = obstacles_(s.p_world);
     us.phi_deg = radToDeg(std::atan2(to_worker.y(), to_worker.x()));
     us.phi_ref_deg = radToDeg(ref.heading_rad);
-    us.elev_deg = radToDeg(std::asin(std::clamp(-to_worker.z() / std::max(1e-9, us.d_t), -1.0, 1.0)));
+    us.elev_deg = view.elevation_deg;
     us.elev_ref_deg = formation::elevationDeg(P, i);
     us.heading_deg = radToDeg(s.heading_rad);
     us.pitch_deg = radToDeg(s.pitch_rad);

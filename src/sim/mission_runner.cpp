@@ -13,49 +13,30 @@
 #include "gesture_formation/estimation/measurement_model.hpp"
 #include "gesture_formation/formation/formation_geometry.hpp"
 #include "gesture_formation/formation/worker_heading.hpp"
+#include "gesture_formation/gesture/gesture_frames.hpp"
 #include "gesture_formation/planning/distance_field.hpp"
 #include "gesture_formation/planning/occupancy_map.hpp"
-#include "gesture_formation/planning/plan_request_builder.hpp"
+#include "gesture_formation/planning/replan_step.hpp"
 #include "gesture_formation/sim/random.hpp"
 #include "gesture_formation/sim/wind.hpp"
 
 namespace gesture_formation::sim {
 
-// --------------------------------------------------------------------------------------
-// Product adapters
-namespace {
-
-class UavPlannerAdapter : public MissionPlanner {
- public:
-  UavPlannerAdapter(const planning::PlannerConfig& c, std::shared_ptr<const planning::OccupancyMap> map,
-                    std::shared_ptr<const planning::DistanceField> field)
-      : planner_(c, std::move(map), std::move(field)) {}
-  planning::PlanResult plan(const planning::PlanRequest& r) override { return planner_.plan(r); }
-
- private:
-  planning::UavPlanner planner_;
-};
-
-}  // namespace
-
 PlannerFactory uavPlannerFactory(const planning::PlannerConfig& config,
                                  std::shared_ptr<const planning::OccupancyMap> map,
                                  std::shared_ptr<const planning::DistanceField> field) {
   return [config, map, field](int) -> std::unique_ptr<MissionPlanner> {
-    return std::make_unique<UavPlannerAdapter>(config, map, field);
+    return std::make_unique<planning::UavPlannerAdapter>(std::make_unique<planning::UavPlanner>(config, map, field));
   };
 }
 
 // --------------------------------------------------------------------------------------
 namespace {
 
-/// What the leader shares every replanning (DESIGN §1: human state, leader plan, formation params).
+/// What the leader shares every replanning (DESIGN §1: human state, leader plan, formation
+/// params) — in ROS the WorkerState, PlannedTrajectory and FormationParams it sends over LCM.
 struct LeaderShare {
-  double stamp_s = 0.0;
-  double worker_stamp_s = 0.0;  ///< time of the leader's last fused worker measurement
-  Eigen::Vector3d p_world = Eigen::Vector3d::Zero();
-  Eigen::Vector3d v_world = Eigen::Vector3d::Zero();
-  double human_heading_rad = 0.0;
+  planning::WorkerKnowledge worker;  ///< stamp_s = when the leader sent it
   formation::FormationParams params;
   std::uint64_t params_version = 0;
   planning::PlannedTrajectory plan;
@@ -79,16 +60,14 @@ struct UavRuntime {
   Multirotor plant;
   TrackingController ctl;
   Odometry odo;
-  std::unique_ptr<MissionPlanner> planner;
+  std::unique_ptr<planning::ReplanStep> step;  ///< the product's replanning step (planner, hold, listening)
   EstimatedState est;
   WindEstimate wind_estimate;  ///< the flight stack's wind estimate (planning's wind allowance)
   double next_plan_s = 0.0;
   std::optional<LeaderShare> share;                           ///< followers: last received from the leader
   std::vector<std::optional<PlanMessage>> received;  ///< plans received from the followers
   bool offline = false;                                      ///< follower dropout in progress
-  double rejoined_s = -std::numeric_limits<double>::infinity();  ///< end of the last dropout
   std::string mode = "start";                                ///< last mode recorded (ModeChange)
-  planning::HoldPlanner hold;                                ///< hold / search decision and its latched state
 };
 
 void addCounters(MissionMetrics& M, const LinkCounters& c) {
@@ -116,20 +95,18 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
   std::uint64_t params_version = 0;
 
   WorkerModel worker(cfg.worker, mixSeed(seed ^ static_cast<std::uint64_t>(Stream::kWorker)));
-  formation::WorkerHeading human_heading(cfg.formation.worker_heading);
   WindModel wind(cfg.wind, makeRng(seed, Stream::kWind));
   LeaderCamera camera(cfg, world.map, seed);
   estimation::HumanKalman kf(cfg.estimator.filter);
   const estimation::CameraModel cam_model(cfg.estimator.camera);
-  gesture::GestureFilter filter(cfg.gesture_filter);
   // The formation's cameras vote (docs/gestures.md §4.1); min_agreeing_views 1 = the paper's
   // pipeline on the leader's camera alone.
   const bool follower_views = cfg.view_fusion.min_agreeing_views > 1;
-  gesture::ViewFusion fusion(cfg.view_fusion, follower_views ? n : 1, cfg.gesture_filter.max_gesture_id);
+  gesture::GestureFrames frames(cfg.gesture_filter, cfg.view_fusion, cfg.gesture_mapping, n, 0.0);
 
   // --- UAVs: initial states at the formation references around the worker's start -------
   const WorkerState w0 = worker.stateAt(0.0);
-  const double hphi0 = human_heading.heading();
+  const double hphi0 = formation::WorkerHeading(cfg.formation.worker_heading).heading();
   const formation::UavReference lref0 = formation::leaderReference(w0.p_world, hphi0, cfg.formation.params.leader);
   std::vector<std::unique_ptr<UavRuntime>> uavs;
   const planning::FreshnessLimits freshness{cfg.faults.max_share_age_s, cfg.faults.max_worker_age_s};
@@ -151,10 +128,18 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
       return R::fail(os.str());
     }
     auto u = std::make_unique<UavRuntime>(cfg.uavs[static_cast<std::size_t>(i)], cfg, s0, seed, i);
-    u->planner = planners(i);
+    planning::ReplanConfig rc;
+    rc.uav_index = i;
+    rc.dt_s = cfg.horizon_dt_s;
+    rc.steps = cfg.horizon_steps;
+    rc.freshness = freshness;
+    rc.rule = planning::AvoidanceRule{cfg.faults.avoid_all_plans, cfg.faults.max_plan_age_s};
+    rc.search = cfg.faults.search;
+    rc.brake_accel_mps2 = cfg.controller.brake_accel_mps2;
+    rc.worker_heading = cfg.formation.worker_heading;
+    u->step = std::make_unique<planning::ReplanStep>(rc, planners(i));
     u->next_plan_s = cfg.replanning_period_s * static_cast<double>(i) / static_cast<double>(n);
     u->received.resize(static_cast<std::size_t>(n));
-    u->hold = planning::HoldPlanner(freshness, cfg.faults.search, cfg.controller.brake_accel_mps2);
     uavs.push_back(std::move(u));
   }
 
@@ -189,13 +174,12 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
   int last_class = -1;
   double last_ratio = 0.0;
   double last_fused_s = -std::numeric_limits<double>::infinity();  // the leader's last fused worker measurement
+  std::optional<planning::WorkerKnowledge> leader_knowledge;        // the leader's last confirmed estimate
 
   const double dt = cfg.step_s;
   const long steps = std::lround(duration / dt);
   StepSchedule camera_frames(1.0 / cfg.camera.rate_hz, dt);
   StepSchedule timeline_samples(1.0 / cfg.timeline_rate_hz, dt);
-  const double hdt = cfg.horizon_dt_s;
-  const int hsteps = cfg.horizon_steps;
 
   auto applyCommand = [&](std::size_t record, const formation::FormationCommand& cmd, double t) {
     const auto outcome = fstate.apply(cmd);
@@ -227,97 +211,47 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
         return;
       }
     }
-    Eigen::Vector3d p0, v0;
-    double hphi = 0.0;
-    formation::FormationParams params;
-    std::uint64_t version = 0;
+    // What this UAV knows: the leader its estimator's state as the WorkerEstimator publishes it
+    // (only a confirmed track, the prediction to now; the last one kept while the track is
+    // re-initialised), a follower the leader's last share.
     const LeaderShare* share = nullptr;
-    double worker_stamp = 0.0;
-    bool worker_lost = false;
-    std::string hold;  // non-empty: hold a safe position (docs/safety.md), the reason
+    const formation::FormationParams* params = &fstate.params();
+    std::uint64_t version = params_version;
     if (i == 0) {
-      // Nothing to plan on before the first estimate, nor on a tentative track (initialised from
-      // one measurement that may be a gross range error: range_outliers / harsh seed 97): fly the
-      // last plan, as the ROS leader does while its WorkerEstimator publishes nothing new.
-      if (!kf.confirmed()) {
-        ++M.plans_skipped;
-        return;
+      if (kf.confirmed()) {
+        planning::WorkerKnowledge w;
+        w.stamp_s = t;
+        w.fused_s = last_fused_s;
+        w.p_world = kf.predicted(t).p_world;
+        w.v_world = kf.state().tail<3>();
+        w.lost = kf.lost(t);
+        leader_knowledge = w;
       }
-      const estimation::Vector6d& x = kf.state();
-      worker_stamp = last_fused_s;
-      worker_lost = kf.lost(t);
-      hold = planning::holdReason(i, t, t, worker_stamp, freshness);
-      const bool stale = !hold.empty() || worker_lost;
-      v0 = stale ? Eigen::Vector3d::Zero() : Eigen::Vector3d(x.tail<3>());
-      // Stale: the estimator's prediction (constant velocity for lost_timeout_s, then held) — what
-      // the WorkerEstimator nodelet publishes — serves as camera target and obstacle only.
-      p0 = stale ? kf.predicted(t).p_world : Eigen::Vector3d(x.head<3>() + (t - kf.time()) * v0);
-      hphi = stale ? human_heading.heading() : human_heading.update(v0);
-      params = fstate.params();
-      version = params_version;
-    } else {
-      if (!u.share) {
-        ++M.plans_skipped;  // nothing known about the worker: the controller holds (its plan's end, or brakes)
-        setMode(i, t, "hold", "no leader share received yet");
-        return;
-      }
+    } else if (u.share) {
       share = &*u.share;
-      worker_stamp = share->worker_stamp_s;
-      hold = planning::holdReason(i, t, share->stamp_s, worker_stamp, freshness);
-      if (hold.empty() && u.rejoined_s > -std::numeric_limits<double>::infinity()) {
-        hold = planning::listeningReason(i, u.rejoined_s, u.received,
-                                         [&](int j) { return uavs[static_cast<std::size_t>(j)]->offline; });
-        if (hold.empty()) u.rejoined_s = -std::numeric_limits<double>::infinity();
-      }
-      const bool stale = !hold.empty();
-      v0 = stale ? Eigen::Vector3d::Zero() : Eigen::Vector3d(share->v_world);
-      p0 = share->p_world + (stale ? 0.0 : (t - share->stamp_s)) * v0;
-      hphi = share->human_heading_rad;
-      params = share->params;
+      params = &share->params;
       version = share->params_version;
     }
-    // Hold (stop where braking at the controller's deceleration ends, camera on the worker
-    // estimate; the stale data serve only as an obstacle and camera target) or, the leader that
-    // lost the worker, search with the camera — the decision the FormationPlanner makes too.
-    planning::HoldPlanner::Situation situation;
-    situation.uav_index = i;
-    situation.t_s = t;
-    situation.dt_s = hdt;
-    situation.steps = hsteps;
-    situation.hold_reason = hold;
-    situation.worker_stamp_s = worker_stamp;
-    situation.worker_lost = worker_lost;
-    situation.p_world = u.est.p_world;
-    situation.v_world = u.est.v_world;
-    situation.heading_rad = u.est.heading_rad;
-    situation.worker_world = p0;
-    const planning::HoldPlanner::Decision decision = u.hold.decide(situation);
-    if (decision.holding()) {
-      ++M.plans_hold;
-      setMode(i, t, decision.mode, hold);
-    } else {
-      setMode(i, t, "track", "fresh data");
-    }
-    const formation::WorkerHorizon wh = formation::constantVelocityHorizon(p0, v0, hphi, hsteps, hdt);
-    planning::PlanRequestInputs in;
-    in.uav_index = i;
+    planning::ReplanInputs in;
     in.t_s = t;
-    in.dt_s = hdt;
     in.state.p_world = u.est.p_world;
     in.state.v_world = u.est.v_world;
-    in.state.a_world = u.plant.state().a_world;
     in.state.heading_rad = u.est.heading_rad;
     in.state.pitch_rad = u.est.pitch_rad;
     in.wind_estimate_mps = u.wind_estimate.value();
-    in.worker = wh;
-    in.params = &params;
+    in.worker = i == 0 ? (leader_knowledge ? &*leader_knowledge : nullptr) : (share != nullptr ? &share->worker : nullptr);
+    in.params = params;
     in.leader_plan = share != nullptr ? &share->plan : nullptr;
     in.received = &u.received;
-    in.hold_reference = decision.holding() ? &decision.reference : nullptr;
-    if (decision.camera_target.cols() > 0) in.camera_target = &decision.camera_target;
-    in.rule = planning::AvoidanceRule{cfg.faults.avoid_all_plans, cfg.faults.max_plan_age_s};
-    const planning::PlanRequest req = planning::buildPlanRequest(in);
-    const planning::PlanResult res = u.planner->plan(req);
+    const planning::ReplanOutcome out = u.step->step(in);
+    if (!out.planned()) {
+      ++M.plans_skipped;  // nothing known about the worker: the controller holds (its plan's end, or brakes)
+      if (i != 0) setMode(i, t, "hold", out.reason);
+      return;
+    }
+    if (out.holding()) ++M.plans_hold;
+    setMode(i, t, planning::toString(out.mode), out.holding() ? out.reason : "fresh data");
+    const planning::PlanResult& res = out.result;
     metrics.plan(i, t, version, res.status, res.timings.total_ms, res.reason, res.qp_sparse_timeouts);
     if (res.trajectory.empty()) {
       u.ctl.clearPlan();
@@ -326,17 +260,13 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
     }
     if (i == 0) {
       LeaderShare s;
-      s.stamp_s = t;
-      s.worker_stamp_s = worker_stamp;
-      s.p_world = p0;
-      s.v_world = v0;
-      s.human_heading_rad = hphi;
-      s.params = params;
+      s.worker = *leader_knowledge;  // the estimator's state, as the WorkerEstimator's over LCM
+      s.params = *params;
       s.params_version = version;
       s.plan = res.trajectory;
       for (int j = 1; j < n; ++j) share_links[static_cast<std::size_t>(j)]->send(t, s);
     } else {
-      const PlanMessage msg{res.trajectory, res.status != planning::PlanStatus::kOptimized || !hold.empty()};
+      const PlanMessage msg{res.trajectory, out.fallback};
       for (int j = 0; j < n; ++j) {
         if (j != i) plan_links[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)]->send(t, msg);
       }
@@ -368,8 +298,7 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
       } else if (!off && u.offline) {
         u.share.reset();
         for (auto& r : u.received) r.reset();
-        u.planner = planners(i);
-        u.rejoined_s = t;
+        u.step->restart(planners(i));
         setMode(i, t, "rejoin", "back online: listening before it moves");
       }
       u.offline = off;
@@ -380,7 +309,7 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
       UavRuntime& u = *uavs[static_cast<std::size_t>(i)];
       for (auto& s : share_links[static_cast<std::size_t>(i)]->receive(t)) {
         if (u.offline) continue;
-        if (!u.share || s.stamp_s > u.share->stamp_s) u.share = std::move(s);
+        if (!u.share || s.worker.stamp_s > u.share->worker.stamp_s) u.share = std::move(s);
       }
     }
     for (int i = 0; i < n; ++i) {
@@ -420,7 +349,6 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
       }
       // Each camera's classification → the vote (geometry from the leader's worker estimate
       // and each UAV's odometry: a view votes only inside the classifier's envelope) → filter.
-      bool classified = false;
       const std::optional<Eigen::Vector3d> worker_est =
           kf.confirmed() ? std::optional<Eigen::Vector3d>(kf.predicted(t).p_world) : std::nullopt;
       const auto observation = [&](int view, const gesture::Classification& c, const gesture::CalibratedSkeleton& cal) {
@@ -431,9 +359,9 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
         o.distance_m = std::nan("");
         o.elevation_deg = std::nan("");
         if (worker_est) {
-          const Eigen::Vector3d rel = uavs[static_cast<std::size_t>(view)]->est.p_world - *worker_est;
-          o.distance_m = rel.norm();
-          o.elevation_deg = common::radToDeg(std::asin(std::clamp(rel.z() / std::max(1e-9, rel.norm()), -1.0, 1.0)));
+          const formation::ViewGeometry g = formation::viewGeometry(uavs[static_cast<std::size_t>(view)]->est.p_world, *worker_est);
+          o.distance_m = g.distance_m;
+          o.elevation_deg = g.elevation_deg;
         }
         if (cfg.view_fusion.confirm_3d) {
           // The camera pose as the UAV knows it: the rendering pose moved by its odometry's
@@ -449,10 +377,14 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
         }
         return o;
       };
-      if (cf.classification) classified = fusion.observe(observation(0, *cf.classification, cf.calibrated));
-      // The followers' votes travel the link; those that arrived by now are counted. The views are
-      // compared view_fusion.fusion_lag_s in the past (the link's delay budget): a vote that is
-      // older than max_age_s at that moment, or arrives later than the lag, does not count.
+      // The leader's classification and the followers' votes that arrived by now go to the
+      // frame aggregation the GestureCommander nodelet runs (gesture::GestureFrames): a frame is
+      // fused once every view reported it, or view_fusion.fusion_lag_s after its stamp.
+      std::vector<gesture::GestureFrame> closed;
+      const auto take = [&closed](std::vector<gesture::GestureFrame> frames_closed) {
+        for (auto& f : frames_closed) closed.push_back(std::move(f));
+      };
+      if (cf.classification) take(frames.observe(observation(0, *cf.classification, cf.calibrated)));
       for (std::size_t i = 0; i < cf.followers.size(); ++i) {
         if (cf.followers[i].classification) {
           vote_links[i + 1]->send(t, observation(static_cast<int>(i) + 1, *cf.followers[i].classification,
@@ -460,20 +392,16 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
         }
       }
       for (int i = 1; follower_views && i < n; ++i) {
-        for (const auto& o : vote_links[static_cast<std::size_t>(i)]->receive(t)) classified = fusion.observe(o) || classified;
+        for (const auto& o : vote_links[static_cast<std::size_t>(i)]->receive(t)) take(frames.observe(o));
       }
-      if (classified) {
-        const double t_fused = follower_views ? t - cfg.view_fusion.fusion_lag_s : t;
-        const int fused = follower_views ? fusion.fuse(t_fused).gesture_id : cf.classification->gesture_id;
-        last_class = fused;
-        const auto fo = filter.update(t_fused, fused);
-        last_ratio = fo.dominant_ratio;
-        if (fo.fired) {
-          const std::size_t record = metrics.addRequest(firedGestureRecord(t, fo.dominant_id, cfg.gesture_mapping));
-          const gesture::GestureAction* action = cfg.gesture_mapping.find(fo.dominant_id);
-          if (action != nullptr && action->kind != gesture::GestureAction::Kind::kEvent) {
-            applyCommand(record, gesture::toCommand(*action, ++gesture_seq), t);
-          }
+      take(frames.closeDue(t));
+      for (const gesture::GestureFrame& f : closed) {
+        last_class = f.fused.gesture_id;
+        last_ratio = f.filter.dominant_ratio;
+        if (!f.filter.fired) continue;
+        const std::size_t record = metrics.addRequest(firedGestureRecord(t, f.filter.dominant_id, cfg.gesture_mapping));
+        if (f.action != nullptr && f.action->kind != gesture::GestureAction::Kind::kEvent) {
+          applyCommand(record, gesture::toCommand(*f.action, ++gesture_seq), t);
         }
       }
       // The estimate the system acts on (a tentative track is not published: docs/estimation.md).
@@ -507,7 +435,7 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
       in.gesture_class = last_class;
       in.dominant_ratio = last_ratio;
       in.params = fstate.params();
-      in.human_heading_rad = human_heading.heading();
+      in.human_heading_rad = uavs[0]->step->workerHeading();
       for (const auto& u : uavs) in.uavs.push_back(u->plant.state());
       metrics.sampleTimeline(in);
     }

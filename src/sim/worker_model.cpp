@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 
 #include "gesture_formation/common/angles.hpp"
+#include "gesture_formation/formation/formation_geometry.hpp"
 #include "gesture_formation/sim/random.hpp"
 #include "validate_util.hpp"
 
@@ -215,8 +216,9 @@ void WorkerModel::startMotion(double t_s, gesture::Motion motion, const std::vec
   std::vector<gesture::SkeletonSynthesizer::View> views;
   for (const Eigen::Vector3d& camera_world : cameras) {
     const Eigen::Vector3d diff = camera_world - s.p_world;
-    const double d = std::max(1.5, diff.norm());
-    const double el = radToDeg(std::asin(std::clamp(diff.z() / std::max(1e-9, diff.norm()), -1.0, 1.0)));
+    const formation::ViewGeometry view = formation::viewGeometry(camera_world, s.p_world);
+    const double d = std::max(1.5, view.distance_m);
+    const double el = view.elevation_deg;
     const double az = radToDeg(common::wrapAngle(std::atan2(diff.y(), diff.x()) - s.heading_rad));
     views.push_back({d, el, az});
   }

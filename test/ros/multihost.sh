@@ -8,7 +8,7 @@
 set -o pipefail
 SRC=$1
 BUILD=$2
-[ "$(id -u)" -eq 0 ] || { echo "SKIP: needs root (network namespaces)"; exit 0; }
+[ "$(id -u)" -eq 0 ] || { echo "SKIP: needs root (network namespaces)"; exit 77; }
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 GF_BUILD_DIR=$BUILD timeout 130 "$SRC/tools/run_multihost.sh" --out "$T/out" --duration 40 --rtf 1.5 \

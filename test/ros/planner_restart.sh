@@ -8,7 +8,7 @@
 # throughout (SimWorld's modes.csv and metrics.json).
 set -o pipefail
 source "$(dirname "$0")/common.bash"
-[ "$(id -u)" -eq 0 ] || { echo "SKIP: needs root (unshare -n keeps LCM on this machine)"; exit 0; }
+[ "$(id -u)" -eq 0 ] || { echo "SKIP: needs root (unshare -n keeps LCM on this machine)"; exit 77; }
 make_key "$T/keys"
 mkdir -p "$T/out"
 cat > "$T/restart.py" <<'PY'

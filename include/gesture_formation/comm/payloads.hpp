@@ -25,7 +25,7 @@
 #include "gesture_formation/formation/formation_commands.hpp"
 #include "gesture_formation/formation/formation_params.hpp"
 #include "gesture_formation/gesture/view_triangulation.hpp"
-#include "gesture_formation/planning/uav_planner.hpp"
+#include "gesture_formation/planning/planned_trajectory.hpp"
 
 namespace gesture_formation::comm {
 

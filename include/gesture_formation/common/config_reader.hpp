@@ -10,6 +10,7 @@
 /// only the keys a subcommand uses"). Out-of-range or malformed values are always errors.
 /// Thread safety: none; one reader per thread.
 
+#include <functional>
 #include <limits>
 #include <set>
 #include <string>
@@ -73,6 +74,9 @@ class ConfigReader {
   /// once, but never consumed — most likely typos. Sections never touched are ignored, so
   /// one file can hold the configuration of several components.
   std::vector<std::string> unusedKeys() const;
+  /// Every leaf key of the document never consumed, whether or not its section was read (a
+  /// document that is one component's configuration: withSubReader).
+  std::vector<std::string> unusedKeysOfWholeDocument() const;
 
   /// All errors joined, one per line, each prefixed with the source name.
   std::string errorReport() const;
@@ -83,6 +87,7 @@ class ConfigReader {
   /// node if absent.
   YAML::Node lookup(const std::string& key, bool report_missing);
   void markUsed(const std::string& key);
+  std::vector<std::string> unusedLeaves(bool whole_document) const;
 
   YAML::Node root_;
   std::string source_;
@@ -91,5 +96,11 @@ class ConfigReader {
   std::vector<std::string> errors_;
   std::set<std::string> used_;
 };
+
+/// \brief Runs `fn` on a sub-reader over the node at `key` of `r` (a reader whose top level is
+/// that node, for another module's loader) and copies its problems into `r`, each renamed
+/// "<key>.<field>: message"; keys of the node `fn` did not read are reported as unknown.
+void withSubReader(ConfigReader& r, const std::string& key, ConfigReader::MissingKeys mode,
+                   const std::function<void(ConfigReader&)>& fn);
 
 }  // namespace gesture_formation::common

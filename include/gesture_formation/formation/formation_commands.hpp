@@ -175,4 +175,8 @@ class FormationState {
   DuplicateWindow duplicates_;
 };
 
+/// \brief Parses a command target by name: all | leader | followers | follower<i> (i ≥ 1).
+/// Fails naming the accepted forms and the text.
+common::Result<CommandTarget> parseTarget(const std::string& text);
+
 }  // namespace gesture_formation::formation

@@ -35,6 +35,17 @@ using HorizonPoints = Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::ColMajor, 
 /// \brief One scalar per horizon step (angles [rad]). Fixed maximum size.
 using HorizonScalars = Eigen::Matrix<double, 1, Eigen::Dynamic, Eigen::RowMajor, 1, kMaxHorizonSteps>;
 
+/// \brief Where a camera sees the worker from: its distance and its elevation above him
+/// (positive: the camera is above the worker). The geometry the gesture vote gates on
+/// (gesture::ViewFusionConfig's envelope), the metrics report and the worker model renders.
+struct ViewGeometry {
+  double distance_m = 0.0;     ///< |camera − worker| [m]
+  double elevation_deg = 0.0;  ///< asin((camera − worker)_z / distance) [deg], 0 when they coincide
+};
+/// \brief The view of `worker_world` from `camera_world` (world frame, [m]); non-finite inputs
+/// give non-finite fields.
+ViewGeometry viewGeometry(const Eigen::Vector3d& camera_world, const Eigen::Vector3d& worker_world);
+
 /// \brief Desired state of one UAV at one instant.
 struct UavReference {
   Eigen::Vector3d p_world = Eigen::Vector3d::Zero();  ///< position [m], world frame

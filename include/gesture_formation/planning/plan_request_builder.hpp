@@ -53,6 +53,9 @@ struct PlanRequestInputs {
   /// Followers: the leader's last received plan (null or empty: none; the reference then
   /// uses the leader's desired heading and pitch).
   const PlannedTrajectory* leader_plan = nullptr;
+  /// The leader's plan shapes the reference only while t_s − its t0_s ≤ this (an older plan's
+  /// heading and pitch are not the leader's now); it is avoided whatever its age (right of way).
+  double leader_plan_max_age_s = std::numeric_limits<double>::infinity();
   /// The plans received from the followers, indexed by sender (entries 0 and uav_index are
   /// ignored); may be null.
   const std::vector<std::optional<ReceivedPlan>>* received = nullptr;
@@ -146,6 +149,11 @@ formation::HorizonPoints searchTargets(const Eigen::Vector3d& worker_world, cons
 formation::ReferenceTrajectory holdReference(const Eigen::Vector3d& hold_world, const Eigen::Vector3d& worker_world,
                                              double heading_rad, int steps);
 
+/// \brief What HoldPlanner decided.
+enum class HoldMode { kTrack, kHold, kSearch };
+/// \brief "track", "hold", "search".
+const char* toString(HoldMode mode);
+
 /// \brief The hold / search part of one UAV's replanning (docs/safety.md §1 rules 2–4, §2.2),
 /// with its state — the latched braking point, the sweep's start. gfctl simulate's UAVs and the
 /// FormationPlanner nodelet each own one and call decide() once per replanning, so both run the
@@ -174,10 +182,10 @@ class HoldPlanner {
 
   /// The decision: track (nothing else set), hold (reference) or search (reference + camera target).
   struct Decision {
-    std::string mode = "track";                ///< "track", "hold" or "search"
+    HoldMode mode = HoldMode::kTrack;
     formation::ReferenceTrajectory reference;  ///< hold / search: at the latched braking point, camera on worker_world
     formation::HorizonPoints camera_target;    ///< search: the sweep (steps columns); otherwise 0 columns
-    bool holding() const { return mode != "track"; }
+    bool holding() const { return mode != HoldMode::kTrack; }
   };
 
   /// \brief Decides (see the struct comments). Entering hold latches brakingPoint(p, v) until the

@@ -158,8 +158,4 @@ common::Result<MissionConfig> parseMissionConfig(const std::string& yaml, const 
 /// cameras are inside, or without a gesture model. For gfctl simulate and SimWorld to warn with.
 std::vector<std::string> gestureReadabilityWarnings(const MissionConfig& m);
 
-/// \brief Parses a request target: all | leader | followers | follower<i> | a list of UAV
-/// indices [0, 2] (0 = leader).
-common::Result<formation::CommandTarget> parseTarget(const std::string& text);
-
 }  // namespace gesture_formation::sim

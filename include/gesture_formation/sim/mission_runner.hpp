@@ -37,6 +37,7 @@
 #include "gesture_formation/common/result.hpp"
 #include "gesture_formation/gesture/gesture_classifier.hpp"
 #include "gesture_formation/planning/shapes.hpp"
+#include "gesture_formation/planning/replan_step.hpp"
 #include "gesture_formation/planning/uav_planner.hpp"
 #include "gesture_formation/sim/leader_camera.hpp"
 #include "gesture_formation/sim/mission_config.hpp"
@@ -50,12 +51,9 @@ class DistanceField;
 namespace gesture_formation::sim {
 
 /// \brief One UAV's planner as the mission calls it (planning::UavPlanner in the product;
-/// tests may substitute their own).
-class MissionPlanner {
- public:
-  virtual ~MissionPlanner() = default;
-  virtual planning::PlanResult plan(const planning::PlanRequest& request) = 0;
-};
+/// tests may substitute their own): the replanning step's planner interface.
+using MissionPlanner = planning::Planner;
+
 /// \brief Creates the planner of UAV `uav_index`.
 using PlannerFactory = std::function<std::unique_ptr<MissionPlanner>(int uav_index)>;
 

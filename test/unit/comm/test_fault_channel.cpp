@@ -152,8 +152,9 @@ TEST(CommFaultChannelTest, DeterministicForASeed) {
 }
 
 TEST(CommFaultChannelTest, RegressionFiguresForSeedOne) {
-  // Pins the random stream (mt19937_64 is fixed by the standard): a change here changes
-  // every simulation that uses the channel.
+  // Pins the random stream (mt19937_64 is fixed by the standard): a change here changes every
+  // simulation that uses the channel. The delivered ids were recorded once from the channel
+  // (5 draws per packet, loss on the first) and are kept as literals, not recomputed here.
   FaultChannelConfig c;
   c.loss_probability = 0.5;
   c.seed = 1;
@@ -161,14 +162,7 @@ TEST(CommFaultChannelTest, RegressionFiguresForSeedOne) {
   std::vector<int> delivered;
   for (int i = 0; i < 16; ++i) ch.send(Packet{i, 0.0}, 0.0);
   for (const Packet& p : ch.poll(0.0)) delivered.push_back(p.id);
-  std::mt19937_64 ref(1);
-  std::vector<int> expected;
-  for (int i = 0; i < 16; ++i) {
-    const double u_loss = static_cast<double>(ref() >> 11) * 0x1.0p-53;
-    for (int k = 0; k < 4; ++k) ref();
-    if (!(u_loss < 0.5)) expected.push_back(i);
-  }
-  EXPECT_EQ(delivered, expected);
+  EXPECT_EQ(delivered, (std::vector<int>{1, 6, 7, 8, 9, 10, 13, 14, 15}));
 }
 
 TEST(CommFaultChannelTest, ValidateNamesFields) {

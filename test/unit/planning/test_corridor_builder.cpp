@@ -93,7 +93,7 @@ class CorridorRandomWorlds : public ::testing::TestWithParam<int> {};
 
 TEST_P(CorridorRandomWorlds, ContainsSegmentExcludesEveryPointOverlapsNeighbours) {
   const int first_seed = GetParam();
-  std::size_t segments = 0, failures = 0;
+  std::size_t segments = 0;  // the checks are checkCorridor's and the neighbours' EXPECTs
   for (int seed = first_seed; seed < first_seed + 10; ++seed) {
     std::mt19937 rng(static_cast<unsigned>(seed));
     const OccupancyMap map = randomWorld(rng);
@@ -119,7 +119,6 @@ TEST_P(CorridorRandomWorlds, ContainsSegmentExcludesEveryPointOverlapsNeighbours
     }
   }
   EXPECT_EQ(segments, 40u);
-  EXPECT_EQ(failures, 0u);
 }
 
 INSTANTIATE_TEST_SUITE_P(HundredWorlds, CorridorRandomWorlds, ::testing::Range(1, 101, 10));

@@ -1,6 +1,6 @@
 // The parts gfctl simulate and the ROS simulation share: the metrics accumulator and its
 // writer (sim/mission_metrics.hpp), the leader's camera and the step schedule
-// (sim/leader_camera.hpp), and the planning request (sim/plan_request_builder.hpp).
+// (sim/leader_camera.hpp). The planning request's tests: test/unit/planning/.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -345,109 +345,6 @@ TEST(StepScheduleTest, FiresAtTheRoundedMultiplesOfThePeriod) {
   EXPECT_EQ(due, expected);
   EXPECT_EQ(due.count(7), 1u);
   EXPECT_EQ(due.count(6), 0u);
-}
-
-// ---- planning request -------------------------------------------------------------------
-
-namespace {
-
-gf::planning::PlannedTrajectory planOf(int uav, double t0_s, double heading_rad) {
-  gf::planning::PlannedTrajectory p;
-  p.uav_index = uav;
-  p.t0_s = t0_s;
-  p.dt_s = 0.2;
-  for (int k = 0; k < 20; ++k) {
-    gf::planning::TrajectorySample s;
-    s.p_world = Eigen::Vector3d(uav * 10.0, k * 0.1, 5.0);
-    s.heading_rad = heading_rad;
-    s.pitch_rad = -0.1;
-    p.samples.push_back(s);
-  }
-  return p;
-}
-
-std::vector<int> senders(const gf::planning::PlanRequest& r) {
-  std::vector<int> v;
-  for (const auto& p : r.higher_priority_plans) v.push_back(p.uav_index);
-  return v;
-}
-
-struct RequestFixture {
-  gf::formation::FormationParams params;
-  gf::planning::PlannedTrajectory leader = planOf(0, 10.0, 0.7);
-  std::vector<std::optional<gf::planning::ReceivedPlan>> received;
-  RequestFixture() {
-    received.resize(3);
-    received[1] = gf::planning::ReceivedPlan{planOf(1, 9.9, 0.0), false};
-    received[2] = gf::planning::ReceivedPlan{planOf(2, 9.95, 0.0), false};
-  }
-  gf::planning::PlanRequestInputs inputs(int uav, bool avoid_all) const {
-    gf::planning::PlanRequestInputs in;
-    in.uav_index = uav;
-    in.t_s = 10.0;
-    in.dt_s = 0.2;
-    in.worker = gf::formation::constantVelocityHorizon(Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(0.5, 0, 0), 0.0, 10, 0.2);
-    in.params = &params;
-    in.leader_plan = uav == 0 ? nullptr : &leader;
-    in.received = &received;
-    in.rule = gf::planning::AvoidanceRule{avoid_all, 1.0};
-    return in;
-  }
-};
-
-}  // namespace
-
-TEST(PlanRequestBuilderTest, AvoidAllPlansVersusThePriorityRule) {
-  RequestFixture f;
-  ASSERT_EQ(f.params.uavCount(), 3);
-  EXPECT_EQ(senders(gf::planning::buildPlanRequest(f.inputs(1, true))), std::vector<int>({0, 2}));
-  EXPECT_EQ(senders(gf::planning::buildPlanRequest(f.inputs(1, false))), std::vector<int>({0}));
-  EXPECT_EQ(senders(gf::planning::buildPlanRequest(f.inputs(2, false))), std::vector<int>({0, 1}));
-  EXPECT_EQ(senders(gf::planning::buildPlanRequest(f.inputs(0, true))), std::vector<int>({1, 2}));
-  EXPECT_TRUE(senders(gf::planning::buildPlanRequest(f.inputs(0, false))).empty());
-  // Right of way under the priority rule: a fallback plan, or a silent UAV.
-  f.received[2]->fallback = true;
-  EXPECT_EQ(senders(gf::planning::buildPlanRequest(f.inputs(1, false))), std::vector<int>({0, 2}));
-  f.received[2]->fallback = false;
-  f.received[2]->plan.t0_s = 8.5;  // 1.5 s > max_plan_age_s
-  EXPECT_EQ(senders(gf::planning::buildPlanRequest(f.inputs(0, false))), std::vector<int>({2}));
-}
-
-TEST(PlanRequestBuilderTest, ReferencesAndHold) {
-  const RequestFixture f;
-  // Follower: eq. follower_ref on the leader's planned heading and pitch.
-  const auto in = f.inputs(1, true);
-  const auto req = gf::planning::buildPlanRequest(in);
-  gf::formation::LeaderPlan lp;
-  lp.heading_rad.resize(1, 10);
-  lp.pitch_rad.resize(1, 10);
-  lp.heading_rad.setConstant(0.7);
-  lp.pitch_rad.setConstant(-0.1);
-  gf::formation::ReferenceTrajectory expected;
-  gf::formation::followerHorizon(in.worker, f.params.leader, &lp, f.params.followers[0], expected);
-  ASSERT_EQ(req.reference.steps(), 10);
-  EXPECT_TRUE(req.reference.p_world.isApprox(expected.p_world, 1e-12));
-  EXPECT_TRUE(req.reference.heading_rad.isApprox(expected.heading_rad, 1e-12));
-  EXPECT_EQ(req.uav_index, 1);
-  EXPECT_DOUBLE_EQ(req.t_now_s, 10.0);
-  EXPECT_DOUBLE_EQ(req.state.t_s, 10.0);
-  // Without the leader's plan: the leader's desired heading (a different reference).
-  auto no_plan = f.inputs(1, true);
-  no_plan.leader_plan = nullptr;
-  const auto req2 = gf::planning::buildPlanRequest(no_plan);
-  EXPECT_FALSE(req2.reference.p_world.isApprox(expected.p_world, 1e-6));
-  EXPECT_EQ(senders(req2), std::vector<int>({2}));
-  // Hold: the given reference, and every received plan even under the priority rule.
-  gf::formation::ReferenceTrajectory hold;
-  hold.resize(10);
-  hold.p_world.setConstant(3.0);
-  hold.heading_rad.setZero();
-  hold.pitch_rad.setZero();
-  auto h = f.inputs(1, false);
-  h.hold_reference = &hold;
-  const auto req3 = gf::planning::buildPlanRequest(h);
-  EXPECT_TRUE(req3.reference.p_world.isApprox(hold.p_world));
-  EXPECT_EQ(senders(req3), std::vector<int>({0, 2}));
 }
 
 // ---- the leader's camera ----------------------------------------------------------------

@@ -1,0 +1,163 @@
+#pragma once
+/// \file
+/// \brief One UAV's replanning step — the single home of what `gfctl simulate`'s UAVs and the
+/// FormationPlanner nodelet do every replanning period (docs/planning.md §"The replanning step",
+/// docs/safety.md §1):
+///
+///   1. nothing known of the worker yet → skip (the controller flies its plan to its end, then hovers);
+///   2. freshness (planning::holdReason): data older than its age limit → hold;
+///   3. listen before moving: from its first replanning (start-up, or a restart after a reboot)
+///      a UAV holds until it has, from every other follower, a plan made since then — or for at
+///      most AvoidanceRule::max_plan_age_s (a UAV not heard from by then has right of way);
+///   4. the worker's prediction over the horizon: the estimate extrapolated at constant velocity
+///      from its stamp to now (frozen while holding or when the estimator lost him), the
+///      worker's heading from this UAV's own formation::WorkerHeading filter;
+///   5. hold / search (planning::HoldPlanner), or track;
+///   6. the request (planning::buildPlanRequest: reference + the plans to avoid), with the
+///      acceleration the UAV's current plan commands now as the start's acceleration (odometry
+///      carries none), and the planner's verified plan or fallback.
+///
+/// Thread safety: not thread-safe; one instance per UAV, called from its planning thread.
+
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "gesture_formation/formation/formation_geometry.hpp"
+#include "gesture_formation/formation/formation_params.hpp"
+#include "gesture_formation/formation/worker_heading.hpp"
+#include "gesture_formation/planning/plan_request_builder.hpp"
+#include "gesture_formation/planning/planned_trajectory.hpp"
+#include "gesture_formation/planning/uav_planner.hpp"
+
+namespace gesture_formation::planning {
+
+/// \brief A UAV's planner as the replanning step calls it: UavPlanner in the product; tests and
+/// fault injection may substitute their own.
+class Planner {
+ public:
+  virtual ~Planner() = default;
+  virtual PlanResult plan(const PlanRequest& request) = 0;
+};
+
+/// \brief planning::UavPlanner behind the Planner interface (owns it).
+class UavPlannerAdapter final : public Planner {
+ public:
+  explicit UavPlannerAdapter(std::unique_ptr<UavPlanner> planner) : planner_(std::move(planner)) {}
+  PlanResult plan(const PlanRequest& request) override { return planner_->plan(request); }
+  UavPlanner& planner() { return *planner_; }
+
+ private:
+  std::unique_ptr<UavPlanner> planner_;
+};
+
+/// \brief What a UAV knows of the worker at one replanning: the leader from its estimator (the
+/// WorkerEstimator's published state), a follower from the leader's share (received over LCM).
+struct WorkerKnowledge {
+  /// When position and velocity were valid: the estimate's time (leader) or when the leader sent
+  /// the share (follower; its age decides hold with FreshnessLimits::max_share_age_s).
+  double stamp_s = std::numeric_limits<double>::quiet_NaN();
+  /// The estimate's last fused measurement (non-finite: never); its age decides hold.
+  double fused_s = std::numeric_limits<double>::quiet_NaN();
+  Eigen::Vector3d p_world = Eigen::Vector3d::Zero();   ///< worker position at stamp_s [m]
+  Eigen::Vector3d v_world = Eigen::Vector3d::Zero();   ///< worker velocity [m/s]
+  bool lost = false;  ///< the estimator no longer extrapolates (HumanKalman::lost, WorkerState.lost)
+  /// \brief The position at t_s: p + (t_s − stamp_s)·v (constant velocity; p when stamp_s is not
+  /// finite). The one extrapolation of a worker estimate in the product.
+  Eigen::Vector3d positionAt(double t_s) const {
+    return std::isfinite(stamp_s) ? Eigen::Vector3d(p_world + (t_s - stamp_s) * v_world) : p_world;
+  }
+  EIGEN_MAKE_ALIGNED_OPERATOR_NEW
+};
+
+/// \brief A replanning's mode.
+enum class ReplanMode {
+  kSkipped,  ///< nothing known of the worker: no plan made
+  kTrack,    ///< fresh data: the formation reference
+  kHold,     ///< stale data or listening: the latched braking point, camera on the estimate
+  kSearch,   ///< the leader lost the worker: hold point, camera sweeps (HoldPlanner)
+};
+const char* toString(ReplanMode mode);
+
+/// \brief The settings of one UAV's replanning (FormationPlanner parameters; mission file).
+struct ReplanConfig {
+  int uav_index = 0;                ///< 0 = leader, i = follower i (priority order)
+  double dt_s = 0.2;                ///< horizon step [s], > 0
+  int steps = 10;                   ///< horizon steps, ≥ 2
+  FreshnessLimits freshness;        ///< hold on data older than these
+  AvoidanceRule rule;               ///< which received plans are avoided; listening's time limit
+  SearchConfig search;              ///< the leader's camera search
+  double brake_accel_mps2 = 4.0;    ///< where a holding UAV stops (brakingPoint)
+  formation::WorkerHeadingConfig worker_heading;  ///< the worker-heading filter (^Hφ)
+};
+
+/// \brief The inputs of one replanning.
+struct ReplanInputs {
+  double t_s = 0.0;  ///< now
+  /// The UAV's estimated state (odometry: position, velocity, camera heading and pitch; its
+  /// a_world is ignored — the step takes the acceleration its current plan commands).
+  UavKinematicState state;
+  /// The flight stack's wind estimate (world, m/s; non-finite: none).
+  Eigen::Vector3d wind_estimate_mps = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  const WorkerKnowledge* worker = nullptr;                    ///< null: nothing known yet → skipped
+  const formation::FormationParams* params = nullptr;         ///< required
+  const PlannedTrajectory* leader_plan = nullptr;             ///< followers: the leader's last plan (null: none)
+  const std::vector<std::optional<ReceivedPlan>>* received = nullptr;  ///< plans by sender (may be null)
+  EIGEN_MAKE_ALIGNED_OPERATOR_NEW
+};
+
+/// \brief The outcome of one replanning.
+struct ReplanOutcome {
+  ReplanMode mode = ReplanMode::kSkipped;
+  std::string reason;      ///< skipped / hold / search: why (empty while tracking)
+  /// An event worth a log line (the core never logs), e.g. listening ended at its time limit
+  /// without a plan from some UAVs; empty otherwise.
+  std::string note;
+  PlanResult result;       ///< the planner's result (empty trajectory when skipped)
+  bool fallback = false;   ///< others must avoid this plan: the planner fell back, or the UAV holds
+  formation::WorkerHorizon worker;          ///< the worker prediction planned around
+  formation::ReferenceTrajectory reference; ///< the stage-1 reference (or hold reference)
+  bool planned() const { return mode != ReplanMode::kSkipped; }
+  bool holding() const { return mode == ReplanMode::kHold || mode == ReplanMode::kSearch; }
+  EIGEN_MAKE_ALIGNED_OPERATOR_NEW
+};
+
+/// \brief One UAV's replanning (see the file comment). Owns the UAV's planner, its hold/search
+/// state, its worker-heading filter, its listening state and the plan it flies.
+class ReplanStep {
+ public:
+  /// \param planner required (non-null).
+  ReplanStep(const ReplanConfig& config, std::unique_ptr<Planner> planner);
+
+  /// \brief One replanning at in.t_s (preconditions: in.params non-null with an entry for the UAV).
+  ReplanOutcome step(const ReplanInputs& in);
+
+  /// \brief A restart (a rebooted computer): a new planner, no memory — hold, heading, the plan
+  /// flown — and it listens again before it moves.
+  void restart(std::unique_ptr<Planner> planner);
+
+  /// \brief The plan the UAV flies now (the last result; empty before the first or when the
+  /// planner returned none — the controller then brakes to hover).
+  const PlannedTrajectory& flownPlan() const { return flown_; }
+  /// \brief The worker heading this UAV last used [rad].
+  double workerHeading() const { return heading_.heading(); }
+  const ReplanConfig& config() const { return config_; }
+
+ private:
+  std::string listeningHold(double t_s, const std::vector<std::optional<ReceivedPlan>>* received);
+
+  ReplanConfig config_;
+  std::unique_ptr<Planner> planner_;
+  HoldPlanner hold_;
+  formation::WorkerHeading heading_;
+  PlannedTrajectory flown_;
+  double listen_since_s_ = std::numeric_limits<double>::quiet_NaN();  ///< the first replanning since the (re)start
+  bool listening_ = true;
+};
+
+}  // namespace gesture_formation::planning

@@ -1,0 +1,120 @@
+#include "gesture_formation/planning/replan_step.hpp"
+
+#include <cmath>
+#include <utility>
+
+namespace gesture_formation::planning {
+
+const char* toString(ReplanMode mode) {
+  switch (mode) {
+    case ReplanMode::kSkipped: return "skipped";
+    case ReplanMode::kTrack: return "track";
+    case ReplanMode::kHold: return "hold";
+    case ReplanMode::kSearch: return "search";
+  }
+  return "unknown";
+}
+
+ReplanStep::ReplanStep(const ReplanConfig& config, std::unique_ptr<Planner> planner)
+    : config_(config),
+      planner_(std::move(planner)),
+      hold_(config.freshness, config.search, config.brake_accel_mps2),
+      heading_(config.worker_heading) {}
+
+void ReplanStep::restart(std::unique_ptr<Planner> planner) {
+  planner_ = std::move(planner);
+  hold_ = HoldPlanner(config_.freshness, config_.search, config_.brake_accel_mps2);
+  heading_ = formation::WorkerHeading(config_.worker_heading);
+  flown_ = PlannedTrajectory{};
+  listen_since_s_ = std::numeric_limits<double>::quiet_NaN();
+  listening_ = true;
+}
+
+std::string ReplanStep::listeningHold(double t_s, const std::vector<std::optional<ReceivedPlan>>* received) {
+  if (!listening_) return "";
+  if (!std::isfinite(listen_since_s_)) listen_since_s_ = t_s;
+  static const std::vector<std::optional<ReceivedPlan>> kNone;
+  const auto& plans = received != nullptr ? *received : kNone;
+  const std::vector<int> unheard = unheardFollowers(config_.uav_index, listen_since_s_, plans, nullptr);
+  // A follower that is not in the received table at all (fewer entries) is waited for too.
+  if (unheard.empty() || t_s - listen_since_s_ > config_.rule.max_plan_age_s) {
+    listening_ = false;
+    return "";
+  }
+  return listeningReason(config_.uav_index, listen_since_s_, plans, nullptr);
+}
+
+ReplanOutcome ReplanStep::step(const ReplanInputs& in) {
+  ReplanOutcome out;
+  const int i = config_.uav_index;
+  const double t = in.t_s;
+  if (in.worker == nullptr) {
+    out.reason = i == 0 ? "no confirmed worker estimate yet" : "no leader share received yet";
+    return out;
+  }
+  const WorkerKnowledge& w = *in.worker;
+  // Freshness first, then listening (a UAV listens from its first replanning with data).
+  std::string hold = holdReason(i, t, w.stamp_s, w.fused_s, config_.freshness);
+  if (hold.empty()) {
+    const double since = listen_since_s_;
+    const bool was_listening = listening_;
+    hold = listeningHold(t, in.received);
+    if (was_listening && !listening_ && in.received != nullptr) {
+      const std::vector<int> unheard =
+          unheardFollowers(i, std::isfinite(since) ? since : t, *in.received, nullptr);
+      if (!unheard.empty()) {
+        out.note = "no plan since the start from UAV(s)";
+        for (int j : unheard) out.note += " " + std::to_string(j);
+        out.note += " after max_plan_age_s; tracking without them";
+      }
+    }
+  }
+  // The worker over the horizon: extrapolated from its stamp while fresh, frozen otherwise.
+  const bool still = !hold.empty() || w.lost;
+  const Eigen::Vector3d v0 = still ? Eigen::Vector3d::Zero() : w.v_world;
+  const Eigen::Vector3d p0 = still ? w.p_world : w.positionAt(std::max(t, w.stamp_s));
+  const double heading = still ? heading_.heading() : heading_.update(v0);
+  out.worker = formation::constantVelocityHorizon(p0, v0, heading, config_.steps, config_.dt_s);
+
+  HoldPlanner::Situation situation;
+  situation.uav_index = i;
+  situation.t_s = t;
+  situation.dt_s = config_.dt_s;
+  situation.steps = config_.steps;
+  situation.hold_reason = hold;
+  situation.worker_stamp_s = w.fused_s;
+  situation.worker_lost = w.lost;
+  situation.p_world = in.state.p_world;
+  situation.v_world = in.state.v_world;
+  situation.heading_rad = in.state.heading_rad;
+  situation.worker_world = p0;
+  const HoldPlanner::Decision decision = hold_.decide(situation);
+  out.mode = decision.mode == HoldMode::kSearch ? ReplanMode::kSearch
+             : decision.holding()               ? ReplanMode::kHold
+                                                : ReplanMode::kTrack;
+  out.reason = hold;
+
+  PlanRequestInputs req_in;
+  req_in.uav_index = i;
+  req_in.t_s = t;
+  req_in.dt_s = config_.dt_s;
+  req_in.state = in.state;
+  req_in.state.a_world = flown_.empty() ? Eigen::Vector3d::Zero() : Eigen::Vector3d(flown_.sampleAt(t).a_world);
+  req_in.wind_estimate_mps = in.wind_estimate_mps;
+  req_in.worker = out.worker;
+  req_in.params = in.params;
+  req_in.leader_plan = in.leader_plan;
+  req_in.leader_plan_max_age_s = config_.freshness.max_share_age_s;
+  req_in.received = in.received;
+  req_in.hold_reference = decision.holding() ? &decision.reference : nullptr;
+  if (decision.camera_target.cols() > 0) req_in.camera_target = &decision.camera_target;
+  req_in.rule = config_.rule;
+  const PlanRequest request = buildPlanRequest(req_in);
+  out.reference = request.reference;
+  out.result = planner_->plan(request);
+  out.fallback = out.result.status != PlanStatus::kOptimized || !hold.empty();
+  flown_ = out.result.trajectory;  // empty: the controller brakes to hover on its own
+  return out;
+}
+
+}  // namespace gesture_formation::planning

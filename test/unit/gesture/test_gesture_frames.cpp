@@ -1,0 +1,112 @@
+// gesture::GestureFrames — the frame aggregation of the GestureCommander nodelet and gfctl
+// simulate: frames close when every view reported or close_after_s after their stamp, a late
+// observation votes only in later frames, the single-camera mode, and a fired gesture's action.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "gesture_formation/gesture/gesture_frames.hpp"
+
+namespace gg = gesture_formation::gesture;
+
+namespace {
+
+gg::ViewFusionConfig fusion(int min_agreeing) {
+  gg::ViewFusionConfig c;
+  c.min_agreeing_views = min_agreeing;
+  c.fusion_lag_s = 0.4;
+  c.vote_window_s = 0.0;  // each view votes its newest classification
+  return c;
+}
+
+gg::GestureFilterConfig filter() {
+  gg::GestureFilterConfig c;
+  c.window_size = 5;
+  c.min_measurements = 5;
+  c.ratio_threshold = 0.8;
+  c.cooldown_s = 5.0;
+  return c;
+}
+
+gg::ViewObservation obs(int view, double t, int id) {
+  gg::ViewObservation o;
+  o.view = view;
+  o.t_s = t;
+  o.gesture_id = id;
+  o.distance_m = 8.0;
+  o.elevation_deg = 20.0;
+  return o;
+}
+
+}  // namespace
+
+TEST(GestureFramesTest, FrameClosesOnceEveryViewReported) {
+  gg::GestureFrames frames(filter(), fusion(2), gg::GestureMapping::paperDefault(), 3, 0.1);
+  EXPECT_EQ(frames.views(), 3);
+  EXPECT_DOUBLE_EQ(frames.closeAfterS(), 0.4);
+  EXPECT_TRUE(frames.observe(obs(0, 1.0, 2)).empty());
+  EXPECT_TRUE(frames.observe(obs(1, 1.0, 2)).empty());
+  const auto closed = frames.observe(obs(2, 1.0, 2));
+  ASSERT_EQ(closed.size(), 1u);
+  EXPECT_DOUBLE_EQ(closed[0].t_s, 1.0);
+  EXPECT_EQ(closed[0].reported, 3);
+  EXPECT_EQ(closed[0].fused.gesture_id, 2);
+  EXPECT_EQ(closed[0].fused.agreeing_views, 3);
+}
+
+TEST(GestureFramesTest, FrameWithAMissingViewClosesAfterTheLagAndALateVoteCountsLater) {
+  gg::GestureFrames frames(filter(), fusion(2), gg::GestureMapping::paperDefault(), 3, 0.1);
+  EXPECT_TRUE(frames.observe(obs(0, 2.0, 3)).empty());
+  EXPECT_TRUE(frames.observe(obs(1, 2.0, 3)).empty());
+  EXPECT_TRUE(frames.closeDue(2.39).empty());  // follower 2 may still report
+  auto closed = frames.closeDue(2.4);
+  ASSERT_EQ(closed.size(), 1u);
+  EXPECT_EQ(closed[0].reported, 2);
+  EXPECT_EQ(closed[0].fused.gesture_id, 3);  // 2 of 2 voting views agree
+  // Follower 2's vote of that frame arrives late: no frame is reopened …
+  bool accepted = false;
+  EXPECT_TRUE(frames.observe(obs(2, 2.0, 1), &accepted).empty());
+  EXPECT_TRUE(accepted);
+  EXPECT_TRUE(frames.closeDue(3.0).empty());
+}
+
+TEST(GestureFramesTest, FrameWithNoAcceptedObservationIsNotFiltered) {
+  gg::GestureFrames frames(filter(), fusion(2), gg::GestureMapping::paperDefault(), 3, 0.1);
+  gg::ViewObservation bad = obs(0, 1.0, 9);  // id beyond max_gesture_id: refused by the vote
+  bool accepted = true;
+  std::string reason;
+  frames.observe(bad, &accepted, &reason);
+  EXPECT_FALSE(accepted);
+  EXPECT_FALSE(reason.empty());
+  EXPECT_TRUE(frames.closeDue(5.0).empty());
+}
+
+TEST(GestureFramesTest, SingleCameraTakesTheLeadersClassificationAndIgnoresFollowers) {
+  gg::GestureFrames frames(filter(), fusion(1), gg::GestureMapping::paperDefault(), 3, 0.1);
+  EXPECT_EQ(frames.views(), 1);
+  bool accepted = true;
+  EXPECT_TRUE(frames.observe(obs(1, 1.0, 4), &accepted).empty());
+  EXPECT_FALSE(accepted);
+  const auto closed = frames.observe(obs(0, 1.0, 4));
+  ASSERT_EQ(closed.size(), 1u);  // its only view reported
+  EXPECT_EQ(closed[0].fused.gesture_id, 4);
+}
+
+TEST(GestureFramesTest, AHeldGestureFiresOnceWithItsActionThenCoolsDown) {
+  gg::GestureFrames frames(filter(), fusion(1), gg::GestureMapping::paperDefault(), 3, 0.0);
+  int fired = 0;
+  const gg::GestureAction* action = nullptr;
+  for (int k = 0; k < 30; ++k) {  // 3 s of gesture 1 at 10 Hz, less than the 5 s cool-down
+    for (const auto& f : frames.observe(obs(0, 0.1 * k, 1))) {
+      if (f.filter.fired) {
+        ++fired;
+        action = f.action;
+        EXPECT_EQ(f.filter.dominant_id, 1);
+      }
+    }
+  }
+  EXPECT_EQ(fired, 1);
+  ASSERT_NE(action, nullptr);
+  EXPECT_EQ(action, frames.mapping().find(1));
+}

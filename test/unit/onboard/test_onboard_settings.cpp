@@ -1,0 +1,74 @@
+// onboard::loadOnboardSettings — the product settings of a scenario's mission, the one parse the
+// onboard nodelets (mission_file) and gfctl simulate share: the shipped scenarios load, a fault
+// profile's limits are merged, every problem is listed at once with its key.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <string>
+
+#include "gesture_formation/onboard/onboard_settings.hpp"
+
+namespace go = gesture_formation::onboard;
+
+namespace {
+
+std::string writeTemp(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+}  // namespace
+
+TEST(OnboardSettingsTest, PowerTowerMissionLoadsWithItsOwnValues) {
+  const auto s = go::loadOnboardSettings(std::string(GF_SOURCE_DIR) + "/config/scenarios/power_towers.yaml");
+  ASSERT_TRUE(s) << s.reason();
+  EXPECT_EQ(s->formation.params.uavCount(), 3);
+  EXPECT_GT(s->horizon_steps, 1);
+  EXPECT_GT(s->replanning_period_s, 0.0);
+  EXPECT_GT(s->view_fusion.min_agreeing_views, 1);  // the formation's cameras vote
+}
+
+TEST(OnboardSettingsTest, FaultProfileReplacesTheMissionsFaultLimits) {
+  const std::string scenario = writeTemp("onboard_scenario.yaml",
+                                         "mission:\n  horizon_steps: 30\n  faults:\n    max_share_age_s: 2.0\n");
+  const std::string faults = writeTemp("onboard_faults.yaml", "faults:\n  max_share_age_s: 0.7\n  max_plan_age_s: 3.0\n");
+  const auto plain = go::loadOnboardSettings(scenario);
+  ASSERT_TRUE(plain) << plain.reason();
+  EXPECT_DOUBLE_EQ(plain->freshness.max_share_age_s, 2.0);
+  EXPECT_EQ(plain->horizon_steps, 30);
+  const auto merged = go::loadOnboardSettings(scenario, faults);
+  ASSERT_TRUE(merged) << merged.reason();
+  EXPECT_DOUBLE_EQ(merged->freshness.max_share_age_s, 0.7);
+  EXPECT_DOUBLE_EQ(merged->rule.max_plan_age_s, 3.0);
+  EXPECT_EQ(merged->horizon_steps, 30);
+}
+
+TEST(OnboardSettingsTest, EveryProblemIsListedWithItsKey) {
+  const std::string scenario = writeTemp("onboard_bad.yaml",
+                                         "mission:\n"
+                                         "  horizon_steps: 1\n"
+                                         "  controller:\n    brake_accel_mps2: -2\n"
+                                         "  faults:\n    max_worker_age_s: 0\n    search_period_s: nan\n"
+                                         "  planner:\n    no_such_key: 3\n");
+  const auto s = go::loadOnboardSettings(scenario);
+  ASSERT_FALSE(s);
+  for (const char* key : {"mission.horizon_steps", "mission.controller.brake_accel_mps2", "mission.faults.max_worker_age_s",
+                          "mission.faults.search_period_s", "mission.planner.no_such_key"}) {
+    EXPECT_NE(s.reason().find(key), std::string::npos) << key << " not named in:\n" << s.reason();
+  }
+}
+
+TEST(OnboardSettingsTest, MissingFilesAndSectionsAreNamed) {
+  const auto none = go::loadOnboardSettings("/nonexistent/scenario.yaml");
+  ASSERT_FALSE(none);
+  EXPECT_NE(none.reason().find("/nonexistent/scenario.yaml"), std::string::npos);
+  const std::string no_mission = writeTemp("onboard_nomission.yaml", "scenario: {}\n");
+  const auto s = go::loadOnboardSettings(no_mission);
+  ASSERT_FALSE(s);
+  EXPECT_NE(s.reason().find("mission"), std::string::npos);
+  const std::string faults = writeTemp("onboard_badfaults.yaml", "faults: {}\nextra: 1\n");
+  const auto f = go::loadOnboardSettings(std::string(GF_SOURCE_DIR) + "/config/scenarios/power_towers.yaml", faults);
+  ASSERT_FALSE(f);
+  EXPECT_NE(f.reason().find("extra: unknown key"), std::string::npos) << f.reason();
+}

@@ -1,0 +1,256 @@
+// planning::ReplanStep — the one replanning step of gfctl simulate's UAVs and the
+// FormationPlanner nodelet: skip, freshness, listen before moving (with its time limit), the
+// worker's extrapolation, hold / search, the start's acceleration from the flown plan, restart.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "gesture_formation/planning/replan_step.hpp"
+
+namespace gf = gesture_formation;
+namespace pl = gf::planning;
+
+namespace {
+
+/// Test-only planner: records every request; returns a plan along the reference whose samples
+/// all command `accel` (so that the next request's start acceleration can be checked).
+class RecordingPlanner : public pl::Planner {
+ public:
+  RecordingPlanner(std::shared_ptr<std::vector<pl::PlanRequest>> log, Eigen::Vector3d accel,
+                   pl::PlanStatus status = pl::PlanStatus::kOptimized)
+      : log_(std::move(log)), accel_(std::move(accel)), status_(status) {}
+  pl::PlanResult plan(const pl::PlanRequest& r) override {
+    log_->push_back(r);
+    pl::PlanResult res;
+    res.status = status_;
+    res.trajectory.uav_index = r.uav_index;
+    res.trajectory.t0_s = r.t_now_s;
+    res.trajectory.dt_s = r.dt_s;
+    for (int k = 0; k < r.reference.steps(); ++k) {
+      pl::TrajectorySample s;
+      s.p_world = r.reference.p_world.col(k);
+      s.a_world = accel_;
+      res.trajectory.samples.push_back(s);
+    }
+    return res;
+  }
+
+ private:
+  std::shared_ptr<std::vector<pl::PlanRequest>> log_;
+  Eigen::Vector3d accel_;
+  pl::PlanStatus status_;
+};
+
+pl::ReplanConfig config(int uav) {
+  pl::ReplanConfig c;
+  c.uav_index = uav;
+  c.dt_s = 0.2;
+  c.steps = 10;
+  c.freshness = pl::FreshnessLimits{2.0, 3.0};
+  c.rule = pl::AvoidanceRule{true, 1.0};
+  return c;
+}
+
+pl::WorkerKnowledge fresh(double t, const Eigen::Vector3d& p, const Eigen::Vector3d& v) {
+  pl::WorkerKnowledge w;
+  w.stamp_s = t;
+  w.fused_s = t;
+  w.p_world = p;
+  w.v_world = v;
+  return w;
+}
+
+/// A received plan from `uav` made at t0.
+std::optional<pl::ReceivedPlan> planFrom(int uav, double t0) {
+  pl::ReceivedPlan r;
+  r.plan.uav_index = uav;
+  r.plan.t0_s = t0;
+  r.plan.dt_s = 0.2;
+  r.plan.samples.resize(10);
+  for (auto& s : r.plan.samples) s.p_world = Eigen::Vector3d(40.0 + uav, 0.0, 10.0);
+  return r;
+}
+
+struct Fixture {
+  explicit Fixture(int uav, Eigen::Vector3d accel = Eigen::Vector3d::Zero(),
+                   pl::PlanStatus status = pl::PlanStatus::kOptimized)
+      : log(std::make_shared<std::vector<pl::PlanRequest>>()),
+        step(config(uav), std::make_unique<RecordingPlanner>(log, accel, status)) {
+    received.resize(3);
+    in.params = &params;
+    in.received = &received;
+    in.state.p_world = Eigen::Vector3d(0.0, -8.0, 6.0);
+  }
+  pl::ReplanOutcome at(double t, const pl::WorkerKnowledge* w) {
+    in.t_s = t;
+    in.worker = w;
+    return step.step(in);
+  }
+  std::shared_ptr<std::vector<pl::PlanRequest>> log;
+  pl::ReplanStep step;
+  gf::formation::FormationParams params;  // paper Table II: leader + 2 followers
+  std::vector<std::optional<pl::ReceivedPlan>> received;
+  pl::ReplanInputs in;
+};
+
+}  // namespace
+
+TEST(ReplanStepTest, SkipsWithoutWorkerKnowledgeAndCallsNoPlanner) {
+  Fixture f(0);
+  const auto out = f.at(1.0, nullptr);
+  EXPECT_FALSE(out.planned());
+  EXPECT_EQ(out.mode, pl::ReplanMode::kSkipped);
+  EXPECT_FALSE(out.reason.empty());
+  EXPECT_TRUE(f.log->empty());
+}
+
+TEST(ReplanStepTest, ListensAtStartUntilEveryOtherFollowerPlannedSinceThen) {
+  Fixture f(1);
+  const Eigen::Vector3d p(0.0, 0.0, 0.0);
+  f.received[2] = planFrom(2, 0.5);  // made before this UAV's first replanning: does not count
+  auto w = fresh(1.0, p, Eigen::Vector3d::Zero());
+  auto out = f.at(1.0, &w);
+  EXPECT_EQ(out.mode, pl::ReplanMode::kHold);
+  EXPECT_NE(out.reason.find("listening"), std::string::npos) << out.reason;
+  EXPECT_TRUE(out.fallback);
+  w = fresh(1.2, p, Eigen::Vector3d::Zero());
+  f.received[2] = planFrom(2, 1.1);  // made since: heard
+  out = f.at(1.2, &w);
+  EXPECT_EQ(out.mode, pl::ReplanMode::kTrack) << out.reason;
+  EXPECT_TRUE(out.note.empty());
+  EXPECT_FALSE(out.fallback);
+  // Once done, the rule stays done (a later silence is the avoidance rule's business).
+  f.received[2].reset();
+  w = fresh(1.4, p, Eigen::Vector3d::Zero());
+  EXPECT_EQ(f.at(1.4, &w).mode, pl::ReplanMode::kTrack);
+}
+
+TEST(ReplanStepTest, ListeningEndsAfterMaxPlanAgeNamingTheUnheard) {
+  Fixture f(0);  // the leader listens for followers 1 and 2
+  f.received[1] = planFrom(1, 10.1);
+  const Eigen::Vector3d p(0.0, 0.0, 0.0);
+  int holds = 0;
+  pl::ReplanOutcome out;
+  for (double t = 10.0; t < 11.5; t += 0.2) {
+    const auto w = fresh(t, p, Eigen::Vector3d::Zero());
+    out = f.at(t, &w);
+    if (out.mode == pl::ReplanMode::kHold) {
+      ++holds;
+    } else {
+      break;
+    }
+  }
+  EXPECT_EQ(out.mode, pl::ReplanMode::kTrack);
+  EXPECT_EQ(holds, 6);  // t = 10.0 … 11.0 (age ≤ max_plan_age_s 1.0 s); tracks at 11.2
+  EXPECT_NE(out.note.find("UAV(s) 2"), std::string::npos) << out.note;
+}
+
+TEST(ReplanStepTest, FreshWorkerIsExtrapolatedFromItsStampStaleIsFrozen) {
+  Fixture f(0);
+  f.received[1] = planFrom(1, 5.0);  // made at this UAV's first replanning: heard
+  f.received[2] = planFrom(2, 5.0);
+  const Eigen::Vector3d p(1.0, 2.0, 0.0), v(0.5, 0.0, 0.0);
+  auto w = fresh(4.6, p, v);
+  auto out = f.at(5.0, &w);
+  ASSERT_EQ(out.mode, pl::ReplanMode::kTrack) << out.reason;
+  EXPECT_NEAR((out.worker.p_world.col(0) - (p + 0.4 * v)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((out.worker.p_world.col(3) - (p + (0.4 + 3 * 0.2) * v)).norm(), 0.0, 1e-12);
+  // The last fused measurement older than max_worker_age_s: hold, the worker frozen where the
+  // estimate puts him, every reference step at one point.
+  w = fresh(7.5, p, v);
+  w.fused_s = 3.0;
+  out = f.at(7.5, &w);
+  EXPECT_EQ(out.mode, pl::ReplanMode::kHold);
+  EXPECT_NE(out.reason.find("max_worker_age_s"), std::string::npos);
+  EXPECT_NEAR((out.worker.p_world.col(5) - p).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((out.reference.p_world.col(0) - out.reference.p_world.col(9)).norm(), 0.0, 1e-12);
+}
+
+TEST(ReplanStepTest, LeaderThatLostTheWorkerSearchesAFollowerHolds) {
+  for (int uav : {0, 1}) {
+    Fixture f(uav);
+    f.received[1] = planFrom(1, 20.0);
+    f.received[2] = planFrom(2, 20.0);
+    f.in.leader_plan = &f.received[1]->plan;
+    auto w = fresh(20.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+    w.fused_s = 10.0;  // 10 s without a measurement
+    w.lost = true;
+    const auto out = f.at(20.0, &w);
+    EXPECT_EQ(out.mode, uav == 0 ? pl::ReplanMode::kSearch : pl::ReplanMode::kHold) << "uav " << uav;
+    EXPECT_TRUE(out.holding());
+    EXPECT_TRUE(out.fallback);
+  }
+}
+
+TEST(ReplanStepTest, StartAccelerationIsWhatTheFlownPlanCommandsNotTheInput) {
+  const Eigen::Vector3d accel(0.7, -0.2, 0.1);
+  Fixture f(0, accel);
+  f.received[1] = planFrom(1, 1.0);
+  f.received[2] = planFrom(2, 1.0);
+  f.in.state.a_world = Eigen::Vector3d(9.0, 9.0, 9.0);  // ignored: odometry carries no acceleration
+  auto w = fresh(1.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+  f.at(1.0, &w);
+  ASSERT_EQ(f.log->size(), 1u);
+  EXPECT_NEAR(f.log->back().state.a_world.norm(), 0.0, 1e-12);  // no plan flown yet
+  w = fresh(1.2, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+  f.at(1.2, &w);
+  ASSERT_EQ(f.log->size(), 2u);
+  EXPECT_NEAR((f.log->back().state.a_world - accel).norm(), 0.0, 1e-12);
+  EXPECT_EQ(f.step.flownPlan().t0_s, 1.2);
+}
+
+TEST(ReplanStepTest, PlannerFallbackIsFlaggedForTheOthers) {
+  Fixture f(2, Eigen::Vector3d::Zero(), pl::PlanStatus::kFallbackPrevious);
+  f.received[1] = planFrom(1, 1.0);
+  auto w = fresh(1.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+  const auto out = f.at(1.0, &w);
+  EXPECT_EQ(out.mode, pl::ReplanMode::kTrack);
+  EXPECT_TRUE(out.fallback);
+}
+
+TEST(ReplanStepTest, RestartForgetsAndListensAgain) {
+  Fixture f(1, Eigen::Vector3d(0.3, 0.0, 0.0));
+  f.received[2] = planFrom(2, 1.0);
+  auto w = fresh(1.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+  ASSERT_EQ(f.at(1.0, &w).mode, pl::ReplanMode::kTrack);
+  ASSERT_FALSE(f.step.flownPlan().empty());
+  f.step.restart(std::make_unique<RecordingPlanner>(f.log, Eigen::Vector3d::Zero()));
+  EXPECT_TRUE(f.step.flownPlan().empty());
+  w = fresh(5.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+  const auto out = f.at(5.0, &w);  // follower 2's plan is from before the restart
+  EXPECT_EQ(out.mode, pl::ReplanMode::kHold);
+  EXPECT_NE(out.reason.find("listening"), std::string::npos);
+  EXPECT_NEAR(f.log->back().state.a_world.norm(), 0.0, 1e-12);
+}
+
+TEST(ReplanStepTest, StaleLeaderPlanIsAvoidedButDoesNotShapeTheReference) {
+  Fixture f(1);
+  f.received[2] = planFrom(2, 10.0);
+  auto leader = planFrom(0, 5.0);  // 5 s old (> max_share_age_s 2 s)
+  for (auto& s : leader->plan.samples) s.heading_rad = 2.5;
+  f.in.leader_plan = &leader->plan;
+  auto w = fresh(10.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+  const auto out = f.at(10.0, &w);
+  ASSERT_EQ(out.mode, pl::ReplanMode::kTrack) << out.reason;
+  ASSERT_FALSE(f.log->empty());
+  bool avoided = false;
+  for (const auto& p : f.log->back().higher_priority_plans) avoided = avoided || p.uav_index == 0;
+  EXPECT_TRUE(avoided);
+  // Without a fresh leader plan the follower's reference uses the leader's desired heading, the
+  // same as with no leader plan at all.
+  Fixture g(1);
+  g.received[2] = planFrom(2, 10.0);
+  const auto ref = g.at(10.0, &w);
+  EXPECT_NEAR((out.reference.p_world - ref.reference.p_world).norm(), 0.0, 1e-9);
+  // … whereas the same plan, fresh, turns the follower's reference with the leader's heading.
+  Fixture h(1);
+  h.received[2] = planFrom(2, 10.0);
+  auto fresh_leader = planFrom(0, 10.0);
+  for (auto& s : fresh_leader->plan.samples) s.heading_rad = 2.5;
+  h.in.leader_plan = &fresh_leader->plan;
+  const auto turned = h.at(10.0, &w);
+  EXPECT_GT((turned.reference.p_world - ref.reference.p_world).norm(), 1.0);
+}
