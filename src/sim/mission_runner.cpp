@@ -49,7 +49,7 @@ PlannerFactory uavPlannerFactory(const planning::PlannerConfig& config,
 // --------------------------------------------------------------------------------------
 namespace {
 
-/// What the leader shares every replanning (DESIGN §1: human state, leader plan, formation params).
+/// What the leader shares every replanning (design.md §1: human state, leader plan, parameters).
 struct LeaderShare {
   double stamp_s = 0.0;
   double worker_stamp_s = 0.0;  ///< time of the leader's last fused worker measurement
