@@ -13,7 +13,7 @@ namespace gesture_formation::gfctl {
 namespace {
 
 int cmdClassify(const Args& args);
-const Registrar kRegistrar{"classify", "--in skeletons.csv --out gestures.csv [--model FILE]   gesture LSTM (design.md §8.7)",
+const Registrar kRegistrar{"classify", "--in skeletons.csv --out gestures.csv [--model FILE]   gesture LSTM (docs/design.md §8.7)",
                            cmdClassify};
 
 std::string defaultModel() {

@@ -19,7 +19,7 @@ namespace {
 int cmdCorridor(const Args& args);
 const Registrar kRegistrar{
     "corridor",
-    "--scenario FILE --path path.csv --out corridor.json [--clearance M] [--box-margin M]   convex corridors (design.md §8.6)",
+    "--scenario FILE --path path.csv --out corridor.json [--clearance M] [--box-margin M]   convex corridors (docs/design.md §8.6)",
     cmdCorridor};
 
 /// Parses a finite number option; records the problem and returns false otherwise.

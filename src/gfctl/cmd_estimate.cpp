@@ -24,7 +24,7 @@ constexpr int kMaxWarnings = 20;
 
 namespace {
 int cmdEstimate(const Args& args);
-const Registrar kRegistrar{"estimate", "--config FILE --in meas.csv --out states.csv   replay the worker estimator (design.md §8.1)",
+const Registrar kRegistrar{"estimate", "--config FILE --in meas.csv --out states.csv   replay the worker estimator (docs/design.md §8.1)",
                            cmdEstimate};
 
 int cmdEstimate(const Args& args) {

@@ -20,7 +20,7 @@ constexpr int kMaxWarnings = 20;
 
 int cmdGestureFilter(const Args& args);
 const Registrar kRegistrar{"gesture-filter",
-                           "--config FILE --in gestures.csv --out commands.csv   gesture filter + mapping (design.md §8.3)",
+                           "--config FILE --in gestures.csv --out commands.csv   gesture filter + mapping (docs/design.md §8.3)",
                            cmdGestureFilter};
 
 int cmdGestureFilter(const Args& args) {

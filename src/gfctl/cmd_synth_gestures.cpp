@@ -24,7 +24,7 @@ namespace {
 
 int cmdSynthGestures(const Args& args);
 const Registrar kRegistrar{"synth-gestures",
-                           "--seed S --count N --out DIR [--config FILE] [--views D1,D2]   synthetic gesture/work-motion skeletons (design.md §8.7)",
+                           "--seed S --count N --out DIR [--config FILE] [--views D1,D2]   synthetic gesture/work-motion skeletons (docs/design.md §8.7)",
                            cmdSynthGestures};
 
 bool readSynthConfig(const std::string& path, gesture::SynthConfig& c, std::string& report) {
