@@ -1,4 +1,4 @@
-// Benchmark of the worker estimator (DESIGN §7 budget: one predict+update < 5 µs).
+// Benchmark of the worker estimator (docs/design.md §7 budget: one predict+update < 5 µs).
 // Prints Google Benchmark's table; run with --benchmark_repetitions=10
 // --benchmark_report_aggregates_only=true for medians.
 #include <benchmark/benchmark.h>

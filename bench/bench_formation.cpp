@@ -1,4 +1,4 @@
-// Benchmarks of the formation core and the gesture filter (DESIGN §7 budget: formation
+// Benchmarks of the formation core and the gesture filter (docs/design.md §7 budget: formation
 // references for 3 UAVs over a 40-step horizon < 50 µs). Prints Google Benchmark's table; run
 // with --benchmark_repetitions=5 --benchmark_report_aggregates_only=true for medians.
 #include <benchmark/benchmark.h>

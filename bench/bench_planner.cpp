@@ -1,4 +1,4 @@
-// Benchmarks of the planner (DESIGN §7: one full replanning of one UAV < 20 ms median,
+// Benchmarks of the planner (docs/design.md §7: one full replanning of one UAV < 20 ms median,
 // < 50 ms p99). A program that prints figures (median, p99 over many runs), not a test:
 //   gf_bench_planner [--runs N]        (GF_SOURCE_DIR or the source tree as working directory)
 // Sections:

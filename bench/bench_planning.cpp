@@ -1,4 +1,4 @@
-// Benchmarks of the planning world model and corridors (DESIGN §7 budget: corridor
+// Benchmarks of the planning world model and corridors (docs/design.md §7 budget: corridor
 // decomposition along a 40 m path in the tower map < 2 ms). Prints Google Benchmark's table;
 // run with --benchmark_repetitions=10 --benchmark_report_aggregates_only=true for medians.
 // Figures and the clearance-query decision: docs/planning.md.

@@ -169,7 +169,7 @@ inline common::Result<planning::PlannedTrajectory> fromMsg(const gesture_formati
   }
   return R::ok(std::move(p));
 }
-/// The flight stack's input (DESIGN §6): positions, velocities, accelerations, heading as yaw.
+/// The flight stack's input (design.md §6): positions, velocities, accelerations, heading as yaw.
 inline trajectory_msgs::MultiDOFJointTrajectory toMultiDof(const gesture_formation::PlannedTrajectory& m,
                                                            const std::string& joint_name) {
   trajectory_msgs::MultiDOFJointTrajectory t;

@@ -1,4 +1,4 @@
-// FormationPlanner nodelet: one UAV's replanning (planning::UavPlanner, DESIGN §4) at a fixed
+// FormationPlanner nodelet: one UAV's replanning (planning::UavPlanner, design.md §4) at a fixed
 // period, staggered by UAV index. A thin adapter: stage-1 references from the formation core
 // (formation::leaderHorizon / followerHorizon) on the worker's constant-velocity prediction,
 // the plans received from the other UAVs, and the planner's verified plan (or its fallback:

@@ -1,6 +1,6 @@
 // GestureCommander nodelet (the leader): every UAV's classification of a camera frame →
 // gesture::ViewFusion (the formation's cameras vote, docs/gestures.md §4.1) → gesture::GestureFilter
-// (K, t_c, Π_d, t_d) → gesture::GestureMapping → formation commands (DESIGN §2, §8.3;
+// (K, t_c, Π_d, t_d) → gesture::GestureMapping → formation commands (docs/design.md §2, §8.3;
 // docs/formation.md §6–7). A thin adapter: the vote and the filter decide, the mapping
 // translates, the leader's FormationPlanner applies (and clamps) the command.
 //

@@ -5,7 +5,7 @@ half-space intersection) to a PNG.  Run with the tools venv:
     /opt/gesture_formation/venv/bin/python tools/plot_corridors.py \
         --points pts.csv --path path.csv --corridor corridor.json --out docs/images/corridors_power_towers.png
 
-pts.csv from `gfctl map --export-points`, corridor.json from `gfctl corridor` (DESIGN §8.5, §8.6).
+pts.csv from `gfctl map --export-points`, corridor.json from `gfctl corridor` (design.md §8.5-6).
 """
 import argparse
 import csv

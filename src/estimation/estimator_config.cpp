@@ -78,7 +78,7 @@ EstimatorConfig readEstimatorConfig(ConfigReader& r) {
     std::vector<double> d(c.camera.distortion.begin(), c.camera.distortion.end());
     r.readDoubleList("camera.distortion", d, 5, 5, Range::any());
     for (std::size_t i = 0; i < 5; ++i) c.camera.distortion[i] = d[i];
-    // Image size: DESIGN §8.1 does not list it; absent → the principal point is the centre.
+    // Image size: docs/design.md §8.1 does not list it; absent → the principal point is the centre.
     c.camera.width_px = static_cast<int>(std::lround(2.0 * c.camera.cx));
     c.camera.height_px = static_cast<int>(std::lround(2.0 * c.camera.cy));
     if (r.has("camera.width") || r.mode() == ConfigReader::MissingKeys::kError) {

@@ -1,4 +1,4 @@
-// gfctl classify --in skeletons.csv --out gestures.csv [--model FILE]   (DESIGN §8.7)
+// gfctl classify --in skeletons.csv --out gestures.csv [--model FILE]   (docs/design.md §8.7)
 // Buffers N = 9 frames per sequence (the optional `sequence` column; without it the whole
 // file is one sequence) and writes t,gesture_id,p0..p4 for every row once the window is full.
 #include <cstdlib>
@@ -13,7 +13,7 @@ namespace gesture_formation::gfctl {
 namespace {
 
 int cmdClassify(const Args& args);
-const Registrar kRegistrar{"classify", "--in skeletons.csv --out gestures.csv [--model FILE]   gesture LSTM (DESIGN 8.7)",
+const Registrar kRegistrar{"classify", "--in skeletons.csv --out gestures.csv [--model FILE]   gesture LSTM (docs/design.md §8.7)",
                            cmdClassify};
 
 std::string defaultModel() {

@@ -1,5 +1,5 @@
 // gfctl corridor --scenario FILE --path path.csv --out corridor.json [--clearance M] [--box-margin M]
-// (DESIGN §8.6)
+// (docs/design.md §8.6)
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -19,7 +19,7 @@ namespace {
 int cmdCorridor(const Args& args);
 const Registrar kRegistrar{
     "corridor",
-    "--scenario FILE --path path.csv --out corridor.json [--clearance M] [--box-margin M]   convex corridors (DESIGN 8.6)",
+    "--scenario FILE --path path.csv --out corridor.json [--clearance M] [--box-margin M]   convex corridors (docs/design.md §8.6)",
     cmdCorridor};
 
 /// Parses a finite number option; records the problem and returns false otherwise.

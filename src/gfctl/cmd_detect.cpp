@@ -1,7 +1,7 @@
 // gfctl detect --image FILE|--video FILE --out annotated.png|.mp4 --csv boxes_keypoints.csv
 //              [--models DIR] [--max-frames N] [--detector movenet_multipose|blazepose]
 //              [--skeleton movenet_lightning|blazepose_landmark] [--tracker kcf|csrt] [--detect-every K]
-// Runs the perception pipeline (docs/perception.md) and writes the skeleton CSV of DESIGN §8.7.
+// Runs the perception pipeline (docs/perception.md) and writes the skeleton CSV of design.md §8.7.
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -30,7 +30,7 @@ const Registrar kRegistrar{
     "detect",
     "--image FILE|--video FILE --out annotated.png|.mp4 --csv boxes_keypoints.csv [--models DIR] [--max-frames N] "
     "[--detector movenet_multipose|blazepose] [--skeleton movenet_lightning|blazepose_landmark] [--tracker kcf|csrt] "
-    "[--detect-every K]   worker box + COCO-17 skeleton per frame (DESIGN 8.7)",
+    "[--detect-every K]   worker box + COCO-17 skeleton per frame (docs/design.md §8.7)",
     cmdDetect};
 
 constexpr float kDrawMinConfidence = 0.3f;

@@ -1,4 +1,4 @@
-// gfctl estimate --config FILE --in meas.csv --out states.csv   (DESIGN §8.1)
+// gfctl estimate --config FILE --in meas.csv --out states.csv   (docs/design.md §8.1)
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -24,7 +24,7 @@ constexpr int kMaxWarnings = 20;
 
 namespace {
 int cmdEstimate(const Args& args);
-const Registrar kRegistrar{"estimate", "--config FILE --in meas.csv --out states.csv   replay the worker estimator (DESIGN 8.1)",
+const Registrar kRegistrar{"estimate", "--config FILE --in meas.csv --out states.csv   replay the worker estimator (docs/design.md §8.1)",
                            cmdEstimate};
 
 int cmdEstimate(const Args& args) {

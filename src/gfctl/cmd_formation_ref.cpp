@@ -1,4 +1,4 @@
-// gfctl formation-ref --config FILE --in human.csv --out refs.csv   (DESIGN §8.2)
+// gfctl formation-ref --config FILE --in human.csv --out refs.csv   (docs/design.md §8.2)
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -16,7 +16,7 @@ using common::formatDouble;
 
 int cmdFormationRef(const Args& args);
 const Registrar kRegistrar{"formation-ref",
-                           "--config FILE --in human.csv --out refs.csv   formation reference geometry (DESIGN 8.2)",
+                           "--config FILE --in human.csv --out refs.csv   formation reference geometry (docs/design.md §8.2)",
                            cmdFormationRef};
 
 void writeRow(std::ostream& out, const std::string& t, const std::string& label, const formation::UavReference& r) {

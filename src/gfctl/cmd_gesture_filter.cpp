@@ -1,4 +1,4 @@
-// gfctl gesture-filter --config FILE --in gestures.csv --out commands.csv   (DESIGN §8.3)
+// gfctl gesture-filter --config FILE --in gestures.csv --out commands.csv   (docs/design.md §8.3)
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -20,7 +20,7 @@ constexpr int kMaxWarnings = 20;
 
 int cmdGestureFilter(const Args& args);
 const Registrar kRegistrar{"gesture-filter",
-                           "--config FILE --in gestures.csv --out commands.csv   gesture filter + mapping (DESIGN 8.3)",
+                           "--config FILE --in gestures.csv --out commands.csv   gesture filter + mapping (docs/design.md §8.3)",
                            cmdGestureFilter};
 
 int cmdGestureFilter(const Args& args) {

@@ -1,4 +1,4 @@
-// gfctl map --scenario FILE [--export-points pts.csv] [--out map.bt]   (DESIGN §8.5)
+// gfctl map --scenario FILE [--export-points pts.csv] [--out map.bt]   (docs/design.md §8.5)
 #include <chrono>
 #include <fstream>
 #include <iostream>
@@ -13,7 +13,7 @@ namespace gesture_formation::gfctl {
 namespace {
 int cmdMap(const Args& args);
 const Registrar kRegistrar{"map",
-                           "--scenario FILE [--export-points pts.csv] [--out map.bt]   build the scenario's OctoMap (DESIGN 8.5)",
+                           "--scenario FILE [--export-points pts.csv] [--out map.bt]   build the scenario's OctoMap (docs/design.md §8.5)",
                            cmdMap};
 
 int cmdMap(const Args& args) {

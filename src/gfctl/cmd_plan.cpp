@@ -92,7 +92,7 @@ int cmdPlan(const Args& args) {
   req.state.a_world = readVec3(r, "state.a", false);
   if (r.has("state.heading_rad")) r.readDouble("state.heading_rad", req.state.heading_rad, Range::any());
   if (r.has("state.pitch_rad")) r.readDouble("state.pitch_rad", req.state.pitch_rad, Range::any());
-  // The worker: constant-velocity prediction over the horizon (DESIGN §3).
+  // The worker: constant-velocity prediction over the horizon (docs/design.md §3).
   const Eigen::Vector3d worker_p = readVec3(r, "worker.p", true);
   const Eigen::Vector3d worker_v = readVec3(r, "worker.v", false);
   double worker_heading = 0.0;

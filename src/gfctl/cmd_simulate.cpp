@@ -1,6 +1,6 @@
 // gfctl simulate --scenario FILE --out DIR [--seed N] [--seeds A..B] [--duration S] [--model ONNX] [--no-plot]
 //                [--faults FILE | --fault-profile NAME] [--threads N]
-// (DESIGN §8.4; docs/simulation.md)
+// (docs/design.md §8.4; docs/simulation.md)
 #include <sys/stat.h>
 
 #include <algorithm>
@@ -35,7 +35,7 @@ const Registrar kRegistrar{
     "simulate",
     "--scenario FILE --out DIR [--seed N | --seeds A..B] [--duration S] [--model ONNX] [--no-plot] "
     "[--faults FILE | --fault-profile NAME] [--threads N]   closed-loop mission: metrics.json, timeline.csv, events.csv, modes.csv, "
-    "timeline.png (DESIGN 8.4); --faults replaces mission.faults with FILE's faults: section, --fault-profile NAME "
+    "timeline.png (docs/design.md §8.4); --faults replaces mission.faults with FILE's faults: section, --fault-profile NAME "
     "uses <scenario dir>/../faults/NAME.yaml (config/faults/; docs/safety.md); --threads N classifies the UAVs' "
     "camera views of a frame on N threads (default: the UAV count, at most the cores; results do not depend on it)",
     cmdSimulate};

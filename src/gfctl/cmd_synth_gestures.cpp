@@ -1,5 +1,5 @@
 // gfctl synth-gestures --seed S --count N --out DIR [--config FILE] [--views D1,D2,…]
-// Writes DIR/skeletons.csv (DESIGN §8.7 + label, sequence) and DIR/sequences.csv (what
+// Writes DIR/skeletons.csv (docs/design.md §8.7 + label, sequence) and DIR/sequences.csv (what
 // produced each sequence). Config keys: the fields of gesture::SynthConfig (all optional).
 // --views: the same performances also seen by further cameras at these azimuth offsets [deg]
 // from the primary one (the formation's followers, e.g. 60,-60): DIR/skeletons_view1.csv, …
@@ -24,7 +24,7 @@ namespace {
 
 int cmdSynthGestures(const Args& args);
 const Registrar kRegistrar{"synth-gestures",
-                           "--seed S --count N --out DIR [--config FILE] [--views D1,D2]   synthetic gesture/work-motion skeletons (DESIGN 8.7)",
+                           "--seed S --count N --out DIR [--config FILE] [--views D1,D2]   synthetic gesture/work-motion skeletons (docs/design.md §8.7)",
                            cmdSynthGestures};
 
 bool readSynthConfig(const std::string& path, gesture::SynthConfig& c, std::string& report) {

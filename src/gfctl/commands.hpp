@@ -1,5 +1,5 @@
 #pragma once
-// gfctl subcommands (contracts: DESIGN §8). Each returns the process exit code:
+// gfctl subcommands (contracts: docs/design.md §8). Each returns the process exit code:
 // 0 success, 2 bad arguments or input (one-line message on stderr naming file, line, field).
 
 #include <map>

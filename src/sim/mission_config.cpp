@@ -120,7 +120,7 @@ const std::vector<std::pair<std::string, gesture::Motion>>& motionNames() {
 }
 
 void readPlant(ConfigReader& r, const std::string& p, MultirotorParams& m) {
-  // Physical limits: every key required (STYLE rule 4).
+  // Physical limits: every key required (docs/conventions.md, code style 4).
   const auto req = [&](const std::string& k, double& v, const Range& range) {
     if (!r.has(p + k)) {
       r.addError(p + k, "missing (required: physical limits have no defaults)");

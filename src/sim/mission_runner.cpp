@@ -33,7 +33,7 @@ PlannerFactory uavPlannerFactory(const planning::PlannerConfig& config,
 // --------------------------------------------------------------------------------------
 namespace {
 
-/// What the leader shares every replanning (DESIGN §1: human state, leader plan, formation
+/// What the leader shares every replanning (design.md §1: human state, leader plan, formation
 /// params) — in ROS the WorkerState, PlannedTrajectory and FormationParams it sends over LCM.
 struct LeaderShare {
   planning::WorkerKnowledge worker;  ///< stamp_s = when the leader sent it

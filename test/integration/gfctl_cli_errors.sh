@@ -1,5 +1,5 @@
 #!/bin/bash
-# gfctl's error contract (DESIGN §8): exit 2 on bad arguments or input, with a message that
+# gfctl's error contract (docs/design.md §8): exit 2 on bad arguments or input, with a message that
 # names the file, line and field; nothing written that looks like a result.
 set -uo pipefail
 GFCTL=$1

@@ -1,6 +1,6 @@
 #!/bin/bash
 # gfctl map / corridor reject bad input with exit code 2 and a message naming file, line and
-# field (DESIGN §8); a path through a tower leg is reported, not answered with a bad polytope.
+# field (design.md §8); a path through a tower leg is reported, not answered with a bad polytope.
 set -uo pipefail
 GFCTL=$1
 SRC=$2

@@ -1,6 +1,6 @@
 #!/bin/bash
 # gfctl detect end to end on real imagery (Debian opencv-doc + the committed astronaut.png):
-# CSV per DESIGN §8.7 (header, 56 columns, box overlapping the hand label, t = frame/fps),
+# CSV per docs/design.md §8.7 (header, 56 columns, box overlapping the hand label, t = frame/fps),
 # annotated outputs written, and exit 2 with a message naming the file/option on bad input.
 # Reports skipped (exit 77, ctest SKIP_RETURN_CODE) when a Debian data file is absent, after
 # checking what it has.
@@ -63,7 +63,7 @@ def rows(path):
     with open(path) as f:
         r = list(csv.reader(f))
     if r[0] != header:
-        sys.exit(f"FAIL: {path}: header {r[0][:8]}... is not DESIGN 8.7")
+        sys.exit(f"FAIL: {path}: header {r[0][:8]}... is not docs/design.md §8.7")
     for row in r[1:]:
         if len(row) != 56:
             sys.exit(f"FAIL: {path}: row with {len(row)} fields")

@@ -1,6 +1,6 @@
 #!/bin/bash
 # gfctl plan rejects bad input with exit code 2 and a message naming the file and field
-# (DESIGN §8); a NaN-free but impossible start (inside the ground) is answered with a
+# (docs/design.md §8); a NaN-free but impossible start (inside the ground) is answered with a
 # braking fallback and its reason, exit 0.
 set -uo pipefail
 GFCTL=$1

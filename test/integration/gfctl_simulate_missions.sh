@@ -27,7 +27,7 @@ for k in ["min_mutual_distance_m", "min_obstacle_distance_m", "min_human_distanc
           "gesture_mean_latency_s", "false_adaptations", "planning_ms_median", "planning_ms_p99",
           "human_estimate_error_rms_m"]:
     if k not in m:
-        problems.append(f"key {k} missing (DESIGN 8.4)")
+        problems.append(f"key {k} missing (docs/design.md §8.4)")
 if m["min_mutual_distance_m"] < 2.5:
     problems.append(f"min_mutual_distance_m {m['min_mutual_distance_m']:.3f} < 2.5")
 if m["min_obstacle_distance_m"] < 0.5:

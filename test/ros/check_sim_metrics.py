@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Checks what SimWorld wrote at the end of a short simulation.launch run (test/ros/
 simulation_launch.sh: 40 s of the power-tower mission; a gesture 2 injected at the leader at
-t ~ 8 s; the mission's first operator request at t = 20 s): metrics.json carries every DESIGN
+t ~ 8 s; the mission's first operator request at t = 20 s): metrics.json carries every design.md
 §8.4 key with the definitions of gfctl simulate (sim::MetricsAccumulator), and the requests
 were followed through the ROS system — applied by the leader (FormationParams.last_command_*)
 and adapted to by the UAVs' next plans (PlannedTrajectory.params_version / planned_at).
@@ -35,7 +35,7 @@ def main():
     out = sys.argv[1]
     m = json.load(open(f"{out}/metrics.json"))
     missing = [k for k in DESIGN_KEYS if k not in m]
-    check(not missing, "metrics.json has every DESIGN 8.4 key" + (f" (missing {missing})" if missing else ""))
+    check(not missing, "metrics.json has every design.md §8.4 key" + (f" (missing {missing})" if missing else ""))
     check(abs(num(m.get("sim_time_s")) - 40.0) < 0.05, f"the mission ran to its 40 s (sim_time_s {m.get('sim_time_s')})")
     check(m.get("collisions") == 0, f"no collision ({m.get('collisions')})")
     check(2.5 <= num(m.get("min_mutual_distance_m")) < 50, f"min mutual distance {m.get('min_mutual_distance_m')} m >= 2.5")

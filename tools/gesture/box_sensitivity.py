@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """How much the gesture LSTM's reading depends on the worker's box (docs/gestures.md §6).
 
-The classifier sees keypoints normalised to the box (DESIGN §8.7), so a box that moves while the
+The classifier sees keypoints normalised to the box (design.md §8.7), so a box that moves while the
 person does not changes its input. This script moves every frame's box edges of a labelled
 skeleton CSV (default: the committed held-out test set) by independent normal draws of
 σ × the box's width / height (seeded), classifies with `gfctl classify` (the product's C++ /

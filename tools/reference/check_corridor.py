@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Independent checker of `gfctl corridor` output (DESIGN §8.6) against the map's occupied
-voxel centres from `gfctl map --export-points` (DESIGN §8.5). Written from the contract,
+"""Independent checker of `gfctl corridor` output (docs/design.md §8.6) against the map's occupied
+voxel centres from `gfctl map --export-points` (docs/design.md §8.5). Written from the contract,
 not from the C++ code.
 
     check_corridor.py --corridor corridor.json --points pts.csv --path path.csv [--tol 1e-6]

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Independent reference implementation of `gfctl estimate` (DESIGN §3 and §8.1), written
+"""Independent reference implementation of `gfctl estimate` (docs/design.md §3 and §8.1), written
 straight from the paper's equations with numpy, to check the C++ core against.
 
     estimate_reference.py --config estimator.yaml --in meas.csv --out states.csv

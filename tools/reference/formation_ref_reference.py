@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Independent reference implementation of `gfctl formation-ref` (DESIGN §4 and §8.2),
-written from the DESIGN text (paper eqs. leader_ref / follower_ref) with numpy, vectorised
+"""Independent reference implementation of `gfctl formation-ref` (docs/design.md §4 and §8.2),
+written from docs/design.md (paper eqs. leader_ref / follower_ref) with numpy, vectorised
 over the input rows, to check the C++ core against.
 
     formation_ref_reference.py --config formation.yaml --in human.csv --out refs.csv
@@ -12,7 +12,7 @@ Equations (angles in radians, headings wrapped to (-pi, pi], pitch = camera pitc
   follower i: pi = pH - di [cos(phiL - bi) cos(gi - xiL), sin(phiL - bi) cos(gi - xiL), sin(xiL - gi)]
               phii = phiL - bi, xii = xiL - gi
 Followers use the leader's desired phiL, xiL of the same row; h_heading is phiH.
-Config: leader/followers as in DESIGN §8.2 (degrees), defaults Table II; limits as in
+Config: leader/followers as in docs/design.md §8.2 (degrees), defaults Table II; limits as in
 docs/formation.md §3 (this script checks them and exits 2 on a violation, like gfctl).
 
 --compare: same header and labels; numeric fields equal to an absolute tol (gfctl

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Independent reference implementation of `gfctl gesture-filter` (DESIGN §2, §8.3 and the
+"""Independent reference implementation of `gfctl gesture-filter` (docs/design.md §2, §8.3 and the
 boundary semantics fixed in docs/formation.md §6-7), written from the text, not from the C++.
 
     gesture_filter_reference.py --config gestures.yaml --in gestures.csv --out commands.csv

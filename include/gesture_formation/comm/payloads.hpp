@@ -48,7 +48,7 @@ struct Heartbeat {
   std::uint32_t last_plan_sequence = 0;  ///< PlannedTrajectory::sequence of the last plan sent
 };
 
-/// \brief The leader's worker estimate (DESIGN §3): state at t_s with the covariance diagonal.
+/// \brief The leader's worker estimate (design.md §3): state at t_s with the covariance diagonal.
 struct WorkerStateMessage {
   double t_s = 0.0;
   /// When the estimator last fused a measurement [s], ≤ t_s: the estimate's age for the hold rule

@@ -6,7 +6,7 @@
 /// Each `read*` call leaves the caller's value untouched unless the key is present and valid,
 /// so the caller's initial value is the documented default. Missing keys are an error in
 /// `MissingKeys::kError` mode (onboard nodelets: physical limits have no silent defaults) and
-/// keep the default in `MissingKeys::kUseDefaults` mode (gfctl: DESIGN §8 "config files need
+/// keep the default in `MissingKeys::kUseDefaults` mode (gfctl: design.md §8 "config files need
 /// only the keys a subcommand uses"). Out-of-range or malformed values are always errors.
 /// Thread safety: none; one reader per thread.
 

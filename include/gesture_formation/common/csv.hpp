@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// \brief CSV with a header row (DESIGN §8): a reader that names file, line and field in
+/// \brief CSV with a header row (docs/design.md §8): a reader that names file, line and field in
 /// every error, and number formatting that round-trips to 1e-10 relative.
 
 #include <cstddef>

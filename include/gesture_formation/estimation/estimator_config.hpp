@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// \brief Configuration of the worker position estimator, as read by `gfctl estimate` and
-/// the WorkerEstimator nodelet (keys: DESIGN §8.1, config/estimator.yaml).
+/// the WorkerEstimator nodelet (keys: docs/design.md §8.1, config/estimator.yaml).
 
 #include <string>
 #include <vector>

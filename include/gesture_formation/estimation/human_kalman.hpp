@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// \brief Constant-velocity Kalman filter of the worker's position and velocity
-/// (paper: "Human 3D position estimation"; DESIGN §3 and §8.1).
+/// (paper: "Human 3D position estimation"; docs/design.md §3 and §8.1).
 ///
 ///   x = [p; v] ∈ R⁶ (world),  x⁺ = F x,  F = [[I, Δt I], [0, I]],
 ///   P⁺ = F P Fᵀ + Q,  Q = diag(σ_p² I₃, σ_v² I₃)  (added once per prediction step),

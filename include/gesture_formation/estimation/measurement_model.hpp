@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// \brief The worker's 3-D position measurement from a bounding box and a distance
-/// (paper: "Human 3D position estimation"; DESIGN §3):
+/// (paper: "Human 3D position estimation"; docs/design.md §3):
 ///
 ///   z = R_C (d · d̂) + p_C,   Σ = R_C diag(σ_xy², σ_xy², σ_z²) R_Cᵀ,
 ///
@@ -135,7 +135,7 @@ inline common::Result<double> apparentDistance(const CameraModel& camera, const 
 /// \brief A distance is available when finite and > 0 (NaN encodes "no reading").
 inline bool distanceAvailable(double d_m) { return std::isfinite(d_m) && d_m > 0.0; }
 
-/// \brief Builds the measurement of DESIGN §3 from a detection. `d_uwb_m`, `d_stereo_m`: NaN
+/// \brief Builds the measurement of design.md §3 from a detection. `d_uwb_m`, `d_stereo_m`: NaN
 /// when unavailable. Fails (with a reason) for a bad box, pose or geometry; never returns
 /// non-finite values.
 inline common::Result<PositionMeasurement> makeMeasurement(const CameraModel& camera, const CameraPose& pose,

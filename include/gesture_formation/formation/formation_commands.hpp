@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// \brief View-adaptation commands of the formation (DESIGN §4 "each command adds an
+/// \brief View-adaptation commands of the formation (docs/design.md §4 "each command adds an
 /// increment q ← q + i_q, clamped to configured limits"; docs/formation.md §4): increment or
 /// set one parameter (β, γ, d) of one UAV, a subset, or all; from the operator or from a
 /// gesture; with an id so that a command delivered twice is applied once.

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// \brief Configuration of the formation (config/formation.yaml; DESIGN §8.2), as read by
+/// \brief Configuration of the formation (config/formation.yaml; docs/design.md §8.2), as read by
 /// `gfctl formation-ref`, `gfctl gesture-filter` and the formation planner nodelet.
 ///
 /// Keys (defaults: Table II and FormationLimits / WorkerHeadingConfig / DuplicateWindowConfig):

@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// \brief Reference geometry of the formation: the paper's eqs. leader_ref and follower_ref
-/// (DESIGN §4), for one instant and along a planning horizon.
+/// (docs/design.md §4), for one instant and along a planning horizon.
 ///
 /// Frames and units: positions in the world frame [m] (z up); headings φ are camera headings
 /// about world z [rad], wrapped to (−π, π] (common/angles.hpp); pitches ξ are camera pitch

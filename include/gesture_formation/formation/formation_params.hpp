@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// \brief Adaptive parameters of the formation (paper: "Formation control", Table II;
-/// DESIGN §4) and the limits every command is clamped to (docs/formation.md §3).
+/// docs/design.md §4) and the limits every command is clamped to (docs/formation.md §3).
 ///
 /// Every UAV has an observation heading β, an observation pitch γ and a distance d. The
 /// leader's β and γ are relative to the worker's heading ^Hφ and the horizontal plane; a
@@ -22,14 +22,14 @@ namespace gesture_formation::formation {
 using UavIndex = int;
 constexpr UavIndex kLeader = 0;
 
-/// \brief "L" for the leader, "1", "2", … for the followers (the CSV labels of DESIGN §8.2).
+/// \brief "L" for the leader, "1", "2", … for the followers (the CSV labels of design.md §8.2).
 std::string uavLabel(UavIndex uav);
 
 /// \brief Wraps an angle in degrees to (−180, 180]. Non-finite input is returned unchanged.
 /// Exact for integer-degree arithmetic (uses std::remainder).
 double wrapDeg(double angle_deg);
 
-/// \brief Observation parameters of one UAV (DESIGN §4).
+/// \brief Observation parameters of one UAV (docs/design.md §4).
 struct UavObservation {
   double beta_deg = 0.0;    ///< observation heading β [deg], wrapped to (−180, 180]
   double gamma_deg = 0.0;   ///< observation pitch γ [deg]; positive = UAV above its reference

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// \brief The worker's heading ^Hφ used by eq. leader_ref (DESIGN §4; docs/formation.md §5).
+/// \brief The worker's heading ^Hφ used by eq. leader_ref (design.md §4; docs/formation.md §5).
 ///
 /// Modes:
 /// - kConstant (default, the paper): ^Hφ = constant_heading_rad (default 0).

@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// \brief The gesture classifier: an LSTM over the last N = 9 box-normalised skeletons
-/// (DESIGN §2), trained by tools/train_gesture_lstm.py and run by OpenCV DNN from ONNX.
+/// (docs/design.md §2), trained by tools/train_gesture_lstm.py and run by OpenCV DNN from ONNX.
 
 #include <array>
 #include <deque>

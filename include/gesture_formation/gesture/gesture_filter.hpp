@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// \brief Post-processing of the gesture classifier's output (paper: "Human detection and
-/// gesture recognition", last paragraph; DESIGN §2 and §8.3; docs/formation.md §6).
+/// gesture recognition", last paragraph; docs/design.md §2 and §8.3; docs/formation.md §6).
 ///
 /// Per measurement (t, id), in this order:
 ///  1. reject (state unchanged, reason given) when t is not finite, t is earlier than the
@@ -36,7 +36,7 @@ namespace gesture_formation::gesture {
 constexpr int kGestureNone = 0;
 
 /// \brief Parameters of the filter (YAML top-level keys of config/gestures.yaml).
-/// Defaults: DESIGN §2 (K = 20, t_c = 20 s, Π_d = 0.8, t_d = 5 s).
+/// Defaults: docs/design.md §2 (K = 20, t_c = 20 s, Π_d = 0.8, t_d = 5 s).
 struct GestureFilterConfig {
   int window_size = 20;         ///< K: at most this many newest measurements in G, ≥ 1
   int min_measurements = 20;    ///< evaluate only when |G| ≥ this, in [1, window_size] (default K)

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// \brief Gesture id → action mapping (DESIGN §2: "configuration, not code"; file format in
+/// \brief Gesture id → action mapping (docs/design.md §2: "configuration, not code"; file format in
 /// docs/formation.md §7 and config/gestures.yaml).
 ///
 /// ```

@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// \brief The 2-D skeleton exchanged between perception, the gesture classifier and the
-/// simulator: the worker's box and the 17 COCO keypoints (DESIGN §2, §8.7).
+/// simulator: the worker's box and the 17 COCO keypoints (docs/design.md §2, §8.7).
 
 #include <array>
 #include <cstddef>
@@ -9,7 +9,7 @@
 
 namespace gesture_formation::gesture {
 
-/// COCO-17 keypoint order (DESIGN §8.7).
+/// COCO-17 keypoint order (docs/design.md §8.7).
 enum Keypoint : int {
   kNose = 0, kLeftEye, kRightEye, kLeftEar, kRightEar, kLeftShoulder, kRightShoulder, kLeftElbow, kRightElbow,
   kLeftWrist, kRightWrist, kLeftHip, kRightHip, kLeftKnee, kRightKnee, kLeftAnkle, kRightAnkle
@@ -18,10 +18,10 @@ constexpr int kNumKeypoints = 17;
 /// Values per keypoint in the classifier input: x, y (box-normalised) and confidence.
 constexpr int kValuesPerKeypoint = 3;
 constexpr int kFeaturesPerFrame = kNumKeypoints * kValuesPerKeypoint;  // 51
-/// Frames per classifier window (N, DESIGN §2).
+/// Frames per classifier window (N, docs/design.md §2).
 constexpr int kWindowFrames = 9;
 
-/// Gesture ids (DESIGN §2).
+/// Gesture ids (docs/design.md §2).
 enum GestureId : int { kNone = 0, kCrossArms = 1, kExtendArmSide = 2, kPalmsTogether = 3, kRaiseArmUp = 4 };
 constexpr int kNumGestureClasses = 5;
 

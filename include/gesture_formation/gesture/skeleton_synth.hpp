@@ -1,11 +1,11 @@
 #pragma once
 /// \file
 /// \brief Synthetic skeleton sequences of the worker's gestures and of work motions that
-/// resemble them (issue 6; DESIGN §2 pose definitions), seen from a drone's camera.
+/// resemble them (issue 6; docs/design.md §2 pose definitions), seen from a drone's camera.
 ///
 /// A parametric 3-D body (random height and segment proportions) is animated through one
 /// motion per sequence: the four gestures (rest → raise into the pose → hold → lower) or a
-/// "none" motion — the near-misses of DESIGN §2 (reaching up to a bolt, arms folded low,
+/// "none" motion — the near-misses of docs/design.md §2 (reaching up to a bolt, arms folded low,
 /// a tool held at the waist, an arm raised part-way or pointing, walking, climbing a
 /// ladder, standing idle; since v3 also an object held or caught in front of the chest and a
 /// balancing lunge with the torso leaning and the arms out — since v8 half of them a side kick). Body frame: x forward, y left, z up, feet at z = 0. The body is
@@ -151,7 +151,7 @@ class SkeletonSynthesizer {
   std::uint64_t seed_ = 0;
 };
 
-/// \brief Writes sequences as DESIGN §8.7 CSV with `label` and `sequence` columns.
+/// \brief Writes sequences as docs/design.md §8.7 CSV with `label` and `sequence` columns.
 bool writeSkeletonCsv(const std::string& path, const std::vector<SynthSequence>& sequences, std::string* error);
 
 }  // namespace gesture_formation::gesture

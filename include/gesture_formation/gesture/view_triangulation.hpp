@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// \brief The worker's skeleton in 3-D from the formation's calibrated 2-D views, and the arm
-/// geometry of DESIGN §2's one-arm gestures measured in it (docs/gestures.md §6, "3-D fusion":
+/// geometry of design.md §2's one-arm gestures measured in it (docs/gestures.md §6, "3-D fusion":
 /// the step after the 2-of-3 vote: gesture::ViewFusion with view_fusion.confirm_3d).
 ///
 /// One camera cannot tell an arm extended to the side from an arm pointing forward-outward seen
@@ -102,7 +102,7 @@ struct Stance {
 };
 Stance stanceOf(const Skeleton3D& s);
 
-/// \brief DESIGN §2's one-arm gestures as 3-D tests on a triangulated skeleton: "extend an arm to
+/// \brief design.md §2 one-arm gestures, 3-D tests on a triangulated skeleton: "extend an arm to
 /// the side" (2) when an arm is within extend_max_deg of its outward axis and nearly straight;
 /// "raise an arm up" (4) within raise_max_deg of vertical; otherwise 0 — and 0 unless the worker
 /// stands upright (stanceOf: trunk within max_trunk_tilt_deg of vertical, each ankle within

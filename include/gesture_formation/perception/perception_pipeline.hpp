@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// \brief The whole detection layer for one camera (DESIGN §2): person detector ⇄ visual
+/// \brief The whole detection layer for one camera (docs/design.md §2): person detector ⇄ visual
 /// tracker → skeleton extractor on the worker's box → FIFO of N normalised skeletons.
 
 #include <memory>

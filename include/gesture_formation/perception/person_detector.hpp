@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// \brief `PersonDetector`: finds people in a BGR image (DESIGN §2). Two implementations:
+/// \brief `PersonDetector`: finds people in a BGR image (docs/design.md §2). Two implementations:
 /// `BlazePoseDetector` (SSD anchors + weighted NMS, near-field) and
 /// `MoveNetMultiposeDetector` (CenterNet-style, finds small distant people; the default —
 /// docs/perception.md says why).

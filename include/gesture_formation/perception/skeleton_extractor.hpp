@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// \brief `SkeletonExtractor`: 17 COCO keypoints of the person inside a box (DESIGN §2).
+/// \brief `SkeletonExtractor`: 17 COCO keypoints of the person inside a box (docs/design.md §2).
 /// Two implementations: MoveNet lightning on a square crop (the default —
 /// docs/perception.md says why) and BlazePose landmark full (33 points mapped to COCO-17).
 

@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// \brief The FIFO of the last N skeletons normalised to the worker box — the gesture
-/// classifier's input (DESIGN §2: N = 9).
+/// classifier's input (docs/design.md §2: N = 9).
 ///
 /// Normalisation per frame, with that frame's box (u, v, w, h) [px]:
 ///   x' = (x − u)/w,  y' = (y − v)/h,  c' = c.
@@ -20,7 +20,7 @@ namespace gesture_formation::perception {
 
 constexpr int kValuesPerKeypoint = 3;                                  ///< x', y', c
 constexpr int kFeaturesPerFrame = kNumKeypoints * kValuesPerKeypoint;  ///< 51
-constexpr int kDefaultFifoFrames = 9;                                  ///< N (DESIGN §2)
+constexpr int kDefaultFifoFrames = 9;                                  ///< N (docs/design.md §2)
 
 /// \brief Writes the 51 normalised features (x', y', c per keypoint, COCO order) of one
 /// skeleton into `out`.

@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// \brief Value types of the perception module: person detections and COCO-17 skeletons in
-/// image pixels (DESIGN §2, §8.7).
+/// image pixels (docs/design.md §2, §8.7).
 ///
 /// Pixel convention (docs/conventions.md, as OpenCV): u/x right, v/y down, origin at the
 /// top-left image corner, pixel centres at integer coordinates. A box is (u, v, w, h) =
@@ -17,7 +17,7 @@
 
 namespace gesture_formation::perception {
 
-/// Number of COCO keypoints (DESIGN §8.7 order: nose, l/r eye, l/r ear, l/r shoulder,
+/// Number of COCO keypoints (docs/design.md §8.7 order: nose, l/r eye, l/r ear, l/r shoulder,
 /// l/r elbow, l/r wrist, l/r hip, l/r knee, l/r ankle). "Left" is the person's left.
 constexpr int kNumKeypoints = 17;
 

@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// \brief `WorkerTracker`: detector–tracker alternation that follows ONE person (the worker)
-/// and keeps its identity when several people are visible (DESIGN §2).
+/// and keeps its identity when several people are visible (docs/design.md §2).
 ///
 /// Per frame: if a track exists, the visual tracker (OpenCV contrib KCF or CSRT) predicts
 /// the box. The detector runs when (a) no track exists, (b) `detect_every_k` frames have

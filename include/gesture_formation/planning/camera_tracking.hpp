@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// \brief Camera heading φ and pitch ξ along planned positions: line of sight to the
-/// predicted worker under hard rate limits (DESIGN §4; conventions.md: heading from +x
+/// predicted worker under hard rate limits (docs/design.md §4; conventions.md: heading from +x
 /// towards +y, pitch positive up, headings wrapped to (−π, π]).
 ///
 /// Ceres formulation (solveCameraCeres): per angle, the variables are the increments

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// \brief One UAV's planning request from what it knows (DESIGN §4; docs/safety.md §1): the
+/// \brief One UAV's planning request from what it knows (docs/design.md §4; docs/safety.md §1): the
 /// stage-1 reference (eq. leader_ref on the worker's predicted trajectory for the leader;
 /// eq. follower_ref relative to the leader's received plan — ^Lφ, ^Lξ per step — for a
 /// follower; or a given hold reference) and the other UAVs' plans it plans around. Shared by

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// \brief One replanning of one UAV: the three stages of DESIGN §4 behind one call.
+/// \brief One replanning of one UAV: the three stages of docs/design.md §4 behind one call.
 ///
 ///   stage 1  reference trajectory (formation core, given in the request)
 ///   stage 2  collision-free path near the reference on the map (references inside an
@@ -122,7 +122,7 @@ class GridPathSearch;
 class TrajectoryQp;
 struct TrajectoryQpProblem;
 
-/// \brief One UAV's planner: the three stages of DESIGN §4 with verification and fallback
+/// \brief One UAV's planner: the three stages of docs/design.md §4 with verification and fallback
 /// (docs/planning.md §5–§8). Construct once per UAV from the scenario's map and distance
 /// field (built once per scenario and shared by every UAV's planner; they must outlive it).
 /// Stateful (last verified plan, QP warm start, plan sequence); deterministic for the same
@@ -196,7 +196,7 @@ class UavPlanner {
   std::unique_ptr<TrajectoryQpProblem> last_qp_;
 };
 
-/// \brief Plans a formation in priority order (DESIGN §4): planners[0] (the leader) first,
+/// \brief Plans a formation in priority order (docs/design.md §4): planners[0] (the leader) first,
 /// then followers in index order; request i gets the plans returned for 0..i−1 appended to
 /// its higher_priority_plans (so each UAV avoids every higher-priority UAV's fresh plan).
 /// Precondition: planners.size() == requests.size(). Deterministic.

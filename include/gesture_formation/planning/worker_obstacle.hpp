@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// \brief The worker as a moving obstacle: a vertical cylinder around the estimator's
-/// predicted position (DESIGN §3 constant-velocity model), queried separately from the
+/// predicted position (docs/design.md §3 constant-velocity model), queried separately from the
 /// static map because it moves. World frame, metres, seconds.
 /// Thread safety: value type.
 

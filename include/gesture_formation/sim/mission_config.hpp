@@ -45,7 +45,7 @@ struct UavConfig {
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
 
-/// \brief A scheduled operator request (DESIGN §4 command).
+/// \brief A scheduled operator request (docs/design.md §4 command).
 struct OperatorRequest {
   double t_s = 0.0;
   std::string target_text;  ///< as written (for the timeline)

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// \brief The mission's metrics (DESIGN §8.4; docs/simulation.md §4 defines each), measured
+/// \brief The mission's metrics (docs/design.md §8.4; docs/simulation.md §4 defines each), measured
 /// the same way by `gfctl simulate` (sim::runMission) and by the ROS simulation (the SimWorld
 /// nodelet): an accumulator fed with true UAV states, the worker's truth, the leader's
 /// parameters, camera frames, plans and requests; its finish() gives the metrics struct, the
@@ -47,7 +47,7 @@ class DistanceField;
 
 namespace gesture_formation::sim {
 
-/// \brief DESIGN §8.4 metrics (docs/simulation.md §4 defines each) plus diagnostics.
+/// \brief docs/design.md §8.4 metrics (docs/simulation.md §4 defines each) plus diagnostics.
 struct MissionMetrics {
   double min_mutual_distance_m = 0.0;
   double min_obstacle_distance_m = 0.0;
@@ -91,7 +91,7 @@ struct MissionMetrics {
   std::vector<std::string> not_measured;
 };
 
-/// \brief One UAV's part of a timeline sample (DESIGN §8.4 timeline.csv).
+/// \brief One UAV's part of a timeline sample (docs/design.md §8.4 timeline.csv).
 struct UavSample {
   Eigen::Vector3d p_world = Eigen::Vector3d::Zero();
   double d_t = 0, d_ref = 0, d_o = 0;        ///< worker distance, its reference, obstacle clearance [m]
@@ -319,7 +319,7 @@ class MetricsAccumulator {
   long dist_n_ = 0, est_n_ = 0, frames_ = 0, visible_frames_ = 0;
 };
 
-/// \brief metrics.json text (keys of DESIGN §8.4 first; NaN → null; `not_measured` → null).
+/// \brief metrics.json text (keys of docs/design.md §8.4 first; NaN → null; `not_measured` → null).
 std::string metricsJson(const MissionMetrics& m);
 /// \brief Writes timeline.csv (header documented in docs/simulation.md §4).
 bool writeTimelineCsv(const std::string& path, const MissionOutput& out, int uav_count, std::string* error);

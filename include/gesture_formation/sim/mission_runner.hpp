@@ -1,12 +1,12 @@
 #pragma once
 /// \file
-/// \brief The closed-loop mission (DESIGN §5, issue 7; docs/simulation.md): worker, sensors,
+/// \brief The closed-loop mission (design.md §5, issue 7; docs/simulation.md): worker, sensors,
 /// the real estimator (HumanKalman), the real gesture pipeline (classifier → GestureFilter →
 /// mapping → FormationState), operator requests, the real formation core, one planner per UAV
 /// called through the UavPlanner API in priority order with the plans each UAV has received,
 /// inter-UAV messages through delayed links, and the plant tracking each UAV's plan.
 ///
-/// Data flow per UAV (DESIGN §1): the leader estimates the worker, owns the FormationState
+/// Data flow per UAV (docs/design.md §1): the leader estimates the worker, owns the FormationState
 /// (commands from the operator link and the gesture filter), and every replanning shares
 /// {worker estimate, ^Hφ, parameters, its plan}; follower i plans from the last share it
 /// received (if not older than faults.max_share_age_s) and around the plans received from the

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// \brief Point-mass multirotor plant (DESIGN §5): total thrust along the body z axis with
+/// \brief Point-mass multirotor plant (docs/design.md §5): total thrust along the body z axis with
 /// thrust and tilt limits, a first-order attitude (thrust-vector) response, linear and
 /// quadratic drag relative to the wind, and a camera whose heading (the UAV's yaw) and pitch
 /// (a gimbal) follow rate commands within rate and pitch limits.

@@ -3,7 +3,7 @@
 /// \brief Deterministic random streams of the simulation: every component draws from its own
 /// `std::mt19937_64` seeded from (mission seed, stream id), so that adding draws in one
 /// component never changes another's numbers. Distributions are libstdc++'s (deterministic
-/// for one build; DESIGN §8.4 "deterministic for a seed").
+/// for one build; docs/design.md §8.4 "deterministic for a seed").
 
 #include <cstdint>
 #include <random>

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// \brief Synthetic sensing of the worker from ground truth (DESIGN §5), feeding the real
+/// \brief Synthetic sensing of the worker from ground truth (docs/design.md §5), feeding the real
 /// estimator (estimation::makeMeasurement + HumanKalman):
 /// - the worker's **box** in the leader's camera: the body (a 0.5 m wide upright slab from the
 ///   feet to the head top, facing the camera) projected through the plumb_bob camera model

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// \brief The simulated worker (DESIGN §5): walks a route of legs (walk, climb a tower,
+/// \brief The simulated worker (docs/design.md §5): walks a route of legs (walk, climb a tower,
 /// work at height, descend, wait), faces the direction of motion (or a leg's `facing_deg`),
 /// performs gestures at scheduled times and work motions otherwise, and is seen by the
 /// leader's camera as synthetic skeletons (gesture::SkeletonSynthesizer) rendered from the
@@ -40,7 +40,7 @@ const char* toString(RouteLeg::Kind k);
 /// leg, checked by the mission loader).
 struct ScheduledGesture {
   double t_s = 0.0;
-  int gesture_id = 1;  ///< 1..4 (DESIGN §2)
+  int gesture_id = 1;  ///< 1..4 (docs/design.md §2)
 };
 
 struct WorkerConfig {
@@ -49,7 +49,7 @@ struct WorkerConfig {
   double start_facing_deg = 0.0;
   std::vector<RouteLeg> route;
   std::vector<ScheduledGesture> gestures;  ///< ascending t_s
-  /// Motions cycled through during work legs (near-misses and idle; DESIGN §2).
+  /// Motions cycled through during work legs (near-misses and idle; docs/design.md §2).
   std::vector<gesture::Motion> work_motions{gesture::Motion::kReachUpBolt, gesture::Motion::kToolAtWaist,
                                             gesture::Motion::kIdle, gesture::Motion::kArmsFoldedLow,
                                             gesture::Motion::kArmPartwayOrPointing};
@@ -134,7 +134,7 @@ class WorkerModel {
   std::vector<GestureEpisode> episodes_;
 };
 
-/// \brief The motion of gesture id 1..4 (DESIGN §2).
+/// \brief The motion of gesture id 1..4 (docs/design.md §2).
 gesture::Motion motionOfGesture(int gesture_id);
 
 }  // namespace gesture_formation::sim

@@ -32,7 +32,7 @@ double height(const Body3D& b) { return b.head_top.z(); }
 
 }  // namespace
 
-// DESIGN §2 pose definitions, checked in the body frame over 200 random bodies each.
+// docs/design.md §2 pose definitions, checked in the body frame over 200 random bodies each.
 TEST(SkeletonSynthTest, GesturePosesMatchTheirDefinitions) {
   for (int seed = 0; seed < 200; ++seed) {
     SkeletonSynthesizer synth(SynthConfig{}, static_cast<std::uint64_t>(seed));
@@ -70,7 +70,7 @@ TEST(SkeletonSynthTest, GesturePosesMatchTheirDefinitions) {
   }
 }
 
-// The near-misses differ from the gestures exactly where DESIGN §2 draws the line.
+// The near-misses differ from the gestures exactly where docs/design.md §2 draws the line.
 TEST(SkeletonSynthTest, NearMissesStayOutsideTheGestureDefinitions) {
   for (int seed = 0; seed < 200; ++seed) {
     SkeletonSynthesizer synth(SynthConfig{}, static_cast<std::uint64_t>(seed));

@@ -1,4 +1,4 @@
-// gesture/view_triangulation.hpp: 3-D skeleton from calibrated views and DESIGN §2's one-arm
+// gesture/view_triangulation.hpp: 3-D skeleton from calibrated views and design.md §2's one-arm
 // gestures tested in it (docs/gestures.md §6, the step after the 2-of-3 vote).
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// Properties of the convex corridors (STYLE §7): each polytope contains its segment, excludes
+// Corridor properties (conventions.md, code style 7): each polytope contains its segment, excludes
 // every obstacle point of the whole map (not only the local ones), keeps its achieved
 // clearance, overlaps its neighbour at the shared waypoint; correct with no obstacles, with
 // obstacles touching the segment, and in 3-D. 100 random worlds with fixed seeds.

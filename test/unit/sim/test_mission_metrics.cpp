@@ -319,7 +319,7 @@ TEST(MetricsJsonTest, Design84KeysFirstAndUnmeasuredOnesNull) {
   for (const char* k : keys) {
     const auto at = j.find(std::string("\"") + k + "\": ");
     ASSERT_NE(at, std::string::npos) << k;
-    EXPECT_GT(at, last) << k << " out of DESIGN §8.4 order";
+    EXPECT_GT(at, last) << k << " out of docs/design.md §8.4 order";
     last = at;
   }
   EXPECT_NE(j.find("\"plans_hold\": 4,"), std::string::npos);
