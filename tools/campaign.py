@@ -313,11 +313,13 @@ class Progress:
 
 def start_cluster(args):
     """(client, cluster or None): a LocalCluster on 127.0.0.1 (default) or an existing scheduler."""
-    import cloudpickle
     from distributed import Client, LocalCluster
-    cloudpickle.register_pickle_by_value(campaign_worker)  # workers need no checkout of tools/
     if args.scheduler:
-        return Client(args.scheduler, timeout=30), None
+        client = Client(args.scheduler, timeout=30)
+        # The scheduler unpickles the tasks and the workers run them: both import this module,
+        # sent to them (and to workers that join later) so that they need no checkout of tools/.
+        client.upload_file(campaign_worker.__file__)
+        return client, None
     workers = args.workers or os.cpu_count() or 1
     cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
                            dashboard_address=None, worker_dashboard_address=None,

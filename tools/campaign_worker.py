@@ -1,8 +1,8 @@
 """One mission of a campaign, run on a Dask worker (tools/campaign.py; docs/campaigns.md).
 
-Standard library only: tools/campaign.py ships this module to the workers by value
-(cloudpickle), so a worker needs the tools venv's Python and Dask, the gfctl build and the
-model file, not this source tree. The worker checks that its gfctl and model have the sha256
+Standard library only: tools/campaign.py sends this file to the scheduler and the workers
+(Client.upload_file), so a worker needs the tools venv's Python and Dask, the gfctl build and
+the model file, not this source tree. The worker checks that its gfctl and model have the sha256
 the client expects before it runs anything: a row is never labelled with a binary or a model
 other than the one that produced it.
 
