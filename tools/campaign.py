@@ -121,11 +121,11 @@ def _validate(c, root):
     profiles = c["profiles"]
     if not isinstance(profiles, list) or not profiles or not all(isinstance(p, str) for p in profiles):
         raise BadInput(f"profiles: expected a non-empty list of fault profile names, got {profiles!r}")
+    if len(set(profiles)) != len(profiles):
+        raise BadInput(f"profiles: duplicate names in {profiles!r}")
     for p in profiles:
         if not NAME_RE.match(p):
             raise BadInput(f"profiles: {p!r}: expected a name of [a-z0-9_-] (config/faults/NAME.yaml, or none)")
-        if len(set(profiles)) != len(profiles):
-            raise BadInput(f"profiles: duplicate names in {profiles!r}")
         for s in scenarios:
             if p != "none" and not os.path.isfile(faults_file(root, s, p)):
                 raise BadInput(f"profiles: {p!r}: {faults_file(root, s, p)} does not exist")
@@ -233,7 +233,7 @@ def source_commit(root=ROOT):
         return subprocess.run(["git", "-C", root, *a], capture_output=True, check=True).stdout
     try:
         head = git("rev-parse", "HEAD").decode().strip()
-        status = git("status", "--porcelain", "--", *DIRTY_PATHS)
+        status = git("status", "--porcelain", "--untracked-files=all", "--", *DIRTY_PATHS)
     except (OSError, subprocess.CalledProcessError):
         raise BadInput(f"{root}: not a git checkout: pass --commit LABEL") from None
     if not status.strip():
@@ -322,31 +322,37 @@ def start_cluster(args):
         return client, None
     workers = args.workers or os.cpu_count() or 1
     cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
-                           dashboard_address=None, worker_dashboard_address=None,
+                           dashboard_address="127.0.0.1:0", worker_dashboard_address=None,  # health endpoints only: no bokeh
                            local_directory=os.path.join(args.work_dir, "dask"), silence_logs=40)
     return Client(cluster), cluster
 
 
 def overhead_figures(results):
-    """Scheduler overhead per mission: per worker, the gaps between one mission's end and the
-    next one's start, plus the task's own time outside gfctl; mean mission time. None when empty."""
+    """Scheduler overhead per mission: per worker, the gap between one mission's end and the next
+    one's start plus the task's own time outside gfctl, averaged over the missions after each
+    worker's first; the first task's time outside gfctl is the worker's start-up (hashing gfctl
+    and its libraries once), given apart. None when there are no results."""
     by_worker = {}
     for r in results:
         by_worker.setdefault(r["worker"], []).append(r)
-    gaps, inside, mission = [], [], []
+    gaps, inside, startup, mission = [], [], [], []
     for rs in by_worker.values():
         rs.sort(key=lambda r: r["t_start"])
         for a, b in zip(rs, rs[1:]):
             gaps.append(max(0.0, b["t_start"] - a["t_end"]))
-        for r in rs:
-            inside.append(max(0.0, r["t_end"] - r["t_start"] - r["mission_s"]))
+        for i, r in enumerate(rs):
+            (inside if i else startup).append(max(0.0, r["t_end"] - r["t_start"] - r["mission_s"]))
             mission.append(r["mission_s"])
     if not mission:
         return None
     mean_mission = sum(mission) / len(mission)
-    per_mission = (sum(gaps) + sum(inside)) / len(mission)
+    per_mission = (sum(gaps) + sum(inside)) / len(inside) if inside else 0.0
+    gaps.sort()
     return {"mean_mission_s": mean_mission, "overhead_s": per_mission,
-            "overhead_pct": 100.0 * per_mission / mean_mission if mean_mission > 0 else None}
+            "overhead_pct": 100.0 * per_mission / mean_mission if mean_mission > 0 else None,
+            "gap_median_s": gaps[len(gaps) // 2] if gaps else 0.0, "gap_max_s": gaps[-1] if gaps else 0.0,
+            "inside_mean_s": sum(inside) / len(inside) if inside else 0.0,
+            "startup_s": sum(startup) / len(startup), "steady_missions": len(inside)}
 
 
 def run_campaign(args):
@@ -383,7 +389,8 @@ def _run(args, c, store, todo, total, already):
     from distributed import as_completed
     client, cluster = start_cluster(args)
     progress = Progress(total, already)
-    results, interrupted = [], False
+    results, interrupted, mismatch = [], False, False
+    t_first = time.time()
 
     def on_signal(signum, frame):
         raise KeyboardInterrupt
@@ -396,7 +403,6 @@ def _run(args, c, store, todo, total, already):
         queue.reverse()
         ac = as_completed()
         running = {}
-        t_first = time.time()
 
         def refill():
             window = 2 * max(1, sum(client.nthreads().values())) + 2
@@ -434,9 +440,11 @@ def _run(args, c, store, todo, total, already):
                 what = f"FAILED ({r['status']}, exit {r.get('exit_code')}) {short_key(m['key'])}: " + \
                        (tail[-1][:160] if tail else "")
             progress.line(len(running), what)
-            if progress.failed > args.max_failures:
-                log(f"stopping: {progress.failed} failures (> --max-failures {args.max_failures}); see "
-                    f"`campaign.py failures`")
+            mismatch = mismatch or r["status"] == "mismatch"
+            if progress.failed > args.max_failures or mismatch:
+                log("stopping: " + (f"a worker's gfctl or model differs from the client's: {r.get('log_tail')}"
+                                    if mismatch else f"{progress.failed} failures (> --max-failures {args.max_failures})")
+                    + "; see `campaign.py failures`")
                 queue.clear()
                 for f in list(ac.futures):
                     f.cancel()
@@ -463,7 +471,10 @@ def summarize(results, t_first, t_last, progress, client_workers):
     line = f"{progress.done} missions done, {progress.failed} failed in {fmt_duration(wall)}: {per_hour:.1f} missions/hour"
     if ov:
         line += (f"; mean mission {ov['mean_mission_s']:.2f} s, scheduler overhead {ov['overhead_s'] * 1000:.0f} ms "
-                 f"per mission = {ov['overhead_pct']:.2f} % of a mission")
+                 f"per mission = {ov['overhead_pct']:.2f} % of a mission over the {ov['steady_missions']} missions after "
+                 f"each worker's first (gap between missions on a worker: median {ov['gap_median_s'] * 1000:.0f} ms, max "
+                 f"{ov['gap_max_s'] * 1000:.0f} ms; in the task outside gfctl {ov['inside_mean_s'] * 1000:.0f} ms); "
+                 f"worker start-up (hashing gfctl and its libraries once) {ov['startup_s']:.2f} s")
     log(line)
     return {"done": progress.done, "failed": progress.failed, "wall_s": wall, "missions_per_hour": per_hour,
             "overhead": ov}

@@ -416,13 +416,16 @@ def bench(args, run_campaign):
              "tests: the load average (1/5/15 min) before and after each run is given; figures under load are lower "
              "bounds of what the tool does on an idle machine.\n\n",
              "| workers | missions | wall [s] | missions/hour | speed-up vs first | mean mission [s] | scheduler overhead "
-             "per mission [ms] | overhead [% of a mission] | load before | load after |\n",
-             "|---|---|---|---|---|---|---|---|---|---|\n"]
+             "per mission [ms] | overhead [% of a mission] | gap between missions median / max [ms] | worker start-up [s] | "
+             "load before | load after |\n",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|\n"]
     for n, s, l0, l1 in results:
         ov = s["overhead"] or {}
         lines.append(f"| {n} | {s['done']} | {s['wall_s']:.1f} | {s['missions_per_hour']:.0f} | "
                      f"{s['missions_per_hour'] / base:.2f}× | {ov.get('mean_mission_s', float('nan')):.2f} | "
                      f"{ov.get('overhead_s', float('nan')) * 1000:.0f} | {ov.get('overhead_pct', float('nan')):.2f} | "
+                     f"{ov.get('gap_median_s', float('nan')) * 1000:.0f} / {ov.get('gap_max_s', float('nan')) * 1000:.0f} | "
+                     f"{ov.get('startup_s', float('nan')):.2f} | "
                      f"{' '.join(l0)} | {' '.join(l1)} |\n")
     for n, s, _, _ in results:
         print(f"bench: {n} worker(s): {s['missions_per_hour']:.0f} missions/hour ({s['missions_per_hour'] / base:.2f}× the "
@@ -435,7 +438,8 @@ def bench(args, run_campaign):
                     "Each section: the same missions run into a fresh scratch store once per worker count. Missions per "
                     "hour = missions / (first submission → last result); scheduler overhead per mission = the time a "
                     "worker spends between one mission's end and the next one's start plus the task's own time outside "
-                    "gfctl, averaged over missions (docs/campaigns.md §Measuring).\n")
+                    "gfctl, averaged over the missions after each worker's first; worker start-up = the first task's time "
+                    "outside gfctl (hashing gfctl and its libraries once per worker process; docs/campaigns.md §6).\n")
         f.write("".join(lines))
     print(f"appended to {args.results}")
     return 0

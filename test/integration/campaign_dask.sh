@@ -199,6 +199,16 @@ rc=$?
   && grep -q "missions/hour" "$T/run6.log" && pass "local cluster: 2 missions, missions/hour printed" \
   || { fail "local cluster: exit $rc"; tail -5 "$T/run6.log"; }
 
+# A worker whose gfctl is another binary than the client's: stored as a mismatch, the run stops.
+campaign mismatch.yaml mismatch "[8]"
+(cd "$SRC" && GF_CAMPAIGN_GFCTL=/bin/true $C --store "$T/s5.sqlite" run "$T/mismatch.yaml" --workers 1 --work-dir "$T/work" \
+  > "$T/run7.log" 2>&1)
+rc=$?
+nm=$(q "$T/s5.sqlite" "SELECT COUNT(*) FROM failures WHERE status = 'mismatch' AND log_tail LIKE '%/bin/true has sha256%'")
+[ "$rc" = 1 ] && [ "$nm" -ge 1 ] && grep -q "stopping: a worker's gfctl or model differs" "$T/run7.log" \
+  && [ "$(q "$T/s5.sqlite" 'SELECT COUNT(*) FROM missions')" = 2 ] \
+  && pass "a worker with another gfctl: mismatch stored, the run stops, no row" || { fail "mismatch: exit $rc, $nm"; tail -3 "$T/run7.log"; }
+
 # ---- 6. corrupt, foreign and non-SQLite stores are refused, untouched ----------------------
 "$PY" - "$S1" "$T/corrupt.sqlite" "$T/foreign.sqlite" "$T/text.sqlite" <<'P'
 import shutil, sqlite3, sys
