@@ -9,7 +9,8 @@
 #  3. a mission's row equals `gfctl simulate` run by hand (metrics.json, wall-clock keys aside);
 #  4. a mission with a bad config value (gfctl exit 2) and one over its timeout are stored as
 #     failures with their log tails and counted (exit 1), not dropped;
-#  5. the default local cluster (started and stopped by the tool);
+#  5. the default local cluster (started and stopped by the tool; killed with the tool and resumed),
+#     and a worker whose gfctl differs from the client's (stored as a mismatch, the run stops);
 #  6. a corrupt store, a foreign SQLite file and a non-SQLite file are refused (exit 2, a clear
 #     error) and left byte-for-byte untouched.
 # Skipped (exit 77) when gfctl is not built or the tools venv is missing.
@@ -198,6 +199,34 @@ rc=$?
 [ "$rc" = 0 ] && [ "$(q "$T/s5.sqlite" 'SELECT COUNT(*) FROM missions')" = 2 ] && grep -q "local, 127.0.0.1" "$T/run6.log" \
   && grep -q "missions/hour" "$T/run6.log" && pass "local cluster: 2 missions, missions/hour printed" \
   || { fail "local cluster: exit $rc"; tail -5 "$T/run6.log"; }
+
+# The whole tool killed with kill -9 while its local cluster runs missions: its worker processes
+# and their gfctl stop with it; the same command then finishes the campaign, each mission once.
+campaign local_kill.yaml local_kill 1..3
+S6=$T/s6.sqlite
+(cd "$SRC" && exec $C --store "$S6" run "$T/local_kill.yaml" --workers 2 --work-dir "$T/work" > "$T/run8.log" 2>&1) &
+TOOL=$!
+PIDS+=("$TOOL")
+if wait_rows "$S6" 1 120; then
+  kids=$(pgrep -P "$TOOL" | tr '\n' ' ')
+  kill -9 "$TOOL"
+  wait "$TOOL" 2>/dev/null
+  left=""
+  for _ in $(seq 1 60); do
+    left=$(for k in $kids; do kill -0 "$k" 2>/dev/null && echo "$k"; done; pgrep -f "$T/work/missions")
+    [ -z "$left" ] && break
+    sleep 0.5
+  done
+  [ -z "$left" ] && pass "tool killed: its local workers ($kids) and missions stopped within 30 s" \
+    || fail "tool killed: still running after 30 s: $left"
+  before=$(q "$S6" 'SELECT COUNT(*) FROM missions')
+  (cd "$SRC" && $C --store "$S6" run "$T/local_kill.yaml" --workers 2 --work-dir "$T/work" > "$T/run9.log" 2>&1)
+  rc=$?
+  [ "$rc" = 0 ] && [ "$(q "$S6" 'SELECT COUNT(*) FROM missions')" = 6 ] && grep -q "6 missions, $before already in" "$T/run9.log" \
+    && pass "local cluster resumed after kill -9 of the tool: 6 missions, each once" || { fail "local resume: exit $rc"; tail -3 "$T/run9.log"; }
+else
+  fail "local_kill: no mission stored within 120 s"; tail -5 "$T/run8.log"
+fi
 
 # A worker whose gfctl is another binary than the client's: stored as a mismatch, the run stops.
 campaign mismatch.yaml mismatch "[8]"
