@@ -108,6 +108,29 @@ def load_campaign(path, root=ROOT):
         raise BadInput(f"{path}: {e}") from None
 
 
+def campaign_from_args(args, root=ROOT):
+    """The campaign file with --seeds / --profiles (if given) in place of its own."""
+    import yaml
+    c = load_campaign(args.campaign, root)
+    if getattr(args, "seeds", None) is None and getattr(args, "profiles", None) is None:
+        return c
+    with open(args.campaign) as f:
+        raw = yaml.safe_load(f)
+    if args.seeds is not None:
+        raw["seeds"] = args.seeds
+        if ".." not in args.seeds:
+            try:
+                raw["seeds"] = [int(x) for x in re.split(r"[,\s]+", args.seeds.strip("[] ")) if x]
+            except ValueError:
+                raise BadInput(f"--seeds: expected A..B or a list of integers, got {args.seeds!r}") from None
+    if args.profiles is not None:
+        raw["profiles"] = [p for p in re.split(r"[,\s]+", args.profiles) if p]
+    try:
+        return _validate(raw, root)
+    except BadInput as e:
+        raise BadInput(f"{args.campaign} with --seeds/--profiles: {e}") from None
+
+
 def _validate(c, root):
     name = c["name"]
     if not isinstance(name, str) or not NAME_RE.match(name):
@@ -356,7 +379,7 @@ def overhead_figures(results):
 
 
 def run_campaign(args):
-    c = load_campaign(args.campaign)
+    c = campaign_from_args(args)
     gfctl = find_gfctl(args.gfctl)
     commit = args.commit or source_commit()
     gfctl_sha = campaign_worker.binary_sha256(gfctl)
@@ -366,6 +389,11 @@ def run_campaign(args):
                        "set model: in the campaign file")
     model_path = model_paths.pop()
     model_sha = campaign_worker.file_sha256(model_path) if model_path else "none"
+    if args.dry_run and not os.path.exists(args.store):  # count only: no store created
+        log(f"{c['name']}: {len(c['seeds']) * len(c['scenarios']) * len(c['profiles']) * len(variant_configs(c))} "
+            f"missions, 0 already in {args.store} (no such store yet), commit {commit[:10]}, gfctl {gfctl_sha[:12]} = "
+            f"{gfctl}, model {model_sha[:12]}")
+        return EXIT_OK, None
     os.makedirs(args.work_dir, exist_ok=True)
     store = Store(args.store, lock=True)
     try:
@@ -509,7 +537,7 @@ def cmd_failures(args):
 
 def cmd_report(args):
     import campaign_report
-    return campaign_report.report(args, load_campaign(args.campaign) if args.campaign else None)
+    return campaign_report.report(args, campaign_from_args(args))
 
 
 def cmd_compare(args):
@@ -529,7 +557,12 @@ def main(argv=None):
                     help="the SQLite store (default: docs/results/campaigns.sqlite; $GF_CAMPAIGN_STORE)")
     sub = ap.add_subparsers(dest="cmd", required=True)
 
+    def selection_args(p):
+        p.add_argument("--seeds", help="these seeds instead of the campaign's, e.g. 1..10 or 1,5,9")
+        p.add_argument("--profiles", help="these fault profiles instead of the campaign's, e.g. nominal,harsh")
+
     def cluster_args(p):
+        selection_args(p)
         p.add_argument("--scheduler", help="an existing Dask scheduler, e.g. tcp://127.0.0.1:8786")
         p.add_argument("--workers", type=int, help="local cluster: worker processes (default: the cores)")
         p.add_argument("--gfctl", help="the gfctl binary (default: $GFCTL, build*/devel/..., catkin devel/, PATH)")
@@ -556,6 +589,7 @@ def main(argv=None):
 
     p = sub.add_parser("report", help="the fault-matrix report (docs/results/reliability.md) from the store")
     p.add_argument("campaign", nargs="?", default=os.path.join(ROOT, "config", "campaigns", "fault_matrix.yaml"))
+    selection_args(p)
     p.add_argument("--commit", action="append", help="commit (prefix) of the tables; repeat for a matrix run over "
                                                      "several commits (default: the newest complete matrix)")
     p.add_argument("--out", default=os.path.join(ROOT, "docs", "results", "reliability.md"))

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The fault matrix at a glance (docs/reliability.md): per fault profile, every mission's minimum
+"""The fault matrix at a glance (docs/results/reliability.md): per fault profile, every mission's minimum
 UAV–UAV distance, minimum obstacle distance and minimum UAV–worker distance as dots, with the
 median marked and the safety thresholds drawn. `tools/campaign.py report` calls draw() with the
 missions of the campaign store; the command line reads a CSV with the same columns.

@@ -91,7 +91,15 @@ end=$((SECONDS + 120))
 while [ $SECONDS -lt $end ] && [ -z "$victim" ]; do  # w1 busy with a mission, one mission stored
   g=$(pgrep -P "$W1" -f "gfctl simulate" | head -1)
   if [ -n "$g" ] && [ -f "$S1" ] && [ "$(q "$S1" 'SELECT COUNT(*) FROM missions' 2>/dev/null || echo 0)" -ge 1 ]; then
-    victim=$g
+    args=$(tr '\0' ' ' < "/proc/$g/cmdline" 2>/dev/null)
+    vdir=$(dirname "$(sed -E 's/.*--scenario ([^ ]+).*/\1/' <<<"$args")")
+    vprofile=nominal
+    cmp -s "$vdir/faults.yaml" "$SRC/config/faults/loss30.yaml" 2>/dev/null && vprofile=loss30
+    if [ -n "$args" ] && kill -0 "$g" 2>/dev/null; then  # still running: kill its worker now
+      kill -9 "$W1"
+      victim=$g
+      vseed=$(sed -E 's/.*--seed ([0-9]+).*/\1/' <<<"$args")
+    fi
   else
     sleep 0.2
   fi
@@ -99,12 +107,6 @@ done
 if [ -z "$victim" ]; then
   fail "worker w1 never ran a mission after the first was stored"; cat "$T/run1.log"
 else
-  args=$(tr '\0' ' ' < "/proc/$victim/cmdline")
-  vseed=$(sed -E 's/.*--seed ([0-9]+).*/\1/' <<<"$args")
-  vdir=$(dirname "$(sed -E 's/.*--scenario ([^ ]+).*/\1/' <<<"$args")")
-  vprofile=nominal
-  cmp -s "$vdir/faults.yaml" "$SRC/config/faults/loss30.yaml" && vprofile=loss30
-  kill -9 "$W1"
   echo "killed worker w1 (pid $W1) while it ran $vprofile seed $vseed (gfctl pid $victim)"
   wait "$TOOL"
   rc=$(cat "$T/run1.rc")
