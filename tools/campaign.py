@@ -613,7 +613,11 @@ def main(argv=None):
     p.add_argument("--limit", type=int, default=20)
     p.set_defaults(func=cmd_failures)
 
+    for sp in sub.choices.values():  # --store also after the command
+        sp.add_argument("--store", dest="store_after", default=None, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
+    if args.store_after:
+        args.store = args.store_after
     try:
         return args.func(args)
     except (BadInput, StoreError) as e:
