@@ -276,94 +276,115 @@ def _fmt(v):
     return f"{v:.0f}" if float(v).is_integer() else f"{v:.2f}"
 
 
-def compare(args, campaign):
-    store = Store(args.store, create=False)
-    try:
-        rows_a = [r for r in store.rows("source_commit LIKE ?", (args.a + "%",))]
-        rows_b = [r for r in store.rows("source_commit LIKE ?", (args.b + "%",))]
-    finally:
-        store.close()
-    for name, rows in ((args.a, rows_a), (args.b, rows_b)):
-        if not rows:
-            print(f"campaign.py compare: no missions of commit {name!r} in {args.store}", file=sys.stderr)
-            return 2
-        full = sorted({r["source_commit"] for r in rows})
-        if len(full) > 1:
-            print(f"campaign.py compare: {name!r} names several commits: {', '.join(full)}", file=sys.stderr)
-            return 2
+def _commit_rows(store, prefix, campaign):
+    """(rows of the one commit named by prefix, restricted to the campaign, or an error message)."""
+    rows = store.rows("source_commit LIKE ?", (prefix + "%",))
+    full = sorted({r["source_commit"] for r in rows})
+    if len(full) > 1:
+        return None, f"{prefix!r} names several commits: {', '.join(full)}"
     if campaign:
-        def keep(r):
-            return r["scenario"] in campaign["scenarios"] and r["profile"] in campaign["profiles"] and \
-                r["seed"] in campaign["seeds"]
-        rows_a, rows_b = [r for r in rows_a if keep(r)], [r for r in rows_b if keep(r)]
+        rows = [r for r in rows if r["scenario"] in campaign["scenarios"] and r["profile"] in campaign["profiles"]
+                and r["seed"] in campaign["seeds"]]
+    if not rows:
+        return None, f"no missions of commit {prefix!r} in {store.path}" + (" for this campaign" if campaign else "")
+    return rows, None
 
-    def index(rows):
-        out = {}
-        for r in sorted(rows, key=lambda r: (r["gfctl_sha256"] != UNKNOWN_BINARY, r["finished_utc"] or "")):
-            out[(r["scenario"], r["config_hash"], r["profile"], r["seed"])] = r  # the last: known binary, latest
-        return out
 
-    ia, ib = index(rows_a), index(rows_b)
-    common = sorted(set(ia) & set(ib), key=lambda k: (k[0], k[1], k[2], k[3]))
-    ca, cb = rows_a[0]["source_commit"], rows_b[0]["source_commit"]
-    print(f"compare A = {ca[:10]} ({len(ia)} missions) vs B = {cb[:10]} ({len(ib)} missions): {len(common)} missions "
-          f"in both, {len(set(ia) - set(ib))} only in A, {len(set(ib) - set(ia))} only in B")
-    print("each cell: A → B over the missions both ran (worst case: the minimum of a distance, the sum of a count, "
-          "the maximum of an error; median in brackets); ▼ a regression beyond the tolerance, ▲ an improvement\n")
+def _index(rows):
+    """(scenario, config hash, profile, seed) -> row; of two binaries, the known one, then the latest."""
+    out = {}
+    for r in sorted(rows, key=lambda r: (r["gfctl_sha256"] != UNKNOWN_BINARY, r["finished_utc"] or "")):
+        out[(r["scenario"], r["config_hash"], r["profile"], r["seed"])] = r
+    return out
+
+
+def _profile_cells(keys, ia, ib, prof, regressions):
+    """The table cells of one profile: each SAFETY figure A → B, then the violations."""
+    cells = []
+    for col, label, better, how, tol in SAFETY:
+        va = [ia[k][col] for k in keys if ia[k][col] is not None]
+        vb = [ib[k][col] for k in keys if ib[k][col] is not None]
+        sa, sb = _stat(va, how), _stat(vb, how)
+        flag = ""
+        if sa is not None and sb is not None:
+            worse = (sa - sb) if better == "high" else (sb - sa)
+            if worse > _tol(tol, sa) + 1e-12:
+                flag = " ▼"
+                regressions.append(f"{prof}: {label} {_fmt(sa)} → {_fmt(sb)}")
+            elif -worse > _tol(tol, sa) + 1e-12:
+                flag = " ▲"
+        med = "" if how == "sum" or not va or not vb else \
+            f" ({_fmt(statistics.median(va))} → {_fmt(statistics.median(vb))})"
+        cells.append(f"{_fmt(sa)} → {_fmt(sb)}{flag}{med}")
+    viol_a = sum(1 for k in keys if is_violation(ia[k]))
+    viol_b = sum(1 for k in keys if is_violation(ib[k]))
+    if viol_b > viol_a:
+        regressions.append(f"{prof}: safety violations {viol_a} → {viol_b}")
+    cells.append(f"{viol_a} → {viol_b}{' ▼' if viol_b > viol_a else (' ▲' if viol_b < viol_a else '')}")
+    return cells
+
+
+def _print_tables(common, ia, ib, order):
+    """One table per (scenario, config); returns the regressions."""
     groups = {}
     for k in common:
         groups.setdefault(k[:3], []).append(k)
-    order = campaign["profiles"] if campaign else None
-    regressions = []
+    rank = lambda p: (order.index(p) if order and p in order else len(order or []), p)  # noqa: E731
     header = "| profile | n | " + " | ".join(label for _, label, *_ in SAFETY) + " | violations |"
-    last_sc = None
-    for (sc, cfg, prof), keys in sorted(groups.items(), key=lambda kv: (kv[0][0], kv[0][1], (
-            order.index(kv[0][2]) if order and kv[0][2] in order else 99, kv[0][2]))):
-        if (sc, cfg) != last_sc:
+    regressions, last = [], None
+    for (sc, cfg, prof), keys in sorted(groups.items(), key=lambda kv: (kv[0][0], kv[0][1], rank(kv[0][2]))):
+        if (sc, cfg) != last:
             print(f"\n{sc}, config {cfg[:8]}:\n\n{header}\n|---|---|" + "---|" * (len(SAFETY) + 1))
-            last_sc = (sc, cfg)
-        cells = []
-        for col, label, better, how, tol in SAFETY:
-            va = [ia[k][col] for k in keys if ia[k][col] is not None]
-            vb = [ib[k][col] for k in keys if ib[k][col] is not None]
-            sa, sb = _stat(va, how), _stat(vb, how)
-            flag = ""
-            if sa is not None and sb is not None:
-                worse = (sa - sb) if better == "high" else (sb - sa)
-                if worse > _tol(tol, sa) + 1e-12:
-                    flag = " ▼"
-                    regressions.append(f"{prof}: {label} {_fmt(sa)} → {_fmt(sb)}")
-                elif -worse > _tol(tol, sa) + 1e-12:
-                    flag = " ▲"
-            med = "" if how == "sum" or not va or not vb else \
-                f" ({_fmt(statistics.median(va))} → {_fmt(statistics.median(vb))})"
-            cells.append(f"{_fmt(sa)} → {_fmt(sb)}{flag}{med}")
-        viol_a = sum(1 for k in keys if is_violation(ia[k]))
-        viol_b = sum(1 for k in keys if is_violation(ib[k]))
-        if viol_b > viol_a:
-            regressions.append(f"{prof}: safety violations {viol_a} → {viol_b}")
-        cells.append(f"{viol_a} → {viol_b}{' ▼' if viol_b > viol_a else (' ▲' if viol_b < viol_a else '')}")
-        print(f"| `{prof}` | {len(keys)} | " + " | ".join(cells) + " |")
-    differing, worse_list = 0, []
+            last = (sc, cfg)
+        print(f"| `{prof}` | {len(keys)} | " + " | ".join(_profile_cells(keys, ia, ib, prof, regressions)) + " |")
+    return regressions
+
+
+def _worse_missions(common, ia, ib):
+    """(number of missions differing in a safety figure, those worse in B: new violations first,
+    then by the first SAFETY figure that got worse, most first)."""
+    differing, worse = 0, []
     for k in common:
         a, b = ia[k], ib[k]
         changes = []
         for i, (col, label, better, how, tol) in enumerate(SAFETY):
             if a[col] is None or b[col] is None or abs(a[col] - b[col]) <= 1e-9:
                 continue
-            worse = (a[col] - b[col]) if better == "high" else (b[col] - a[col])
-            changes.append((worse, i, label, a[col], b[col], _tol(tol, a[col])))
-        if changes:
-            differing += 1
-            bad = [c for c in changes if c[0] > c[5] + 1e-12]
-            if bad or is_violation(b) != is_violation(a):
-                first = bad[0] if bad else changes[0]  # the first safety figure (SAFETY order) that got worse
-                worse_list.append((is_violation(b) and not is_violation(a), first[1], -first[0], k, bad))
+            d = (a[col] - b[col]) if better == "high" else (b[col] - a[col])
+            changes.append((d, i, label, a[col], b[col], _tol(tol, a[col])))
+        if not changes:
+            continue
+        differing += 1
+        bad = [c for c in changes if c[0] > c[5] + 1e-12]
+        if bad or is_violation(b) != is_violation(a):
+            first = bad[0] if bad else changes[0]
+            worse.append((is_violation(b) and not is_violation(a), first[1], -first[0], k, bad))
+    worse.sort(key=lambda t: (not t[0], t[1], t[2]))
+    return differing, worse
+
+
+def compare(args, campaign):
+    store = Store(args.store, create=False)
+    try:
+        (rows_a, err_a), (rows_b, err_b) = _commit_rows(store, args.a, campaign), _commit_rows(store, args.b, campaign)
+    finally:
+        store.close()
+    if err_a or err_b:
+        print(f"campaign.py compare: {err_a or err_b}", file=sys.stderr)
+        return 2
+    ia, ib = _index(rows_a), _index(rows_b)
+    common = sorted(set(ia) & set(ib))
+    print(f"compare A = {rows_a[0]['source_commit'][:10]} ({len(ia)} missions) vs B = {rows_b[0]['source_commit'][:10]} "
+          f"({len(ib)} missions): {len(common)} missions in both, {len(set(ia) - set(ib))} only in A, "
+          f"{len(set(ib) - set(ia))} only in B")
+    print("each cell: A → B over the missions both ran (worst case: the minimum of a distance, the sum of a count, "
+          "the maximum of an error; median in brackets); ▼ a regression beyond the tolerance, ▲ an improvement")
+    regressions = _print_tables(common, ia, ib, campaign["profiles"] if campaign else None)
     print(f"\nregressions: {len(regressions)}" + (":\n" + "\n".join(f"  ▼ {r}" for r in regressions) if regressions else ""))
+    differing, worse = _worse_missions(common, ia, ib)
     print(f"\nmissions that differ in a safety figure: {differing} of {len(common)}; worse in B beyond the tolerance: "
-          f"{len(worse_list)}" + (f" (the {min(args.limit, len(worse_list))} worst):" if worse_list else ""))
-    worse_list.sort(key=lambda t: (not t[0], t[1], t[2]))
-    for new_violation, _, _, k, bad in worse_list[:args.limit]:
+          f"{len(worse)}" + (f" (the {min(args.limit, len(worse))} worst):" if worse else ""))
+    for new_violation, _, _, k, bad in worse[:args.limit]:
         what = ", ".join(f"{label} {_fmt(va)} → {_fmt(vb)}" for _, _, label, va, vb, _ in bad)
         print(f"  {os.path.basename(k[0])} {k[2]} seed {k[3]} config {k[1][:8]}: {what}"
               + ("  NEW SAFETY VIOLATION" if new_violation else ""))
