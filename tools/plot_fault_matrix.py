@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
-"""The fault matrix at a glance (docs/reliability.md): per fault profile, every mission's minimum
+"""The fault matrix at a glance (docs/results/reliability.md): per fault profile, every mission's minimum
 UAV–UAV distance, minimum obstacle distance and minimum UAV–worker distance as dots, with the
-median marked and the safety thresholds drawn. Reads the runs file of tools/run_fault_matrix.sh.
+median marked and the safety thresholds drawn. `tools/campaign.py report` calls draw() with the
+missions of the campaign store; the command line reads a CSV with the same columns.
 
   /opt/gesture_formation/venv/bin/python tools/plot_fault_matrix.py RUNS.csv OUT.png [PROFILE ...]
 """
@@ -26,6 +27,16 @@ def main(argv):
         return 2
     runs, out, profiles = argv[1], argv[2], argv[3:]
     rows = list(csv.DictReader(open(runs)))
+    try:
+        draw(rows, profiles, out, source=runs)
+    except ValueError as e:
+        print(f"plot_fault_matrix.py: {e}", file=sys.stderr)
+        return 2
+    return 0
+
+
+def draw(rows, profiles, out, source="the store"):
+    """rows: dicts with profile and the PANELS columns (numbers, numeric strings, None or "")."""
     if not profiles:
         profiles = list(dict.fromkeys(r["profile"] for r in rows))
     data = {}
@@ -34,17 +45,15 @@ def main(argv):
         for p in profiles:
             vals = []
             for r in rows:
-                if r["profile"] != p or r.get(col, "") == "":
+                if r["profile"] != p or r.get(col) is None or r.get(col) == "":
                     continue
                 try:
                     vals.append(float(r[col]))
                 except ValueError:
-                    print(f"plot_fault_matrix.py: {runs}: column {col}, profile {p}: not a number: {r[col]!r}",
-                          file=sys.stderr)
-                    return 2
+                    raise ValueError(f"{source}: column {col}, profile {p}: not a number: {r[col]!r}") from None
             per.append(vals)
         data[col] = per
-    n = len(rows)
+    n = sum(1 for r in rows if r["profile"] in profiles)
     fig, axes = plt.subplots(1, len(PANELS), figsize=(15, 0.42 * len(profiles) + 1.6), sharey=True)
     for ax, (col, title, thr, thr_label) in zip(axes, PANELS):
         for k, vals in enumerate(data[col]):
@@ -70,8 +79,8 @@ def main(argv):
                  "(dot: one mission; bar: median; number: the minimum)", fontsize=11)
     fig.tight_layout()
     fig.savefig(out, dpi=110)
+    plt.close(fig)
     print(f"wrote {out}")
-    return 0
 
 
 if __name__ == "__main__":

@@ -65,11 +65,13 @@ else
   echo "setup: all ${#PACKAGES[@]} Debian packages present"
 fi
 
-# --- tools venv: proxsuite (headers + CMake config), matplotlib, numpy ----------------
+# --- tools venv: proxsuite (headers + CMake config), matplotlib, numpy, Dask -----------
 # Debian's python3 (not a pyenv shim) so that the venv matches the system ROS Python.
 VENV="$GF_PREFIX/venv"
 STAMP="$VENV/.gf_requirements"
-REQS="proxsuite==$PROXSUITE_VERSION matplotlib==3.8.4 numpy==1.26.4 pyyaml==6.0.2 scipy==1.13.1"
+# dask[distributed] + dask-jobqueue: tools/campaign.py (docs/campaigns.md).
+PY_REQS=(matplotlib==3.8.4 numpy==1.26.4 pyyaml==6.0.2 scipy==1.13.1 "dask[distributed]==2026.8.0" dask-jobqueue==0.9.0)
+REQS="proxsuite==$PROXSUITE_VERSION ${PY_REQS[*]}"
 if [ ! -f "$STAMP" ] || [ "$(cat "$STAMP")" != "$REQS" ]; then
   echo "setup: creating tools venv in $VENV ($REQS)"
   $SUDO mkdir -p "$GF_PREFIX"
@@ -77,7 +79,7 @@ if [ ! -f "$STAMP" ] || [ "$(cat "$STAMP")" != "$REQS" ]; then
   $SUDO "$VENV/bin/pip" install -q --disable-pip-version-check --upgrade pip >/dev/null
   # --no-deps for proxsuite: we build against Debian's Eigen, not the cmeel-eigen wheel.
   $SUDO "$VENV/bin/pip" install -q --disable-pip-version-check --no-deps "proxsuite==$PROXSUITE_VERSION"
-  $SUDO "$VENV/bin/pip" install -q --disable-pip-version-check matplotlib==3.8.4 numpy==1.26.4 pyyaml==6.0.2 scipy==1.13.1
+  $SUDO "$VENV/bin/pip" install -q --disable-pip-version-check "${PY_REQS[@]}"
   echo "$REQS" | $SUDO tee "$STAMP" >/dev/null
 else
   echo "setup: tools venv up to date ($VENV)"
