@@ -84,7 +84,7 @@ void main() {
 const char* kSkyVertexShader = R"(#version 330 core
 void main() {
   vec2 p = vec2(gl_VertexID == 1 ? 3.0 : -1.0, gl_VertexID == 2 ? 3.0 : -1.0);
-  gl_Position = vec4(p, 0.0, 1.0);
+  gl_Position = vec4(p, 1.0, 1.0);  // on the far plane: drawn last, only where nothing else is
 }
 )";
 
@@ -244,6 +244,7 @@ struct Renderer::Impl {
   GpuMesh world, ground, uav, worker;
   std::shared_ptr<WorkerMesh> worker_mesh;
   bool worker_set = false;
+  cv::Mat rgba;  ///< read-back buffer, reused
   std::vector<Eigen::Isometry3d, Eigen::aligned_allocator<Eigen::Isometry3d>> uavs;
 
   bool makeCurrent() const { return eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, context) == EGL_TRUE; }
@@ -471,20 +472,11 @@ common::Result<RenderedFrame> Renderer::render(const CameraView& cam, std::optio
   glBindFramebuffer(GL_FRAMEBUFFER, m.fbo);
   glViewport(0, 0, k.width_px, k.height_px);
   glDisable(GL_CULL_FACE);
+  glClearDepth(1.0);
   glClear(GL_DEPTH_BUFFER_BIT);
-  // sky (every pixel), then the world with depth test
-  glDisable(GL_DEPTH_TEST);
-  glUseProgram(m.sky_program);
-  Eigen::Matrix3d Kinv = Eigen::Matrix3d::Identity();
-  Kinv(0, 0) = 1.0 / k.fx, Kinv(1, 1) = 1.0 / k.fy, Kinv(0, 2) = -k.cx / k.fx, Kinv(1, 2) = -k.cy / k.fy;
-  const Eigen::Matrix3f ray = (cam.T_world_camera.linear() * Kinv).cast<float>();
-  glUniformMatrix3fv(glGetUniformLocation(m.sky_program, "u_ray"), 1, GL_FALSE, ray.data());
-  const Eigen::Vector3f sun = m.config.sun_direction_world.normalized().cast<float>();
-  glUniform3fv(glGetUniformLocation(m.sky_program, "u_sun"), 1, sun.data());
-  glBindVertexArray(m.sky_vao);
-  glDrawArrays(GL_TRIANGLES, 0, 3);
+  // the world with depth test, then the sky where nothing was drawn (each pixel shaded once)
   glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_LESS);
+  glDepthFunc(GL_LEQUAL);
   glUseProgram(m.program);
   const Eigen::Matrix4d view = cam.T_world_camera.inverse().matrix();
   const Eigen::Matrix4d proj = projection(k, m.config.near_m, m.config.far_m);
@@ -503,14 +495,23 @@ common::Result<RenderedFrame> Renderer::render(const CameraView& cam, std::optio
     m.setUniforms(m.program, I, view, proj, 0, PixelClass::kWorker, eye);
     m.worker.draw();
   }
+  glUseProgram(m.sky_program);
+  Eigen::Matrix3d Kinv = Eigen::Matrix3d::Identity();
+  Kinv(0, 0) = 1.0 / k.fx, Kinv(1, 1) = 1.0 / k.fy, Kinv(0, 2) = -k.cx / k.fx, Kinv(1, 2) = -k.cy / k.fy;
+  const Eigen::Matrix3f ray = (cam.T_world_camera.linear() * Kinv).cast<float>();
+  glUniformMatrix3fv(glGetUniformLocation(m.sky_program, "u_ray"), 1, GL_FALSE, ray.data());
+  const Eigen::Vector3f sun = m.config.sun_direction_world.normalized().cast<float>();
+  glUniform3fv(glGetUniformLocation(m.sky_program, "u_sun"), 1, sun.data());
+  glBindVertexArray(m.sky_vao);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
   // read back
   RenderedFrame f;
-  f.rgb.create(k.height_px, k.width_px, CV_8UC3);
+  m.rgba.create(k.height_px, k.width_px, CV_8UC4);
   f.depth_m.create(k.height_px, k.width_px, CV_32FC1);
   f.classes.create(k.height_px, k.width_px, CV_8UC1);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   glReadBuffer(GL_COLOR_ATTACHMENT0);
-  glReadPixels(0, 0, k.width_px, k.height_px, GL_RGB, GL_UNSIGNED_BYTE, f.rgb.data);
+  glReadPixels(0, 0, k.width_px, k.height_px, GL_RGBA, GL_UNSIGNED_BYTE, m.rgba.data);  // RGBA: the fast path
   glReadBuffer(GL_COLOR_ATTACHMENT1);
   glReadPixels(0, 0, k.width_px, k.height_px, GL_RED, GL_FLOAT, f.depth_m.data);
   glReadBuffer(GL_COLOR_ATTACHMENT2);
@@ -521,6 +522,7 @@ common::Result<RenderedFrame> Renderer::render(const CameraView& cam, std::optio
     s << "OpenGL error 0x" << std::hex << err << " while rendering";
     return R::fail(s.str());
   }
+  cv::cvtColor(m.rgba, f.rgb, cv::COLOR_RGBA2RGB);
   f.worker = m.truth(cam, f);
   return R::ok(std::move(f));
 }
