@@ -55,7 +55,11 @@ uniform vec3 u_eye;        // camera centre, world
 layout(location = 0) out vec4 o_colour;
 layout(location = 1) out float o_depth;
 layout(location = 2) out float o_class;
-float hash(vec2 p) { return fract(sin(dot(p, vec2(127.1, 311.7))) * 43758.5453); }
+float hash(vec2 p) {                 // sine-free hash (cheap on llvmpipe)
+  vec3 q = fract(vec3(p.xyx) * 0.1031);
+  q += dot(q, q.yzx + 33.33);
+  return fract((q.x + q.y) * q.z);
+}
 float noise(vec2 p) {
   vec2 i = floor(p), f = fract(p);
   vec2 u = f * f * (3.0 - 2.0 * f);
@@ -67,11 +71,11 @@ void main() {
   if (dot(n, to_eye) < 0.0) n = -n;   // two-sided
   vec3 base = v_colour;
   if (u_material == 1) {               // grass and gravel patches, 0.3 m and 4 m scales
-    float big = noise(v_world.xy * 0.25), small = noise(v_world.xy * 3.0), fine = noise(v_world.xy * 17.0);
+    float big = noise(v_world.xy * 0.25), small = noise(v_world.xy * 3.0), fine = hash(floor(v_world.xy * 17.0));
     vec3 grass = vec3(0.30, 0.42, 0.18), dry = vec3(0.52, 0.50, 0.34), gravel = vec3(0.48, 0.46, 0.43);
     base = mix(grass, dry, smoothstep(0.35, 0.75, big));
     base = mix(base, gravel, smoothstep(0.72, 0.9, noise(v_world.xy * 0.07 + 7.0)));
-    base *= 0.80 + 0.25 * small + 0.12 * (fine - 0.5);
+    base *= 0.80 + 0.25 * small + 0.10 * (fine - 0.5);
   }
   float diffuse = max(dot(n, u_sun), 0.0);
   vec3 lit = base * (0.45 + 0.65 * diffuse) + 0.06 * pow(max(dot(reflect(-u_sun, n), to_eye), 0.0), 16.0);
