@@ -33,6 +33,7 @@ const Registrar kRegistrar{
     cmdRender};
 
 using Eigen::Vector3d;
+constexpr int kExitNoRenderer = 1;  ///< no EGL display or OpenGL 3.3 context here
 using Poses = std::vector<Eigen::Isometry3d, Eigen::aligned_allocator<Eigen::Isometry3d>>;
 
 std::string modelsRoot(const Args& args) {
@@ -186,9 +187,10 @@ int cmdRender(const Args& args) {
   render::RendererConfig rc;
   rc.worker_asset_path = modelsRoot(args) + "/mannequin/wooden_mannequin.glb";
   auto renderer = render::Renderer::create(rc);
-  if (!renderer) {
+  if (!renderer && renderer.reason().rfind("worker asset", 0) == 0) return badInput(args, renderer.reason());
+  if (!renderer) {  // no EGL display / OpenGL context: not the input's fault
     std::cerr << "gfctl render: " << renderer.reason() << "\n";
-    return 1;
+    return kExitNoRenderer;
   }
   auto r = (*renderer)->setWorld(*scenario);
   if (r) r = (*renderer)->setWorker(joints, m.worker.height_m, look);
