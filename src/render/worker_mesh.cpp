@@ -402,6 +402,7 @@ common::Result<bool> WorkerMesh::pose(const WorkerJoints& t, double height_m) {
     const Vector3d a_rest = rj(L ? kLElbow : kRElbow) - rj(L ? kLShoulder : kRShoulder);
     limb(L ? kLShoulder : kRShoulder, L ? kLElbow : kRElbow, L ? kLWrist : kRWrist, L ? kLCollar : kRCollar, a_arm, f_arm,
          a_rest.normalized().cross(Vector3d::UnitX()).normalized(), Vector3d::Zero());
+    setG(L ? kLWrist : kRWrist, getG(L ? kLElbow : kRElbow));  // the hand continues the forearm
   }
   // hands and fingers follow the forearm
   for (int j : m.order) {
