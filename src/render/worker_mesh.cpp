@@ -43,6 +43,17 @@ Matrix3d frameXZ(const Vector3d& a, const Vector3d& b) {
   return F;
 }
 
+/// Orthonormal frame with z along `up` and x along the part of `lateral` orthogonal to it.
+Matrix3d frameUp(const Vector3d& up, const Vector3d& lateral) {
+  const Vector3d z = up.normalized();
+  const Vector3d x = (lateral - lateral.dot(z) * z).normalized();
+  Matrix3d F;
+  F.col(0) = x;
+  F.col(1) = z.cross(x);
+  F.col(2) = z;
+  return F;
+}
+
 Matrix3d slerp(const Matrix3d& a, const Matrix3d& b, double t) {
   return Quaterniond(a).slerp(t, Quaterniond(b)).toRotationMatrix();
 }
@@ -352,13 +363,14 @@ common::Result<bool> WorkerMesh::pose(const WorkerJoints& t, double height_m) {
   // trunk
   const Vector3d hip_mid_t = 0.5 * (T(g::kLeftHip) + T(g::kRightHip)), sh_mid_t = 0.5 * (T(g::kLeftShoulder) + T(g::kRightShoulder));
   const Vector3d hip_mid_r = 0.5 * (rj(kLHip) + rj(kRHip)), sh_mid_r = 0.5 * (rj(kLShoulder) + rj(kRShoulder));
-  const Matrix3d G_pelvis = frameXZ(T(g::kLeftHip) - T(g::kRightHip), sh_mid_t - hip_mid_t) *
-                            frameXZ(rj(kLHip) - rj(kRHip), sh_mid_r - hip_mid_r).transpose();
-  const Matrix3d G_chest = frameXZ(T(g::kLeftShoulder) - T(g::kRightShoulder), sh_mid_t - hip_mid_t) *
-                           frameXZ(rj(kLShoulder) - rj(kRShoulder), sh_mid_r - hip_mid_r).transpose();
+  // the trunk axis (hip centre → shoulder centre) exactly, the hip / shoulder line as near as it allows
+  const Matrix3d G_pelvis = frameUp(sh_mid_t - hip_mid_t, T(g::kLeftHip) - T(g::kRightHip)) *
+                            frameUp(sh_mid_r - hip_mid_r, rj(kLHip) - rj(kRHip)).transpose();
+  const Matrix3d G_chest = frameUp(sh_mid_t - hip_mid_t, T(g::kLeftShoulder) - T(g::kRightShoulder)) *
+                           frameUp(sh_mid_r - hip_mid_r, rj(kLShoulder) - rj(kRShoulder)).transpose();
   const Vector3d ear_mid_t = 0.5 * (T(g::kLeftEar) + T(g::kRightEar)), ear_mid_r = 0.5 * (rv(m.v_ear_l) + rv(m.v_ear_r));
-  const Matrix3d G_head = frameXZ(T(g::kLeftEar) - T(g::kRightEar), t.head_top_world - ear_mid_t) *
-                          frameXZ(rv(m.v_ear_l) - rv(m.v_ear_r), rv(m.v_head_top) - ear_mid_r).transpose();
+  const Matrix3d G_head = frameUp(t.head_top_world - ear_mid_t, T(g::kLeftEar) - T(g::kRightEar)) *
+                          frameUp(rv(m.v_head_top) - ear_mid_r, rv(m.v_ear_l) - rv(m.v_ear_r)).transpose();
   for (auto& G : m.G) G = G_pelvis;  // joints not set below follow the pelvis
   setG(kPelvis, G_pelvis);
   setG(kSpine1, slerp(G_pelvis, G_chest, 1.0 / 3.0));

@@ -224,3 +224,64 @@ TEST(WorkerMeshTest, LoadsTheSkinnedMannequin) {
 }
 
 }  // namespace
+
+namespace {
+
+double angleDeg(const Vector3d& a, const Vector3d& b) {
+  return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) * 180.0 / M_PI;
+}
+
+class WorkerPoseTest : public ::testing::TestWithParam<int> {};
+
+// Every limb bone of the posed mannequin points where the worker model's bone points, its hip
+// centre sits over the model's, its lower ankle at the model's height, for every motion of the
+// worker model (pose at full progress). Needs no GL.
+TEST_P(WorkerPoseTest, PosedBonesPointWhereTheModelsBonesPoint) {
+  const auto motion = static_cast<gg::Motion>(GetParam());
+  auto mesh = gr::WorkerMesh::load(assetPath());
+  ASSERT_TRUE(mesh) << mesh.reason();
+  gg::SynthConfig sc;
+  sc.height_min_m = sc.height_max_m = 1.78;
+  gg::SkeletonSynthesizer synth(sc, 11);
+  synth.generate(motion);
+  const auto model = gr::WorkerJoints::fromBody(synth.pose(motion, 1.0, 0.7, true), Vector3d(3.0, -2.0, 0.5), 0.8);
+  ASSERT_OK((*mesh)->pose(model, 1.78));
+  const auto& posed = (*mesh)->keypoints().p_world;
+  const auto& m = model.p_world;
+  const std::array<std::pair<int, int>, 8> bones{{{gg::kLeftShoulder, gg::kLeftElbow}, {gg::kLeftElbow, gg::kLeftWrist},
+                                                  {gg::kRightShoulder, gg::kRightElbow}, {gg::kRightElbow, gg::kRightWrist},
+                                                  {gg::kLeftHip, gg::kLeftKnee}, {gg::kLeftKnee, gg::kLeftAnkle},
+                                                  {gg::kRightHip, gg::kRightKnee}, {gg::kRightKnee, gg::kRightAnkle}}};
+  for (const auto& [a, b] : bones) {
+    EXPECT_LT(angleDeg(posed[b] - posed[a], m[b] - m[a]), 1.0) << gg::toString(motion) << ": bone " << a << "-" << b;
+  }
+  const Vector3d hips_posed = 0.5 * (posed[gg::kLeftHip] + posed[gg::kRightHip]), hips_model = 0.5 * (m[gg::kLeftHip] + m[gg::kRightHip]);
+  EXPECT_LT((hips_posed - hips_model).head<2>().norm(), 1e-6);
+  EXPECT_NEAR(std::min(posed[gg::kLeftAnkle].z(), posed[gg::kRightAnkle].z()),
+              std::min(m[gg::kLeftAnkle].z(), m[gg::kRightAnkle].z()), 1e-6);
+  const Vector3d trunk_posed = 0.5 * (posed[gg::kLeftShoulder] + posed[gg::kRightShoulder]) - hips_posed;
+  const Vector3d trunk_model = 0.5 * (m[gg::kLeftShoulder] + m[gg::kRightShoulder]) - hips_model;
+  EXPECT_LT(angleDeg(trunk_posed, trunk_model), 10.0) << gg::toString(motion);
+  // the face looks where the model's face looks (nose in front of the ears)
+  const Vector3d ears_posed = 0.5 * (posed[gg::kLeftEar] + posed[gg::kRightEar]), ears_model = 0.5 * (m[gg::kLeftEar] + m[gg::kRightEar]);
+  EXPECT_LT(angleDeg((posed[gg::kNose] - ears_posed).head<2>().homogeneous(), (m[gg::kNose] - ears_model).head<2>().homogeneous()), 45.0);
+}
+INSTANTIATE_TEST_SUITE_P(AllMotions, WorkerPoseTest, ::testing::Range(0, static_cast<int>(gg::Motion::kCount)),
+                         [](const auto& info) { return std::string(gg::toString(static_cast<gg::Motion>(info.param))); });
+
+// The hand continues the forearm: with the arm raised, the mesh reaches a hand's length above the wrist.
+TEST(WorkerPoseHandTest, RaisedHandReachesAboveTheWrist) {
+  auto mesh = gr::WorkerMesh::load(assetPath());
+  ASSERT_TRUE(mesh) << mesh.reason();
+  gg::SynthConfig sc;
+  sc.height_min_m = sc.height_max_m = 1.78;
+  gg::SkeletonSynthesizer synth(sc, 3);
+  synth.generate(gg::Motion::kRaiseArmUp);
+  ASSERT_OK((*mesh)->pose(gr::WorkerJoints::fromBody(synth.pose(gg::Motion::kRaiseArmUp, 1.0, 0.0, true), Vector3d::Zero(), 0.0), 1.78));
+  double top = -1e9;
+  for (const auto& v : (*mesh)->mesh().vertices) top = std::max(top, static_cast<double>(v.p[2]));
+  const double wrist = std::max((*mesh)->keypoints().p_world[gg::kLeftWrist].z(), (*mesh)->keypoints().p_world[gg::kRightWrist].z());
+  EXPECT_GT(top - wrist, 0.12) << "highest vertex " << top << " m, raised wrist " << wrist << " m";
+}
+
+}  // namespace
