@@ -345,6 +345,173 @@ void WorkerMesh::dress(const Appearance& a) {
   }
 }
 
+namespace {
+
+/// The stages of WorkerMesh::pose on one asset, one set of model joints and one scale: joint
+/// rotations (trunk, limbs, the joints that follow), forward kinematics with placement, skinning.
+class Poser {
+ public:
+  Poser(WorkerMesh::Impl& m, const std::vector<Vector3d>& bind_body, const WorkerJoints& t, double scale)
+      : m_(m), bind_(bind_body), t_(t), s_(scale) {}
+
+  void rotations() {
+    trunk();
+    for (bool left : {true, false}) {
+      leg(left);
+      arm(left);
+    }
+    hands();
+  }
+
+  /// Joint positions from the rotations; pelvis over the model's hip centre, lower ankle at its height.
+  void forwardKinematics() {
+    for (int j : m_.order) {
+      const auto ju = static_cast<std::size_t>(j);
+      const int p = m_.parent[ju];
+      const auto pu = static_cast<std::size_t>(p);
+      m_.P[ju] = p < 0 ? Vector3d::Zero() : Vector3d(m_.P[pu] + m_.G[pu] * (s_ * (bind_[ju] - bind_[pu])));
+    }
+    Vector3d shift = 0.5 * (T(g::kLeftHip) + T(g::kRightHip)) - 0.5 * (P(kLHip) + P(kRHip));
+    shift.z() = std::min(T(g::kLeftAnkle).z(), T(g::kRightAnkle).z()) - std::min(P(kLAnkle).z(), P(kRAnkle).z());
+    for (auto& p : m_.P) p += shift;
+  }
+
+  /// Linear blend skinning of positions and normals into `out`; returns the skinned positions.
+  std::vector<Vector3d> skin(TriangleMesh& out) const {
+    const std::size_t nv = m_.rest_p.size();
+    out.vertices.resize(nv);
+    std::vector<Vector3d> skinned(nv);
+    for (std::size_t i = 0; i < nv; ++i) {
+      Vector3d p = Vector3d::Zero(), n = Vector3d::Zero();
+      for (std::size_t k = 0; k < 4; ++k) {
+        const float wk = m_.vw[i][k];
+        if (wk == 0.0f) continue;
+        const auto j = static_cast<std::size_t>(m_.vj[i][k]);
+        p += wk * (m_.G[j] * (s_ * (m_.rest_p[i] - bind_[j])) + m_.P[j]);
+        n += wk * (m_.G[j] * m_.rest_n[i]);
+      }
+      n.normalize();
+      skinned[i] = p;
+      Vertex& v = out.vertices[i];
+      for (int c = 0; c < 3; ++c) {
+        v.p[c] = static_cast<float>(p[c]);
+        v.n[c] = static_cast<float>(n[c]);
+        v.c[c] = static_cast<float>(m_.colours[i][c]);
+      }
+    }
+    if (out.indices.size() != m_.indices.size()) out.indices = m_.indices;
+    return skinned;
+  }
+
+  /// Truth keypoints: the mesh's joints, and skinned face points.
+  void keypoints(const std::vector<Vector3d>& skinned, PosedKeypoints& kp) const {
+    kp.on_surface.fill(false);
+    const std::array<std::pair<int, int>, 12> joints{{{g::kLeftShoulder, kLShoulder}, {g::kRightShoulder, kRShoulder},
+                                                      {g::kLeftElbow, kLElbow},       {g::kRightElbow, kRElbow},
+                                                      {g::kLeftWrist, kLWrist},       {g::kRightWrist, kRWrist},
+                                                      {g::kLeftHip, kLHip},           {g::kRightHip, kRHip},
+                                                      {g::kLeftKnee, kLKnee},         {g::kRightKnee, kRKnee},
+                                                      {g::kLeftAnkle, kLAnkle},       {g::kRightAnkle, kRAnkle}}};
+    for (const auto& [coco, joint] : joints) kp.p_world[static_cast<std::size_t>(coco)] = P(joint);
+    const std::array<std::pair<int, int>, 5> face{{{g::kNose, m_.v_nose}, {g::kLeftEye, m_.v_eye_l}, {g::kRightEye, m_.v_eye_r},
+                                                   {g::kLeftEar, m_.v_ear_l}, {g::kRightEar, m_.v_ear_r}}};
+    for (const auto& [coco, v] : face) {
+      kp.p_world[static_cast<std::size_t>(coco)] = skinned[static_cast<std::size_t>(v)];
+      kp.on_surface[static_cast<std::size_t>(coco)] = true;
+    }
+  }
+
+ private:
+  std::size_t idx(int k) const { return static_cast<std::size_t>(m_.named[static_cast<std::size_t>(k)]); }
+  Vector3d rj(int k) const { return s_ * bind_[idx(k)]; }  ///< rest joint, scaled
+  Vector3d rv(int v) const { return s_ * m_.rest_p[static_cast<std::size_t>(v)]; }  ///< rest vertex, scaled
+  const Vector3d& T(int coco) const { return t_.p_world[static_cast<std::size_t>(coco)]; }
+  const Vector3d& P(int k) const { return m_.P[idx(k)]; }
+  void setG(int k, const Matrix3d& R) { m_.G[idx(k)] = R; }
+  const Matrix3d& G(int k) const { return m_.G[idx(k)]; }
+
+  /// Pelvis, spine, collars, neck, head: the trunk axis (hip centre → shoulder centre) and the
+  /// head axis (ear centre → head top) exactly, the hip / shoulder / ear lines as near as they allow.
+  void trunk() {
+    const Vector3d hip_t = 0.5 * (T(g::kLeftHip) + T(g::kRightHip)), sh_t = 0.5 * (T(g::kLeftShoulder) + T(g::kRightShoulder));
+    const Vector3d hip_r = 0.5 * (rj(kLHip) + rj(kRHip)), sh_r = 0.5 * (rj(kLShoulder) + rj(kRShoulder));
+    pelvis_ = frameUp(sh_t - hip_t, T(g::kLeftHip) - T(g::kRightHip)) * frameUp(sh_r - hip_r, rj(kLHip) - rj(kRHip)).transpose();
+    const Matrix3d chest = frameUp(sh_t - hip_t, T(g::kLeftShoulder) - T(g::kRightShoulder)) *
+                           frameUp(sh_r - hip_r, rj(kLShoulder) - rj(kRShoulder)).transpose();
+    const Vector3d ear_t = 0.5 * (T(g::kLeftEar) + T(g::kRightEar)), ear_r = 0.5 * (rv(m_.v_ear_l) + rv(m_.v_ear_r));
+    const Matrix3d head = frameUp(t_.head_top_world - ear_t, T(g::kLeftEar) - T(g::kRightEar)) *
+                          frameUp(rv(m_.v_head_top) - ear_r, rv(m_.v_ear_l) - rv(m_.v_ear_r)).transpose();
+    for (auto& R : m_.G) R = pelvis_;  // joints not set below follow the pelvis
+    setG(kSpine1, slerp(pelvis_, chest, 1.0 / 3.0));
+    setG(kSpine2, slerp(pelvis_, chest, 2.0 / 3.0));
+    for (int k : {kSpine3, kLCollar, kRCollar}) setG(k, chest);
+    setG(kNeck, slerp(chest, head, 0.5));
+    setG(kHead, head);
+  }
+
+  /// The upper bone turned onto `a_t` in its bend plane (normal `n_rest` at rest; `n_fallback`
+  /// when the limb is straight, or a pure swing from the parent when that is zero), the lower
+  /// bone by the remaining swing onto `f_t`.
+  void limb(int upper, int lower, int end, int parent, const Vector3d& a_t, const Vector3d& f_t, const Vector3d& n_rest,
+            const Vector3d& n_fallback) {
+    const Vector3d a_r = rj(lower) - rj(upper), f_r = rj(end) - rj(lower);
+    const Matrix3d Gp = G(parent);
+    const Matrix3d G_swing = swing(Gp * a_r, a_t) * Gp;
+    const Vector3d bend = a_t.normalized().cross(f_t.normalized());
+    const double sin_bend = bend.norm();
+    const bool has_fallback = n_fallback.squaredNorm() > 0.0;
+    Matrix3d G_up = G_swing;
+    if (sin_bend > 1e-6 || has_fallback) {
+      const Vector3d n_t = sin_bend > 1e-6 ? Vector3d(bend / sin_bend) : n_fallback;
+      const Matrix3d G_hinge = frameXZ(a_t, n_t) * frameXZ(a_r, n_rest).transpose();
+      const double w = has_fallback ? 1.0 : std::clamp((sin_bend - 0.05) / 0.15, 0.0, 1.0);
+      G_up = slerp(G_swing, G_hinge, w);
+    }
+    setG(upper, G_up);
+    setG(lower, swing(G_up * f_r, f_t) * G_up);
+  }
+
+  /// Legs: the knee bends about the lateral axis (rest: straight legs); feet follow the pelvis.
+  void leg(bool L) {
+    const Vector3d lateral = pelvis_ * Vector3d::UnitY();
+    const Vector3d a = T(L ? g::kLeftKnee : g::kRightKnee) - T(L ? g::kLeftHip : g::kRightHip);
+    const Vector3d f = T(L ? g::kLeftAnkle : g::kRightAnkle) - T(L ? g::kLeftKnee : g::kRightKnee);
+    Vector3d n = a.normalized().cross(f.normalized());
+    if (n.norm() < 0.05 || n.dot(lateral) < 0.0) n = lateral;
+    limb(L ? kLHip : kRHip, L ? kLKnee : kRKnee, L ? kLAnkle : kRAnkle, kPelvis, a, f, Vector3d::UnitY(), n.normalized());
+    for (int k : {L ? kLAnkle : kRAnkle, L ? kLFoot : kRFoot}) setG(k, pelvis_);
+  }
+
+  /// Arms: rest T-pose, the elbow bends the forearm forward; the hand continues the forearm.
+  void arm(bool L) {
+    const Vector3d a = T(L ? g::kLeftElbow : g::kRightElbow) - T(L ? g::kLeftShoulder : g::kRightShoulder);
+    const Vector3d f = T(L ? g::kLeftWrist : g::kRightWrist) - T(L ? g::kLeftElbow : g::kRightElbow);
+    const Vector3d a_rest = rj(L ? kLElbow : kRElbow) - rj(L ? kLShoulder : kRShoulder);
+    limb(L ? kLShoulder : kRShoulder, L ? kLElbow : kRElbow, L ? kLWrist : kRWrist, L ? kLCollar : kRCollar, a, f,
+         a_rest.normalized().cross(Vector3d::UnitX()).normalized(), Vector3d::Zero());
+    setG(L ? kLWrist : kRWrist, G(L ? kLElbow : kRElbow));
+  }
+
+  /// Hands and fingers (the joints the posing does not drive) follow their parent.
+  void hands() {
+    for (int j : m_.order) {
+      const auto ju = static_cast<std::size_t>(j);
+      if (m_.parent[ju] < 0) continue;
+      const std::string& name = m_.joint_names[ju];
+      const bool driven = std::find(kJointNames.begin(), kJointNames.end(), name) != kJointNames.end();
+      if (!driven && (name.rfind("L_", 0) == 0 || name.rfind("R_", 0) == 0)) m_.G[ju] = m_.G[static_cast<std::size_t>(m_.parent[ju])];
+    }
+  }
+
+  WorkerMesh::Impl& m_;
+  const std::vector<Vector3d>& bind_;
+  const WorkerJoints& t_;
+  double s_;
+  Matrix3d pelvis_ = Matrix3d::Identity();
+};
+
+}  // namespace
+
 common::Result<bool> WorkerMesh::pose(const WorkerJoints& t, double height_m) {
   using R = common::Result<bool>;
   if (!(height_m >= 1.0 && height_m <= 2.3)) return R::fail("worker height_m must be in [1.0, 2.3], got " + std::to_string(height_m));
@@ -352,130 +519,10 @@ common::Result<bool> WorkerMesh::pose(const WorkerJoints& t, double height_m) {
     if (!p.allFinite()) return R::fail("worker joints: a keypoint is not finite");
   }
   if (!t.head_top_world.allFinite()) return R::fail("worker joints: head_top is not finite");
-  Impl& m = *impl_;
-  const double s = height_m / rest_height_m_;
-  auto rj = [&](int k) -> Vector3d { return s * bind_body_[static_cast<std::size_t>(m.named[static_cast<std::size_t>(k)])]; };
-  auto rv = [&](int v) -> Vector3d { return s * m.rest_p[static_cast<std::size_t>(v)]; };
-  auto T = [&](int k) -> const Vector3d& { return t.p_world[static_cast<std::size_t>(k)]; };
-  auto setG = [&](int k, const Matrix3d& R) { m.G[static_cast<std::size_t>(m.named[static_cast<std::size_t>(k)])] = R; };
-  auto getG = [&](int k) -> const Matrix3d& { return m.G[static_cast<std::size_t>(m.named[static_cast<std::size_t>(k)])]; };
-
-  // trunk
-  const Vector3d hip_mid_t = 0.5 * (T(g::kLeftHip) + T(g::kRightHip)), sh_mid_t = 0.5 * (T(g::kLeftShoulder) + T(g::kRightShoulder));
-  const Vector3d hip_mid_r = 0.5 * (rj(kLHip) + rj(kRHip)), sh_mid_r = 0.5 * (rj(kLShoulder) + rj(kRShoulder));
-  // the trunk axis (hip centre → shoulder centre) exactly, the hip / shoulder line as near as it allows
-  const Matrix3d G_pelvis = frameUp(sh_mid_t - hip_mid_t, T(g::kLeftHip) - T(g::kRightHip)) *
-                            frameUp(sh_mid_r - hip_mid_r, rj(kLHip) - rj(kRHip)).transpose();
-  const Matrix3d G_chest = frameUp(sh_mid_t - hip_mid_t, T(g::kLeftShoulder) - T(g::kRightShoulder)) *
-                           frameUp(sh_mid_r - hip_mid_r, rj(kLShoulder) - rj(kRShoulder)).transpose();
-  const Vector3d ear_mid_t = 0.5 * (T(g::kLeftEar) + T(g::kRightEar)), ear_mid_r = 0.5 * (rv(m.v_ear_l) + rv(m.v_ear_r));
-  const Matrix3d G_head = frameUp(t.head_top_world - ear_mid_t, T(g::kLeftEar) - T(g::kRightEar)) *
-                          frameUp(rv(m.v_head_top) - ear_mid_r, rv(m.v_ear_l) - rv(m.v_ear_r)).transpose();
-  for (auto& G : m.G) G = G_pelvis;  // joints not set below follow the pelvis
-  setG(kPelvis, G_pelvis);
-  setG(kSpine1, slerp(G_pelvis, G_chest, 1.0 / 3.0));
-  setG(kSpine2, slerp(G_pelvis, G_chest, 2.0 / 3.0));
-  for (int k : {kSpine3, kLCollar, kRCollar}) setG(k, G_chest);
-  setG(kNeck, slerp(G_chest, G_head, 0.5));
-  setG(kHead, G_head);
-
-  // limbs: upper bone with its bend plane, lower bone by the remaining swing
-  auto limb = [&](int upper, int lower, int end, int parent, const Vector3d& a_t, const Vector3d& f_t, const Vector3d& n_rest,
-                  const Vector3d& n_fallback) {
-    const Vector3d a_r = rj(lower) - rj(upper), f_r = rj(end) - rj(lower);
-    const Matrix3d Gp = getG(parent);
-    const Matrix3d G_swing = swing(Gp * a_r, a_t) * Gp;
-    const Vector3d bend = a_t.normalized().cross(f_t.normalized());
-    Matrix3d G_up = G_swing;
-    const double sin_bend = bend.norm();
-    const Vector3d n_t = sin_bend > 1e-6 ? Vector3d(bend / sin_bend) : n_fallback;
-    if (sin_bend > 1e-6 || n_fallback.squaredNorm() > 0.0) {
-      const Matrix3d G_hinge = frameXZ(a_t, n_t) * frameXZ(a_r, n_rest).transpose();
-      const double wgt = n_fallback.squaredNorm() > 0.0 ? 1.0 : std::clamp((sin_bend - 0.05) / 0.15, 0.0, 1.0);
-      G_up = slerp(G_swing, G_hinge, wgt);
-    }
-    setG(upper, G_up);
-    setG(lower, swing(G_up * f_r, f_t) * G_up);
-  };
-  const Vector3d lateral = G_pelvis * Vector3d::UnitY();
-  for (int side = 0; side < 2; ++side) {
-    const bool L = side == 0;
-    // legs: the knee bends about the lateral axis (rest: straight legs)
-    const Vector3d a_leg = T(L ? g::kLeftKnee : g::kRightKnee) - T(L ? g::kLeftHip : g::kRightHip);
-    const Vector3d f_leg = T(L ? g::kLeftAnkle : g::kRightAnkle) - T(L ? g::kLeftKnee : g::kRightKnee);
-    Vector3d n_leg = a_leg.normalized().cross(f_leg.normalized());
-    if (n_leg.norm() < 0.05 || n_leg.dot(lateral) < 0.0) n_leg = lateral;
-    limb(L ? kLHip : kRHip, L ? kLKnee : kRKnee, L ? kLAnkle : kRAnkle, kPelvis, a_leg, f_leg, Vector3d::UnitY(),
-         n_leg.normalized());
-    for (int k : {L ? kLAnkle : kRAnkle, L ? kLFoot : kRFoot}) setG(k, G_pelvis);
-    // arms: rest T-pose, the elbow bends the forearm forward
-    const Vector3d a_arm = T(L ? g::kLeftElbow : g::kRightElbow) - T(L ? g::kLeftShoulder : g::kRightShoulder);
-    const Vector3d f_arm = T(L ? g::kLeftWrist : g::kRightWrist) - T(L ? g::kLeftElbow : g::kRightElbow);
-    const Vector3d a_rest = rj(L ? kLElbow : kRElbow) - rj(L ? kLShoulder : kRShoulder);
-    limb(L ? kLShoulder : kRShoulder, L ? kLElbow : kRElbow, L ? kLWrist : kRWrist, L ? kLCollar : kRCollar, a_arm, f_arm,
-         a_rest.normalized().cross(Vector3d::UnitX()).normalized(), Vector3d::Zero());
-    setG(L ? kLWrist : kRWrist, getG(L ? kLElbow : kRElbow));  // the hand continues the forearm
-  }
-  // hands and fingers follow the forearm
-  for (int j : m.order) {
-    const int p = m.parent[static_cast<std::size_t>(j)];
-    if (p < 0) continue;
-    const std::string& name = m.joint_names[static_cast<std::size_t>(j)];
-    const bool driven = std::find(kJointNames.begin(), kJointNames.end(), name) != kJointNames.end();
-    if (!driven && (name.rfind("L_", 0) == 0 || name.rfind("R_", 0) == 0)) m.G[static_cast<std::size_t>(j)] = m.G[static_cast<std::size_t>(p)];
-  }
-  // forward kinematics, then place: pelvis over the hip centre, lower ankle at the model's
-  for (int j : m.order) {
-    const int p = m.parent[static_cast<std::size_t>(j)];
-    const auto ju = static_cast<std::size_t>(j);
-    m.P[ju] = p < 0 ? Vector3d::Zero()
-                    : Vector3d(m.P[static_cast<std::size_t>(p)] + m.G[static_cast<std::size_t>(p)] * (s * (bind_body_[ju] - bind_body_[static_cast<std::size_t>(p)])));
-  }
-  auto P = [&](int k) -> Vector3d& { return m.P[static_cast<std::size_t>(m.named[static_cast<std::size_t>(k)])]; };
-  Vector3d shift = hip_mid_t - 0.5 * (P(kLHip) + P(kRHip));
-  shift.z() = std::min(T(g::kLeftAnkle).z(), T(g::kRightAnkle).z()) - std::min(P(kLAnkle).z(), P(kRAnkle).z());
-  for (auto& p : m.P) p += shift;
-
-  // linear blend skinning
-  const std::size_t nv = m.rest_p.size();
-  posed_.vertices.resize(nv);
-  std::vector<Vector3d> skinned(nv);
-  for (std::size_t i = 0; i < nv; ++i) {
-    Vector3d p = Vector3d::Zero(), n = Vector3d::Zero();
-    for (int k = 0; k < 4; ++k) {
-      const float wk = m.vw[i][static_cast<std::size_t>(k)];
-      if (wk == 0.0f) continue;
-      const auto j = static_cast<std::size_t>(m.vj[i][static_cast<std::size_t>(k)]);
-      p += wk * (m.G[j] * (s * (m.rest_p[i] - bind_body_[j])) + m.P[j]);
-      n += wk * (m.G[j] * m.rest_n[i]);
-    }
-    n.normalize();
-    skinned[i] = p;
-    Vertex& v = posed_.vertices[i];
-    for (int k = 0; k < 3; ++k) {
-      v.p[k] = static_cast<float>(p[k]);
-      v.n[k] = static_cast<float>(n[k]);
-      v.c[k] = static_cast<float>(m.colours[i][k]);
-    }
-  }
-  if (posed_.indices.size() != m.indices.size()) posed_.indices = m.indices;
-
-  // truth keypoints of the posed mesh
-  auto& kp = keypoints_;
-  kp.on_surface.fill(false);
-  const std::array<std::pair<int, int>, 12> joints{{{g::kLeftShoulder, kLShoulder}, {g::kRightShoulder, kRShoulder},
-                                                    {g::kLeftElbow, kLElbow},       {g::kRightElbow, kRElbow},
-                                                    {g::kLeftWrist, kLWrist},       {g::kRightWrist, kRWrist},
-                                                    {g::kLeftHip, kLHip},           {g::kRightHip, kRHip},
-                                                    {g::kLeftKnee, kLKnee},         {g::kRightKnee, kRKnee},
-                                                    {g::kLeftAnkle, kLAnkle},       {g::kRightAnkle, kRAnkle}}};
-  for (const auto& [coco, joint] : joints) kp.p_world[static_cast<std::size_t>(coco)] = P(joint);
-  const std::array<std::pair<int, int>, 5> face{{{g::kNose, m.v_nose}, {g::kLeftEye, m.v_eye_l}, {g::kRightEye, m.v_eye_r},
-                                                 {g::kLeftEar, m.v_ear_l}, {g::kRightEar, m.v_ear_r}}};
-  for (const auto& [coco, v] : face) {
-    kp.p_world[static_cast<std::size_t>(coco)] = skinned[static_cast<std::size_t>(v)];
-    kp.on_surface[static_cast<std::size_t>(coco)] = true;
-  }
+  Poser poser(*impl_, bind_body_, t, height_m / rest_height_m_);
+  poser.rotations();
+  poser.forwardKinematics();
+  poser.keypoints(poser.skin(posed_), keypoints_);
   return R::ok(true);
 }
 
