@@ -258,6 +258,8 @@ struct Renderer::Impl {
   void setUniforms(GLuint prog, const Eigen::Matrix4d& model, const Eigen::Matrix4d& view, const Eigen::Matrix4d& proj,
                    int material, PixelClass cls, const Vector3d& eye) const;
   WorkerTruth truth(const CameraView& cam, const RenderedFrame& f) const;
+  void drawScene(const CameraView& cam, std::optional<std::size_t> skip_uav);
+  void readBack(int width, int height, RenderedFrame& f);
   ~Impl() {
     if (display == EGL_NO_DISPLAY) return;
     if (context != EGL_NO_CONTEXT && makeCurrent()) {
@@ -462,6 +464,59 @@ WorkerTruth Renderer::Impl::truth(const CameraView& cam, const RenderedFrame& f)
   return t;
 }
 
+void Renderer::Impl::drawScene(const CameraView& cam, std::optional<std::size_t> skip_uav) {
+  const auto& k = cam.intrinsics;
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  glViewport(0, 0, k.width_px, k.height_px);
+  glDisable(GL_CULL_FACE);
+  glClearDepth(1.0);
+  glClear(GL_DEPTH_BUFFER_BIT);
+  // the world with depth test, then the sky where nothing was drawn (each pixel shaded once)
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LEQUAL);
+  glUseProgram(program);
+  const Eigen::Matrix4d view = cam.T_world_camera.inverse().matrix();
+  const Eigen::Matrix4d proj = projection(k, config.near_m, config.far_m);
+  const Vector3d eye = cam.T_world_camera.translation();
+  const Eigen::Matrix4d I = Eigen::Matrix4d::Identity();
+  setUniforms(program, I, view, proj, 1, PixelClass::kGround, eye);
+  ground.draw();
+  setUniforms(program, I, view, proj, 0, PixelClass::kObstacle, eye);
+  world.draw();
+  for (std::size_t i = 0; i < uavs.size(); ++i) {
+    if (skip_uav && *skip_uav == i) continue;
+    setUniforms(program, uavs[i].matrix(), view, proj, 0, PixelClass::kUav, eye);
+    uav.draw();
+  }
+  if (worker_set) {
+    setUniforms(program, I, view, proj, 0, PixelClass::kWorker, eye);
+    worker.draw();
+  }
+  glUseProgram(sky_program);
+  Eigen::Matrix3d Kinv = Eigen::Matrix3d::Identity();
+  Kinv(0, 0) = 1.0 / k.fx, Kinv(1, 1) = 1.0 / k.fy, Kinv(0, 2) = -k.cx / k.fx, Kinv(1, 2) = -k.cy / k.fy;
+  const Eigen::Matrix3f ray = (cam.T_world_camera.linear() * Kinv).cast<float>();
+  glUniformMatrix3fv(glGetUniformLocation(sky_program, "u_ray"), 1, GL_FALSE, ray.data());
+  const Eigen::Vector3f sun = config.sun_direction_world.normalized().cast<float>();
+  glUniform3fv(glGetUniformLocation(sky_program, "u_sun"), 1, sun.data());
+  glBindVertexArray(sky_vao);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+}
+
+void Renderer::Impl::readBack(int width, int height, RenderedFrame& f) {
+  rgba.create(height, width, CV_8UC4);
+  f.depth_m.create(height, width, CV_32FC1);
+  f.classes.create(height, width, CV_8UC1);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);  // RGBA: the fast path
+  glReadBuffer(GL_COLOR_ATTACHMENT1);
+  glReadPixels(0, 0, width, height, GL_RED, GL_FLOAT, f.depth_m.data);
+  glReadBuffer(GL_COLOR_ATTACHMENT2);
+  glReadPixels(0, 0, width, height, GL_RED, GL_UNSIGNED_BYTE, f.classes.data);
+  cv::cvtColor(rgba, f.rgb, cv::COLOR_RGBA2RGB);
+}
+
 common::Result<RenderedFrame> Renderer::render(const CameraView& cam, std::optional<std::size_t> skip_uav) {
   using R = common::Result<RenderedFrame>;
   const auto& k = cam.intrinsics;
@@ -473,60 +528,15 @@ common::Result<RenderedFrame> Renderer::render(const CameraView& cam, std::optio
   Impl& m = *impl_;
   if (!m.makeCurrent()) return R::fail("eglMakeCurrent failed: " + eglErrorText());
   m.ensureFramebuffer(k.width_px, k.height_px);
-  glBindFramebuffer(GL_FRAMEBUFFER, m.fbo);
-  glViewport(0, 0, k.width_px, k.height_px);
-  glDisable(GL_CULL_FACE);
-  glClearDepth(1.0);
-  glClear(GL_DEPTH_BUFFER_BIT);
-  // the world with depth test, then the sky where nothing was drawn (each pixel shaded once)
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_LEQUAL);
-  glUseProgram(m.program);
-  const Eigen::Matrix4d view = cam.T_world_camera.inverse().matrix();
-  const Eigen::Matrix4d proj = projection(k, m.config.near_m, m.config.far_m);
-  const Vector3d eye = cam.T_world_camera.translation();
-  const Eigen::Matrix4d I = Eigen::Matrix4d::Identity();
-  m.setUniforms(m.program, I, view, proj, 1, PixelClass::kGround, eye);
-  m.ground.draw();
-  m.setUniforms(m.program, I, view, proj, 0, PixelClass::kObstacle, eye);
-  m.world.draw();
-  for (std::size_t i = 0; i < m.uavs.size(); ++i) {
-    if (skip_uav && *skip_uav == i) continue;
-    m.setUniforms(m.program, m.uavs[i].matrix(), view, proj, 0, PixelClass::kUav, eye);
-    m.uav.draw();
-  }
-  if (m.worker_set) {
-    m.setUniforms(m.program, I, view, proj, 0, PixelClass::kWorker, eye);
-    m.worker.draw();
-  }
-  glUseProgram(m.sky_program);
-  Eigen::Matrix3d Kinv = Eigen::Matrix3d::Identity();
-  Kinv(0, 0) = 1.0 / k.fx, Kinv(1, 1) = 1.0 / k.fy, Kinv(0, 2) = -k.cx / k.fx, Kinv(1, 2) = -k.cy / k.fy;
-  const Eigen::Matrix3f ray = (cam.T_world_camera.linear() * Kinv).cast<float>();
-  glUniformMatrix3fv(glGetUniformLocation(m.sky_program, "u_ray"), 1, GL_FALSE, ray.data());
-  const Eigen::Vector3f sun = m.config.sun_direction_world.normalized().cast<float>();
-  glUniform3fv(glGetUniformLocation(m.sky_program, "u_sun"), 1, sun.data());
-  glBindVertexArray(m.sky_vao);
-  glDrawArrays(GL_TRIANGLES, 0, 3);
-  // read back
+  m.drawScene(cam, skip_uav);
   RenderedFrame f;
-  m.rgba.create(k.height_px, k.width_px, CV_8UC4);
-  f.depth_m.create(k.height_px, k.width_px, CV_32FC1);
-  f.classes.create(k.height_px, k.width_px, CV_8UC1);
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glReadBuffer(GL_COLOR_ATTACHMENT0);
-  glReadPixels(0, 0, k.width_px, k.height_px, GL_RGBA, GL_UNSIGNED_BYTE, m.rgba.data);  // RGBA: the fast path
-  glReadBuffer(GL_COLOR_ATTACHMENT1);
-  glReadPixels(0, 0, k.width_px, k.height_px, GL_RED, GL_FLOAT, f.depth_m.data);
-  glReadBuffer(GL_COLOR_ATTACHMENT2);
-  glReadPixels(0, 0, k.width_px, k.height_px, GL_RED, GL_UNSIGNED_BYTE, f.classes.data);
+  m.readBack(k.width_px, k.height_px, f);
   const GLenum err = glGetError();
   if (err != GL_NO_ERROR) {
     std::ostringstream s;
     s << "OpenGL error 0x" << std::hex << err << " while rendering";
     return R::fail(s.str());
   }
-  cv::cvtColor(m.rgba, f.rgb, cv::COLOR_RGBA2RGB);
   f.worker = m.truth(cam, f);
   return R::ok(std::move(f));
 }
