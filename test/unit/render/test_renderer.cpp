@@ -13,6 +13,7 @@
 
 #include "gesture_formation/estimation/camera_model.hpp"
 #include "gesture_formation/gesture/skeleton_synth.hpp"
+#include "gesture_formation/planning/scenario.hpp"
 #include "gesture_formation/render/renderer.hpp"
 
 namespace gr = gesture_formation::render;
@@ -206,6 +207,88 @@ TEST_F(RendererTest, ColourImageShowsTheWorkerWhereTheTruthBoxSays) {
   EXPECT_TRUE(f->worker.keypoints[gg::kNose].visible);
   EXPECT_TRUE(f->worker.keypoints[gg::kLeftShoulder].visible);
   EXPECT_TRUE(f->worker.keypoints[gg::kRightShoulder].visible);
+}
+
+TEST_F(RendererTest, ObstaclePixelsLieOnThePlannersSolids) {
+  // every obstacle pixel of the power-tower world, back-projected with its depth, lies on a solid of
+  // the planner's primitive set (the geometry the occupancy map is rasterised from)
+  auto sc = gesture_formation::planning::loadScenario(std::string(GF_SOURCE_DIR) + "/config/scenarios/power_towers.yaml");
+  ASSERT_TRUE(sc) << sc.reason();
+  ASSERT_OK(renderer_->setWorld(*sc));
+  // the planner's solids without the towers' keep-out plates (planning-only, not rendered)
+  gesture_formation::planning::Scenario physical = *sc;
+  for (auto& t : physical.towers) t.keep_out = false;
+  const auto solids = physical.primitives();
+  gr::CameraView cam;
+  cam.intrinsics = k_;
+  cam.T_world_camera = gr::cameraPoseFromHeadingPitch(Vector3d(-12.0, -6.0, 12.0), 0.35, -0.12);
+  auto f = renderer_->render(cam);
+  ASSERT_TRUE(f) << f.reason();
+  // A tessellated cylinder lies up to kMaxChordErrorM inside the true one; along a ray grazing its
+  // silhouette that is up to sqrt(2 r e) — 1.1 cm for the 0.12 m tower legs — plus 5 mm.
+  double r_max = 0.0;
+  for (const auto& c : solids.cylinders) r_max = std::max(r_max, c.radius_m);
+  const double front_m = std::sqrt(2.0 * r_max * gr::kMaxChordErrorM) + 0.005;
+  // Interior pixels: the four neighbours see obstacles at depths within 2 %. At silhouettes and
+  // depth edges the pixel centre's ray grazes a surface, where rasterisation's sub-pixel snapping
+  // moves the hit by centimetres along the ray; those keep only the on-a-solid check.
+  auto interior = [&](int u, int v) {
+    if (u < 1 || v < 1 || u + 1 >= k_.width_px || v + 1 >= k_.height_px) return false;
+    const float z = f->depth_m.at<float>(v, u);
+    for (auto [du, dv] : {std::pair{-1, 0}, {1, 0}, {0, -1}, {0, 1}}) {
+      if (static_cast<gr::PixelClass>(f->classes.at<std::uint8_t>(v + dv, u + du)) != gr::PixelClass::kObstacle) return false;
+      if (std::abs(f->depth_m.at<float>(v + dv, u + du) - z) > 0.02f * z) return false;
+    }
+    return true;
+  };
+  int checked = 0, interior_count = 0, inside_front = 0;
+  double worst = 0.0;
+  for (int v = 0; v < k_.height_px; v += 3) {
+    for (int u = 0; u < k_.width_px; u += 3) {
+      if (static_cast<gr::PixelClass>(f->classes.at<std::uint8_t>(v, u)) != gr::PixelClass::kObstacle) continue;
+      const double z = f->depth_m.at<float>(v, u);
+      const Vector3d p = cam.T_world_camera * Vector3d((u - k_.cx) / k_.fx * z, (v - k_.cy) / k_.fy * z, z);
+      worst = std::max(worst, solids.distance(p));
+      // and it is the first surface along the ray: a little nearer the camera is outside every solid
+      const Vector3d front = p - front_m * (p - cam.T_world_camera.translation()).normalized();
+      if (interior(u, v)) {
+        ++interior_count;
+        if (solids.distance(front) <= 0.0) ++inside_front;
+      }
+      ++checked;
+    }
+  }
+  std::printf("tower world: %d obstacle pixels checked (%d interior), largest distance to the planner's solids %.4f m, %d "
+              "interior ones with a solid %.3f m nearer the camera\n", checked, interior_count, worst, inside_front, front_m);
+  EXPECT_GT(checked, 300);
+  EXPECT_LT(worst, 0.01);
+  EXPECT_GT(interior_count, checked / 2);
+  EXPECT_EQ(inside_front, 0);
+}
+
+TEST_F(RendererTest, OtherUavsAreDrawnAndTheCamerasOwnIsSkipped) {
+  ASSERT_OK(renderer_->setWorldMesh(gr::TriangleMesh(), 0.0, Vector3d::Zero()));
+  std::vector<Eigen::Isometry3d, Eigen::aligned_allocator<Eigen::Isometry3d>> uavs(2, Eigen::Isometry3d::Identity());
+  uavs[0].translation() = Vector3d(0.0, 0.0, 3.0);  // carries the camera
+  uavs[1].translation() = Vector3d(6.0, 0.5, 3.2);
+  renderer_->setUavs(uavs);
+  gr::CameraView cam;
+  cam.intrinsics = k_;
+  cam.T_world_camera = gr::cameraPoseFromHeadingPitch(uavs[0].translation(), 0.0, 0.0);
+  auto f = renderer_->render(cam, 0);
+  ASSERT_TRUE(f) << f.reason();
+  const cv::Mat mask = f->classes == static_cast<int>(gr::PixelClass::kUav);
+  ASSERT_GT(cv::countNonZero(mask), 50);
+  const auto uv = ge::CameraModel(k_).project(cam.T_world_camera.inverse() * uavs[1].translation());
+  ASSERT_TRUE(uv);
+  EXPECT_TRUE(cv::boundingRect(mask).contains(cv::Point(cvRound(uv->x()), cvRound(uv->y()))));
+  // 0.55 m across at 6 m: about 615 * 0.55 / 6 = 56 px wide
+  EXPECT_NEAR(cv::boundingRect(mask).width, k_.fx * 0.55 / 6.0, 10.0);
+  // without skipping, the camera's own UAV (around the camera centre, behind the near plane or
+  // filling the view) changes the image; the other one is still there
+  auto all = renderer_->render(cam);
+  ASSERT_TRUE(all) << all.reason();
+  EXPECT_GE(cv::countNonZero(all->classes == static_cast<int>(gr::PixelClass::kUav)), cv::countNonZero(mask));
 }
 
 TEST(WorkerMeshTest, MissingAssetNamesTheFileAndHowToGetIt) {
