@@ -191,48 +191,35 @@ void classifyVertices(WorkerMesh::Impl& m) {
 
 }  // namespace
 
-common::Result<std::shared_ptr<WorkerMesh>> WorkerMesh::load(const std::string& glb_path) {
-  using R = common::Result<std::shared_ptr<WorkerMesh>>;
-  const std::string how = " (regenerate it: tools/setup.sh, then /opt/gesture_formation/venv/bin/python "
-                          "tools/models/convert_mannequin.py; docs/rendering.md)";
-  if (!std::ifstream(glb_path).good()) return R::fail("worker asset " + glb_path + ": no such file" + how);
-  Assimp::Importer importer;
-  const aiScene* scene = importer.ReadFile(glb_path, aiProcess_Triangulate);
-  if (scene == nullptr || scene->mNumMeshes == 0) {
-    return R::fail("worker asset " + glb_path + ": Assimp cannot read it (" + importer.GetErrorString() + ")" + how);
-  }
-  const aiMesh* mesh = scene->mMeshes[0];
-  if (mesh->mNumBones == 0 || !mesh->HasNormals()) {
-    return R::fail("worker asset " + glb_path + ": its mesh has no skin or no normals" + how);
-  }
-  std::shared_ptr<WorkerMesh> w(new WorkerMesh());
-  Impl& m = *w->impl_;
-  // joints: every bone; parents and bind positions from the node hierarchy
+namespace {
+
+/// Joints (every bone of the mesh), their parents and bind positions (node hierarchy, body frame),
+/// the named joints the posing drives and a parents-first order. Returns "" or what is wrong.
+std::string readSkeleton(const aiScene& scene, const aiMesh& mesh, WorkerMesh::Impl& m, std::vector<Vector3d>& bind_body) {
   std::map<std::string, int> index;
-  for (unsigned b = 0; b < mesh->mNumBones; ++b) {
-    index[mesh->mBones[b]->mName.C_Str()] = static_cast<int>(b);
-    m.joint_names.push_back(mesh->mBones[b]->mName.C_Str());
+  for (unsigned b = 0; b < mesh.mNumBones; ++b) {
+    index[mesh.mBones[b]->mName.C_Str()] = static_cast<int>(b);
+    m.joint_names.push_back(mesh.mBones[b]->mName.C_Str());
   }
   const std::size_t nj = m.joint_names.size();
   m.parent.assign(nj, -1);
-  w->bind_body_.assign(nj, Vector3d::Zero());
+  bind_body.assign(nj, Vector3d::Zero());
   for (std::size_t j = 0; j < nj; ++j) {
-    const aiNode* node = scene->mRootNode->FindNode(m.joint_names[j].c_str());
-    if (node == nullptr) return R::fail("worker asset " + glb_path + ": no node for joint " + m.joint_names[j] + how);
+    const aiNode* node = scene.mRootNode->FindNode(m.joint_names[j].c_str());
+    if (node == nullptr) return "no node for joint " + m.joint_names[j];
     aiMatrix4x4 global = node->mTransformation;
     for (const aiNode* p = node->mParent; p != nullptr; p = p->mParent) global = p->mTransformation * global;
-    w->bind_body_[j] = toBody(aiVector3D(global.a4, global.b4, global.c4));
+    bind_body[j] = toBody(aiVector3D(global.a4, global.b4, global.c4));
     if (node->mParent != nullptr) {
       const auto it = index.find(node->mParent->mName.C_Str());
       if (it != index.end()) m.parent[j] = it->second;
     }
   }
-  for (int k = 0; k < kNumNamed; ++k) {
-    const auto it = index.find(kJointNames[static_cast<std::size_t>(k)]);
-    if (it == index.end()) return R::fail(std::string("worker asset ") + glb_path + ": no joint " + kJointNames[static_cast<std::size_t>(k)] + how);
-    m.named[static_cast<std::size_t>(k)] = it->second;
+  for (std::size_t k = 0; k < kJointNames.size(); ++k) {
+    const auto it = index.find(kJointNames[k]);
+    if (it == index.end()) return std::string("no joint ") + kJointNames[k];
+    m.named[k] = it->second;
   }
-  // topological order
   std::vector<bool> done(nj, false);
   while (m.order.size() < nj) {
     const std::size_t before = m.order.size();
@@ -241,30 +228,37 @@ common::Result<std::shared_ptr<WorkerMesh>> WorkerMesh::load(const std::string& 
       done[j] = true;
       m.order.push_back(static_cast<int>(j));
     }
-    if (m.order.size() == before) return R::fail("worker asset " + glb_path + ": the skeleton has a cycle" + how);
+    if (m.order.size() == before) return "the skeleton has a cycle";
   }
-  // vertices, normals, weights (4 strongest, renormalised)
-  const std::size_t nv = mesh->mNumVertices;
+  m.G.assign(nj, Matrix3d::Identity());
+  m.P.assign(nj, Vector3d::Zero());
+  return "";
+}
+
+/// Vertices and normals (body frame), the 4 strongest skin weights renormalised, each vertex's
+/// strongest joint, triangles. Returns "" or what is wrong.
+std::string readSkin(const aiMesh& mesh, WorkerMesh::Impl& m) {
+  const std::size_t nv = mesh.mNumVertices;
   m.rest_p.resize(nv);
   m.rest_n.resize(nv);
   for (std::size_t i = 0; i < nv; ++i) {
-    m.rest_p[i] = toBody(mesh->mVertices[i]);
-    m.rest_n[i] = toBody(mesh->mNormals[i]).normalized();
+    m.rest_p[i] = toBody(mesh.mVertices[i]);
+    m.rest_n[i] = toBody(mesh.mNormals[i]).normalized();
   }
-  std::vector<std::vector<std::pair<float, int>>> inf(nv);
-  for (unsigned b = 0; b < mesh->mNumBones; ++b) {
-    const aiBone* bone = mesh->mBones[b];
+  std::vector<std::vector<std::pair<float, int>>> influences(nv);
+  for (unsigned b = 0; b < mesh.mNumBones; ++b) {
+    const aiBone* bone = mesh.mBones[b];
     for (unsigned k = 0; k < bone->mNumWeights; ++k) {
       const auto& vw = bone->mWeights[k];
-      if (vw.mVertexId < nv && vw.mWeight > 0.0f) inf[vw.mVertexId].push_back({vw.mWeight, static_cast<int>(b)});
+      if (vw.mVertexId < nv && vw.mWeight > 0.0f) influences[vw.mVertexId].push_back({vw.mWeight, static_cast<int>(b)});
     }
   }
   m.vj.resize(nv);
   m.vw.resize(nv);
   m.dominant.resize(nv);
   for (std::size_t i = 0; i < nv; ++i) {
-    auto& list = inf[i];
-    if (list.empty()) return R::fail("worker asset " + glb_path + ": vertex " + std::to_string(i) + " has no skin weight" + how);
+    auto& list = influences[i];
+    if (list.empty()) return "vertex " + std::to_string(i) + " has no skin weight";
     std::sort(list.begin(), list.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
     float sum = 0.0f;
     for (std::size_t k = 0; k < 4; ++k) {
@@ -275,21 +269,40 @@ common::Result<std::shared_ptr<WorkerMesh>> WorkerMesh::load(const std::string& 
     for (auto& x : m.vw[i]) x /= sum;
     m.dominant[i] = list[0].second;
   }
-  for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
-    if (mesh->mFaces[f].mNumIndices != 3) continue;
-    for (int k = 0; k < 3; ++k) m.indices.push_back(mesh->mFaces[f].mIndices[k]);
+  for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+    if (mesh.mFaces[f].mNumIndices != 3) continue;
+    for (int k = 0; k < 3; ++k) m.indices.push_back(mesh.mFaces[f].mIndices[k]);
   }
+  return "";
+}
+
+}  // namespace
+
+common::Result<std::shared_ptr<WorkerMesh>> WorkerMesh::load(const std::string& glb_path) {
+  using R = common::Result<std::shared_ptr<WorkerMesh>>;
+  const std::string how = " (regenerate it: tools/setup.sh, then /opt/gesture_formation/venv/bin/python "
+                          "tools/models/convert_mannequin.py; docs/rendering.md)";
+  auto fail = [&](const std::string& what) { return R::fail("worker asset " + glb_path + ": " + what + how); };
+  if (!std::ifstream(glb_path).good()) return fail("no such file");
+  Assimp::Importer importer;
+  const aiScene* scene = importer.ReadFile(glb_path, aiProcess_Triangulate);
+  if (scene == nullptr || scene->mNumMeshes == 0) return fail(std::string("Assimp cannot read it (") + importer.GetErrorString() + ")");
+  const aiMesh* mesh = scene->mMeshes[0];
+  if (mesh->mNumBones == 0 || !mesh->HasNormals()) return fail("its mesh has no skin or no normals");
+  std::shared_ptr<WorkerMesh> w(new WorkerMesh());
+  Impl& m = *w->impl_;
+  std::string error = readSkeleton(*scene, *mesh, m, w->bind_body_);
+  if (error.empty()) error = readSkin(*mesh, m);
+  if (!error.empty()) return fail(error);
   double zmin = 1e9, zmax = -1e9;
   for (const auto& p : m.rest_p) zmin = std::min(zmin, p.z()), zmax = std::max(zmax, p.z());
   w->rest_height_m_ = zmax - zmin;
   classifyVertices(m);
-  m.G.assign(nj, Matrix3d::Identity());
-  m.P.assign(nj, Vector3d::Zero());
   w->dress(Appearance());
   // the rest pose as the initial mesh
   w->posed_.indices = m.indices;
-  w->posed_.vertices.resize(nv);
-  for (std::size_t i = 0; i < nv; ++i) {
+  w->posed_.vertices.resize(m.rest_p.size());
+  for (std::size_t i = 0; i < m.rest_p.size(); ++i) {
     for (int k = 0; k < 3; ++k) {
       w->posed_.vertices[i].p[k] = static_cast<float>(m.rest_p[i][k]);
       w->posed_.vertices[i].n[k] = static_cast<float>(m.rest_n[i][k]);
