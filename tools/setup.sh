@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs everything gesture_formation needs on Debian 12 (bookworm): Debian packages,
-# ProxQP headers from the `proxsuite` PyPI wheel, and the tools venv (matplotlib, numpy).
+# ProxQP headers from the `proxsuite` PyPI wheel, and the tools venv (matplotlib, numpy, mannequin-x).
 # Idempotent: a second run checks and returns in seconds. Works as root or through sudo.
 #
 #   tools/setup.sh            # packages + proxsuite + tools venv
@@ -43,6 +43,7 @@ PACKAGES=(
   python3-rosnode python3-rosservice python3-rosmsg rosbash
   python3-tf2-ros python3-std-srvs python3-geometry-msgs python3-sensor-msgs python3-nav-msgs python3-visualization-msgs python3-tf2-msgs python3-trajectory-msgs
   libeigen3-dev libopencv-dev libopencv-contrib-dev libompl-dev liboctomap-dev libfcl-dev libceres-dev
+  libegl-dev libgl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri libassimp-dev   # render/: headless OpenGL (EGL, Mesa llvmpipe), Assimp
   liblcm-dev liblcm-bin libyaml-cpp-dev libssl-dev
   libcereal-dev libsimde-dev
   python3-venv python3-pip python3-yaml python3-numpy
@@ -71,7 +72,8 @@ VENV="$GF_PREFIX/venv"
 STAMP="$VENV/.gf_requirements"
 # dask[distributed] + dask-jobqueue: tools/campaign.py (docs/campaigns.md).
 PY_REQS=(matplotlib==3.8.4 numpy==1.26.4 pyyaml==6.0.2 scipy==1.13.1 "dask[distributed]==2026.8.0" dask-jobqueue==0.9.0)
-REQS="proxsuite==$PROXSUITE_VERSION ${PY_REQS[*]}"
+MANNEQUIN_VERSION="0.3.0"   # the worker mesh (tools/models/convert_mannequin.py)
+REQS="proxsuite==$PROXSUITE_VERSION ${PY_REQS[*]} mannequin-x==$MANNEQUIN_VERSION"
 if [ ! -f "$STAMP" ] || [ "$(cat "$STAMP")" != "$REQS" ]; then
   echo "setup: creating tools venv in $VENV ($REQS)"
   $SUDO mkdir -p "$GF_PREFIX"
@@ -80,6 +82,8 @@ if [ ! -f "$STAMP" ] || [ "$(cat "$STAMP")" != "$REQS" ]; then
   # --no-deps for proxsuite: we build against Debian's Eigen, not the cmeel-eigen wheel.
   $SUDO "$VENV/bin/pip" install -q --disable-pip-version-check --no-deps "proxsuite==$PROXSUITE_VERSION"
   $SUDO "$VENV/bin/pip" install -q --disable-pip-version-check "${PY_REQS[@]}"
+  # --no-deps for mannequin-x: only its data file is read (its runtime wants numpy >= 2).
+  $SUDO "$VENV/bin/pip" install -q --disable-pip-version-check --no-deps "mannequin-x==$MANNEQUIN_VERSION"
   echo "$REQS" | $SUDO tee "$STAMP" >/dev/null
 else
   echo "setup: tools venv up to date ($VENV)"

@@ -81,4 +81,6 @@ fi
 
 # --- MODELS.md ------------------------------------------------------------------------------
 "$PY" "$HERE/write_models_md.py" --src "$SRC" ${CHECK_JSON:+--check "$CHECK_JSON"}
-(cd "$ROOT" && sha256sum third_party_models/*/*.onnx)
+# the worker mesh for render/ (tools venv of tools/setup.sh; writes its own MODELS.md section)
+/opt/gesture_formation/venv/bin/python "$HERE/convert_mannequin.py"
+(cd "$ROOT" && sha256sum third_party_models/*/*.onnx third_party_models/mannequin/*.glb)
