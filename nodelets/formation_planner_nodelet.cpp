@@ -74,11 +74,13 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     params.load("params_rate_hz", params_rate_hz, 0.1, 50.0);
     formation::FormationConfig fcfg;
     planning::PlannerConfig pcfg;
+    bool formation_loaded = false;
     if (!mission_file.empty()) {
       // Simulation: the mission file's settings — the very values gfctl simulate runs with —
       // win over every parameter; the replanning parameters below are not read.
       onboard::OnboardSettings mission;
       if (loadOnboard(mission_file, params, mission)) {
+        formation_loaded = true;
         fcfg = mission.formation;
         pcfg = mission.planner;
         period_s_ = mission.replanning_period_s;
@@ -108,16 +110,17 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
       params.load("search_vertical_speed_mps", search_.vertical_speed_mps, 0.01, 10.0);
       params.load("search_period_s", search_.period_s, 0.5, 120.0);
       params.load("search_horizontal_speed_mps", search_.horizontal_speed_mps, 0.0, 10.0);
-      if (!formation_file.empty()) loadFormation(formation_file, params, fcfg);
+      formation_loaded = !formation_file.empty() && loadFormation(formation_file, params, fcfg);
       if (!planner_file.empty()) loadPlanner(planner_file, params, pcfg);
     }
-    if (params.ok() && fcfg.params.uavCount() != uav_count_) {
+    // Every source is checked before refusing (cross-field checks whenever both fields loaded).
+    if (formation_loaded && fcfg.params.uavCount() != uav_count_) {
       params.addError("uav_count: " + std::to_string(uav_count_) + " but the formation config has " +
                       std::to_string(fcfg.params.uavCount()) + " UAVs");
     }
-    if (params.ok() && uav_index_ >= uav_count_) params.addError("uav_index: must be < uav_count");
+    if (uav_index_ >= uav_count_) params.addError("uav_index: must be < uav_count");
     WorldMap world;
-    if (params.ok()) loadWorldMap(scenario_file, params, world);
+    loadWorldMap(scenario_file, params, world);
     if (!params.ok()) {
       NODELET_ERROR_STREAM("FormationPlanner refuses to start; fix these parameters:\n" << params.report());
       return;

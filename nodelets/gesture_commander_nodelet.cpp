@@ -50,9 +50,11 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
     gesture::GestureFilterConfig fcfg;
     gesture::ViewFusionConfig vcfg;
     gesture::GestureMapping mapping;
+    bool gestures_loaded = false;
     if (!mission_file.empty()) {
       onboard::OnboardSettings mission;
       if (loadOnboard(mission_file, params, mission)) {
+        gestures_loaded = true;
         fcfg = mission.gesture_filter;
         mapping = mission.gesture_mapping;
         vcfg = mission.view_fusion;
@@ -63,10 +65,11 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
       }
     } else {
       params.load("gesture_config", gesture_file);
-      if (!gesture_file.empty() && uav_count >= 1) loadGestures(gesture_file, uav_count - 1, params, fcfg, mapping, vcfg);
+      gestures_loaded = !gesture_file.empty() && uav_count >= 1 &&
+                        loadGestures(gesture_file, uav_count - 1, params, fcfg, mapping, vcfg);
     }
     if (sender_.empty() || sender_.find(' ') != std::string::npos) params.addError("sender_name: must be non-empty without spaces");
-    if (params.ok() && frame_wait_s_ >= vcfg.max_age_s) {
+    if (gestures_loaded && frame_wait_s_ >= vcfg.max_age_s) {
       params.addError("frame_wait_s: value " + std::to_string(frame_wait_s_) +
                       " must be below view_fusion.max_age_s " + std::to_string(vcfg.max_age_s));
     }

@@ -64,9 +64,7 @@ class PerceptionNodelet : public nodelet::Nodelet {
       else params.addError("skeleton: " + k.reason());
     }
     if (!(stereo_.max_depth_m > stereo_.min_depth_m)) params.addError("max_depth_m: must exceed min_depth_m");
-    if (params.ok()) {
-      for (const auto& e : cfg.validate()) params.addError(e);
-    }
+    for (const auto& e : cfg.validate()) params.addError(e);
     if (params.ok()) {
       auto p = perception::PerceptionPipeline::create(cfg);
       if (p) pipeline_ = std::move(*p);

@@ -66,7 +66,7 @@ class VisualizerNodelet : public nodelet::Nodelet {
     params.load("frustum_vfov_deg", vfov_deg_, 1.0, 179.0);
     params.load("scenario_file", scenario_file);
     WorldMap world;
-    if (params.ok() && !scenario_file.empty()) loadWorldMap(scenario_file, params, world);
+    if (!scenario_file.empty()) loadWorldMap(scenario_file, params, world);
     if (!params.ok()) {
       NODELET_ERROR_STREAM("Visualizer refuses to start; fix these parameters:\n" << params.report());
       return;

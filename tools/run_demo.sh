@@ -19,7 +19,7 @@ BUILD_DIR=${GF_BUILD_DIR:-build}
 mkdir -p "$BUILD_DIR"
 echo "== build: gfctl, the nodelets and their messages (tools/build.sh; log $BUILD_DIR/demo_build.log)"
 LOG=$BUILD_DIR/demo_build.log
-build() { tools/build.sh gfctl gesture_formation_nodelets gesture_formation_generate_messages > "$LOG" 2>&1; }
+build() { tools/build.sh gfctl gesture_formation_nodelets gesture_formation_sim_nodelets gesture_formation_generate_messages > "$LOG" 2>&1; }
 if ! build; then
   built=false
   if grep -q "Please rerun cmake" "$LOG"; then

@@ -46,7 +46,7 @@ while [ $# -gt 0 ]; do
   shift 2
 done
 [ "$(id -u)" -eq 0 ] || { echo "$0: needs root for the network namespaces (sudo $0 ...)" >&2; exit 2; }
-[ -f "$BUILD/devel/lib/libgesture_formation_nodelets.so" ] || { echo "$0: build first (tools/build.sh; GF_BUILD_DIR=$BUILD)" >&2; exit 2; }
+[ -f "$BUILD/devel/lib/libgesture_formation_nodelets.so" ] && [ -f "$BUILD/devel/lib/libgesture_formation_sim_nodelets.so" ] || { echo "$0: build first (tools/build.sh; GF_BUILD_DIR=$BUILD)" >&2; exit 2; }
 # The relay validates its own arguments (and names the bad one) before anything is set up.
 python3 tools/radio_relay.py --links 10.0.0.1,10.0.1.1 --loss "$LOSS" --delay-ms "$DELAY" --jitter-ms "$JITTER" \
   --duplicate "$DUP" --check-only || exit 2

@@ -37,7 +37,7 @@ while [ $# -gt 0 ]; do
     *) echo "usage: $0 [--out DIR] [--duration S] [--rtf X] [--seed N] [--mission FILE] [--faults FILE] [--rviz]" >&2; exit 2 ;;
   esac
 done
-[ -f "$BUILD/devel/lib/libgesture_formation_nodelets.so" ] || { echo "$0: build first (tools/build.sh; GF_BUILD_DIR=$BUILD)" >&2; exit 2; }
+[ -f "$BUILD/devel/lib/libgesture_formation_nodelets.so" ] && [ -f "$BUILD/devel/lib/libgesture_formation_sim_nodelets.so" ] || { echo "$0: build first (tools/build.sh; GF_BUILD_DIR=$BUILD)" >&2; exit 2; }
 NETNS=(unshare -n)
 if [ "$(id -u)" -ne 0 ]; then
   command -v sudo > /dev/null || { echo "$0: not root and no sudo: the private network namespace (unshare -n) that keeps LCM on this machine needs root" >&2; exit 2; }

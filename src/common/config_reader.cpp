@@ -97,19 +97,19 @@ ConfigReader ConfigReader::fromFile(const std::string& path, MissingKeys mode) {
     ConfigReader reader(YAML::LoadFile(path), path, mode);
     if (!reader.root_.IsMap() && !reader.root_.IsNull()) {
       reader.parse_failed_ = true;
-      reader.errors_.push_back(path + ": the top level must be a mapping of keys");
+      reader.errors_.push_back({"", "the top level must be a mapping of keys"});
     }
     if (reader.root_.IsNull()) reader.root_ = YAML::Node(YAML::NodeType::Map);
     return reader;
   } catch (const YAML::BadFile&) {
     ConfigReader reader(YAML::Node(YAML::NodeType::Map), path, mode);
     reader.parse_failed_ = true;
-    reader.errors_.push_back(path + ": cannot open file");
+    reader.errors_.push_back({"", "cannot open file"});
     return reader;
   } catch (const YAML::Exception& e) {
     ConfigReader reader(YAML::Node(YAML::NodeType::Map), path, mode);
     reader.parse_failed_ = true;
-    reader.errors_.push_back(path + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
+    reader.errors_.push_back({"", "line " + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg});
     return reader;
   }
 }
@@ -119,14 +119,14 @@ ConfigReader ConfigReader::fromString(const std::string& yaml, const std::string
     ConfigReader reader(YAML::Load(yaml), source_name, mode);
     if (!reader.root_.IsMap() && !reader.root_.IsNull()) {
       reader.parse_failed_ = true;
-      reader.errors_.push_back(source_name + ": the top level must be a mapping of keys");
+      reader.errors_.push_back({"", "the top level must be a mapping of keys"});
     }
     if (reader.root_.IsNull()) reader.root_ = YAML::Node(YAML::NodeType::Map);
     return reader;
   } catch (const YAML::Exception& e) {
     ConfigReader reader(YAML::Node(YAML::NodeType::Map), source_name, mode);
     reader.parse_failed_ = true;
-    reader.errors_.push_back(source_name + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
+    reader.errors_.push_back({"", "line " + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg});
     return reader;
   }
 }
@@ -149,7 +149,7 @@ YAML::Node ConfigReader::lookup(const std::string& key, bool report_missing) {
     }
     if (!next.IsDefined()) {
       if (report_missing && mode_ == MissingKeys::kError && !parse_failed_) {
-        errors_.push_back(source_ + ": " + key + ": missing (required)");
+        errors_.push_back({key, "missing (required)"});
       }
       return YAML::Node(YAML::NodeType::Undefined);
     }
@@ -170,7 +170,7 @@ YAML::Node ConfigReader::node(const std::string& key) {
 }
 
 void ConfigReader::addError(const std::string& key, const std::string& message) {
-  errors_.push_back(source_ + ": " + key + ": " + message);
+  errors_.push_back({key, message});
 }
 
 void ConfigReader::readDouble(const std::string& key, double& value, const Range& range) {
@@ -301,9 +301,16 @@ std::vector<std::string> ConfigReader::unusedLeaves(bool whole_document) const {
   return unused;
 }
 
+std::vector<std::string> ConfigReader::errors() const {
+  std::vector<std::string> out;
+  out.reserve(errors_.size());
+  for (const ConfigError& e : errors_) out.push_back(source_ + ": " + (e.key.empty() ? "" : e.key + ": ") + e.message);
+  return out;
+}
+
 std::string ConfigReader::errorReport() const {
   std::string s;
-  for (const auto& e : errors_) s += e + "\n";
+  for (const auto& e : errors()) s += e + "\n";
   return s;
 }
 
@@ -322,17 +329,7 @@ void withSubReader(ConfigReader& r, const std::string& key, ConfigReader::Missin
   }
   ConfigReader sub = ConfigReader::fromString(text, r.source() + " " + key, mode);
   fn(sub);
-  const std::string sub_prefix = sub.source() + ": ";
-  for (const auto& e : sub.errors()) {
-    // "<file> <key>: field: message" → "<file>: <key>.field: message"
-    const std::string rest = e.rfind(sub_prefix, 0) == 0 ? e.substr(sub_prefix.size()) : e;
-    const auto colon = rest.find(": ");
-    if (colon == std::string::npos || rest.find(' ') < colon) {
-      r.addError(key, rest);
-    } else {
-      r.addError(key + "." + rest.substr(0, colon), rest.substr(colon + 2));
-    }
-  }
+  for (const ConfigError& e : sub.problems()) r.addError(e.key.empty() ? key : key + "." + e.key, e.message);
   for (const auto& u : sub.unusedKeysOfWholeDocument()) r.addError(key + "." + u, "unknown key");
 }
 

@@ -40,6 +40,14 @@ struct Range {
   std::string describe() const;
 };
 
+/// \brief One configuration problem: the key it is about (dotted path, e.g.
+/// "mission.faults.max_share_age_s"; empty: the document as a whole — unreadable, not YAML) and
+/// what is wrong, naming the value.
+struct ConfigError {
+  std::string key;
+  std::string message;
+};
+
 class ConfigReader {
  public:
   enum class MissingKeys { kUseDefaults, kError };
@@ -65,7 +73,10 @@ class ConfigReader {
   /// Records a problem found by the caller (e.g. a cross-field constraint).
   void addError(const std::string& key, const std::string& message);
 
-  const std::vector<std::string>& errors() const { return errors_; }
+  /// Every problem, typed (in the order found).
+  const std::vector<ConfigError>& problems() const { return errors_; }
+  /// Every problem as text: "<source>: <key>: <message>" ("<source>: <message>" without a key).
+  std::vector<std::string> errors() const;
   bool ok() const { return errors_.empty(); }
   const std::string& source() const { return source_; }
   MissingKeys mode() const { return mode_; }
@@ -93,7 +104,7 @@ class ConfigReader {
   std::string source_;
   MissingKeys mode_;
   bool parse_failed_ = false;
-  std::vector<std::string> errors_;
+  std::vector<ConfigError> errors_;
   std::set<std::string> used_;
 };
 

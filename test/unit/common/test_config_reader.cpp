@@ -122,3 +122,27 @@ TEST(ConfigReaderTest, NonScalarKeysAreReportedNotThrown) {
   EXPECT_EQ(unused.size(), 2u);
   EXPECT_TRUE(contains(unused, "a.<non-scalar key>"));
 }
+
+TEST(ConfigReaderTest, ProblemsAreTypedAndSubReadersRenameTheirKeys) {
+  ConfigReader r = ConfigReader::fromString("mission:\n  planner:\n    speed: -1\n    typo_key: 2\n  x: 1\n", "m.yaml",
+                                            ConfigReader::MissingKeys::kUseDefaults);
+  double x = 0.0;
+  r.readDouble("mission.x", x, Range::closed(2.0, 3.0));
+  gesture_formation::common::withSubReader(r, "mission.planner", ConfigReader::MissingKeys::kUseDefaults,
+                                           [](ConfigReader& s) {
+                                             double speed = 1.0;
+                                             s.readDouble("speed", speed, Range::positive());
+                                           });
+  ASSERT_EQ(r.problems().size(), 3u) << r.errorReport();
+  EXPECT_EQ(r.problems()[0].key, "mission.x");
+  EXPECT_NE(r.problems()[0].message.find("value 1 is out of range"), std::string::npos);
+  EXPECT_EQ(r.problems()[1].key, "mission.planner.speed");
+  EXPECT_EQ(r.problems()[2].key, "mission.planner.typo_key");
+  EXPECT_EQ(r.problems()[2].message, "unknown key");
+  EXPECT_EQ(r.errors()[1], "m.yaml: mission.planner.speed: " + r.problems()[1].message);
+  // A document-level problem has no key.
+  ConfigReader bad = ConfigReader::fromString("a: [1, 2", "b.yaml", ConfigReader::MissingKeys::kUseDefaults);
+  ASSERT_EQ(bad.problems().size(), 1u);
+  EXPECT_TRUE(bad.problems()[0].key.empty());
+  EXPECT_NE(bad.errors()[0].find("b.yaml: line "), std::string::npos) << bad.errors()[0];
+}
