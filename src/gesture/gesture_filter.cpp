@@ -27,6 +27,7 @@ const char* toString(FilterVerdict v) {
     case FilterVerdict::kBelowThreshold: return "below_threshold";
     case FilterVerdict::kNoneDominant: return "none_dominant";
     case FilterVerdict::kCooldown: return "cooldown";
+    case FilterVerdict::kAwaitingRelease: return "awaiting_release";
     case FilterVerdict::kFired: return "fired";
   }
   return "?";
@@ -44,6 +45,7 @@ std::vector<std::string> GestureFilterConfig::validate() const {
     e.push_back("ratio_threshold must be in [0, 1], got " + num(ratio_threshold));
   }
   if (!(std::isfinite(cooldown_s) && cooldown_s >= 0.0)) e.push_back("cooldown_s must be >= 0, got " + num(cooldown_s));
+  if (!(std::isfinite(release_s) && release_s >= 0.0)) e.push_back("release_s must be >= 0, got " + num(release_s));
   if (max_gesture_id < 1 || max_gesture_id > 1000) {
     e.push_back("max_gesture_id must be in [1, 1000], got " + std::to_string(max_gesture_id));
   }
@@ -59,6 +61,10 @@ GestureFilterConfig readGestureFilterConfig(ConfigReader& r) {
   r.readDouble("ratio_threshold", c.ratio_threshold, Range::closed(0.0, 1.0));
   r.readDouble("cooldown_s", c.cooldown_s, Range::nonNegative());
   r.readInt("max_gesture_id", c.max_gesture_id, Range::closed(1, 1000));
+  std::string rearm = c.rearm_on_release ? "release" : "cooldown";
+  r.readString("rearm", rearm, {"release", "cooldown"});
+  c.rearm_on_release = rearm == "release";
+  r.readDouble("release_s", c.release_s, Range::nonNegative());
   if (c.min_measurements > c.window_size) {
     r.addError("min_measurements", "value " + std::to_string(c.min_measurements) + " exceeds window_size " +
                                        std::to_string(c.window_size) + " (the filter could never evaluate)");
@@ -71,7 +77,8 @@ GestureFilter::GestureFilter(const GestureFilterConfig& config)
       ring_(static_cast<std::size_t>(config.window_size > 0 ? config.window_size : 1)),
       counts_(static_cast<std::size_t>(config.max_gesture_id > 0 ? config.max_gesture_id + 1 : 1), 0),
       last_t_s_(std::numeric_limits<double>::quiet_NaN()),
-      last_fired_s_(std::numeric_limits<double>::quiet_NaN()) {}
+      last_fired_s_(std::numeric_limits<double>::quiet_NaN()),
+      none_since_s_(std::numeric_limits<double>::quiet_NaN()) {}
 
 common::Result<GestureFilter> GestureFilter::create(const GestureFilterConfig& config) {
   const auto e = config.validate();
@@ -89,6 +96,8 @@ void GestureFilter::reset() {
   for (int& c : counts_) c = 0;
   last_t_s_ = std::numeric_limits<double>::quiet_NaN();
   last_fired_s_ = std::numeric_limits<double>::quiet_NaN();
+  armed_ = true;
+  none_since_s_ = std::numeric_limits<double>::quiet_NaN();
 }
 
 void GestureFilter::popFront() {
@@ -115,6 +124,8 @@ GestureFilterOutput GestureFilter::update(double t_s, double gesture_id) {
   }
   const int id = static_cast<int>(gesture_id);
   out.accepted = true;
+  // Every earlier entry has expired (nothing seen for t_c): what follows is a new performance.
+  if (!std::isnan(last_t_s_) && last_t_s_ < t_s - config_.max_age_s) armed_ = true;
   last_t_s_ = t_s;
 
   // 2.–4. append, drop entries older than t − t_c, keep the K newest.
@@ -144,6 +155,13 @@ GestureFilterOutput GestureFilter::update(double t_s, double gesture_id) {
     }
   }
   out.dominant_ratio = static_cast<double>(best_count) / static_cast<double>(size_);
+  // Release: "none" dominating (no tie) for release_s re-arms; anything else restarts the run.
+  if (!tie && best == kGestureNone) {
+    if (std::isnan(none_since_s_)) none_since_s_ = t_s;
+    if (t_s - none_since_s_ >= config_.release_s) armed_ = true;
+  } else {
+    none_since_s_ = std::numeric_limits<double>::quiet_NaN();
+  }
   if (tie) {
     out.verdict = FilterVerdict::kTie;
     return out;
@@ -156,10 +174,14 @@ GestureFilterOutput GestureFilter::update(double t_s, double gesture_id) {
     out.verdict = FilterVerdict::kNoneDominant;
   } else if (!std::isnan(last_fired_s_) && !(t_s - last_fired_s_ >= config_.cooldown_s)) {
     out.verdict = FilterVerdict::kCooldown;
+  } else if (config_.rearm_on_release && !armed_) {
+    out.verdict = FilterVerdict::kAwaitingRelease;
   } else {
     out.verdict = FilterVerdict::kFired;
     out.fired = true;
     last_fired_s_ = t_s;
+    armed_ = !config_.rearm_on_release;
+    none_since_s_ = std::numeric_limits<double>::quiet_NaN();
   }
   return out;
 }

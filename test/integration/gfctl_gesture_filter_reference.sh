@@ -72,6 +72,7 @@ min_measurements: 5
 max_age_s: 3.0
 ratio_threshold: 0.6
 cooldown_s: 2.0
+rearm: cooldown
 YAML
 cat > "$OUT/distance5.yaml" <<'YAML'
 window_size: 12
@@ -113,6 +114,16 @@ min_measurements: 4
 max_age_s: 1.0
 ratio_threshold: 0.75
 cooldown_s: 2.5
+rearm: cooldown
+YAML
+# The same held gesture with the default re-arming (release): one performance, one command.
+cat > "$OUT/boundary_release.yaml" <<'YAML'
+window_size: 8
+min_measurements: 4
+max_age_s: 1.0
+ratio_threshold: 0.75
+cooldown_s: 2.5
+release_s: 0.5
 YAML
 # Sparse at 1.5 s: with max_age_s 6 the window holds exactly 5 entries only because an
 # entry exactly t_c old is kept (t_i >= t - t_c); min_measurements 5 makes that decisive.
@@ -122,6 +133,7 @@ min_measurements: 5
 max_age_s: 6.0
 ratio_threshold: 0.75
 cooldown_s: 3.0
+rearm: cooldown
 YAML
 
 fails=0
@@ -150,6 +162,8 @@ run distance5_noisy "$OUT/distance5.yaml" noisy
 run distance5_bursty "$OUT/distance5.yaml" bursty
 run events3_noisy "$OUT/events3.yaml" noisy
 run boundary_exact "$OUT/boundary.yaml" boundary
+run boundary_release "$OUT/boundary_release.yaml" boundary
+run events3_bursty "$OUT/events3.yaml" bursty
 run default_invalid "$SRC/config/gestures.yaml" invalid
 run small_invalid "$OUT/small.yaml" invalid
 
@@ -171,4 +185,8 @@ if t[0] != 0.75 or gaps != {2.5}:
     sys.exit(1)
 print(f"ok: boundary: first command at 0.75 s, then every 2.5 s ({len(t)} commands)")
 PYEOF
+[ "$(cat "$OUT/boundary_release.count")" -eq 1 ] \
+  || { echo "FAIL: a held gesture fired $(cat "$OUT/boundary_release.count") times with rearm: release (want 1)"; fails=$((fails + 1)); }
+[ "$(cat "$OUT/default_bursty.count")" -lt "$(cat "$OUT/small_bursty.count")" ] \
+  || echo "note: release fired no less than cooldown on the bursty stream"
 exit $fails

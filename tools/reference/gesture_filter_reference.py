@@ -9,7 +9,10 @@ earlier than the last accepted row, or the id is not an integer in 0..max_gestur
 Otherwise append; drop entries with t_i < t - max_age_s; keep the window_size newest;
 evaluate when len(G) >= min_measurements; f_d = max count / len(G); tie for the maximum ->
 nothing; fire when f_d > ratio_threshold, dominant != 0, and (no earlier command or
-t - t_last >= cooldown_s). Fired rows: `t,gesture_id,parameter,increment,value` with value
+t - t_last >= cooldown_s), and — with `rearm: release` (the default) — the filter is armed: a
+fired command disarms it; it re-arms when every evaluation since some time s had 0 as its sole
+most frequent id and t - s >= release_s, or when the previous accepted row is older than
+t - max_age_s (nothing seen for t_c). With `rearm: cooldown` it is always armed. Fired rows: `t,gesture_id,parameter,increment,value` with value
 the parameter after the increment, beta wrapped to (-180, 180], gamma / distance clamped
 (docs/formation.md §3-4: every UAV's elevation - leader gamma_L, follower gamma_L + gamma_i -
 within [gamma_min_deg, gamma_max_deg]; distance within [max(distance_min_m,
@@ -114,11 +117,15 @@ def main():
     min_meas = int(cfg.get("min_measurements", K))
     t_c, ratio, t_d, max_id = float(p["max_age_s"]), float(p["ratio_threshold"]), float(p["cooldown_s"]), int(p["max_gesture_id"])
     mapping = {int(k): v for k, v in (cfg["mapping"] if "mapping" in cfg else PAPER_MAPPING).items()}
+    release_mode = cfg.get("rearm", "release") == "release"
+    release_s = float(cfg.get("release_s", 1.0))
     formation = Formation(cfg)
 
     G = []  # (t, id), oldest first
     last_t = None
     last_fire = None
+    armed = True
+    none_run_start = None  # first evaluation of the current run whose sole top id is 0
     out = ["t,gesture_id,parameter,increment,value"]
     with open(args.inp) as f:
         for row in csv.DictReader(f):
@@ -128,6 +135,8 @@ def main():
             if not math.isfinite(g) or g != int(g) or not 0 <= g <= max_id:
                 continue
             g = int(g)
+            if last_t is not None and last_t < t - t_c:
+                armed = True  # nothing seen for t_c: a new performance
             last_t = t
             G.append((t, g))
             G = [e for e in G if e[0] >= t - t_c]
@@ -137,6 +146,13 @@ def main():
             counts = collections.Counter(e[1] for e in G)
             top = max(counts.values())
             leaders = [k for k, c in counts.items() if c == top]
+            if len(leaders) == 1 and leaders[0] == 0:
+                if none_run_start is None:
+                    none_run_start = t
+                if t - none_run_start >= release_s:
+                    armed = True
+            else:
+                none_run_start = None
             if len(leaders) > 1:
                 continue
             dominant = leaders[0]
@@ -144,7 +160,11 @@ def main():
                 continue
             if last_fire is not None and not (t - last_fire >= t_d):
                 continue
+            if release_mode and not armed:
+                continue
             last_fire = t
+            armed = not release_mode
+            none_run_start = None
             action = mapping.get(dominant)
             if action is None:
                 out.append(f"{fmt(t)},{dominant},none,0,nan")

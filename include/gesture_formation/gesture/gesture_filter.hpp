@@ -14,11 +14,17 @@
 ///  5. evaluate only when |G| ≥ min_measurements: f_d = (count of the most frequent id) / |G|
 ///     (computed as a double division); when two or more ids share the highest count
 ///     (a tie) nothing fires;
-///  6. fire when f_d > Π_d (ratio_threshold; STRICTLY greater), the dominant id ≠ 0, and
-///     either nothing has fired yet (the first command has no cooldown) or
-///     t − t_last_fired ≥ t_d (cooldown_s; an elapsed time exactly t_d may fire).
-/// Firing does not clear G; the cooldown alone prevents repeated adjustments from the same
-/// measurements (paper). Rejected measurements do not count toward anything.
+///  6. fire when f_d > Π_d (ratio_threshold; STRICTLY greater), the dominant id ≠ 0, the
+///     filter is armed (below), and either nothing has fired yet (the first command has no
+///     cooldown) or t − t_last_fired ≥ t_d (cooldown_s; an elapsed time exactly t_d may fire).
+/// Re-arming (`rearm`): with `release` (the default: one performance, one command) a fired
+/// command disarms the filter until the gesture has been released — the dominant id of every
+/// evaluation has been 0 (none; no tie) for at least release_s (from the first such evaluation;
+/// any other evaluation restarts it), or every earlier entry of G has expired (nothing seen for
+/// t_c: a new performance). A gesture held, or misread and held, for longer than t_d thus fires
+/// once. With `cooldown` (the paper) the filter is always armed: a held gesture fires again
+/// every t_d. Firing does not clear G. Rejected and unevaluated measurements do not count
+/// toward anything.
 /// Cost per measurement: O(max_gesture_id) with no heap allocation (ring buffer and counts
 /// are allocated at construction).
 /// Thread safety: none; one filter per thread.
@@ -44,6 +50,10 @@ struct GestureFilterConfig {
   double ratio_threshold = 0.8;  ///< Π_d ∈ [0, 1]: fire when f_d > Π_d
   double cooldown_s = 5.0;      ///< t_d [s], ≥ 0: minimum time between two fired commands
   int max_gesture_id = 4;       ///< valid ids are 0..max_gesture_id (0 none, 1..4 the paper's), ≥ 1
+  /// `rearm`: release (true, default: fire again only after the gesture was released) or
+  /// cooldown (false: the paper — fire again every cooldown_s while it is held).
+  bool rearm_on_release = true;
+  double release_s = 1.0;       ///< `release_s` [s], ≥ 0: how long "none" must dominate to re-arm
 
   /// \brief Every problem, each naming the key; empty when valid.
   std::vector<std::string> validate() const;
@@ -62,10 +72,12 @@ enum class FilterVerdict {
   kBelowThreshold,  ///< f_d ≤ ratio_threshold
   kNoneDominant,    ///< the dominant id is 0 (none)
   kCooldown,        ///< less than cooldown_s since the last fired command
+  kAwaitingRelease,  ///< rearm: release — the gesture that fired has not been released yet
   kFired,           ///< a command fires
 };
 
-/// \brief "rejected", "too_few", "tie", "below_threshold", "none_dominant", "cooldown", "fired".
+/// \brief "rejected", "too_few", "tie", "below_threshold", "none_dominant", "cooldown",
+/// "awaiting_release", "fired".
 const char* toString(FilterVerdict v);
 
 /// \brief The result of one GestureFilter::update. No heap allocation unless rejected.
@@ -101,6 +113,8 @@ class GestureFilter {
   double lastFiredTime() const { return last_fired_s_; }
   /// \brief Time of the last accepted measurement [s]; NaN before the first.
   double lastTime() const { return last_t_s_; }
+  /// \brief Whether a dominant gesture may fire (always with rearm: cooldown).
+  bool armed() const { return armed_; }
 
  private:
   struct Entry {
@@ -116,6 +130,8 @@ class GestureFilter {
   std::vector<int> counts_;  ///< occurrences of each id in G
   double last_t_s_;
   double last_fired_s_;
+  bool armed_ = true;
+  double none_since_s_;  ///< first evaluation of the current run with "none" dominant (NaN: none)
 };
 
 }  // namespace gesture_formation::gesture

@@ -10,13 +10,22 @@ using gesture_formation::common::ConfigReader;
 
 namespace {
 
+/// The paper's filter (rearm: cooldown): the tests below that pin the window, ratio, tie and
+/// cooldown semantics use it; the re-arming on release has its own tests at the end.
 GestureFilterConfig config(int k, int min_meas, double max_age, double ratio, double cooldown) {
   GestureFilterConfig c;
+  c.rearm_on_release = false;
   c.window_size = k;
   c.min_measurements = min_meas;
   c.max_age_s = max_age;
   c.ratio_threshold = ratio;
   c.cooldown_s = cooldown;
+  return c;
+}
+
+GestureFilterConfig paperDefaults() {
+  GestureFilterConfig c;
+  c.rearm_on_release = false;
   return c;
 }
 
@@ -38,6 +47,8 @@ TEST(GestureFilterTest, DefaultsAreThePapers) {
   EXPECT_EQ(c.max_age_s, 20.0);
   EXPECT_EQ(c.ratio_threshold, 0.8);
   EXPECT_EQ(c.cooldown_s, 5.0);
+  EXPECT_TRUE(c.rearm_on_release);  // ours: one performance, one command (the paper: cooldown)
+  EXPECT_EQ(c.release_s, 1.0);
   EXPECT_TRUE(c.validate().empty());
 }
 
@@ -195,7 +206,7 @@ TEST(GestureFilterTest, RejectsBadMeasurementsWithoutChangingState) {
 TEST(GestureFilterTest, NoisyStreamNeverFiresForNonGestureIdsAndRespectsCooldown) {
   std::mt19937 rng(99);
   std::uniform_int_distribution<int> id(0, 4);
-  GestureFilter f(GestureFilterConfig{});
+  GestureFilter f(paperDefaults());
   double t = 0.0, last = -1e9;
   int fired = 0;
   for (int i = 0; i < 20000; ++i) {
@@ -247,4 +258,108 @@ TEST(GestureFilterTest, ReadConfigMinMeasurementsDefaultsToWindowSize) {
   readGestureFilterConfig(bad);
   EXPECT_NE(bad.errorReport().find("min_measurements"), std::string::npos);
   EXPECT_NE(bad.errorReport().find("max_age_s"), std::string::npos);
+}
+
+// ---- rearm: release (default) — one performance, one command ---------------------------
+
+TEST(GestureFilterReleaseTest, AHeldGestureFiresOnceHoweverLongItIsHeld) {
+  GestureFilter f(GestureFilterConfig{});  // K 20, t_d 5 s, release
+  int fired = 0;
+  FilterVerdict last = FilterVerdict::kRejected;
+  for (int i = 0; i < 600; ++i) {  // 60 s of "raise an arm" at 10 Hz: the paper would fire 12 times
+    const auto o = f.update(0.1 * i, 4);
+    fired += o.fired ? 1 : 0;
+    last = o.verdict;
+  }
+  EXPECT_EQ(fired, 1);
+  EXPECT_EQ(last, FilterVerdict::kAwaitingRelease);
+  EXPECT_STREQ(toString(last), "awaiting_release");
+  EXPECT_FALSE(f.armed());
+  // The paper's filter on the same stream: every t_d.
+  GestureFilter paper(paperDefaults());
+  int paper_fired = 0;
+  for (int i = 0; i < 600; ++i) paper_fired += paper.update(0.1 * i, 4).fired ? 1 : 0;
+  EXPECT_EQ(paper_fired, 12);
+}
+
+TEST(GestureFilterReleaseTest, ReleasedForReleaseSThenTheSameGestureFiresAgain) {
+  GestureFilterConfig c;
+  c.release_s = 1.0;
+  GestureFilter f(c);
+  double t = 0.0;
+  const auto run = [&](int id, double seconds) {
+    std::vector<double> fired;
+    for (double end = t + seconds; t < end - 1e-9; t += 0.1) {
+      if (f.update(t, id).fired) fired.push_back(t);
+    }
+    return fired;
+  };
+  EXPECT_EQ(run(2, 8.0).size(), 1u);
+  // Arms down for 0.8 s: "none" never dominates the 20-entry window (8 of 20): not released.
+  EXPECT_TRUE(run(0, 0.8).empty());
+  EXPECT_FALSE(f.armed());
+  EXPECT_EQ(run(2, 6.0).size(), 0u);  // the same performance goes on: nothing more
+  // Arms down for 3 s: "none" dominates from 1.1 s in (11 of 20) and for release_s after.
+  EXPECT_TRUE(run(0, 3.0).empty());
+  EXPECT_TRUE(f.armed());
+  EXPECT_EQ(run(2, 6.0).size(), 1u);   // a new performance fires once
+}
+
+TEST(GestureFilterReleaseTest, ATieOrAnotherGestureRestartsTheRelease) {
+  GestureFilterConfig c;  // times are multiples of 0.25 s: exact in binary
+  c.window_size = 4;
+  c.min_measurements = 4;
+  c.cooldown_s = 0.0;
+  c.release_s = 0.75;
+  GestureFilter f(c);
+  int fired = 0;
+  for (int i = 0; i < 4; ++i) fired += f.update(0.25 * i, 1).fired ? 1 : 0;  // fires at 0.75
+  EXPECT_EQ(fired, 1);
+  EXPECT_FALSE(f.armed());
+  const auto feedAt = [&f](double t, int id) { f.update(t, id); };
+  feedAt(1.0, 0);   // [1 1 1 0]: 1 dominates
+  feedAt(1.25, 0);  // [1 1 0 0]: tie
+  feedAt(1.5, 0);   // [1 0 0 0]: none dominates from 1.5
+  feedAt(1.75, 3);  // [0 0 0 3]: still none (0.25 s)
+  EXPECT_FALSE(f.armed());
+  feedAt(2.0, 3);   // [0 0 3 3]: a tie restarts the release (else it would re-arm at 2.25)
+  feedAt(2.25, 0);  // [0 3 3 0]: tie
+  feedAt(2.5, 0);   // [3 3 0 0]: tie
+  feedAt(2.75, 0);  // [3 0 0 0]: none dominates from 2.75
+  feedAt(3.25, 0);  // 0.5 s
+  EXPECT_FALSE(f.armed());
+  feedAt(3.5, 0);   // 0.75 s = release_s
+  EXPECT_TRUE(f.armed());
+}
+
+TEST(GestureFilterReleaseTest, NothingSeenForMaxAgeIsANewPerformance) {
+  GestureFilterConfig c;
+  c.window_size = 5;
+  c.min_measurements = 5;
+  c.max_age_s = 2.0;
+  c.cooldown_s = 0.0;
+  GestureFilter f(c);
+  int fired = 0;
+  for (int i = 0; i < 10; ++i) fired += f.update(0.1 * i, 4).fired ? 1 : 0;
+  EXPECT_EQ(fired, 1);
+  EXPECT_FALSE(f.armed());
+  // The worker out of view for 3 s (> max_age_s): the same gesture again is a new performance.
+  for (int i = 0; i < 10; ++i) fired += f.update(4.0 + 0.1 * i, 4).fired ? 1 : 0;
+  EXPECT_EQ(fired, 2);
+}
+
+TEST(GestureFilterReleaseTest, ConfigKeysAreReadAndValidated) {
+  ConfigReader r = ConfigReader::fromString("rearm: cooldown\nrelease_s: 2.5\n", "g.yaml", ConfigReader::MissingKeys::kError);
+  const auto c = readGestureFilterConfig(r);
+  EXPECT_FALSE(c.rearm_on_release);
+  EXPECT_EQ(c.release_s, 2.5);
+  ConfigReader bad = ConfigReader::fromString("rearm: sometimes\nrelease_s: -1\n", "g.yaml", ConfigReader::MissingKeys::kUseDefaults);
+  readGestureFilterConfig(bad);
+  ASSERT_EQ(bad.problems().size(), 2u) << bad.errorReport();
+  EXPECT_EQ(bad.problems()[0].key, "rearm");
+  EXPECT_EQ(bad.problems()[1].key, "release_s");
+  GestureFilterConfig v;
+  v.release_s = std::nan("");
+  ASSERT_EQ(v.validate().size(), 1u);
+  EXPECT_NE(v.validate()[0].find("release_s"), std::string::npos);
 }

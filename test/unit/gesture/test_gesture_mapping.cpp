@@ -104,8 +104,11 @@ TEST(GestureMappingTest, ShippedConfigIsThePapersAndComplete) {
 }
 
 TEST(GestureMappingTest, GestureToFormationEndToEnd) {
-  // 20 × "raise an arm" → one command: leader γ 11° → 16°; the next one only after the cooldown.
-  GestureFilter filter(GestureFilterConfig{});
+  // 20 × "raise an arm" → one command: leader γ 11° → 16°; the next one only after the cooldown
+  // (the paper's re-arming: a held gesture fires every t_d).
+  GestureFilterConfig paper;
+  paper.rearm_on_release = false;
+  GestureFilter filter(paper);
   auto state = fm::FormationState::create(fm::FormationParams{}, fm::FormationLimits{}).value();
   const GestureMapping m = GestureMapping::paperDefault();
   std::uint64_t seq = 0;
