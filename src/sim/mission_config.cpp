@@ -37,7 +37,7 @@ std::vector<std::string> FaultConfig::validate(const std::string& prefix) const 
       const auto& [a, b] = w[i];
       if (!(std::isfinite(a) && std::isfinite(b) && a < b)) {
         e.push_back(prefix + name + "[" + std::to_string(i) + "] must be [from, to] with from < to, got [" +
-                    detail::num(a) + ", " + detail::num(b) + "]");
+                    common::formatNumber(a) + ", " + common::formatNumber(b) + "]");
       }
     }
   };
@@ -52,7 +52,7 @@ std::vector<std::string> FaultConfig::validate(const std::string& prefix) const 
     const auto& o = follower_dropouts[i];
     const std::string k = prefix + "follower_dropouts[" + std::to_string(i) + "]";
     if (!(o.from_s < o.to_s)) {
-      e.push_back(k + " needs from_s < to_s, got from_s " + detail::num(o.from_s) + ", to_s " + detail::num(o.to_s));
+      e.push_back(k + " needs from_s < to_s, got from_s " + common::formatNumber(o.from_s) + ", to_s " + common::formatNumber(o.to_s));
     }
     if (o.uav < 1) e.push_back(k + ".uav must be a follower (>= 1), got " + std::to_string(o.uav));
   }
