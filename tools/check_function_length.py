@@ -92,7 +92,7 @@ def tokens_with_lines(code):
 
 def classify_head(head):
     """Kind of the scope a `{` opens after the statement tokens `head` at namespace/class scope."""
-    words = [t for t, _ in head]
+    words = without_template_parameters([t for t, _ in head])
     if not words:
         return "block"
     if "namespace" in words or (words[0] == "extern" and len(words) <= 2):
@@ -163,6 +163,25 @@ def functions_in(path):
             head = []
         else:
             head.append((tok, line))
+
+
+def without_template_parameters(words):
+    """`words` without the parameter lists of `template <...>` (whose `class` is no class)."""
+    out = []
+    i = 0
+    while i < len(words):
+        if words[i] == "template" and i + 1 < len(words) and words[i + 1] == "<":
+            depth = 0
+            i += 1
+            while i < len(words):
+                depth += {"<": 1, ">": -1}.get(words[i], 0)
+                i += 1
+                if depth == 0:
+                    break
+            continue
+        out.append(words[i])
+        i += 1
+    return out
 
 
 def in_ctor_initializer(head):
@@ -249,10 +268,14 @@ int S_free(int v) noexcept {
   }
   return 0;
 }
+template <class F, template <class> class G>
+void forEach(F&& f) {
+  f(Row{1, 2});
+}
 }  // namespace a::b
 """
 SELF_TEST_EXPECTED = [("S", 13, 15), ("get", 16, 16), ("operator==", 17, 19), ("twice", 22, 28),
-                      ("S_free", 30, 35)]
+                      ("S_free", 30, 35), ("forEach", 36, 39)]
 
 
 def self_test():
