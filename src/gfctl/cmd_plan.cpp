@@ -8,6 +8,7 @@
 #include <iomanip>
 #include <iostream>
 #include <sstream>
+#include <tuple>
 
 #include "commands.hpp"
 #include "gesture_formation/common/config_reader.hpp"
@@ -236,18 +237,16 @@ int dumpQp(const Args& args, const planning::TrajectoryQpProblem* qp) {
       x.segment<3>(9 * (k - 1) + 3) = sol.v[static_cast<std::size_t>(k)];
       x.segment<3>(9 * (k - 1) + 6) = sol.a[static_cast<std::size_t>(k)];
     }
-    q << "{\"H\": ";
-    writeSparse(q, m.H);
-    q << ", \"g\": ";
-    writeVector(q, m.g);
-    q << ", \"A\": ";
-    writeSparse(q, m.A);
-    q << ", \"b\": ";
-    writeVector(q, m.b);
-    q << ", \"C\": ";
-    writeSparse(q, m.C);
-    q << ", \"l\": ";
-    writeVector(q, m.l);
+    // The objective (H, g), the equalities (A, b), the inequalities (C, l, u).
+    const char* separator = "{";
+    for (const auto& [matrix, matrix_key, vector, vector_key] :
+         {std::tuple{&m.H, "H", &m.g, "g"}, std::tuple{&m.A, "A", &m.b, "b"}, std::tuple{&m.C, "C", &m.l, "l"}}) {
+      q << separator << "\"" << matrix_key << "\": ";
+      writeSparse(q, *matrix);
+      q << ", \"" << vector_key << "\": ";
+      writeVector(q, *vector);
+      separator = ", ";
+    }
     q << ", \"u\": ";
     writeVector(q, m.u);
     q << ", \"cost_constant\": " << num(m.cost_constant) << ", \"status\": \"" << (sol.solved() ? "solved" : sol.reason)
