@@ -61,20 +61,17 @@ inline gesture_formation::WorkerState toWorkerState(const estimation::Vector6d& 
 
 
 // ---- points and vectors ----------------------------------------------------------------
-inline geometry_msgs::Point toPoint(const Eigen::Vector3d& p) {
-  geometry_msgs::Point m;
-  m.x = p.x();
-  m.y = p.y();
-  m.z = p.z();
-  return m;
-}
-inline geometry_msgs::Vector3 toVector3(const Eigen::Vector3d& v) {
-  geometry_msgs::Vector3 m;
+/// Any message with x, y, z fields (Point, Vector3) from an Eigen vector.
+template <typename XyzMsg>
+XyzMsg toXyzMsg(const Eigen::Vector3d& v) {
+  XyzMsg m;
   m.x = v.x();
   m.y = v.y();
   m.z = v.z();
   return m;
 }
+inline geometry_msgs::Point toPoint(const Eigen::Vector3d& p) { return toXyzMsg<geometry_msgs::Point>(p); }
+inline geometry_msgs::Vector3 toVector3(const Eigen::Vector3d& v) { return toXyzMsg<geometry_msgs::Vector3>(v); }
 inline Eigen::Vector3d toEigen(const geometry_msgs::Point& p) { return Eigen::Vector3d(p.x, p.y, p.z); }
 inline Eigen::Vector3d toEigen(const geometry_msgs::Vector3& v) { return Eigen::Vector3d(v.x, v.y, v.z); }
 
@@ -364,11 +361,16 @@ inline sensor_msgs::CameraInfo toCameraInfo(const estimation::CameraIntrinsics& 
   m.P = {k.fx, 0.0, k.cx, 0.0, 0.0, k.fy, k.cy, 0.0, 0.0, 0.0, 1.0, 0.0};
   return m;
 }
+/// Copies x, y, z between messages that have them (Point, Vector3).
+template <typename To, typename From>
+void copyXyz(const From& from, To& to) {
+  to.x = from.x;
+  to.y = from.y;
+  to.z = from.z;
+}
 inline geometry_msgs::Pose toPose(const Eigen::Quaterniond& q, const Eigen::Vector3d& p) {
   geometry_msgs::Pose m;
-  m.position.x = p.x();
-  m.position.y = p.y();
-  m.position.z = p.z();
+  m.position = toPoint(p);
   m.orientation.w = q.w();
   m.orientation.x = q.x();
   m.orientation.y = q.y();
@@ -377,17 +379,13 @@ inline geometry_msgs::Pose toPose(const Eigen::Quaterniond& q, const Eigen::Vect
 }
 inline geometry_msgs::Pose toPose(const geometry_msgs::Transform& t) {
   geometry_msgs::Pose m;
-  m.position.x = t.translation.x;
-  m.position.y = t.translation.y;
-  m.position.z = t.translation.z;
+  copyXyz(t.translation, m.position);
   m.orientation = t.rotation;
   return m;
 }
 inline geometry_msgs::Transform toTransform(const geometry_msgs::Pose& p) {
   geometry_msgs::Transform t;
-  t.translation.x = p.position.x;
-  t.translation.y = p.position.y;
-  t.translation.z = p.position.z;
+  copyXyz(p.position, t.translation);
   t.rotation = p.orientation;
   return t;
 }

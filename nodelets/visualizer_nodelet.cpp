@@ -125,6 +125,16 @@ class VisualizerNodelet : public nodelet::Nodelet {
     return m;
   }
 
+  /// A line strip or list `width_m` wide through `points`.
+  visualization_msgs::Marker lines(const std::string& ns, int id, int type, const ros::Time& stamp, double width_m,
+                                   const std_msgs::ColorRGBA& c, const std::vector<geometry_msgs::Point>& points) const {
+    visualization_msgs::Marker m = marker(ns, id, type, stamp);
+    m.scale.x = width_m;
+    m.color = c;
+    m.points = points;
+    return m;
+  }
+
   void publishMap(const planning::OccupancyMap& map, const ros::Time& stamp) {
     visualization_msgs::MarkerArray a;
     auto m = marker("map", 0, visualization_msgs::Marker::CUBE_LIST, stamp);
@@ -173,26 +183,17 @@ class VisualizerNodelet : public nodelet::Nodelet {
       }
       const auto& p = plans_[static_cast<std::size_t>(i)];
       if (p) {
-        auto line = marker("plans", i, visualization_msgs::Marker::LINE_STRIP, now);
-        line.scale.x = 0.12;
-        line.color = color(i);
-        line.points = p->positions;
-        if (line.points.size() >= 2) a.markers.push_back(line);
-        auto ref = marker("references", i, visualization_msgs::Marker::LINE_STRIP, now);
-        ref.scale.x = 0.3;
-        ref.color = color(i, 0.3f);
-        ref.points = p->reference;
-        if (ref.points.size() >= 2) a.markers.push_back(ref);
-        auto path = marker("paths", i, visualization_msgs::Marker::LINE_STRIP, now);
-        path.scale.x = 0.05;
-        path.color = rgba(1.0f, 1.0f, 1.0f, 0.8f);
-        path.points = p->path;
-        if (path.points.size() >= 2) a.markers.push_back(path);
-        auto corridors = marker("corridors", i, visualization_msgs::Marker::LINE_LIST, now);
-        corridors.scale.x = 0.03;
-        corridors.color = color(i, 0.35f);
-        corridors.points = p->corridor_edges;
-        if (corridors.points.size() >= 2 && corridors.points.size() % 2 == 0) a.markers.push_back(corridors);
+        const auto strip = [&](const char* ns, double width_m, const std_msgs::ColorRGBA& c,
+                               const std::vector<geometry_msgs::Point>& points) {
+          if (points.size() >= 2) a.markers.push_back(lines(ns, i, visualization_msgs::Marker::LINE_STRIP, now, width_m, c, points));
+        };
+        strip("plans", 0.12, color(i), p->positions);
+        strip("references", 0.3, color(i, 0.3f), p->reference);
+        strip("paths", 0.05, rgba(1.0f, 1.0f, 1.0f, 0.8f), p->path);
+        if (p->corridor_edges.size() >= 2 && p->corridor_edges.size() % 2 == 0) {
+          a.markers.push_back(
+              lines("corridors", i, visualization_msgs::Marker::LINE_LIST, now, 0.03, color(i, 0.35f), p->corridor_edges));
+        }
         // A UAV that does not track says why (hold / search, docs/safety.md §1–2), above its body.
         if (o && !p->mode.empty() && p->mode != "track") {
           auto label = marker("modes", i, visualization_msgs::Marker::TEXT_VIEW_FACING, now);

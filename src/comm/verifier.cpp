@@ -140,11 +140,7 @@ VerifyResult Verifier::verify(const std::uint8_t* data, std::size_t size, double
 
   VerifyResult r;
   r.verdict = Verdict::kAccepted;
-  r.envelope.type = view.type;
-  r.envelope.sender_id = view.sender_id;
-  r.envelope.key_id = view.key_id;
-  r.envelope.sequence = view.sequence;
-  r.envelope.stamp_s = view.stamp_s;
+  static_cast<EnvelopeHeader&>(r.envelope) = view;  // the header as parsed and authenticated
   r.envelope.payload.assign(view.payload, view.payload + view.payload_bytes);
   window.accept(view.sequence);
   ++counters_.by_verdict[static_cast<std::size_t>(Verdict::kAccepted)];

@@ -4,15 +4,11 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "gesture_formation/common/format_number.hpp"
+
 namespace gesture_formation::common {
 
 namespace {
-
-std::string formatNumber(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
 
 /// Splits "a.b[2].c" into {"a", "b", "[2]", "c"}.
 std::vector<std::string> splitPath(const std::string& key) {

@@ -4,20 +4,12 @@
 #include <limits>
 #include <sstream>
 
+#include "gesture_formation/common/format_number.hpp"
+
 namespace gesture_formation::gesture {
 
 using common::ConfigReader;
 using common::Range;
-
-namespace {
-
-std::string num(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
-
-}  // namespace
 
 const char* toString(FilterVerdict v) {
   switch (v) {
@@ -40,12 +32,12 @@ std::vector<std::string> GestureFilterConfig::validate() const {
     e.push_back("min_measurements must be in [1, window_size=" + std::to_string(window_size) + "], got " +
                 std::to_string(min_measurements));
   }
-  if (!(std::isfinite(max_age_s) && max_age_s > 0.0)) e.push_back("max_age_s must be > 0, got " + num(max_age_s));
+  if (!(std::isfinite(max_age_s) && max_age_s > 0.0)) e.push_back("max_age_s must be > 0, got " + common::formatNumber(max_age_s));
   if (!(ratio_threshold >= 0.0 && ratio_threshold <= 1.0)) {
-    e.push_back("ratio_threshold must be in [0, 1], got " + num(ratio_threshold));
+    e.push_back("ratio_threshold must be in [0, 1], got " + common::formatNumber(ratio_threshold));
   }
-  if (!(std::isfinite(cooldown_s) && cooldown_s >= 0.0)) e.push_back("cooldown_s must be >= 0, got " + num(cooldown_s));
-  if (!(std::isfinite(release_s) && release_s >= 0.0)) e.push_back("release_s must be >= 0, got " + num(release_s));
+  if (!(std::isfinite(cooldown_s) && cooldown_s >= 0.0)) e.push_back("cooldown_s must be >= 0, got " + common::formatNumber(cooldown_s));
+  if (!(std::isfinite(release_s) && release_s >= 0.0)) e.push_back("release_s must be >= 0, got " + common::formatNumber(release_s));
   if (max_gesture_id < 1 || max_gesture_id > 1000) {
     e.push_back("max_gesture_id must be in [1, 1000], got " + std::to_string(max_gesture_id));
   }
@@ -110,16 +102,16 @@ GestureFilterOutput GestureFilter::update(double t_s, double gesture_id) {
   GestureFilterOutput out;
   out.window_count = size_;
   if (!std::isfinite(t_s)) {
-    out.reason = "non-finite time " + num(t_s);
+    out.reason = "non-finite time " + common::formatNumber(t_s);
     return out;
   }
   if (t_s < last_t_s_) {  // false while last_t_s_ is NaN
-    out.reason = "out of order: t=" + num(t_s) + " s is earlier than the previous measurement at " + num(last_t_s_) + " s";
+    out.reason = "out of order: t=" + common::formatNumber(t_s) + " s is earlier than the previous measurement at " + common::formatNumber(last_t_s_) + " s";
     return out;
   }
   if (!(std::isfinite(gesture_id) && gesture_id == std::floor(gesture_id) && gesture_id >= 0.0 &&
         gesture_id <= config_.max_gesture_id)) {
-    out.reason = "unknown gesture id " + num(gesture_id) + " (valid: integers 0.." + std::to_string(config_.max_gesture_id) + ")";
+    out.reason = "unknown gesture id " + common::formatNumber(gesture_id) + " (valid: integers 0.." + std::to_string(config_.max_gesture_id) + ")";
     return out;
   }
   const int id = static_cast<int>(gesture_id);

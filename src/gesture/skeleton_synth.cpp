@@ -127,6 +127,27 @@ void SkeletonSynthesizer::drawShape() {
   var_ = Variation{u01(rng_), u01(rng_), u01(rng_), u01(rng_)};
 }
 
+/// The arms' IK targets and elbow poles being posed (pose()); one-arm motions are written in the
+/// left arm's frame and mirrored for the right arm.
+struct SkeletonSynthesizer::ArmTargets {
+  Vector3d sL, sR;  ///< shoulders
+  double reach;     ///< upper arm + forearm
+  bool left_arm;
+  Vector3d pose_L, pose_R, ppole_L, ppole_R;
+
+  void oneArm(const Vector3d& target_left_frame, const Vector3d& pole_left_frame) {
+    if (left_arm) {
+      pose_L = target_left_frame;
+      ppole_L = pole_left_frame;
+    } else {
+      pose_R = mirror(target_left_frame);
+      ppole_R = mirror(pole_left_frame);
+    }
+  }
+  // Explicit return type: an Eigen expression returned by `auto` would dangle (conventions).
+  Vector3d straight(const Vector3d& dir_left_frame) const { return sL + 0.999 * reach * dir_left_frame.normalized(); }
+};
+
 Body3D SkeletonSynthesizer::pose(Motion motion, double s, double phase, bool left_arm) const {
   const BodyShape& b = shape_;
   const double H = b.height;
@@ -154,88 +175,104 @@ Body3D SkeletonSynthesizer::pose(Motion motion, double s, double phase, bool lef
   Vector3d target_L = sL + 0.97 * reach * rest_dir_L;
   Vector3d target_R = sR + 0.97 * reach * mirror(rest_dir_L);
   Vector3d pole_L(-1, 0.2, 0), pole_R(-1, -0.2, 0);
-  Vector3d pose_L = target_L, pose_R = target_R, ppole_L = pole_L, ppole_R = pole_R;
-  const double va = var_.a, vb = var_.b, vc = var_.c, vd = var_.d;
-  // One-arm motions use the left arm's geometry, mirrored for the right arm.
-  auto oneArm = [&](const Vector3d& target_left_frame, const Vector3d& pole_left_frame) {
-    if (left_arm) {
-      pose_L = target_left_frame;
-      ppole_L = pole_left_frame;
-    } else {
-      pose_R = mirror(target_left_frame);
-      ppole_R = mirror(pole_left_frame);
-    }
-  };
-  // Explicit return type: an Eigen expression returned by `auto` would dangle (conventions).
-  auto straight = [&](const Vector3d& dir_left_frame) -> Vector3d { return sL + 0.999 * reach * dir_left_frame.normalized(); };
+  ArmTargets a{sL, sR, reach, left_arm, target_L, target_R, pole_L, pole_R};
+  if (!staticArms(motion, a)) movingArms(motion, s, phase, a, body);
+  const Vector3d &pose_L = a.pose_L, &pose_R = a.pose_R, &ppole_L = a.ppole_L, &ppole_R = a.ppole_R;
+  const bool cyclic = motion == Motion::kWalking || motion == Motion::kClimbingLadder;
+  const double w = cyclic ? 1.0 : s;
+  target_L = target_L + w * (pose_L - target_L);
+  target_R = target_R + w * (pose_R - target_R);
+  pole_L = (pole_L.normalized() + w * (ppole_L.normalized() - pole_L.normalized()));
+  pole_R = (pole_R.normalized() + w * (ppole_R.normalized() - pole_R.normalized()));
+  solveArm(sL, target_L, b.upper_arm, b.forearm, pole_L, p[kLeftElbow], p[kLeftWrist]);
+  solveArm(sR, target_R, b.upper_arm, b.forearm, pole_R, p[kRightElbow], p[kRightWrist]);
+  lungeStance(motion, s, left_arm, body);
+  return body;
+}
 
+bool SkeletonSynthesizer::staticArms(Motion motion, ArmTargets& a) const {
+  const BodyShape& b = shape_;
+  const double H = b.height;
+  const double va = var_.a, vb = var_.b, vc = var_.c, vd = var_.d;
   switch (motion) {
     case Motion::kCrossArms: {  // forearms crossed in front of the upper chest/face, wrists ≥ shoulders
       const Vector3d wl((0.15 + 0.05 * va) * H, -(0.03 + 0.03 * vb) * H, b.shoulder_z + 0.08 * vc * H);
-      pose_L = wl;
-      pose_R = mirror(wl);
-      ppole_L = Vector3d(0, 1, -1);
-      ppole_R = Vector3d(0, -1, -1);
+      a.pose_L = wl;
+      a.pose_R = mirror(wl);
+      a.ppole_L = Vector3d(0, 1, -1);
+      a.ppole_R = Vector3d(0, -1, -1);
       break;
     }
     case Motion::kExtendArmSide: {  // abducted 70–110°, straight, ±15° forward
       const double abd = degToRad(70 + 40 * va), fwd = degToRad(-15 + 30 * vb);
-      oneArm(straight(Vector3d(std::sin(abd) * std::sin(fwd), std::sin(abd) * std::cos(fwd), -std::cos(abd))),
+      a.oneArm(a.straight(Vector3d(std::sin(abd) * std::sin(fwd), std::sin(abd) * std::cos(fwd), -std::cos(abd))),
              Vector3d(-1, 0, -0.3));
       break;
     }
     case Motion::kPalmsTogether: {  // wrists meet in front of the mid-chest, forearms ~horizontal
       const double x = (0.20 + 0.05 * va) * H, z = (0.70 + 0.04 * vb) * H, half_gap = (0.004 + 0.01 * vc) * H;
-      pose_L = Vector3d(x, half_gap, z);
-      pose_R = Vector3d(x, -half_gap, z);
-      ppole_L = Vector3d(0, 1, -0.3);
-      ppole_R = Vector3d(0, -1, -0.3);
+      a.pose_L = Vector3d(x, half_gap, z);
+      a.pose_R = Vector3d(x, -half_gap, z);
+      a.ppole_L = Vector3d(0, 1, -0.3);
+      a.ppole_R = Vector3d(0, -1, -0.3);
       break;
     }
     case Motion::kRaiseArmUp: {  // straight up, within 25° of vertical (flexion/abduction > 155°)
       const double tilt = degToRad(25 * va), az = degToRad(90 * vb);
-      oneArm(straight(Vector3d(std::sin(tilt) * std::cos(az), std::sin(tilt) * std::sin(az), std::cos(tilt))),
+      a.oneArm(a.straight(Vector3d(std::sin(tilt) * std::cos(az), std::sin(tilt) * std::sin(az), std::cos(tilt))),
              Vector3d(0, 1, 0));
       break;
     }
     case Motion::kReachUpBolt: {  // bent arm in front of the body, hand above the head
       Vector3d t((0.25 + 0.10 * va) * H, (0.05 * vb - 0.02) * H, (0.98 + 0.08 * vc) * H);
-      if ((t - sL).norm() > 0.85 * reach) t = sL + 0.85 * reach * (t - sL).normalized();
-      oneArm(t, Vector3d(0, 0.5, -1));
+      if ((t - a.sL).norm() > 0.85 * a.reach) t = a.sL + 0.85 * a.reach * (t - a.sL).normalized();
+      a.oneArm(t, Vector3d(0, 0.5, -1));
       break;
     }
     case Motion::kArmsFoldedLow: {  // wrists at the opposite elbows, below the chest
       const Vector3d wl(0.12 * H, -(0.06 + 0.03 * va) * H, (0.60 + 0.04 * vb) * H);
-      pose_L = wl;
-      pose_R = mirror(wl) + Vector3d(0, 0, -0.01 * H);
-      ppole_L = Vector3d(-0.3, 1, -0.5);
-      ppole_R = Vector3d(-0.3, -1, -0.5);
+      a.pose_L = wl;
+      a.pose_R = mirror(wl) + Vector3d(0, 0, -0.01 * H);
+      a.ppole_L = Vector3d(-0.3, 1, -0.5);
+      a.ppole_R = Vector3d(-0.3, -1, -0.5);
       break;
     }
     case Motion::kToolAtWaist: {  // both hands low at the waist, wrists below the elbows
       const double x = (0.18 + 0.04 * va) * H, z = (0.52 + 0.05 * vb) * H;
-      pose_L = Vector3d(x, 0.02 * H, z);
-      pose_R = Vector3d(x, -0.02 * H, z);
-      ppole_L = Vector3d(-1, 0.5, 0);
-      ppole_R = Vector3d(-1, -0.5, 0);
+      a.pose_L = Vector3d(x, 0.02 * H, z);
+      a.pose_R = Vector3d(x, -0.02 * H, z);
+      a.ppole_L = Vector3d(-1, 0.5, 0);
+      a.ppole_R = Vector3d(-1, -0.5, 0);
       break;
     }
     case Motion::kArmPartwayOrPointing: {
       if (vd < 0.5) {  // raised part-way to the side: abduction 25–55°
         const double abd = degToRad(25 + 30 * va);
-        oneArm(straight(Vector3d(0.1, std::sin(abd), -std::cos(abd))), Vector3d(-1, 0, 0));
+        a.oneArm(a.straight(Vector3d(0.1, std::sin(abd), -std::cos(abd))), Vector3d(-1, 0, 0));
       } else {  // pointing forward, −10…+20° elevation, 0–35° outward
         const double el = degToRad(-10 + 30 * vb), az = degToRad(35 * vc);
-        oneArm(straight(Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el))),
+        a.oneArm(a.straight(Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el))),
                Vector3d(0, 0, -1));
       }
       break;
     }
+    default:
+      return false;
+  }
+  return true;
+}
+
+void SkeletonSynthesizer::movingArms(Motion motion, double s, double phase, ArmTargets& a, Body3D& body) const {
+  const BodyShape& b = shape_;
+  const double H = b.height;
+  const double va = var_.a, vb = var_.b, vc = var_.c, vd = var_.d;
+  auto& p = body.p;
+  switch (motion) {
     case Motion::kWalking: {
       const double arm_amp = degToRad(20 + 15 * va), leg_amp = degToRad(18 + 12 * vb);
       const double th = s * arm_amp * std::sin(phase);
-      pose_L = sL + 0.97 * reach * Vector3d(std::sin(th), 0.1, -std::cos(th)).normalized();
-      pose_R = sR + 0.97 * reach * mirror(Vector3d(std::sin(-th), 0.1, -std::cos(-th)).normalized());
+      a.pose_L = a.sL + 0.97 * a.reach * Vector3d(std::sin(th), 0.1, -std::cos(th)).normalized();
+      a.pose_R = a.sR + 0.97 * a.reach * mirror(Vector3d(std::sin(-th), 0.1, -std::cos(-th)).normalized());
       const double legL = -s * leg_amp * std::sin(phase), legR = -legL;
       const double leg_len = b.hip_z - b.ankle_z;
       p[kLeftAnkle] = Vector3d(leg_len * std::sin(legL), b.hip_half, b.hip_z - leg_len * std::cos(legL));
@@ -246,10 +283,10 @@ Body3D SkeletonSynthesizer::pose(Motion motion, double s, double phase, bool lef
     }
     case Motion::kClimbingLadder: {  // hands alternate on the rails, knees lift alternately
       const double upL = 0.5 + 0.5 * std::sin(phase), upR = 0.5 + 0.5 * std::sin(phase + common::kPi);
-      pose_L = Vector3d(0.25 * H, (0.10 + 0.04 * va) * H, (0.88 + 0.14 * upL) * H);
-      pose_R = Vector3d(0.25 * H, -(0.10 + 0.04 * va) * H, (0.88 + 0.14 * upR) * H);
-      ppole_L = Vector3d(0, 1, -1);
-      ppole_R = Vector3d(0, -1, -1);
+      a.pose_L = Vector3d(0.25 * H, (0.10 + 0.04 * va) * H, (0.88 + 0.14 * upL) * H);
+      a.pose_R = Vector3d(0.25 * H, -(0.10 + 0.04 * va) * H, (0.88 + 0.14 * upR) * H);
+      a.ppole_L = Vector3d(0, 1, -1);
+      a.ppole_R = Vector3d(0, -1, -1);
       const double liftL = s * std::max(0.0, std::sin(phase)), liftR = s * std::max(0.0, -std::sin(phase));
       p[kLeftKnee] += Vector3d(0.15 * H * liftL, 0, 0.13 * H * liftL);
       p[kLeftAnkle] += Vector3d(0.06 * H * liftL, 0, 0.12 * H * liftL);
@@ -263,10 +300,10 @@ Body3D SkeletonSynthesizer::pose(Motion motion, double s, double phase, bool lef
       // off to one side so that at most one wrist crosses the midline (never the X of gesture 1).
       const double x = (0.16 + 0.10 * va) * H, z = (0.66 + 0.16 * vb) * H;
       const double half = (0.05 + 0.06 * vc) * H, shift = (vd - 0.5) * 0.20 * H;
-      pose_L = Vector3d(x, shift + half, z);
-      pose_R = Vector3d(x, shift - half, z);
-      ppole_L = Vector3d(-0.3, 1, -1);
-      ppole_R = Vector3d(-0.3, -1, -1);
+      a.pose_L = Vector3d(x, shift + half, z);
+      a.pose_R = Vector3d(x, shift - half, z);
+      a.ppole_L = Vector3d(-0.3, 1, -1);
+      a.ppole_R = Vector3d(-0.3, -1, -1);
       break;
     }
     case Motion::kBalanceLunge: {
@@ -278,36 +315,36 @@ Body3D SkeletonSynthesizer::pose(Motion motion, double s, double phase, bool lef
       const double up = kick ? degToRad(-10 + 60 * va) : degToRad(30 + 30 * va), fwd = degToRad(-30 + 60 * vb);
       const Vector3d lead_dir(std::cos(up) * std::sin(fwd), std::cos(up) * std::cos(fwd), std::sin(up));
       const Vector3d trail_dir = Vector3d(-0.3, 0.7, -0.6).normalized();
-      if (left_arm) {
-        pose_L = straight(lead_dir);
-        pose_R = sR + 0.97 * reach * mirror(trail_dir);
+      if (a.left_arm) {
+        a.pose_L = a.straight(lead_dir);
+        a.pose_R = a.sR + 0.97 * a.reach * mirror(trail_dir);
       } else {
-        pose_R = mirror(straight(lead_dir));
-        pose_L = sL + 0.97 * reach * trail_dir;
+        a.pose_R = mirror(a.straight(lead_dir));
+        a.pose_L = a.sL + 0.97 * a.reach * trail_dir;
       }
-      ppole_L = Vector3d(-1, 0, -0.3);
-      ppole_R = Vector3d(-1, 0, -0.3);
+      a.ppole_L = Vector3d(-1, 0, -0.3);
+      a.ppole_R = Vector3d(-1, 0, -0.3);
       break;
     }
     case Motion::kIdle:
     case Motion::kCount: {
       if (va > 0.6) {  // hands on the hips
-        pose_L = Vector3d(0.03 * H, b.hip_half + 0.05 * H, b.hip_z + 0.05 * H);
-        pose_R = mirror(pose_L);
-        ppole_L = Vector3d(-0.5, 1, 0);
-        ppole_R = Vector3d(-0.5, -1, 0);
+        a.pose_L = Vector3d(0.03 * H, b.hip_half + 0.05 * H, b.hip_z + 0.05 * H);
+        a.pose_R = mirror(a.pose_L);
+        a.ppole_L = Vector3d(-0.5, 1, 0);
+        a.ppole_R = Vector3d(-0.5, -1, 0);
       }
       break;
     }
+    default:
+      break;
   }
-  const bool cyclic = motion == Motion::kWalking || motion == Motion::kClimbingLadder;
-  const double w = cyclic ? 1.0 : s;
-  target_L = target_L + w * (pose_L - target_L);
-  target_R = target_R + w * (pose_R - target_R);
-  pole_L = (pole_L.normalized() + w * (ppole_L.normalized() - pole_L.normalized()));
-  pole_R = (pole_R.normalized() + w * (ppole_R.normalized() - pole_R.normalized()));
-  solveArm(sL, target_L, b.upper_arm, b.forearm, pole_L, p[kLeftElbow], p[kLeftWrist]);
-  solveArm(sR, target_R, b.upper_arm, b.forearm, pole_R, p[kRightElbow], p[kRightWrist]);
+}
+
+void SkeletonSynthesizer::lungeStance(Motion motion, double s, bool left_arm, Body3D& body) const {
+  const double H = shape_.height;
+  const double va = var_.a, vb = var_.b, vc = var_.c, vd = var_.d;
+  auto& p = body.p;
   const auto idx = [](int k) { return static_cast<std::size_t>(k); };
   // The balancing lunge's upper body (head, shoulders, arms) rotated by R about the hip centre and
   // lowered by drop with the hips.
@@ -354,7 +391,6 @@ Body3D SkeletonSynthesizer::pose(Motion motion, double s, double phase, bool lef
             .toRotationMatrix();
     leanUpperBody(R, drop);
   }
-  return body;
 }
 
 SynthSequence SkeletonSynthesizer::next() {

@@ -27,28 +27,27 @@ const Registrar kRegistrar{"synth-gestures",
                            "--seed S --count N --out DIR [--config FILE] [--views D1,D2]   synthetic gesture/work-motion skeletons (docs/design.md §8.7)",
                            cmdSynthGestures};
 
+/// Reads `<name>_min<unit>` and `<name>_max<unit>`, both within `range`.
+void readInterval(common::ConfigReader& r, const std::string& name, const std::string& unit, double& min_value,
+                  double& max_value, const common::Range& range) {
+  r.readDouble(name + "_min" + unit, min_value, range);
+  r.readDouble(name + "_max" + unit, max_value, range);
+}
+
 bool readSynthConfig(const std::string& path, gesture::SynthConfig& c, std::string& report) {
   using common::ConfigReader;
   using common::Range;
   ConfigReader r = ConfigReader::fromFile(path, ConfigReader::MissingKeys::kUseDefaults);
   r.readDouble("fps", c.fps, Range::openClosed(0, 120));
-  r.readDouble("height_min_m", c.height_min_m, Range::closed(1.0, 2.3));
-  r.readDouble("height_max_m", c.height_max_m, Range::closed(1.0, 2.3));
+  readInterval(r, "height", "_m", c.height_min_m, c.height_max_m, Range::closed(1.0, 2.3));
   r.readDouble("proportion_jitter", c.proportion_jitter, Range::closed(0, 0.3));
-  r.readDouble("distance_min_m", c.distance_min_m, Range::closed(1.5, 100));
-  r.readDouble("distance_max_m", c.distance_max_m, Range::closed(1.5, 100));
-  r.readDouble("elevation_min_deg", c.elevation_min_deg, Range::closed(-30, 80));
-  r.readDouble("elevation_max_deg", c.elevation_max_deg, Range::closed(-30, 80));
-  r.readDouble("azimuth_min_deg", c.azimuth_min_deg, Range::closed(-360, 360));
-  r.readDouble("azimuth_max_deg", c.azimuth_max_deg, Range::closed(-360, 360));
-  r.readDouble("tempo_min", c.tempo_min, Range::closed(0.1, 5));
-  r.readDouble("tempo_max", c.tempo_max, Range::closed(0.1, 5));
-  r.readDouble("hold_min_s", c.hold_min_s, Range::closed(0, 30));
-  r.readDouble("hold_max_s", c.hold_max_s, Range::closed(0, 30));
-  r.readDouble("lead_min_s", c.lead_min_s, Range::closed(0, 30));
-  r.readDouble("lead_max_s", c.lead_max_s, Range::closed(0, 30));
-  r.readDouble("keypoint_noise_min", c.keypoint_noise_min, Range::closed(0, 0.2));
-  r.readDouble("keypoint_noise_max", c.keypoint_noise_max, Range::closed(0, 0.2));
+  readInterval(r, "distance", "_m", c.distance_min_m, c.distance_max_m, Range::closed(1.5, 100));
+  readInterval(r, "elevation", "_deg", c.elevation_min_deg, c.elevation_max_deg, Range::closed(-30, 80));
+  readInterval(r, "azimuth", "_deg", c.azimuth_min_deg, c.azimuth_max_deg, Range::closed(-360, 360));
+  readInterval(r, "tempo", "", c.tempo_min, c.tempo_max, Range::closed(0.1, 5));
+  readInterval(r, "hold", "_s", c.hold_min_s, c.hold_max_s, Range::closed(0, 30));
+  readInterval(r, "lead", "_s", c.lead_min_s, c.lead_max_s, Range::closed(0, 30));
+  readInterval(r, "keypoint_noise", "", c.keypoint_noise_min, c.keypoint_noise_max, Range::closed(0, 0.2));
   r.readDouble("dropout_max", c.dropout_max, Range::closed(0, 0.9));
   r.readDouble("box_jitter", c.box_jitter, Range::closed(0, 0.3));
   r.readDouble("gesture_fraction", c.gesture_fraction, Range::closed(0, 1));

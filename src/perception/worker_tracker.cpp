@@ -28,6 +28,32 @@ int nearestWithin(const cv::Rect2f& ref, const std::vector<Detection>& dets, flo
   return best;
 }
 
+/// Index of the detection overlapping `ref` most (IoU in best_iou), -1 when none overlaps.
+int bestOverlap(const cv::Rect2f& ref, const std::vector<Detection>& dets, float& best_iou) {
+  int idx = -1;
+  best_iou = 0.0f;
+  for (std::size_t i = 0; i < dets.size(); ++i) {
+    const float o = iou(ref, dets[i].box_px);
+    if (o > best_iou) {
+      best_iou = o;
+      idx = static_cast<int>(i);
+    }
+  }
+  return idx;
+}
+
+/// The square detection window around `ref` (roi_scale · max side, at least roi_min_side_px),
+/// shifted inside the frame.
+cv::Rect detectionWindow(const cv::Rect2f& ref, const cv::Size& frame, const WorkerTrackerConfig& config) {
+  const int side = std::min({std::max(static_cast<int>(std::lround(config.roi_scale * std::max(ref.width, ref.height))),
+                                      static_cast<int>(std::lround(config.roi_min_side_px))),
+                             frame.width, frame.height});
+  const cv::Point2f c = centre(ref);
+  const int x = std::clamp(static_cast<int>(std::lround(c.x - side / 2.0f)), 0, frame.width - side);
+  const int y = std::clamp(static_cast<int>(std::lround(c.y - side / 2.0f)), 0, frame.height - side);
+  return cv::Rect(x, y, side, side);
+}
+
 }  // namespace
 
 common::Result<TrackerKind> parseTrackerKind(const std::string& text) {
@@ -194,14 +220,7 @@ common::Result<TrackStep> WorkerTracker::step(const cv::Mat& frame) {
     }
   };
   if (tracking_ && config_.roi_detection) {
-    const cv::Rect2f ref = have_pred ? predicted : box_;
-    const int side = std::min({std::max(static_cast<int>(std::lround(config_.roi_scale * std::max(ref.width, ref.height))),
-                                        static_cast<int>(std::lround(config_.roi_min_side_px))),
-                               frame.cols, frame.rows});
-    const cv::Point2f c = centre(ref);
-    const int x = std::clamp(static_cast<int>(std::lround(c.x - side / 2.0f)), 0, frame.cols - side);
-    const int y = std::clamp(static_cast<int>(std::lround(c.y - side / 2.0f)), 0, frame.rows - side);
-    out.roi_px = cv::Rect(x, y, side, side);
+    out.roi_px = detectionWindow(have_pred ? predicted : box_, frame.size(), config_);
     out.roi_used = true;
     auto dets = detectIn(frame, out.roi_px);
     if (!dets) return R::fail("worker tracker: " + dets.reason());
@@ -220,15 +239,8 @@ common::Result<TrackStep> WorkerTracker::step(const cv::Mat& frame) {
   bool lost_now = false;
   if (tracking_) {
     const cv::Rect2f ref = have_pred ? predicted : box_;
-    int idx = -1;
     float best_iou = 0.0f;
-    for (std::size_t i = 0; i < out.detections.size(); ++i) {
-      const float o = iou(ref, out.detections[i].box_px);
-      if (o > best_iou) {
-        best_iou = o;
-        idx = static_cast<int>(i);
-      }
-    }
+    int idx = bestOverlap(ref, out.detections, best_iou);
     if (best_iou < config_.associate_min_iou) idx = nearestWithin(ref, out.detections, config_.associate_gate);
     if (idx >= 0) {
       const cv::Rect2f det = out.detections[static_cast<std::size_t>(idx)].box_px;

@@ -65,6 +65,80 @@ struct Plane {
   double b;
 };
 
+/// The point of `in` closest to the ellipsoid's centre in its metric (`in` not empty).
+std::size_t closestInside(const std::vector<std::size_t>& in, const std::vector<Eigen::Vector3d>& q,
+                          const Eigen::Vector3d& axes) {
+  std::size_t best = in.front();
+  double best_m = q[best].cwiseQuotient(axes).squaredNorm();
+  for (const std::size_t i : in) {
+    const double m = q[i].cwiseQuotient(axes).squaredNorm();
+    if (m < best_m) best_m = m, best = i;
+  }
+  return best;
+}
+
+/// Keeps in `in` the points other than `best` still inside the ellipsoid with semi-axes `axes`.
+void keepInside(std::vector<std::size_t>& in, std::size_t best, const std::vector<Eigen::Vector3d>& q,
+                const Eigen::Vector3d& axes) {
+  std::vector<std::size_t> still;
+  for (const std::size_t i : in) {
+    if (i != best && inside(q[i], axes)) still.push_back(i);
+  }
+  in.swap(still);
+}
+
+/// The corridor's ellipsoid (step 1), in the segment frame R (x along the segment) with
+/// semi-axes `axes`; q: the points in that frame.
+struct EllipsoidFit {
+  Eigen::Matrix3d R;
+  Eigen::Vector3d axes;
+  std::vector<Eigen::Vector3d> q;
+};
+
+/// Start from the sphere whose diameter is the segment; shrink the two cross axes together
+/// against the closest point inside, rotating the frame so that this point lies in the x–y
+/// plane; then shrink the remaining z axis alone against what is still inside.
+EllipsoidFit fitEllipsoid(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& center,
+                          const Eigen::Vector3d& u, double length) {
+  Eigen::Matrix3d Rw = frameAlong(u);
+  const double a0 = 0.5 * length;
+  Eigen::Vector3d axes(a0, a0, a0);
+  std::vector<Eigen::Vector3d> q(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) q[i] = Rw.transpose() * (points[i] - center);
+  std::vector<std::size_t> in;
+  for (std::size_t i = 0; i < q.size(); ++i) {
+    if (inside(q[i], axes)) in.push_back(i);
+  }
+  double roll = 0.0;
+  while (!in.empty()) {
+    const std::size_t best = closestInside(in, q, axes);
+    const Eigen::Vector3d& qb = q[best];
+    const double radial = std::hypot(qb.y(), qb.z());
+    const double along = std::min(std::abs(qb.x()) / a0, 1.0 - 1e-12);
+    axes.y() = axes.z() = radial / std::sqrt(1.0 - along * along);
+    roll = std::atan2(qb.z(), qb.y());
+    keepInside(in, best, q, axes);
+  }
+  // Rotate the frame about x by `roll`: the last closest point now lies on the new y axis side.
+  const Eigen::Matrix3d Rroll = Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  Rw = Rw * Rroll;
+  for (auto& qi : q) qi = Rroll.transpose() * qi;
+  axes.z() = std::max(a0, axes.y());
+  for (std::size_t i = 0; i < q.size(); ++i) {
+    if (inside(q[i], axes)) in.push_back(i);
+  }
+  while (!in.empty()) {
+    const std::size_t best = closestInside(in, q, axes);
+    const Eigen::Vector3d& qb = q[best];
+    const double rest = 1.0 - std::pow(qb.x() / axes.x(), 2) - std::pow(qb.y() / axes.y(), 2);
+    // rest > (z/a2)² ≥ 0 for a point inside; a2 ≥ a1 holds because every point is already
+    // outside the symmetric ellipsoid of pass 1 (clamped against rounding).
+    axes.z() = std::max(axes.y(), rest > 0.0 ? std::abs(qb.z()) / std::sqrt(rest) : axes.y());
+    keepInside(in, best, q, axes);
+  }
+  return EllipsoidFit{Rw, axes, std::move(q)};
+}
+
 }  // namespace
 
 common::Result<SegmentCorridor> CorridorBuilder::buildSegment(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
@@ -103,64 +177,11 @@ common::Result<SegmentCorridor> CorridorBuilder::buildSegment(const Eigen::Vecto
     }
   }
 
-  // (1) Ellipsoid, in the segment frame (x along the segment). Start from the sphere whose
-  // diameter is the segment; shrink the two cross axes together against the closest point
-  // inside, rotating the frame so that this point lies in the x–y plane; then shrink the
-  // remaining z axis alone against what is still inside.
-  Eigen::Matrix3d Rw = frameAlong(u);
-  const double a0 = 0.5 * length;
-  Eigen::Vector3d axes(a0, a0, a0);
-  std::vector<Eigen::Vector3d> q(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) q[i] = Rw.transpose() * (points[i] - center);
-  std::vector<std::size_t> in;
-  for (std::size_t i = 0; i < q.size(); ++i) {
-    if (inside(q[i], axes)) in.push_back(i);
-  }
-  double roll = 0.0;
-  while (!in.empty()) {
-    std::size_t best = in.front();
-    double best_m = q[best].cwiseQuotient(axes).squaredNorm();
-    for (const std::size_t i : in) {
-      const double m = q[i].cwiseQuotient(axes).squaredNorm();
-      if (m < best_m) best_m = m, best = i;
-    }
-    const Eigen::Vector3d& qb = q[best];
-    const double radial = std::hypot(qb.y(), qb.z());
-    const double along = std::min(std::abs(qb.x()) / a0, 1.0 - 1e-12);
-    axes.y() = axes.z() = radial / std::sqrt(1.0 - along * along);
-    roll = std::atan2(qb.z(), qb.y());
-    std::vector<std::size_t> still;
-    for (const std::size_t i : in) {
-      if (i != best && inside(q[i], axes)) still.push_back(i);
-    }
-    in.swap(still);
-  }
-  // Rotate the frame about x by `roll`: the last closest point now lies on the new y axis side.
-  const Eigen::Matrix3d Rroll = Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()).toRotationMatrix();
-  Rw = Rw * Rroll;
-  for (auto& qi : q) qi = Rroll.transpose() * qi;
-  axes.z() = std::max(a0, axes.y());
-  for (std::size_t i = 0; i < q.size(); ++i) {
-    if (inside(q[i], axes)) in.push_back(i);
-  }
-  while (!in.empty()) {
-    std::size_t best = in.front();
-    double best_m = q[best].cwiseQuotient(axes).squaredNorm();
-    for (const std::size_t i : in) {
-      const double m = q[i].cwiseQuotient(axes).squaredNorm();
-      if (m < best_m) best_m = m, best = i;
-    }
-    const Eigen::Vector3d& qb = q[best];
-    const double rest = 1.0 - std::pow(qb.x() / axes.x(), 2) - std::pow(qb.y() / axes.y(), 2);
-    // rest > (z/a2)² ≥ 0 for a point inside; a2 ≥ a1 holds because every point is already
-    // outside the symmetric ellipsoid of pass 1 (clamped against rounding).
-    axes.z() = std::max(axes.y(), rest > 0.0 ? std::abs(qb.z()) / std::sqrt(rest) : axes.y());
-    std::vector<std::size_t> still;
-    for (const std::size_t i : in) {
-      if (i != best && inside(q[i], axes)) still.push_back(i);
-    }
-    in.swap(still);
-  }
+  // (1) Ellipsoid, in the segment frame (x along the segment).
+  const EllipsoidFit fit = fitEllipsoid(points, center, u, length);
+  const Eigen::Matrix3d& Rw = fit.R;
+  const Eigen::Vector3d& axes = fit.axes;
+  const std::vector<Eigen::Vector3d>& q = fit.q;
   out.ellipsoid.R_world_ellipsoid = Rw;
   out.ellipsoid.axes_m = axes;
   out.ellipsoid.center_world = center;

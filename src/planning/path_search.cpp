@@ -89,6 +89,37 @@ bool segmentClear(const DistanceField& field, double res, const Eigen::Vector3d&
   return true;
 }
 
+namespace {
+
+std::string noPathReason(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double clearance_m, double margin_m,
+                         int expansions, long pocket_voxels) {
+  std::ostringstream os;
+  os << "A*: no path with clearance " << clearance_m << " m from (" << a.transpose() << ") to (" << b.transpose()
+     << ") within " << margin_m << " m (" << expansions << " expansions";
+  if (pocket_voxels > 0) os << "; the goal lies in a closed pocket of " << pocket_voxels << " voxels";
+  os << ")";
+  return os.str();
+}
+
+/// Greedy shortcut: from each kept point jump to the farthest point in sight (clear by
+/// `clearance_m` and outside the keep-out tube).
+std::vector<Eigen::Vector3d> shortcutPath(const std::vector<Eigen::Vector3d>& raw, const DistanceField& field, double res,
+                                          double clearance_m, const KeepOutTube& keep_out) {
+  std::vector<Eigen::Vector3d> out{raw.front()};
+  std::size_t i = 0;
+  while (i + 1 < raw.size()) {
+    std::size_t j = raw.size() - 1;
+    while (j > i + 1 && !(segmentClear(field, res, raw[i], raw[j], clearance_m) && keep_out.segmentOutside(raw[i], raw[j]))) {
+      --j;
+    }
+    out.push_back(raw[j]);
+    i = j;
+  }
+  return out;
+}
+
+}  // namespace
+
 common::Result<std::vector<Eigen::Vector3d>> GridPathSearch::search(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                                                     double clearance_m, double shortcut_clearance_m,
                                                                     double margin_m, int max_expansions, Stats* stats,
@@ -221,14 +252,7 @@ common::Result<std::vector<Eigen::Vector3d>> GridPathSearch::search(const Eigen:
     }
   }
   if (stats) stats->expansions = expansions;
-  if (!found) {
-    std::ostringstream os;
-    os << "A*: no path with clearance " << clearance_m << " m from (" << a.transpose() << ") to (" << b.transpose()
-       << ") within " << margin_m << " m (" << expansions << " expansions";
-    if (pocket_voxels > 0) os << "; the goal lies in a closed pocket of " << pocket_voxels << " voxels";
-    os << ")";
-    return R::fail(os.str());
-  }
+  if (!found) return R::fail(noPathReason(a, b, clearance_m, margin_m, expansions, pocket_voxels));
   std::vector<Eigen::Vector3d> raw;
   for (std::int32_t i = goal; i != -1; i = parent_[static_cast<std::size_t>(i)]) {
     const VoxelIndex v(lx + i % nx + origin.x(), ly + (i / nx) % ny + origin.y(), lz + i / (nx * ny) + origin.z());
@@ -238,19 +262,7 @@ common::Result<std::vector<Eigen::Vector3d>> GridPathSearch::search(const Eigen:
   raw.front() = a;
   raw.back() = b;
   if (stats) stats->raw_waypoints = static_cast<int>(raw.size());
-  // Greedy shortcut: from each kept point jump to the farthest point in sight.
-  std::vector<Eigen::Vector3d> out{raw.front()};
-  std::size_t i = 0;
-  while (i + 1 < raw.size()) {
-    std::size_t j = raw.size() - 1;
-    while (j > i + 1 && !(segmentClear(field_, res, raw[i], raw[j], shortcut_clearance_m) &&
-                          keep_out.segmentOutside(raw[i], raw[j]))) {
-      --j;
-    }
-    out.push_back(raw[j]);
-    i = j;
-  }
-  return R::ok(std::move(out));
+  return R::ok(shortcutPath(raw, field_, res, shortcut_clearance_m, keep_out));
 }
 
 }  // namespace gesture_formation::planning

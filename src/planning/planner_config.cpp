@@ -3,6 +3,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "gesture_formation/common/format_number.hpp"
+
 namespace gesture_formation::planning {
 
 using common::ConfigReader;
@@ -10,14 +12,8 @@ using common::Range;
 
 namespace {
 
-std::string num(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
-
 void require(std::vector<std::string>& e, bool ok, const std::string& field, double value, const std::string& rule) {
-  if (!ok) e.push_back(field + " " + rule + ", got " + num(value));
+  if (!ok) e.push_back(field + " " + rule + ", got " + common::formatNumber(value));
 }
 
 }  // namespace

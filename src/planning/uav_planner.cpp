@@ -64,6 +64,14 @@ std::vector<double> leastReach(const Eigen::Vector3d& d, const Eigen::Vector3d& 
   return out;
 }
 
+/// The rate and pitch limits of `limits` into a camera problem.
+void setCameraLimits(const DynamicLimits& limits, CameraTrackingProblem& cam) {
+  cam.max_heading_rate_radps = limits.max_heading_rate_radps;
+  cam.max_pitch_rate_radps = limits.max_pitch_rate_radps;
+  cam.min_pitch_rad = limits.min_pitch_rad;
+  cam.max_pitch_rad = limits.max_pitch_rad;
+}
+
 std::string checkRequest(const PlanRequest& r) {
   std::ostringstream e;
   const auto& s = r.state;
@@ -312,10 +320,7 @@ void UavPlanner::aimCamera(const PlanRequest& req, PlannedTrajectory& tr) const 
   if (worker_ok) {
     for (const auto& s : tr.samples) cam.p_world.push_back(s.p_world);
     for (int k = 0; k < n; ++k) cam.target_world.push_back(target.col(k));
-    cam.max_heading_rate_radps = config_.limits.max_heading_rate_radps;
-    cam.max_pitch_rate_radps = config_.limits.max_pitch_rate_radps;
-    cam.min_pitch_rad = config_.limits.min_pitch_rad;
-    cam.max_pitch_rad = config_.limits.max_pitch_rad;
+    setCameraLimits(config_.limits, cam);
   }
   const CameraTrack track = worker_ok ? cameraFilter(cam) : CameraTrack{};
   for (int k = 0; k < n; ++k) {
@@ -437,71 +442,189 @@ PlanResult UavPlanner::fallback(const PlanRequest& req, PlanResult result, const
 
 // ---- the three stages ------------------------------------------------------------------------
 
+/// What one replanning's stages hand each other (docs/planning.md §5–§8): the request's
+/// constants, then the path, the corridors, the QP and its solution, the camera angles.
+struct UavPlanner::PlanContext {
+  PlanContext(const PlanRequest& request, Clock::time_point start) : req(request), t_start(start) {}
+
+  const PlanRequest& req;
+  Clock::time_point t_start;
+  double allowance = 0.0;  ///< tracking + wind allowance added to the planning clearances
+  double res = 0.0;        ///< map resolution
+  double dt = 0.0;
+  int N = 0;  ///< intervals of the horizon
+  Eigen::Vector3d p0 = Eigen::Vector3d::Zero();
+  bool has_worker = false;
+  double worker_keep = 0.0;  ///< worker safety distance + QP buffer
+  double path_clear = 0.0;   ///< path clearance (planning, not verification) + allowance
+  double seg_clear = 0.0;    ///< corridor clearance + allowance
+  double start_clear = 0.0;  ///< the start's distance to the nearest obstacle
+  // Stage 2
+  std::vector<Eigen::Vector3d> ref;  ///< projected references, index 0 = p0
+  KeepOutTube worker_tube;
+  std::vector<Eigen::Vector3d> path;
+  bool path_around_worker = false;
+  // Stage 3
+  std::vector<SegmentCorridor> corridors;
+  std::vector<int> seg;                 ///< corridor of sample k (guide's segment)
+  std::vector<Eigen::Vector3d> guide;   ///< guide point of sample k on the path
+  TrajectoryQpProblem qp;
+  bool have_prev = false;  ///< the last verified plan covers t_now (linearisation, warm start)
+  TrajectoryQpSolution sol;
+  std::vector<double> heading, pitch;
+
+  /// The worker's keep-out tube for the segment a→b, shrunk so that neither end lies inside it.
+  KeepOutTube keepOutFor(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const {
+    KeepOutTube tube = worker_tube;
+    if (tube.polyline_world.empty()) return tube;
+    tube.radius_m = std::min({worker_keep, tube.distance(a) - res, tube.distance(b) - res});
+    return tube;
+  }
+  /// Clearance a segment from waypoint `i` must keep (less for the first, from a start that is closer).
+  double segmentClearance(bool from_start) const {
+    return from_start ? std::min(seg_clear, start_clear - res) : seg_clear;
+  }
+};
+
+namespace {
+
+/// Greedy merge: extend a segment over the following waypoints while it stays clear and
+/// every skipped waypoint lies within the merge tolerance of it.
+template <typename SegmentOk>
+std::vector<Eigen::Vector3d> mergeWaypoints(const std::vector<Eigen::Vector3d>& raw, double tolerance_m,
+                                            const SegmentOk& segment_ok) {
+  std::vector<Eigen::Vector3d> path{raw.front()};
+  std::size_t i = 0;
+  while (i + 1 < raw.size()) {
+    std::size_t j = i + 1;
+    while (j + 1 < raw.size()) {
+      const std::size_t c = j + 1;
+      const Eigen::Vector3d a = raw[i], b = raw[c];
+      const Eigen::Vector3d ab = b - a;
+      const double L2 = ab.squaredNorm();
+      bool close = true;
+      for (std::size_t m = i + 1; m < c && close; ++m) {
+        const double s = L2 > 0 ? std::clamp((raw[m] - a).dot(ab) / L2, 0.0, 1.0) : 0.0;
+        close = (raw[m] - (a + s * ab)).norm() <= tolerance_m;
+      }
+      if (!close || !segment_ok(i, a, b)) break;
+      j = c;
+    }
+    path.push_back(raw[j]);
+    i = j;
+  }
+  return path;
+}
+
+}  // namespace
+
 PlanResult UavPlanner::plan(const PlanRequest& req) {
-  const auto t_start = Clock::now();
+  PlanContext ctx(req, Clock::now());
   PlanResult result;
   result.trajectory.uav_index = req.uav_index;
   updateTrackingAllowance(req);
   const double wind_allowance = updateWindAllowance(req);
-  const double allowance = std::clamp(tracking_deviation_m_, config_.tracking_allowance_min_m + wind_allowance,
-                                      config_.tracking_allowance_max_m + wind_allowance);
-  result.tracking_allowance_m = allowance;
+  ctx.allowance = std::clamp(tracking_deviation_m_, config_.tracking_allowance_min_m + wind_allowance,
+                             config_.tracking_allowance_max_m + wind_allowance);
+  result.tracking_allowance_m = ctx.allowance;
   result.wind_allowance_m = wind_allowance;
   const auto finish = [&](PlanResult r) {
     flown_ = r.trajectory;
-    r.timings.total_ms = msSince(t_start);
+    r.timings.total_ms = msSince(ctx.t_start);
     return r;
   };
-  if (!config_error_.empty()) return finish(fallback(req, result, "invalid planner config: " + config_error_));
-  if (!req.state.p_world.allFinite()) return finish(fallback(req, result, "bad request: state.p_world is not finite"));
-  const std::string bad = checkRequest(req);
-  if (!bad.empty()) return finish(fallback(req, result, bad));
+  std::string failure;
+  if (!config_error_.empty()) {
+    failure = "invalid planner config: " + config_error_;
+  } else if (!req.state.p_world.allFinite()) {
+    failure = "bad request: state.p_world is not finite";
+  } else {
+    failure = checkRequest(req);
+  }
+  if (failure.empty()) failure = runStages(ctx, result);
+  if (!failure.empty()) return finish(fallback(req, result, failure));
+  return finish(result);
+}
 
-  const OccupancyMap& map = *map_;
-  const DistanceField& field = *field_;
-  const double res = map.resolution();
-  const double dt = req.dt_s;
-  const int N = req.reference.steps() - 1;
-  const Eigen::Vector3d p0 = req.state.p_world;
-  const bool has_worker = req.worker.steps() > 0;
-
-  // ---- stage 2: project the references, connect them, merge -----------------------------
-  auto t_stage = Clock::now();
-  std::vector<Eigen::Vector3d> ref(static_cast<std::size_t>(N) + 1, p0);
-  const double worker_keep = config_.worker_safety_distance_m + config_.qp_distance_buffer_m;
+std::string UavPlanner::runStages(PlanContext& ctx, PlanResult& result) {
+  const PlanRequest& req = ctx.req;
+  ctx.res = map_->resolution();
+  ctx.dt = req.dt_s;
+  ctx.N = req.reference.steps() - 1;
+  ctx.p0 = req.state.p_world;
+  ctx.has_worker = req.worker.steps() > 0;
+  ctx.worker_keep = config_.worker_safety_distance_m + config_.qp_distance_buffer_m;
   // Obstacle clearances of planning (not of verification) grown by the tracking allowance.
-  const double path_clear = config_.path_clearance_m + allowance;
-  const double seg_clear = config_.obstacle_clearance_m + allowance;
-  for (int k = 1; k <= N; ++k) {
+  ctx.path_clear = config_.path_clearance_m + ctx.allowance;
+  ctx.seg_clear = config_.obstacle_clearance_m + ctx.allowance;
+  ctx.start_clear = field_->clearance(ctx.p0);
+
+  auto t_stage = Clock::now();
+  projectReferences(ctx, result);
+  planPath(ctx, result);
+  result.timings.path_ms = msSince(t_stage);
+
+  t_stage = Clock::now();
+  std::string failure = buildCorridors(ctx);
+  result.timings.corridor_ms = msSince(t_stage);
+  if (!failure.empty()) return failure;
+  result.corridor_count = static_cast<int>(ctx.corridors.size());
+
+  t_stage = Clock::now();
+  setUpQp(ctx);
+  guideAlongPath(ctx);
+  addCorridorRows(ctx, result);
+  result.corridors = std::move(ctx.corridors);  // for display; not used below
+  addRecoveryRows(ctx, result);
+  addSeparationRows(ctx);
+  failure = solveQp(ctx, result);
+  result.timings.qp_ms = msSince(t_stage);
+  if (!failure.empty()) return failure;
+
+  t_stage = Clock::now();
+  failure = planCamera(ctx);
+  result.timings.heading_ms = msSince(t_stage);
+  if (!failure.empty()) return failure;
+
+  return verifyAndAccept(ctx, result);
+}
+
+// ---- stage 2: project the references, connect them, merge -----------------------------------
+
+void UavPlanner::projectReferences(PlanContext& c, PlanResult& result) const {
+  const PlanRequest& req = c.req;
+  c.ref.assign(static_cast<std::size_t>(c.N) + 1, c.p0);
+  for (int k = 1; k <= c.N; ++k) {
     Eigen::Vector3d r = req.reference.p_world.col(k);
     bool moved = false;
-    if (has_worker) {  // out of the worker's safety sphere, horizontally away from it
+    if (c.has_worker) {  // out of the worker's safety sphere, horizontally away from it
       const Eigen::Vector3d w = req.worker.p_world.col(k);
       Eigen::Vector3d d = r - w;
-      if (d.norm() < worker_keep) {
+      if (d.norm() < c.worker_keep) {
         Eigen::Vector3d h(d.x(), d.y(), 0.0);
-        if (h.norm() < 1e-6) h = Eigen::Vector3d(p0.x() - w.x(), p0.y() - w.y(), 0.0);
+        if (h.norm() < 1e-6) h = Eigen::Vector3d(c.p0.x() - w.x(), c.p0.y() - w.y(), 0.0);
         if (h.norm() < 1e-6) h = Eigen::Vector3d::UnitX();
-        d = d + h.normalized() * (worker_keep - d.norm() + 1e-3);
-        if (d.norm() < worker_keep) d = d.normalized() * (worker_keep + 1e-3);
+        d = d + h.normalized() * (c.worker_keep - d.norm() + 1e-3);
+        if (d.norm() < c.worker_keep) d = d.normalized() * (c.worker_keep + 1e-3);
         r = w + d;
         moved = true;
       }
     }
-    const auto proj = projectToClearance(field, map, r, path_clear, config_.max_projection_m);
+    const auto proj = projectToClearance(*field_, *map_, r, c.path_clear, config_.max_projection_m);
     if (proj) {
       moved = moved || (*proj - r).norm() > 1e-9;
       r = *proj;
     } else {
-      r = ref[static_cast<std::size_t>(k) - 1];  // nothing clear nearby: hold the previous target
+      r = c.ref[static_cast<std::size_t>(k) - 1];  // nothing clear nearby: hold the previous target
       moved = true;
     }
     if (moved) ++result.projected_references;
-    ref[static_cast<std::size_t>(k)] = r;
+    c.ref[static_cast<std::size_t>(k)] = r;
   }
-  // Waypoints: the current position, then the projected references (duplicates dropped),
-  // with A* detours where the straight segment is not clear.
-  const double start_clear = field.clearance(p0);
+}
+
+void UavPlanner::planPath(PlanContext& c, PlanResult& result) const {
+  const PlanRequest& req = c.req;
   // The worker's keep-out for the path: a tube around his predicted positions over the horizon
   // (a ball for a standing worker). A straight segment to a reference far away may pass right by
   // him, and where obstacles make the corridor around that segment a sliver the QP cannot bend
@@ -509,85 +632,63 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
   // replanning infeasible; docs/planning.md §5). Shrunk per segment so that neither end lies
   // inside it (a worker who walked up to the UAV; a reference on his track that he will have
   // passed when the UAV gets there): the QP's half-spaces keep the full distance in time.
-  KeepOutTube worker_tube;
-  if (has_worker) {
+  if (c.has_worker) {
     std::vector<Eigen::Vector3d> track;
     for (int k = 0; k < req.worker.steps(); ++k) track.push_back(req.worker.p_world.col(k));
-    worker_tube.polyline_world = simplifyPolyline(track, 0.05);  // within 5 cm of every step
+    c.worker_tube.polyline_world = simplifyPolyline(track, 0.05);  // within 5 cm of every step
   }
-  const auto keepOutFor = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-    KeepOutTube tube = worker_tube;
-    if (tube.polyline_world.empty()) return tube;
-    tube.radius_m = std::min({worker_keep, tube.distance(a) - res, tube.distance(b) - res});
-    return tube;
-  };
-  std::vector<Eigen::Vector3d> raw{p0};
-  bool truncated = false, path_around_worker = false;
-  for (int k = 1; k <= N && !truncated; ++k) {
-    const Eigen::Vector3d& target = ref[static_cast<std::size_t>(k)];
+  // Waypoints: the current position, then the projected references (duplicates dropped),
+  // with A* detours where the straight segment is not clear.
+  std::vector<Eigen::Vector3d> raw{c.p0};
+  for (int k = 1; k <= c.N; ++k) {
+    const Eigen::Vector3d& target = c.ref[static_cast<std::size_t>(k)];
     if ((target - raw.back()).norm() < 1e-3) continue;
-    const bool from_start = raw.size() == 1;
-    const double need = from_start ? std::min(seg_clear, start_clear - res) : seg_clear;
-    const KeepOutTube tube = keepOutFor(raw.back(), target);
+    const KeepOutTube tube = c.keepOutFor(raw.back(), target);
     const bool outside = tube.segmentOutside(raw.back(), target);
-    if (segmentClear(field, res, raw.back(), target, need) && outside) {
+    if (segmentClear(*field_, c.res, raw.back(), target, c.segmentClearance(raw.size() == 1)) && outside) {
       raw.push_back(target);
       continue;
     }
-    path_around_worker = path_around_worker || !outside;
+    c.path_around_worker = c.path_around_worker || !outside;
     ++result.path_searches;
-    const auto detour = search_->search(raw.back(), target, path_clear, seg_clear, config_.search_margin_m,
+    const auto detour = search_->search(raw.back(), target, c.path_clear, c.seg_clear, config_.search_margin_m,
                                         config_.search_max_expansions, nullptr, tube);
-    if (!detour) {
-      truncated = true;  // the rest of the reference is unreachable for now
-      break;
-    }
+    if (!detour) break;  // the rest of the reference is unreachable for now
     for (std::size_t i = 1; i < detour->size(); ++i) raw.push_back((*detour)[i]);
   }
-  // Greedy merge: extend a segment over the following waypoints while it stays clear and
-  // every skipped waypoint lies within the merge tolerance of it.
-  std::vector<Eigen::Vector3d> path{raw.front()};
-  {
-    std::size_t i = 0;
-    while (i + 1 < raw.size()) {
-      std::size_t j = i + 1;
-      while (j + 1 < raw.size()) {
-        const std::size_t c = j + 1;
-        const Eigen::Vector3d a = raw[i], b = raw[c];
-        const Eigen::Vector3d ab = b - a;
-        const double L2 = ab.squaredNorm();
-        bool close = true;
-        for (std::size_t m = i + 1; m < c && close; ++m) {
-          const double s = L2 > 0 ? std::clamp((raw[m] - a).dot(ab) / L2, 0.0, 1.0) : 0.0;
-          close = (raw[m] - (a + s * ab)).norm() <= config_.path_merge_tolerance_m;
-        }
-        const double need = i == 0 ? std::min(seg_clear, start_clear - res) : seg_clear;
-        if (!close || !segmentClear(field, res, a, b, need) || !keepOutFor(a, b).segmentOutside(a, b)) break;
-        j = c;
-      }
-      path.push_back(raw[j]);
-      i = j;
-    }
-  }
-  if (path.size() == 1) {  // already at the (static) reference: a short segment to hold a corridor
+  c.path = mergeWaypoints(raw, config_.path_merge_tolerance_m,
+                          [&](std::size_t i, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+                            return segmentClear(*field_, c.res, a, b, c.segmentClearance(i == 0)) &&
+                                   c.keepOutFor(a, b).segmentOutside(a, b);
+                          });
+  if (c.path.size() == 1) {  // already at the (static) reference: a short segment to hold a corridor
     Eigen::Vector3d d = req.state.v_world.norm() > 1e-3 ? Eigen::Vector3d(req.state.v_world.normalized()) : Eigen::Vector3d::UnitZ();
-    path.push_back(p0 + 0.05 * d);
+    c.path.push_back(c.p0 + 0.05 * d);
   }
-  result.path_world = path;
-  result.timings.path_ms = msSince(t_stage);
-  (void)truncated;
+  result.path_world = c.path;
+}
 
-  // ---- stage 3a: corridors ----------------------------------------------------------------
-  t_stage = Clock::now();
-  std::vector<SegmentCorridor> corridors;
-  corridors.reserve(path.size() - 1);
+// ---- stage 3a: corridors --------------------------------------------------------------------
+
+std::string UavPlanner::buildCorridors(PlanContext& c) const {
+  c.corridors.reserve(c.path.size() - 1);
   std::unique_ptr<CorridorBuilder> inflated;
-  if (allowance > 0.0) {
+  if (c.allowance > 0.0) {
     CorridorConfig cc = corridors_->config();
-    cc.clearance_m += allowance;
+    cc.clearance_m += c.allowance;
     inflated = std::make_unique<CorridorBuilder>(cc);
   }
   const CorridorBuilder& builder = inflated ? *inflated : *corridors_;
+  const std::unique_ptr<CorridorBuilder> first_builder = firstCorridorBuilder(c);
+  for (std::size_t i = 0; i + 1 < c.path.size(); ++i) {
+    auto corridor = (i == 0 && first_builder ? *first_builder : builder).buildSegment(c.path[i], c.path[i + 1], *map_);
+    if (!corridor) return "corridor " + std::to_string(i) + ": " + corridor.reason();
+    c.corridors.push_back(std::move(corridor.value()));
+  }
+  return {};
+}
+
+std::unique_ptr<CorridorBuilder> UavPlanner::firstCorridorBuilder(const PlanContext& c) const {
   // A start closer to an obstacle than the corridor clearance (flying low over the ground, a
   // gust): the first corridor is asked for a little less than the start has — its exact distance
   // to the nearest voxel centre − the builder's seed margin (the ends lie that far inside every
@@ -597,41 +698,30 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
   // that distance the fan appears too (tangent planes through points just beyond the start). Not
   // less: the corridor must not let the UAV much closer than it is (the move-away rows below ask
   // it to recover).
-  std::unique_ptr<CorridorBuilder> first_builder;
-  if (start_clear < seg_clear) {
-    constexpr double kFirstCorridorGap = 0.03;
-    std::vector<Eigen::Vector3d> near;
-    map.pointsInBox(Aabb{p0 - Eigen::Vector3d::Constant(seg_clear), p0 + Eigen::Vector3d::Constant(seg_clear)}, near);
-    double d_exact = std::numeric_limits<double>::infinity();
-    for (const auto& q : near) d_exact = std::min(d_exact, (q - p0).norm());
-    CorridorConfig cc = corridors_->config();
-    const double first_clear = std::clamp(d_exact - cc.seed_margin_m - kFirstCorridorGap,
-                                          config_.verify_clearance_m + OccupancyMap::rasterInflation(res), seg_clear);  // to centres
-    if (first_clear < seg_clear - 1e-9) {
-      cc.clearance_m = first_clear;
-      first_builder = std::make_unique<CorridorBuilder>(cc);
-    }
-  }
-  for (std::size_t i = 0; i + 1 < path.size(); ++i) {
-    auto c = (i == 0 && first_builder ? *first_builder : builder).buildSegment(path[i], path[i + 1], map);
-    if (!c) {
-      result.timings.corridor_ms = msSince(t_stage);
-      return finish(fallback(req, result, "corridor " + std::to_string(i) + ": " + c.reason()));
-    }
-    corridors.push_back(std::move(c.value()));
-  }
-  result.corridor_count = static_cast<int>(corridors.size());
-  result.timings.corridor_ms = msSince(t_stage);
+  if (!(c.start_clear < c.seg_clear)) return nullptr;
+  constexpr double kFirstCorridorGap = 0.03;
+  std::vector<Eigen::Vector3d> near;
+  map_->pointsInBox(Aabb{c.p0 - Eigen::Vector3d::Constant(c.seg_clear), c.p0 + Eigen::Vector3d::Constant(c.seg_clear)}, near);
+  double d_exact = std::numeric_limits<double>::infinity();
+  for (const auto& q : near) d_exact = std::min(d_exact, (q - c.p0).norm());
+  CorridorConfig cc = corridors_->config();
+  const double first_clear = std::clamp(d_exact - cc.seed_margin_m - kFirstCorridorGap,
+                                        config_.verify_clearance_m + OccupancyMap::rasterInflation(c.res), c.seg_clear);  // to centres
+  if (!(first_clear < c.seg_clear - 1e-9)) return nullptr;
+  cc.clearance_m = first_clear;
+  return std::make_unique<CorridorBuilder>(cc);
+}
 
-  // ---- stage 3b: QP ---------------------------------------------------------------------------
-  t_stage = Clock::now();
-  TrajectoryQpProblem qp;
-  qp.dt_s = dt;
-  qp.intervals = N;
-  qp.p0 = p0;
-  qp.v0 = req.state.v_world;
-  qp.a0 = req.state.a_world;
-  qp.reference = ref;
+// ---- stage 3b: QP rows ----------------------------------------------------------------------
+
+void UavPlanner::setUpQp(PlanContext& c) const {
+  TrajectoryQpProblem& qp = c.qp;
+  qp.dt_s = c.dt;
+  qp.intervals = c.N;
+  qp.p0 = c.p0;
+  qp.v0 = c.req.state.v_world;
+  qp.a0 = c.req.state.a_world;
+  qp.reference = c.ref;
   qp.velocity = NormPolygon{config_.limits.max_speed_mps, config_.limits.max_vertical_speed_mps};
   qp.acceleration = NormPolygon{config_.limits.max_acceleration_mps2, config_.limits.max_vertical_acceleration_mps2};
   qp.w_reference = config_.weights.reference;
@@ -641,12 +731,17 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
   qp.eps_abs = config_.qp_eps_abs;
   qp.max_iterations = config_.qp_max_iterations;
   qp.solve_timeout_s = config_.qp_solve_timeout_s;
+  c.have_prev = !last_verified_.empty() && last_verified_.tEnd() > c.req.t_now_s;
+}
 
+void UavPlanner::guideAlongPath(PlanContext& c) {
   // Assignment of samples to corridors: a guide point moves along the path no faster than the
   // inner speed/acceleration sets allow (70 %), towards the projection of r_k, stopping on
   // every waypoint it passes; sample k must lie in the corridors of the guide's segments at
   // k−1 and k (so every chord x_{k−1}x_k lies in one convex corridor).
+  const std::vector<Eigen::Vector3d>& path = c.path;
   const int M = static_cast<int>(path.size()) - 1;
+  const double dt = c.dt;
   std::vector<double> S(static_cast<std::size_t>(M) + 1, 0.0);
   for (int i = 0; i < M; ++i) S[static_cast<std::size_t>(i) + 1] = S[static_cast<std::size_t>(i)] + (path[static_cast<std::size_t>(i) + 1] - path[static_cast<std::size_t>(i)]).norm();
   const auto segOf = [&](double sigma) {
@@ -657,40 +752,45 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
     const Eigen::Vector3d d = path[static_cast<std::size_t>(s) + 1] - path[static_cast<std::size_t>(s)];
     return Eigen::Vector3d(d / std::max(d.norm(), 1e-12));
   };
-  std::vector<int> seg(static_cast<std::size_t>(N) + 1, 0);
-  std::vector<Eigen::Vector3d> guide(static_cast<std::size_t>(N) + 1, p0);
-  {
-    double sigma = 0.0, target_sigma = 0.0;
-    double u = std::max(0.0, req.state.v_world.dot(tangent(0)));
-    int search_from = 0;
-    for (int k = 1; k <= N; ++k) {
-      // Projection of r_k onto the path (monotone, a window of segments ahead).
-      double best = std::numeric_limits<double>::infinity(), best_sigma = target_sigma;
-      for (int s = search_from; s < std::min(M, search_from + 12); ++s) {
-        const Eigen::Vector3d a = path[static_cast<std::size_t>(s)], b = path[static_cast<std::size_t>(s) + 1];
-        const Eigen::Vector3d ab = b - a;
-        const double t = std::clamp((ref[static_cast<std::size_t>(k)] - a).dot(ab) / std::max(ab.squaredNorm(), 1e-12), 0.0, 1.0);
-        const double d = (ref[static_cast<std::size_t>(k)] - (a + t * ab)).norm();
-        if (d < best - 1e-9) best = d, best_sigma = S[static_cast<std::size_t>(s)] + t * ab.norm();
-      }
-      target_sigma = std::max(target_sigma, best_sigma);
-      const int s_prev = segOf(sigma);
-      search_from = s_prev;
-      const Eigen::Vector3d t_dir = tangent(s_prev);
-      const double v_cap = 0.7 * supportAlong(qp.velocity, t_dir);
-      const double a_cap = 0.5 * supportAlong(qp.acceleration, t_dir);
-      u = std::min(u + a_cap * dt, v_cap);
-      double next = std::min(target_sigma, sigma + u * dt);
-      const double boundary = S[static_cast<std::size_t>(s_prev) + 1];
-      if (s_prev < M - 1 && next > boundary) next = boundary;  // stop on the waypoint
-      if (next < sigma + u * dt) u = (next - sigma) / dt;       // waiting slows the guide down
-      sigma = std::min(next, S.back());
-      const int s = segOf(sigma);
-      seg[static_cast<std::size_t>(k)] = s;
-      const double local = std::clamp(sigma - S[static_cast<std::size_t>(s)], 0.0, S[static_cast<std::size_t>(s) + 1] - S[static_cast<std::size_t>(s)]);
-      guide[static_cast<std::size_t>(k)] = path[static_cast<std::size_t>(s)] + local * tangent(s);
+  c.seg.assign(static_cast<std::size_t>(c.N) + 1, 0);
+  c.guide.assign(static_cast<std::size_t>(c.N) + 1, c.p0);
+  double sigma = 0.0, target_sigma = 0.0;
+  double u = std::max(0.0, c.req.state.v_world.dot(tangent(0)));
+  int search_from = 0;
+  for (int k = 1; k <= c.N; ++k) {
+    // Projection of r_k onto the path (monotone, a window of segments ahead).
+    double best = std::numeric_limits<double>::infinity(), best_sigma = target_sigma;
+    for (int s = search_from; s < std::min(M, search_from + 12); ++s) {
+      const Eigen::Vector3d a = path[static_cast<std::size_t>(s)], b = path[static_cast<std::size_t>(s) + 1];
+      const Eigen::Vector3d ab = b - a;
+      const double t = std::clamp((c.ref[static_cast<std::size_t>(k)] - a).dot(ab) / std::max(ab.squaredNorm(), 1e-12), 0.0, 1.0);
+      const double d = (c.ref[static_cast<std::size_t>(k)] - (a + t * ab)).norm();
+      if (d < best - 1e-9) best = d, best_sigma = S[static_cast<std::size_t>(s)] + t * ab.norm();
     }
+    target_sigma = std::max(target_sigma, best_sigma);
+    const int s_prev = segOf(sigma);
+    search_from = s_prev;
+    const Eigen::Vector3d t_dir = tangent(s_prev);
+    const double v_cap = 0.7 * supportAlong(c.qp.velocity, t_dir);
+    const double a_cap = 0.5 * supportAlong(c.qp.acceleration, t_dir);
+    u = std::min(u + a_cap * dt, v_cap);
+    double next = std::min(target_sigma, sigma + u * dt);
+    const double boundary = S[static_cast<std::size_t>(s_prev) + 1];
+    if (s_prev < M - 1 && next > boundary) next = boundary;  // stop on the waypoint
+    if (next < sigma + u * dt) u = (next - sigma) / dt;       // waiting slows the guide down
+    sigma = std::min(next, S.back());
+    const int s = segOf(sigma);
+    c.seg[static_cast<std::size_t>(k)] = s;
+    const double local = std::clamp(sigma - S[static_cast<std::size_t>(s)], 0.0, S[static_cast<std::size_t>(s) + 1] - S[static_cast<std::size_t>(s)]);
+    c.guide[static_cast<std::size_t>(k)] = path[static_cast<std::size_t>(s)] + local * tangent(s);
   }
+}
+
+namespace {
+constexpr double kMomentumAccelShare = 0.7, kMomentumCushion = 0.02;
+}  // namespace
+
+void UavPlanner::addCorridorRows(PlanContext& c, PlanResult& result) const {
   // Corridor rows, pruned when the sample cannot reach them (‖x_k − p0‖ ≤ v_max t_k). A row the
   // UAV cannot meet (with a 2 cm cushion) even braking with all its acceleration — its momentum
   // carries it over the plane (leastReach) — is moved out to where it can braking at 70 %, by at
@@ -700,29 +800,29 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
   // ground: the plan flown descended towards its floor, the new corridor's floor was 2 cm too high
   // for the state; docs/planning.md §12). Rows it can meet are not touched (plans unchanged); a row
   // still out of reach after the allowance leaves the QP infeasible: the planner falls back.
+  TrajectoryQpProblem& qp = c.qp;
   const double vmax = config_.limits.max_speed_mps;
-  constexpr double kMomentumAccelShare = 0.7, kMomentumCushion = 0.02;
-  const double verify_clear = config_.verify_clearance_m + OccupancyMap::rasterInflation(res);  // to voxel centres
+  const double verify_clear = config_.verify_clearance_m + OccupancyMap::rasterInflation(c.res);  // to voxel centres
   struct Reach {
     std::vector<double> full, soft;  // leastReach braking fully / at kMomentumAccelShare, per k
   };
-  std::vector<std::vector<Reach>> least(corridors.size());  // [corridor][row], computed lazily
-  for (int k = 1; k <= N; ++k) {
-    const double reach = vmax * k * dt;
-    const int s_prev = seg[static_cast<std::size_t>(k) - 1], s_cur = seg[static_cast<std::size_t>(k)];
+  std::vector<std::vector<Reach>> least(c.corridors.size());  // [corridor][row], computed lazily
+  for (int k = 1; k <= c.N; ++k) {
+    const double reach = vmax * k * c.dt;
+    const int s_prev = c.seg[static_cast<std::size_t>(k) - 1], s_cur = c.seg[static_cast<std::size_t>(k)];
     for (int s : {s_prev, s_cur}) {
-      const Polytope& P = corridors[static_cast<std::size_t>(s)].polytope;
-      const double cap = std::min(allowance, corridors[static_cast<std::size_t>(s)].clearance_m - verify_clear);
+      const Polytope& P = c.corridors[static_cast<std::size_t>(s)].polytope;
+      const double cap = std::min(c.allowance, c.corridors[static_cast<std::size_t>(s)].clearance_m - verify_clear);
       auto& rows_least = least[static_cast<std::size_t>(s)];
       if (rows_least.empty()) rows_least.resize(static_cast<std::size_t>(P.rows()));
       for (int r = 0; r < P.rows(); ++r) {
         const Eigen::Vector3d a = P.A.row(r).transpose();
         double b = P.b(r) - config_.corridor_margin_m;
-        if (a.dot(p0) + reach < b) continue;  // unreachable plane
+        if (a.dot(c.p0) + reach < b) continue;  // unreachable plane
         Reach& lr = rows_least[static_cast<std::size_t>(r)];
-        if (lr.full.empty()) lr.full = leastReach(a, p0, qp.v0, qp.a0, qp.velocity, qp.acceleration, 1.0, dt, N);
+        if (lr.full.empty()) lr.full = leastReach(a, c.p0, qp.v0, qp.a0, qp.velocity, qp.acceleration, 1.0, c.dt, c.N);
         if (lr.full[static_cast<std::size_t>(k)] + kMomentumCushion > b && cap > 0.0) {
-          if (lr.soft.empty()) lr.soft = leastReach(a, p0, qp.v0, qp.a0, qp.velocity, qp.acceleration, kMomentumAccelShare, dt, N);
+          if (lr.soft.empty()) lr.soft = leastReach(a, c.p0, qp.v0, qp.a0, qp.velocity, qp.acceleration, kMomentumAccelShare, c.dt, c.N);
           b = std::min(lr.soft[static_cast<std::size_t>(k)] + kMomentumCushion, b + cap);
           ++result.momentum_relaxed_rows;
         }
@@ -731,223 +831,231 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
       if (s_prev == s_cur) break;
     }
   }
-  result.corridors = std::move(corridors);  // for display; not used below
+}
+
+void UavPlanner::addRecoveryRows(PlanContext& c, PlanResult& result) const {
   // Closer to obstacles than the corridor clearance (gusts, a corridor that had to shrink
   // around the start): move away along the distance field's gradient at the recovery pace
   // until the clearance is back, instead of hovering where the last plan left the UAV.
-  {
-    const double d_start = field.clearance(p0);
-    if (d_start < seg_clear) {
-      Eigen::Vector3d g;
-      for (int i = 0; i < 3; ++i) {
-        const Eigen::Vector3d e = Eigen::Vector3d::Unit(i) * res;
-        g(i) = (field.clearance(p0 + e) - field.clearance(p0 - e)) / (2.0 * res);
-      }
-      if (g.allFinite() && g.norm() > 1e-6) {
-        const Eigen::Vector3d away = g.normalized();
-        // Not faster than the UAV can turn round: moving towards the obstacle it first has to stop.
-        // Largest away·(x_k − p0) braking fully / at 70 %, less the cushion:
-        const auto most = [&](double share) {
-          std::vector<double> m = leastReach(-away, p0, qp.v0, qp.a0, qp.velocity, qp.acceleration, share, dt, N);
-          for (double& x : m) x = -(x + kMomentumCushion) - away.dot(p0);
-          return m;
-        };
-        const std::vector<double> most_full = most(1.0), most_soft = most(kMomentumAccelShare);
-        for (int k = 1; k <= N; ++k) {
-          double gain = std::min(seg_clear - d_start,
-                                 -0.5 * config_.recovery_slack_m + 1.2 * recoveryAllowance(config_, k * dt));
-          // away·(x_k − p0) ≥ gain  ⇔  (−away)·x_k ≤ −away·p0 − gain
-          if (gain > most_full[static_cast<std::size_t>(k)]) {
-            gain = most_soft[static_cast<std::size_t>(k)];
-            ++result.momentum_relaxed_rows;
-          }
-          qp.constraints.push_back(PositionConstraint{k, -away, -away.dot(p0) - gain, PositionConstraint::Kind::kCorridor});
-        }
-      }
-    }
+  const DistanceField& field = *field_;
+  const Eigen::Vector3d& p0 = c.p0;
+  const double d_start = field.clearance(p0);
+  if (!(d_start < c.seg_clear)) return;
+  Eigen::Vector3d g;
+  for (int i = 0; i < 3; ++i) {
+    const Eigen::Vector3d e = Eigen::Vector3d::Unit(i) * c.res;
+    g(i) = (field.clearance(p0 + e) - field.clearance(p0 - e)) / (2.0 * c.res);
   }
-  // Linearisation points for the distance half-spaces: the last verified plan at t_k, else
-  // the current position.
-  const bool have_prev = !last_verified_.empty() && last_verified_.tEnd() > req.t_now_s;
-  const auto linPoint = [&](int k) {
-    return have_prev ? evaluateTrajectory(last_verified_, req.t_now_s + k * dt).p : p0;
+  if (!g.allFinite() || !(g.norm() > 1e-6)) return;
+  const Eigen::Vector3d away = g.normalized();
+  TrajectoryQpProblem& qp = c.qp;
+  // Not faster than the UAV can turn round: moving towards the obstacle it first has to stop.
+  // Largest away·(x_k − p0) braking fully / at 70 %, less the cushion:
+  const auto most = [&](double share) {
+    std::vector<double> m = leastReach(-away, p0, qp.v0, qp.a0, qp.velocity, qp.acceleration, share, c.dt, c.N);
+    for (double& x : m) x = -(x + kMomentumCushion) - away.dot(p0);
+    return m;
   };
+  const std::vector<double> most_full = most(1.0), most_soft = most(kMomentumAccelShare);
+  for (int k = 1; k <= c.N; ++k) {
+    double gain = std::min(c.seg_clear - d_start,
+                           -0.5 * config_.recovery_slack_m + 1.2 * recoveryAllowance(config_, k * c.dt));
+    // away·(x_k − p0) ≥ gain  ⇔  (−away)·x_k ≤ −away·p0 − gain
+    if (gain > most_full[static_cast<std::size_t>(k)]) {
+      gain = most_soft[static_cast<std::size_t>(k)];
+      ++result.momentum_relaxed_rows;
+    }
+    qp.constraints.push_back(PositionConstraint{k, -away, -away.dot(p0) - gain, PositionConstraint::Kind::kCorridor});
+  }
+}
+
+Eigen::Vector3d UavPlanner::linearisationPoint(const PlanContext& c, int k) const {
+  // The last verified plan at t_k, else the current position.
+  return c.have_prev ? evaluateTrajectory(last_verified_, c.req.t_now_s + k * c.dt).p : c.p0;
+}
+
+void UavPlanner::addSeparationRows(PlanContext& c) const {
+  const PlanRequest& req = c.req;
   // Half-space keeping x_k at least `margin` from o, linearised at the last plan (at_guide: at
   // the guide point on this path).
   const auto addSeparation = [&](int k, const Eigen::Vector3d& o, double margin, PositionConstraint::Kind kind,
-                                  bool at_guide = false) {
-    if ((o - p0).norm() - margin > vmax * k * dt) return;  // cannot get that close by t_k
-    Eigen::Vector3d n = (at_guide ? guide[static_cast<std::size_t>(k)] : linPoint(k)) - o;
-    if (n.norm() < 1e-6) n = guide[static_cast<std::size_t>(k)] - o;
+                                 bool at_guide = false) {
+    if ((o - c.p0).norm() - margin > config_.limits.max_speed_mps * k * c.dt) return;  // cannot get that close by t_k
+    Eigen::Vector3d n = (at_guide ? c.guide[static_cast<std::size_t>(k)] : linearisationPoint(c, k)) - o;
+    if (n.norm() < 1e-6) n = c.guide[static_cast<std::size_t>(k)] - o;
     if (n.norm() < 1e-6) n = Eigen::Vector3d::UnitZ();
     n.normalize();
     // n·(x − o) ≥ margin  ⇔  (−n)·x ≤ −n·o − margin
-    qp.constraints.push_back(PositionConstraint{k, -n, -n.dot(o) - margin, kind});
+    c.qp.constraints.push_back(PositionConstraint{k, -n, -n.dot(o) - margin, kind});
   };
-  const double buffer = config_.qp_distance_buffer_m;
   for (const auto& other : req.higher_priority_plans) {
     const double age = std::max(0.0, req.t_now_s - other.t0_s);
-    const double margin = config_.mutual_distance_m + config_.age_margin_speed_mps * age + buffer;
-    const double d0 = (p0 - evaluateTrajectory(other, req.t_now_s).p).norm();
-    for (int k = 1; k <= N; ++k) {
+    const double margin = config_.mutual_distance_m + config_.age_margin_speed_mps * age + config_.qp_distance_buffer_m;
+    const double d0 = (c.p0 - evaluateTrajectory(other, req.t_now_s).p).norm();
+    for (int k = 1; k <= c.N; ++k) {
       // Already inside at t0: recover at 1.2× the verifier's pace (recoveringDistance).
-      addSeparation(k, evaluateTrajectory(other, req.t_now_s + k * dt).p, recoveringDistance(config_, margin, d0, k * dt, true),
-                    PositionConstraint::Kind::kUav);
+      addSeparation(k, evaluateTrajectory(other, req.t_now_s + k * c.dt).p,
+                    recoveringDistance(config_, margin, d0, k * c.dt, true), PositionConstraint::Kind::kUav);
     }
-    // A plan may have been replaced by a brake plan that did not arrive yet (an old one), or, a
-    // lower-priority UAV's, be by its next one (the lead): keep Γ_dis from every point where its UAV could stop
-    // (one half-space per envelope segment and step, through the segment's point nearest to the
-    // linearisation point: the whole segment lies on its far side).
-    // Fewer segments: the polyline simplified to within kEnvelopeTolerance, which the margin adds.
-    constexpr double kEnvelopeTolerance = 0.05;
-    const std::vector<Eigen::Vector3d> kept = keptBrakeEnvelope(other, req.uav_index, req.t_now_s, config_);
-    if (kept.empty()) continue;
-    const std::vector<Eigen::Vector3d> env = simplifyPolyline(kept, kEnvelopeTolerance);
-    const double d0_env = distanceToPolyline(env, p0);
-    const std::size_t segments = env.size() > 1 ? env.size() - 1 : env.size();
-    for (std::size_t i = 0; i < segments; ++i) {
-      const Eigen::Vector3d& a = env[i];
-      const Eigen::Vector3d& b = env[std::min(i + 1, env.size() - 1)];
-      const double d_seg = (p0 - closestPointOnSegment(a, b, p0)).norm();
-      for (int k = 1; k <= N; ++k) {
-        const double m = recoveringDistance(config_, config_.mutual_distance_m + buffer, d0_env, k * dt, true) + kEnvelopeTolerance;
-        if (d_seg - m > vmax * k * dt) continue;  // cannot get that close by t_k
-        const Eigen::Vector3d c = closestPointOnSegment(a, b, linPoint(k));
-        Eigen::Vector3d n = linPoint(k) - c;
-        if (n.norm() < 1e-6) n = guide[static_cast<std::size_t>(k)] - c;
-        if (n.norm() < 1e-6) n = p0 - c;
-        if (n.norm() < 1e-6) n = Eigen::Vector3d::UnitZ();
-        n.normalize();
-        qp.constraints.push_back(PositionConstraint{k, -n, -n.dot(c) - m, PositionConstraint::Kind::kUav});
-      }
-    }
+    addBrakeEnvelopeRows(c, other);
   }
-  if (has_worker) {
-    const double d0 = (p0 - req.worker.p_world.col(0)).norm();
+  if (c.has_worker) {
+    const double d0 = (c.p0 - req.worker.p_world.col(0)).norm();
     const double margin = config_.worker_safety_distance_m + config_.qp_distance_buffer_m;
-    for (int k = 1; k <= N; ++k) {
+    for (int k = 1; k <= c.N; ++k) {
       // Already inside at t0 (the worker walked up): recover (recoveringDistance). When the path
       // goes around him, the half-spaces turn with it (through the guide point: on the path,
       // outside his keep-out); a previous plan that did not go around him would keep them a wall
       // between the UAV and its reference.
-      addSeparation(k, req.worker.p_world.col(k), recoveringDistance(config_, margin, d0, k * dt, true),
-                    PositionConstraint::Kind::kWorker, path_around_worker);
+      addSeparation(k, req.worker.p_world.col(k), recoveringDistance(config_, margin, d0, k * c.dt, true),
+                    PositionConstraint::Kind::kWorker, c.path_around_worker);
     }
   }
+}
+
+void UavPlanner::addBrakeEnvelopeRows(PlanContext& c, const PlannedTrajectory& other) const {
+  // A plan may have been replaced by a brake plan that did not arrive yet (an old one), or, a
+  // lower-priority UAV's, be by its next one (the lead): keep Γ_dis from every point where its UAV could stop
+  // (one half-space per envelope segment and step, through the segment's point nearest to the
+  // linearisation point: the whole segment lies on its far side).
+  // Fewer segments: the polyline simplified to within kEnvelopeTolerance, which the margin adds.
+  constexpr double kEnvelopeTolerance = 0.05;
+  const std::vector<Eigen::Vector3d> kept = keptBrakeEnvelope(other, c.req.uav_index, c.req.t_now_s, config_);
+  if (kept.empty()) return;
+  const double vmax = config_.limits.max_speed_mps;
+  const std::vector<Eigen::Vector3d> env = simplifyPolyline(kept, kEnvelopeTolerance);
+  const double d0_env = distanceToPolyline(env, c.p0);
+  const std::size_t segments = env.size() > 1 ? env.size() - 1 : env.size();
+  for (std::size_t i = 0; i < segments; ++i) {
+    const Eigen::Vector3d& a = env[i];
+    const Eigen::Vector3d& b = env[std::min(i + 1, env.size() - 1)];
+    const double d_seg = (c.p0 - closestPointOnSegment(a, b, c.p0)).norm();
+    for (int k = 1; k <= c.N; ++k) {
+      const double m = recoveringDistance(config_, config_.mutual_distance_m + config_.qp_distance_buffer_m, d0_env,
+                                          k * c.dt, true) + kEnvelopeTolerance;
+      if (d_seg - m > vmax * k * c.dt) continue;  // cannot get that close by t_k
+      const Eigen::Vector3d lin = linearisationPoint(c, k);
+      const Eigen::Vector3d q = closestPointOnSegment(a, b, lin);
+      Eigen::Vector3d n = lin - q;
+      if (n.norm() < 1e-6) n = c.guide[static_cast<std::size_t>(k)] - q;
+      if (n.norm() < 1e-6) n = c.p0 - q;
+      if (n.norm() < 1e-6) n = Eigen::Vector3d::UnitZ();
+      n.normalize();
+      c.qp.constraints.push_back(PositionConstraint{k, -n, -n.dot(q) - m, PositionConstraint::Kind::kUav});
+    }
+  }
+}
+
+std::string UavPlanner::solveQp(PlanContext& c, PlanResult& result) {
   // Warm start: the last verified plan re-timed (primal only; the constraint set changes).
   TrajectoryQpSolution warm;
-  if (have_prev) {
-    for (int k = 0; k <= N; ++k) {
-      const TrajectoryPoint x = evaluateTrajectory(last_verified_, req.t_now_s + k * dt);
+  if (c.have_prev) {
+    for (int k = 0; k <= c.N; ++k) {
+      const TrajectoryPoint x = evaluateTrajectory(last_verified_, c.req.t_now_s + k * c.dt);
       warm.p.push_back(x.p);
       warm.v.push_back(x.v);
       warm.a.push_back(x.a);
     }
   }
-  if (keep_last_qp_) last_qp_ = std::make_unique<TrajectoryQpProblem>(qp);
-  const TrajectoryQpSolution sol = qp_->solve(qp, have_prev ? &warm : nullptr);
-  result.qp_variables = sol.variables;
-  result.qp_constraints = sol.equalities + sol.inequalities;
-  result.qp_iterations = sol.iterations;
-  result.qp_sparse_timeouts += sol.sparse_timed_out ? 1 : 0;
-  result.timings.qp_ms = msSince(t_stage);
-  if (!sol.solved()) {
-    // Name the constraint family that makes it infeasible (users and the simulator's failure
-    // statistics need the cause; costs up to three more solves, only on failure). The most
-    // frequent cause first: a relaxed problem that is still infeasible costs 2–4× the failed
-    // solve before ProxQP proves it (power towers seed 7: ~450 ms of a 560 ms failed replanning
-    // with the worker and UAV families tried first, docs/planning.md §7). Not beyond the time
-    // budget: the fallback must not wait for a diagnosis (harsh seed 1: 1.6 s, mostly re-solves).
-    std::string cause;
-    using Kind = PositionConstraint::Kind;
-    for (const auto& [kind, name] : {std::pair{Kind::kCorridor, "corridors"}, std::pair{Kind::kUav, "UAV separation"},
-                                     std::pair{Kind::kWorker, "worker separation"}}) {
-      if (config_.time_budget_ms > 0.0 && msSince(t_start) > config_.time_budget_ms) {
-        std::ostringstream os;
-        os << " (cause not diagnosed: the time budget of " << config_.time_budget_ms << " ms is spent)";
-        cause = os.str();
-        break;
-      }
-      TrajectoryQpProblem relaxed = qp;
-      const auto before = relaxed.constraints.size();
-      relaxed.constraints.erase(std::remove_if(relaxed.constraints.begin(), relaxed.constraints.end(),
-                                               [kind = kind](const PositionConstraint& c) { return c.kind == kind; }),
-                                relaxed.constraints.end());
-      if (relaxed.constraints.size() == before) continue;
-      const TrajectoryQpSolution relaxed_sol = qp_->solve(relaxed, nullptr);
-      result.qp_sparse_timeouts += relaxed_sol.sparse_timed_out ? 1 : 0;
-      if (relaxed_sol.solved()) {
-        cause = std::string(" (feasible without the ") + name + " constraints)";
-        break;
-      }
-    }
-    if (cause.empty()) cause = " (infeasible even without any single family: dynamics vs the initial state)";
-    result.timings.qp_ms = msSince(t_stage);
-    return finish(fallback(req, result, sol.reason + cause));
-  }
+  if (keep_last_qp_) last_qp_ = std::make_unique<TrajectoryQpProblem>(c.qp);
+  c.sol = qp_->solve(c.qp, c.have_prev ? &warm : nullptr);
+  result.qp_variables = c.sol.variables;
+  result.qp_constraints = c.sol.equalities + c.sol.inequalities;
+  result.qp_iterations = c.sol.iterations;
+  result.qp_sparse_timeouts += c.sol.sparse_timed_out ? 1 : 0;
+  if (c.sol.solved()) return {};
+  return c.sol.reason + infeasibilityCause(c, result);
+}
 
-  // ---- camera heading / pitch (filter or Ceres) ----------------------------------------------------------
-  t_stage = Clock::now();
-  std::vector<double> heading(static_cast<std::size_t>(N) + 1, req.state.heading_rad);
-  std::vector<double> pitch(static_cast<std::size_t>(N) + 1, req.state.pitch_rad);
-  if (has_worker) {
-    CameraTrackingProblem cam;
-    cam.dt_s = dt;
-    cam.heading0_rad = req.state.heading_rad;
-    cam.pitch0_rad = req.state.pitch_rad;
-    cam.p_world = sol.p;
-    const bool search = req.camera_target.cols() == req.worker.steps() && req.camera_target.allFinite();
-    for (int k = 0; k <= N; ++k) cam.target_world.push_back(search ? req.camera_target.col(k) : req.worker.p_world.col(k));
-    cam.max_heading_rate_radps = config_.limits.max_heading_rate_radps;
-    cam.max_pitch_rate_radps = config_.limits.max_pitch_rate_radps;
-    cam.min_pitch_rad = config_.limits.min_pitch_rad;
-    cam.max_pitch_rad = config_.limits.max_pitch_rad;
-    cam.weight = config_.heading_weight;
-    cam.smoothness_weight = config_.heading_smoothness_weight;
-    const CameraTrack track =
-        config_.camera_solver == PlannerConfig::CameraSolver::kCeres ? solveCameraCeres(cam) : cameraFilter(cam);
-    if (!track.ok) {
-      result.timings.heading_ms = msSince(t_stage);
-      return finish(fallback(req, result, track.reason));
+std::string UavPlanner::infeasibilityCause(const PlanContext& c, PlanResult& result) {
+  // Name the constraint family that makes it infeasible (users and the simulator's failure
+  // statistics need the cause; costs up to three more solves, only on failure). The most
+  // frequent cause first: a relaxed problem that is still infeasible costs 2–4× the failed
+  // solve before ProxQP proves it (power towers seed 7: ~450 ms of a 560 ms failed replanning
+  // with the worker and UAV families tried first, docs/planning.md §7). Not beyond the time
+  // budget: the fallback must not wait for a diagnosis (harsh seed 1: 1.6 s, mostly re-solves).
+  using Kind = PositionConstraint::Kind;
+  for (const auto& [kind, name] : {std::pair{Kind::kCorridor, "corridors"}, std::pair{Kind::kUav, "UAV separation"},
+                                   std::pair{Kind::kWorker, "worker separation"}}) {
+    if (config_.time_budget_ms > 0.0 && msSince(c.t_start) > config_.time_budget_ms) {
+      std::ostringstream os;
+      os << " (cause not diagnosed: the time budget of " << config_.time_budget_ms << " ms is spent)";
+      return os.str();
     }
-    heading = track.heading_rad;
-    pitch = track.pitch_rad;
-  } else {  // no worker: follow the reference's angles within the rate limits
-    for (int k = 1; k <= N; ++k) {
-      const double sh = config_.limits.max_heading_rate_radps * dt, sp = config_.limits.max_pitch_rate_radps * dt;
+    TrajectoryQpProblem relaxed = c.qp;
+    const auto before = relaxed.constraints.size();
+    relaxed.constraints.erase(std::remove_if(relaxed.constraints.begin(), relaxed.constraints.end(),
+                                             [kind = kind](const PositionConstraint& pc) { return pc.kind == kind; }),
+                              relaxed.constraints.end());
+    if (relaxed.constraints.size() == before) continue;
+    const TrajectoryQpSolution relaxed_sol = qp_->solve(relaxed, nullptr);
+    result.qp_sparse_timeouts += relaxed_sol.sparse_timed_out ? 1 : 0;
+    if (relaxed_sol.solved()) return std::string(" (feasible without the ") + name + " constraints)";
+  }
+  return " (infeasible even without any single family: dynamics vs the initial state)";
+}
+
+// ---- camera heading / pitch (filter or Ceres) -----------------------------------------------
+
+std::string UavPlanner::planCamera(PlanContext& c) const {
+  const PlanRequest& req = c.req;
+  c.heading.assign(static_cast<std::size_t>(c.N) + 1, req.state.heading_rad);
+  c.pitch.assign(static_cast<std::size_t>(c.N) + 1, req.state.pitch_rad);
+  if (!c.has_worker) {  // no worker: follow the reference's angles within the rate limits
+    for (int k = 1; k <= c.N; ++k) {
+      const double sh = config_.limits.max_heading_rate_radps * c.dt, sp = config_.limits.max_pitch_rate_radps * c.dt;
       const auto i = static_cast<std::size_t>(k);
-      heading[i] = common::wrapAngle(heading[i - 1] +
-                                     std::clamp(common::wrapAngle(req.reference.heading_rad(k) - heading[i - 1]), -sh, sh));
-      pitch[i] = pitch[i - 1] + std::clamp(std::clamp(req.reference.pitch_rad(k), config_.limits.min_pitch_rad,
-                                                      config_.limits.max_pitch_rad) - pitch[i - 1], -sp, sp);
+      c.heading[i] = common::wrapAngle(c.heading[i - 1] +
+                                       std::clamp(common::wrapAngle(req.reference.heading_rad(k) - c.heading[i - 1]), -sh, sh));
+      c.pitch[i] = c.pitch[i - 1] + std::clamp(std::clamp(req.reference.pitch_rad(k), config_.limits.min_pitch_rad,
+                                                          config_.limits.max_pitch_rad) - c.pitch[i - 1], -sp, sp);
     }
+    return {};
   }
-  result.timings.heading_ms = msSince(t_stage);
+  CameraTrackingProblem cam;
+  cam.dt_s = c.dt;
+  cam.heading0_rad = req.state.heading_rad;
+  cam.pitch0_rad = req.state.pitch_rad;
+  cam.p_world = c.sol.p;
+  const bool search = req.camera_target.cols() == req.worker.steps() && req.camera_target.allFinite();
+  for (int k = 0; k <= c.N; ++k) cam.target_world.push_back(search ? req.camera_target.col(k) : req.worker.p_world.col(k));
+  setCameraLimits(config_.limits, cam);
+  cam.weight = config_.heading_weight;
+  cam.smoothness_weight = config_.heading_smoothness_weight;
+  const CameraTrack track =
+      config_.camera_solver == PlannerConfig::CameraSolver::kCeres ? solveCameraCeres(cam) : cameraFilter(cam);
+  if (!track.ok) return track.reason;
+  c.heading = track.heading_rad;
+  c.pitch = track.pitch_rad;
+  return {};
+}
 
-  // ---- verification ---------------------------------------------------------------------------
-  t_stage = Clock::now();
+// ---- verification ---------------------------------------------------------------------------
+
+std::string UavPlanner::verifyAndAccept(PlanContext& c, PlanResult& result) {
+  const auto t_stage = Clock::now();
   PlannedTrajectory tr;
-  tr.uav_index = req.uav_index;
-  tr.t0_s = req.t_now_s;
-  tr.dt_s = dt;
-  for (int k = 0; k <= N; ++k) {
+  tr.uav_index = c.req.uav_index;
+  tr.t0_s = c.req.t_now_s;
+  tr.dt_s = c.dt;
+  for (int k = 0; k <= c.N; ++k) {
     const auto i = static_cast<std::size_t>(k);
     TrajectorySample s;
-    s.p_world = sol.p[i];
-    s.v_world = sol.v[i];
-    s.a_world = sol.a[i];
-    s.heading_rad = heading[i];
-    s.pitch_rad = pitch[i];
+    s.p_world = c.sol.p[i];
+    s.v_world = c.sol.v[i];
+    s.a_world = c.sol.a[i];
+    s.heading_rad = c.heading[i];
+    s.pitch_rad = c.pitch[i];
     tr.samples.push_back(s);
   }
   const VerificationReport rep =
-      verifier_->verify(tr, req.t_now_s, req.higher_priority_plans, req.worker, req.t_now_s, dt);
+      verifier_->verify(tr, c.req.t_now_s, c.req.higher_priority_plans, c.req.worker, c.req.t_now_s, c.dt);
   result.timings.verify_ms = msSince(t_stage);
-  if (!rep.ok) return finish(fallback(req, result, rep.reason));
-  if (config_.time_budget_ms > 0.0 && msSince(t_start) > config_.time_budget_ms) {
+  if (!rep.ok) return rep.reason;
+  if (config_.time_budget_ms > 0.0 && msSince(c.t_start) > config_.time_budget_ms) {
     std::ostringstream os;
-    os << "time budget exceeded (" << msSince(t_start) << " ms > " << config_.time_budget_ms << " ms)";
-    return finish(fallback(req, result, os.str()));
+    os << "time budget exceeded (" << msSince(c.t_start) << " ms > " << config_.time_budget_ms << " ms)";
+    return os.str();
   }
   tr.sequence = ++sequence_;
   result.trajectory = tr;
@@ -959,7 +1067,7 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
   result.min_worker_distance_m = rep.min_worker_distance_m;
   last_verified_ = tr;
   brake_ = PlannedTrajectory{};
-  return finish(result);
+  return {};
 }
 
 std::vector<PlanResult> planInPriorityOrder(const std::vector<UavPlanner*>& planners, std::vector<PlanRequest> requests) {

@@ -37,7 +37,7 @@ std::vector<std::string> FaultConfig::validate(const std::string& prefix) const 
       const auto& [a, b] = w[i];
       if (!(std::isfinite(a) && std::isfinite(b) && a < b)) {
         e.push_back(prefix + name + "[" + std::to_string(i) + "] must be [from, to] with from < to, got [" +
-                    detail::num(a) + ", " + detail::num(b) + "]");
+                    common::formatNumber(a) + ", " + common::formatNumber(b) + "]");
       }
     }
   };
@@ -52,7 +52,7 @@ std::vector<std::string> FaultConfig::validate(const std::string& prefix) const 
     const auto& o = follower_dropouts[i];
     const std::string k = prefix + "follower_dropouts[" + std::to_string(i) + "]";
     if (!(o.from_s < o.to_s)) {
-      e.push_back(k + " needs from_s < to_s, got from_s " + detail::num(o.from_s) + ", to_s " + detail::num(o.to_s));
+      e.push_back(k + " needs from_s < to_s, got from_s " + common::formatNumber(o.from_s) + ", to_s " + common::formatNumber(o.to_s));
     }
     if (o.uav < 1) e.push_back(k + ".uav must be a follower (>= 1), got " + std::to_string(o.uav));
   }
@@ -184,6 +184,303 @@ void readRoute(ConfigReader& r, const std::string& p, WorkerConfig& w) {
   }
 }
 
+void readWind(ConfigReader& r, const std::string& k, WindConfig& wd) {
+  wd.mean_mps = vec3(r, k + "mean_mps", wd.mean_mps);
+  r.readDouble(k + "turbulence_std_mps", wd.turbulence_std_mps, Range::nonNegative());
+  r.readDouble(k + "turbulence_time_constant_s", wd.turbulence_time_constant_s, Range::positive());
+  r.readDouble(k + "gusts_per_minute", wd.gusts_per_minute, Range::nonNegative());
+  r.readDouble(k + "gust_peak_mps", wd.gust_peak_mps, Range::nonNegative());
+  r.readDouble(k + "gust_duration_s", wd.gust_duration_s, Range::positive());
+}
+
+void readScheduledGestures(ConfigReader& r, const std::string& wk, WorkerConfig& w) {
+  const YAML::Node gestures = r.node(wk + "gestures");
+  if (gestures.IsDefined() && gestures.IsSequence()) {
+    for (std::size_t i = 0; i < gestures.size(); ++i) {
+      const std::string k = wk + "gestures[" + std::to_string(i) + "].";
+      ScheduledGesture g;
+      if (!r.has(k + "t_s") || !r.has(k + "gesture")) r.addError(k + "t_s", "each gesture needs t_s and gesture");
+      r.readDouble(k + "t_s", g.t_s, Range::nonNegative());
+      r.readInt(k + "gesture", g.gesture_id, Range::closed(1, 4));
+      w.gestures.push_back(g);
+    }
+  } else if (gestures.IsDefined() && !gestures.IsNull()) {
+    r.addError(wk + "gestures", "must be a list");
+  }
+}
+
+void readWorkMotions(ConfigReader& r, const std::string& wk, WorkerConfig& w) {
+  const YAML::Node motions = r.node(wk + "work_motions");
+  if (!motions.IsDefined()) return;
+  if (!motions.IsSequence()) {
+    r.addError(wk + "work_motions", "must be a list of motion names");
+    return;
+  }
+  w.work_motions.clear();
+  for (std::size_t i = 0; i < motions.size(); ++i) {
+    const std::string name = motions[i].IsScalar() ? motions[i].Scalar() : "";
+    bool found = false;
+    for (const auto& [n, mo] : motionNames()) {
+      if (n == name) {
+        w.work_motions.push_back(mo);
+        found = true;
+      }
+    }
+    if (!found) r.addError(wk + "work_motions[" + std::to_string(i) + "]", "unknown motion '" + name + "'");
+  }
+}
+
+/// mission.worker: body, start, route, scheduled gestures, work motions, skeleton synthesis.
+void readWorker(ConfigReader& r, const std::string& m, WorkerConfig& w) {
+  const std::string wk = m + "worker.";
+  r.readDouble(wk + "height_m", w.height_m, Range::closed(1.0, 2.3));
+  if (!r.has(wk + "start")) r.addError(wk + "start", "missing (required)");
+  w.start_feet_world = vec3(r, wk + "start", Eigen::Vector3d::Zero());
+  r.readDouble(wk + "start_facing_deg", w.start_facing_deg, Range::closed(-360.0, 360.0));
+  r.readDouble(wk + "gesture_hold_min_s", w.gesture_hold_min_s, Range::positive());
+  r.readDouble(wk + "gesture_hold_max_s", w.gesture_hold_max_s, Range::positive());
+  readRoute(r, wk, w);
+  readScheduledGestures(r, wk, w);
+  readWorkMotions(r, wk, w);
+  r.readDouble(wk + "synth.keypoint_noise_max", w.synth.keypoint_noise_max, Range::closed(0.0, 0.2));
+  r.readDouble(wk + "synth.dropout_max", w.synth.dropout_max, Range::closed(0.0, 0.9));
+  r.readDouble(wk + "synth.box_jitter", w.synth.box_jitter, Range::closed(0.0, 0.3));
+  r.readDouble(wk + "synth.tempo_min", w.synth.tempo_min, Range::closed(0.1, 5.0));
+  r.readDouble(wk + "synth.tempo_max", w.synth.tempo_max, Range::closed(0.1, 5.0));
+}
+
+/// mission.uavs: the leader first, then the followers.
+void readUavs(ConfigReader& r, const std::string& m, std::vector<UavConfig>& out) {
+  const YAML::Node uavs = r.node(m + "uavs");
+  if (!uavs.IsDefined() || !uavs.IsSequence() || uavs.size() == 0) {
+    r.addError(m + "uavs", "missing or empty (required: the leader first, then the followers)");
+    return;
+  }
+  for (std::size_t i = 0; i < uavs.size(); ++i) {
+    const std::string k = m + "uavs[" + std::to_string(i) + "].";
+    UavConfig u;
+    u.name = i == 0 ? "leader" : "follower" + std::to_string(i);
+    r.readString(k + "name", u.name);
+    readPlant(r, k + "plant.", u.plant);
+    bool present = false;
+    const Eigen::Vector3d p = vec3(r, k + "initial_position", Eigen::Vector3d::Zero(), &present);
+    if (present) u.initial_position = p;
+    out.push_back(u);
+  }
+}
+
+void readControllerGains(ConfigReader& r, const std::string& m, ControllerConfig& ct) {
+  const std::string ck = m + "controller.";
+  for (auto [name, v] : std::initializer_list<std::pair<const char*, double*>>{
+           {"kp_xy", &ct.kp_xy}, {"kp_z", &ct.kp_z}, {"kd_xy", &ct.kd_xy}, {"kd_z", &ct.kd_z},
+           {"ki_xy", &ct.ki_xy}, {"ki_z", &ct.ki_z}, {"integral_limit_mps2", &ct.integral_limit_mps2},
+           {"integral_zone_m", &ct.integral_zone_m}, {"integral_zone_mps", &ct.integral_zone_mps},
+           {"max_accel_mps2", &ct.max_accel_mps2}, {"k_heading", &ct.k_heading}, {"k_pitch", &ct.k_pitch},
+           {"hover_speed_mps", &ct.hover_speed_mps}}) {
+    r.readDouble(ck + name, *v, Range::nonNegative());
+  }
+}
+
+/// The product's settings (replanning, safety limits, formation, gestures, planner, estimator):
+/// one parse with the onboard nodelets (onboard::readOnboardSettings).
+void readOnboard(ConfigReader& r, const std::string& m, MissionConfig& c) {
+  onboard::OnboardSettings onboard;
+  onboard::readOnboardSettings(r, m, onboard);
+  c.replanning_period_s = onboard.replanning_period_s;
+  c.horizon_dt_s = onboard.horizon_dt_s;
+  c.horizon_steps = onboard.horizon_steps;
+  c.controller.brake_accel_mps2 = onboard.brake_accel_mps2;
+  c.faults.max_share_age_s = onboard.freshness.max_share_age_s;
+  c.faults.max_worker_age_s = onboard.freshness.max_worker_age_s;
+  c.faults.search = onboard.search;
+  c.faults.max_command_age_s = onboard.max_command_age_s;
+  c.faults.max_plan_age_s = onboard.rule.max_plan_age_s;
+  c.faults.avoid_all_plans = onboard.rule.avoid_all_plans;
+  c.formation = onboard.formation;
+  c.gesture_filter = onboard.gesture_filter;
+  c.gesture_mapping = onboard.gesture_mapping;
+  c.view_fusion = onboard.view_fusion;
+  c.planner = onboard.planner;
+  c.estimator = onboard.estimator;
+}
+
+void readOdometry(ConfigReader& r, const std::string& m, OdometryConfig& od) {
+  const std::string ok = m + "odometry.";
+  r.readDouble(ok + "position_noise_m", od.position_noise_m, Range::nonNegative());
+  r.readDouble(ok + "velocity_noise_mps", od.velocity_noise_mps, Range::nonNegative());
+  r.readDouble(ok + "heading_noise_deg", od.heading_noise_deg, Range::nonNegative());
+  r.readDouble(ok + "pitch_noise_deg", od.pitch_noise_deg, Range::nonNegative());
+  r.readDouble(ok + "bias_std_m", od.bias_std_m, Range::nonNegative());
+  r.readDouble(ok + "bias_time_constant_s", od.bias_time_constant_s, Range::positive());
+}
+
+/// mission.sensors (camera, stereo, UWB) and mission.links.
+void readSensorsAndLinks(ConfigReader& r, const std::string& m, MissionConfig& c) {
+  const std::string sk = m + "sensors.";
+  r.readDouble(sk + "camera.rate_hz", c.camera.rate_hz, Range::openClosed(0.0, 60.0));
+  r.readDouble(sk + "camera.pixel_noise_px", c.camera.pixel_noise_px, Range::nonNegative());
+  r.readDouble(sk + "camera.detection_dropout", c.camera.detection_dropout, Range{0.0, 1.0, true, false});
+  r.readDouble(sk + "camera.max_detection_range_m", c.camera.max_detection_range_m, Range::positive());
+  r.readDouble(sk + "camera.min_box_height_px", c.camera.min_box_height_px, Range::atLeast(1.0));
+  r.readDouble(sk + "camera.min_visible_fraction", c.camera.min_visible_fraction, Range::openClosed(0.0, 1.0));
+  r.readDouble(sk + "camera.occlusion_ignore_near_worker_m", c.camera.occlusion_ignore_near_worker_m,
+               Range::nonNegative());
+  for (auto [name, rs] : std::initializer_list<std::pair<const char*, RangeSensorConfig*>>{{"stereo", &c.stereo},
+                                                                                         {"uwb", &c.uwb}}) {
+    const std::string k = sk + name + ".";
+    r.readDouble(k + "noise_m", rs->noise_m, Range::nonNegative());
+    r.readDouble(k + "max_range_m", rs->max_range_m, Range::positive());
+    r.readDouble(k + "dropout", rs->dropout, Range::closed(0.0, 1.0));
+  }
+  for (auto [name, lc] : std::initializer_list<std::pair<const char*, LinkConfig*>>{{"links.uav", &c.link},
+                                                                                  {"links.operator", &c.operator_link}}) {
+    readLinkKeys(r, m + name + ".", *lc);
+  }
+}
+
+void readWindows(ConfigReader& r, const std::string& key, std::vector<std::pair<double, double>>& out) {
+  const YAML::Node bl = r.node(key);
+  if (!bl.IsDefined()) return;
+  if (!bl.IsSequence()) {
+    r.addError(key, "must be a list of [from_s, to_s] windows");
+    return;
+  }
+  for (std::size_t i = 0; i < bl.size(); ++i) {
+    std::vector<double> v;
+    r.readDoubleList(key + "[" + std::to_string(i) + "]", v, 2, 2, Range::nonNegative());
+    if (v.size() == 2) out.emplace_back(v[0], v[1]);
+  }
+}
+
+void readPlannerOutages(ConfigReader& r, const std::string& fk, std::vector<PlannerOutage>& out) {
+  const YAML::Node po = r.node(fk + "planner_outages");
+  if (!po.IsDefined() || !po.IsSequence()) return;
+  for (std::size_t i = 0; i < po.size(); ++i) {
+    const std::string k = fk + "planner_outages[" + std::to_string(i) + "].";
+    PlannerOutage o;
+    r.readInt(k + "uav", o.uav, Range::closed(0, 63));
+    r.readDouble(k + "from_s", o.from_s, Range::nonNegative());
+    r.readDouble(k + "to_s", o.to_s, Range::nonNegative());
+    out.push_back(o);
+  }
+}
+
+void readFollowerDropouts(ConfigReader& r, const std::string& fk, std::vector<UavDropout>& out) {
+  const YAML::Node fd = r.node(fk + "follower_dropouts");
+  if (fd.IsDefined() && fd.IsSequence()) {
+    for (std::size_t i = 0; i < fd.size(); ++i) {
+      const std::string k = fk + "follower_dropouts[" + std::to_string(i) + "].";
+      UavDropout o;
+      for (const char* key : {"uav", "from_s", "to_s"}) {
+        if (!r.has(k + key)) r.addError(k + key, "missing (required)");
+      }
+      r.readInt(k + "uav", o.uav, Range::closed(1, 63));
+      r.readDouble(k + "from_s", o.from_s, Range::nonNegative());
+      r.readDouble(k + "to_s", o.to_s, Range::nonNegative());
+      out.push_back(o);
+    }
+  } else if (fd.IsDefined()) {
+    r.addError(fk + "follower_dropouts", "must be a list of {uav, from_s, to_s}");
+  }
+}
+
+/// mission.faults: link and wind overlays (key by key over mission.links.* / mission.wind),
+/// sensor windows, planner outages, follower dropouts, range outliers.
+void readFaults(ConfigReader& r, const std::string& m, MissionConfig& c) {
+  const std::string fk = m + "faults.";
+  for (auto [name, lc] : std::initializer_list<std::pair<const char*, LinkConfig*>>{{"link", &c.link},
+                                                                                  {"operator_link", &c.operator_link}}) {
+    readLinkKeys(r, fk + name + ".", *lc);
+  }
+  readWind(r, fk + "wind.", c.wind);
+  readWindows(r, fk + "camera_blackouts", c.faults.camera_blackouts);
+  readWindows(r, fk + "uwb_dropouts", c.faults.uwb_dropouts);
+  readWindows(r, fk + "stereo_dropouts", c.faults.stereo_dropouts);
+  readPlannerOutages(r, fk, c.faults.planner_outages);
+  readFollowerDropouts(r, fk, c.faults.follower_dropouts);
+  const std::string k = fk + "range_outliers.";
+  r.readDouble(k + "probability", c.faults.range_outliers.probability, Range::closed(0.0, 1.0));
+  r.readDouble(k + "min_error_m", c.faults.range_outliers.min_error_m, Range::nonNegative());
+  r.readDouble(k + "max_error_m", c.faults.range_outliers.max_error_m, Range::nonNegative());
+  for (const auto& e : c.faults.validate()) r.addError(m + "faults", e);
+}
+
+/// Cross-section checks: the UAV list, outages and dropouts against the formation's UAV count.
+void checkUavCount(ConfigReader& r, const std::string& m, const MissionConfig& c) {
+  const int n_uavs = c.formation.params.uavCount();
+  const std::string fk = m + "faults.";
+  if (!c.uavs.empty() && static_cast<int>(c.uavs.size()) != n_uavs) {
+    r.addError(m + "uavs", "has " + std::to_string(c.uavs.size()) + " entries but mission.formation has " +
+                               std::to_string(n_uavs) + " UAVs (leader + followers)");
+  }
+  for (const auto& o : c.faults.planner_outages) {
+    if (o.uav >= n_uavs) r.addError(fk + "planner_outages", "uav " + std::to_string(o.uav) + " does not exist");
+  }
+  for (const auto& o : c.faults.follower_dropouts) {
+    if (o.uav >= n_uavs) r.addError(fk + "follower_dropouts", "uav " + std::to_string(o.uav) + " does not exist");
+  }
+}
+
+/// A request's target: a list of UAV indices or a name (formation::parseTarget).
+void readRequestTarget(ConfigReader& r, const std::string& k, int n_uavs, OperatorRequest& q) {
+  const YAML::Node tn = r.node(k + "target");
+  if (!tn.IsDefined()) {
+    r.addError(k + "target", "missing (required)");
+  } else if (tn.IsSequence()) {
+    std::vector<int> ids;
+    std::string text = "[";
+    for (std::size_t j = 0; j < tn.size(); ++j) {
+      int id = -1;
+      try {
+        id = tn[j].as<int>();
+      } catch (const YAML::Exception&) {
+      }
+      if (id < 0 || id >= n_uavs) {
+        r.addError(k + "target[" + std::to_string(j) + "]", "must be a UAV index in [0, " + std::to_string(n_uavs - 1) + "]");
+      }
+      ids.push_back(id);
+      text += (j ? "," : "") + std::to_string(id);
+    }
+    if (ids.empty()) r.addError(k + "target", "empty list");
+    q.target = formation::CommandTarget::list(ids);
+    q.target_text = text + "]";
+  } else {
+    q.target_text = tn.IsScalar() ? tn.Scalar() : "";
+    const auto t = formation::parseTarget(q.target_text);
+    if (!t) {
+      r.addError(k + "target", t.reason());
+    } else {
+      q.target = *t;
+      if (!q.target.resolve(n_uavs)) r.addError(k + "target", "'" + q.target_text + "' does not exist in the formation");
+    }
+  }
+}
+
+/// mission.requests: the operator's formation requests, in time order.
+void readRequests(ConfigReader& r, const std::string& m, int n_uavs, std::vector<OperatorRequest>& out) {
+  const YAML::Node reqs = r.node(m + "requests");
+  if (!reqs.IsDefined() || !reqs.IsSequence()) return;
+  for (std::size_t i = 0; i < reqs.size(); ++i) {
+    const std::string k = m + "requests[" + std::to_string(i) + "].";
+    OperatorRequest q;
+    if (!r.has(k + "t_s")) r.addError(k + "t_s", "missing (required)");
+    r.readDouble(k + "t_s", q.t_s, Range::nonNegative());
+    readRequestTarget(r, k, n_uavs, q);
+    std::string param;
+    r.readString(k + "parameter", param, {"beta_deg", "gamma_deg", "distance_m"});
+    if (!r.has(k + "parameter")) r.addError(k + "parameter", "missing (required)");
+    q.parameter = param == "gamma_deg" ? formation::Parameter::kGamma
+                  : param == "distance_m" ? formation::Parameter::kDistance
+                                          : formation::Parameter::kBeta;
+    const bool inc = r.has(k + "increment"), set = r.has(k + "set");
+    if (inc == set) r.addError(k.substr(0, k.size() - 1), "needs exactly one of increment, set");
+    q.kind = set ? formation::CommandKind::kSet : formation::CommandKind::kIncrement;
+    r.readDouble(k + (set ? "set" : "increment"), q.amount, Range::any());
+    if (i > 0 && q.t_s < out.back().t_s) r.addError(k + "t_s", "requests must be in time order");
+    out.push_back(q);
+  }
+}
+
 }  // namespace
 
 common::Result<MissionConfig> parseMissionConfig(const std::string& yaml, const std::string& source_name,
@@ -204,281 +501,21 @@ common::Result<MissionConfig> parseMissionConfig(const std::string& yaml, const 
     r.readString(m + "gesture_model", c.gesture_model);
     c.gesture_model = joinPath(base_dir, c.gesture_model);
   }
-
-  // --- worker ---------------------------------------------------------------------------
-  WorkerConfig& w = c.worker;
-  const std::string wk = m + "worker.";
-  r.readDouble(wk + "height_m", w.height_m, Range::closed(1.0, 2.3));
-  if (!r.has(wk + "start")) r.addError(wk + "start", "missing (required)");
-  w.start_feet_world = vec3(r, wk + "start", Eigen::Vector3d::Zero());
-  r.readDouble(wk + "start_facing_deg", w.start_facing_deg, Range::closed(-360.0, 360.0));
-  r.readDouble(wk + "gesture_hold_min_s", w.gesture_hold_min_s, Range::positive());
-  r.readDouble(wk + "gesture_hold_max_s", w.gesture_hold_max_s, Range::positive());
-  readRoute(r, wk, w);
-  const YAML::Node gestures = r.node(wk + "gestures");
-  if (gestures.IsDefined() && gestures.IsSequence()) {
-    for (std::size_t i = 0; i < gestures.size(); ++i) {
-      const std::string k = wk + "gestures[" + std::to_string(i) + "].";
-      ScheduledGesture g;
-      if (!r.has(k + "t_s") || !r.has(k + "gesture")) r.addError(k + "t_s", "each gesture needs t_s and gesture");
-      r.readDouble(k + "t_s", g.t_s, Range::nonNegative());
-      r.readInt(k + "gesture", g.gesture_id, Range::closed(1, 4));
-      w.gestures.push_back(g);
-    }
-  } else if (gestures.IsDefined() && !gestures.IsNull()) {
-    r.addError(wk + "gestures", "must be a list");
-  }
-  const YAML::Node motions = r.node(wk + "work_motions");
-  if (motions.IsDefined()) {
-    if (!motions.IsSequence()) {
-      r.addError(wk + "work_motions", "must be a list of motion names");
-    } else {
-      w.work_motions.clear();
-      for (std::size_t i = 0; i < motions.size(); ++i) {
-        const std::string name = motions[i].IsScalar() ? motions[i].Scalar() : "";
-        bool found = false;
-        for (const auto& [n, mo] : motionNames()) {
-          if (n == name) {
-            w.work_motions.push_back(mo);
-            found = true;
-          }
-        }
-        if (!found) r.addError(wk + "work_motions[" + std::to_string(i) + "]", "unknown motion '" + name + "'");
-      }
-    }
-  }
-  r.readDouble(wk + "synth.keypoint_noise_max", w.synth.keypoint_noise_max, Range::closed(0.0, 0.2));
-  r.readDouble(wk + "synth.dropout_max", w.synth.dropout_max, Range::closed(0.0, 0.9));
-  r.readDouble(wk + "synth.box_jitter", w.synth.box_jitter, Range::closed(0.0, 0.3));
-  r.readDouble(wk + "synth.tempo_min", w.synth.tempo_min, Range::closed(0.1, 5.0));
-  r.readDouble(wk + "synth.tempo_max", w.synth.tempo_max, Range::closed(0.1, 5.0));
-
-  // --- UAVs ------------------------------------------------------------------------------
-  const YAML::Node uavs = r.node(m + "uavs");
-  if (!uavs.IsDefined() || !uavs.IsSequence() || uavs.size() == 0) {
-    r.addError(m + "uavs", "missing or empty (required: the leader first, then the followers)");
-  } else {
-    for (std::size_t i = 0; i < uavs.size(); ++i) {
-      const std::string k = m + "uavs[" + std::to_string(i) + "].";
-      UavConfig u;
-      u.name = i == 0 ? "leader" : "follower" + std::to_string(i);
-      r.readString(k + "name", u.name);
-      readPlant(r, k + "plant.", u.plant);
-      bool present = false;
-      const Eigen::Vector3d p = vec3(r, k + "initial_position", Eigen::Vector3d::Zero(), &present);
-      if (present) u.initial_position = p;
-      c.uavs.push_back(u);
-    }
-  }
-
-  // --- controller, odometry, wind, sensors, links, faults ------------------------------
-  auto& ct = c.controller;
-  const std::string ck = m + "controller.";
-  for (auto [name, v] : std::initializer_list<std::pair<const char*, double*>>{
-           {"kp_xy", &ct.kp_xy}, {"kp_z", &ct.kp_z}, {"kd_xy", &ct.kd_xy}, {"kd_z", &ct.kd_z},
-           {"ki_xy", &ct.ki_xy}, {"ki_z", &ct.ki_z}, {"integral_limit_mps2", &ct.integral_limit_mps2},
-           {"integral_zone_m", &ct.integral_zone_m}, {"integral_zone_mps", &ct.integral_zone_mps},
-           {"max_accel_mps2", &ct.max_accel_mps2}, {"k_heading", &ct.k_heading}, {"k_pitch", &ct.k_pitch},
-           {"hover_speed_mps", &ct.hover_speed_mps}}) {
-    r.readDouble(ck + name, *v, Range::nonNegative());
-  }
-  // The product's settings (replanning, safety limits, formation, gestures, planner, estimator):
-  // one parse with the onboard nodelets (onboard::readOnboardSettings).
-  onboard::OnboardSettings onboard;
-  onboard::readOnboardSettings(r, m, onboard);
-  c.replanning_period_s = onboard.replanning_period_s;
-  c.horizon_dt_s = onboard.horizon_dt_s;
-  c.horizon_steps = onboard.horizon_steps;
-  ct.brake_accel_mps2 = onboard.brake_accel_mps2;
-  c.faults.max_share_age_s = onboard.freshness.max_share_age_s;
-  c.faults.max_worker_age_s = onboard.freshness.max_worker_age_s;
-  c.faults.search = onboard.search;
-  c.faults.max_command_age_s = onboard.max_command_age_s;
-  c.faults.max_plan_age_s = onboard.rule.max_plan_age_s;
-  c.faults.avoid_all_plans = onboard.rule.avoid_all_plans;
-  c.formation = onboard.formation;
-  c.gesture_filter = onboard.gesture_filter;
-  c.gesture_mapping = onboard.gesture_mapping;
-  c.view_fusion = onboard.view_fusion;
-  c.planner = onboard.planner;
-  c.estimator = onboard.estimator;
-  for (const auto& e : ct.validate()) r.addError(m + "controller", e);
-
-  auto& od = c.odometry;
-  const std::string ok = m + "odometry.";
-  r.readDouble(ok + "position_noise_m", od.position_noise_m, Range::nonNegative());
-  r.readDouble(ok + "velocity_noise_mps", od.velocity_noise_mps, Range::nonNegative());
-  r.readDouble(ok + "heading_noise_deg", od.heading_noise_deg, Range::nonNegative());
-  r.readDouble(ok + "pitch_noise_deg", od.pitch_noise_deg, Range::nonNegative());
-  r.readDouble(ok + "bias_std_m", od.bias_std_m, Range::nonNegative());
-  r.readDouble(ok + "bias_time_constant_s", od.bias_time_constant_s, Range::positive());
-
-  auto& wd = c.wind;
-  const std::string wdk = m + "wind.";
-  wd.mean_mps = vec3(r, wdk + "mean_mps", wd.mean_mps);
-  r.readDouble(wdk + "turbulence_std_mps", wd.turbulence_std_mps, Range::nonNegative());
-  r.readDouble(wdk + "turbulence_time_constant_s", wd.turbulence_time_constant_s, Range::positive());
-  r.readDouble(wdk + "gusts_per_minute", wd.gusts_per_minute, Range::nonNegative());
-  r.readDouble(wdk + "gust_peak_mps", wd.gust_peak_mps, Range::nonNegative());
-  r.readDouble(wdk + "gust_duration_s", wd.gust_duration_s, Range::positive());
-
-  const std::string sk = m + "sensors.";
-  r.readDouble(sk + "camera.rate_hz", c.camera.rate_hz, Range::openClosed(0.0, 60.0));
-  r.readDouble(sk + "camera.pixel_noise_px", c.camera.pixel_noise_px, Range::nonNegative());
-  r.readDouble(sk + "camera.detection_dropout", c.camera.detection_dropout, Range{0.0, 1.0, true, false});
-  r.readDouble(sk + "camera.max_detection_range_m", c.camera.max_detection_range_m, Range::positive());
-  r.readDouble(sk + "camera.min_box_height_px", c.camera.min_box_height_px, Range::atLeast(1.0));
-  r.readDouble(sk + "camera.min_visible_fraction", c.camera.min_visible_fraction, Range::openClosed(0.0, 1.0));
-  r.readDouble(sk + "camera.occlusion_ignore_near_worker_m", c.camera.occlusion_ignore_near_worker_m,
-               Range::nonNegative());
-  for (auto [name, rs] : std::initializer_list<std::pair<const char*, RangeSensorConfig*>>{{"stereo", &c.stereo},
-                                                                                         {"uwb", &c.uwb}}) {
-    const std::string k = sk + name + ".";
-    r.readDouble(k + "noise_m", rs->noise_m, Range::nonNegative());
-    r.readDouble(k + "max_range_m", rs->max_range_m, Range::positive());
-    r.readDouble(k + "dropout", rs->dropout, Range::closed(0.0, 1.0));
-  }
-  for (auto [name, lc] : std::initializer_list<std::pair<const char*, LinkConfig*>>{{"links.uav", &c.link},
-                                                                                  {"links.operator", &c.operator_link}}) {
-    const std::string k = m + name + ".";
-    readLinkKeys(r, k, *lc);
-  }
-  const std::string fk = m + "faults.";
-  // Fault overlays of links and wind: key by key over mission.links.* / mission.wind.
-  for (auto [name, lc] : std::initializer_list<std::pair<const char*, LinkConfig*>>{{"link", &c.link},
-                                                                                  {"operator_link", &c.operator_link}}) {
-    const std::string k = fk + name + ".";
-    readLinkKeys(r, k, *lc);
-  }
-  {
-    const std::string k = fk + "wind.";
-    wd.mean_mps = vec3(r, k + "mean_mps", wd.mean_mps);
-    r.readDouble(k + "turbulence_std_mps", wd.turbulence_std_mps, Range::nonNegative());
-    r.readDouble(k + "turbulence_time_constant_s", wd.turbulence_time_constant_s, Range::positive());
-    r.readDouble(k + "gusts_per_minute", wd.gusts_per_minute, Range::nonNegative());
-    r.readDouble(k + "gust_peak_mps", wd.gust_peak_mps, Range::nonNegative());
-    r.readDouble(k + "gust_duration_s", wd.gust_duration_s, Range::positive());
-  }
-  auto readWindows = [&](const char* name, std::vector<std::pair<double, double>>& out) {
-    const YAML::Node bl = r.node(fk + name);
-    if (!bl.IsDefined()) return;
-    if (!bl.IsSequence()) {
-      r.addError(fk + name, "must be a list of [from_s, to_s] windows");
-      return;
-    }
-    for (std::size_t i = 0; i < bl.size(); ++i) {
-      std::vector<double> v;
-      r.readDoubleList(fk + name + "[" + std::to_string(i) + "]", v, 2, 2, Range::nonNegative());
-      if (v.size() == 2) out.emplace_back(v[0], v[1]);
-    }
-  };
-  readWindows("camera_blackouts", c.faults.camera_blackouts);
-  readWindows("uwb_dropouts", c.faults.uwb_dropouts);
-  readWindows("stereo_dropouts", c.faults.stereo_dropouts);
-  const YAML::Node po = r.node(fk + "planner_outages");
-  if (po.IsDefined() && po.IsSequence()) {
-    for (std::size_t i = 0; i < po.size(); ++i) {
-      const std::string k = fk + "planner_outages[" + std::to_string(i) + "].";
-      PlannerOutage o;
-      r.readInt(k + "uav", o.uav, Range::closed(0, 63));
-      r.readDouble(k + "from_s", o.from_s, Range::nonNegative());
-      r.readDouble(k + "to_s", o.to_s, Range::nonNegative());
-      c.faults.planner_outages.push_back(o);
-    }
-  }
-  const YAML::Node fd = r.node(fk + "follower_dropouts");
-  if (fd.IsDefined() && fd.IsSequence()) {
-    for (std::size_t i = 0; i < fd.size(); ++i) {
-      const std::string k = fk + "follower_dropouts[" + std::to_string(i) + "].";
-      UavDropout o;
-      for (const char* key : {"uav", "from_s", "to_s"}) {
-        if (!r.has(k + key)) r.addError(k + key, "missing (required)");
-      }
-      r.readInt(k + "uav", o.uav, Range::closed(1, 63));
-      r.readDouble(k + "from_s", o.from_s, Range::nonNegative());
-      r.readDouble(k + "to_s", o.to_s, Range::nonNegative());
-      c.faults.follower_dropouts.push_back(o);
-    }
-  } else if (fd.IsDefined()) {
-    r.addError(fk + "follower_dropouts", "must be a list of {uav, from_s, to_s}");
-  }
-  {
-    const std::string k = fk + "range_outliers.";
-    r.readDouble(k + "probability", c.faults.range_outliers.probability, Range::closed(0.0, 1.0));
-    r.readDouble(k + "min_error_m", c.faults.range_outliers.min_error_m, Range::nonNegative());
-    r.readDouble(k + "max_error_m", c.faults.range_outliers.max_error_m, Range::nonNegative());
-  }
-  for (const auto& e : c.faults.validate()) r.addError(m + "faults", e);
+  readWorker(r, m, c.worker);
+  readUavs(r, m, c.uavs);
+  readControllerGains(r, m, c.controller);
+  readOnboard(r, m, c);
+  for (const auto& e : c.controller.validate()) r.addError(m + "controller", e);
+  readOdometry(r, m, c.odometry);
+  readWind(r, m + "wind.", c.wind);
+  readSensorsAndLinks(r, m, c);
+  readFaults(r, m, c);
 
   c.camera.camera = c.estimator.camera;  // one camera: what the sensor sees is what the estimator models
   c.worker.synth.camera = c.estimator.camera;
   c.worker.synth.fps = c.camera.rate_hz;
-
-  const int n_uavs = c.formation.params.uavCount();
-  if (!c.uavs.empty() && static_cast<int>(c.uavs.size()) != n_uavs) {
-    r.addError(m + "uavs", "has " + std::to_string(c.uavs.size()) + " entries but mission.formation has " +
-                               std::to_string(n_uavs) + " UAVs (leader + followers)");
-  }
-  for (const auto& o : c.faults.planner_outages) {
-    if (o.uav >= n_uavs) r.addError(fk + "planner_outages", "uav " + std::to_string(o.uav) + " does not exist");
-  }
-  for (const auto& o : c.faults.follower_dropouts) {
-    if (o.uav >= n_uavs) r.addError(fk + "follower_dropouts", "uav " + std::to_string(o.uav) + " does not exist");
-  }
-
-  // --- operator requests ----------------------------------------------------------------
-  const YAML::Node reqs = r.node(m + "requests");
-  if (reqs.IsDefined() && reqs.IsSequence()) {
-    for (std::size_t i = 0; i < reqs.size(); ++i) {
-      const std::string k = m + "requests[" + std::to_string(i) + "].";
-      OperatorRequest q;
-      if (!r.has(k + "t_s")) r.addError(k + "t_s", "missing (required)");
-      r.readDouble(k + "t_s", q.t_s, Range::nonNegative());
-      const YAML::Node tn = r.node(k + "target");
-      if (!tn.IsDefined()) {
-        r.addError(k + "target", "missing (required)");
-      } else if (tn.IsSequence()) {
-        std::vector<int> ids;
-        std::string text = "[";
-        for (std::size_t j = 0; j < tn.size(); ++j) {
-          int id = -1;
-          try {
-            id = tn[j].as<int>();
-          } catch (const YAML::Exception&) {
-          }
-          if (id < 0 || id >= n_uavs) {
-            r.addError(k + "target[" + std::to_string(j) + "]", "must be a UAV index in [0, " + std::to_string(n_uavs - 1) + "]");
-          }
-          ids.push_back(id);
-          text += (j ? "," : "") + std::to_string(id);
-        }
-        if (ids.empty()) r.addError(k + "target", "empty list");
-        q.target = formation::CommandTarget::list(ids);
-        q.target_text = text + "]";
-      } else {
-        q.target_text = tn.IsScalar() ? tn.Scalar() : "";
-        const auto t = formation::parseTarget(q.target_text);
-        if (!t) {
-          r.addError(k + "target", t.reason());
-        } else {
-          q.target = *t;
-          if (!q.target.resolve(n_uavs)) r.addError(k + "target", "'" + q.target_text + "' does not exist in the formation");
-        }
-      }
-      std::string param;
-      r.readString(k + "parameter", param, {"beta_deg", "gamma_deg", "distance_m"});
-      if (!r.has(k + "parameter")) r.addError(k + "parameter", "missing (required)");
-      q.parameter = param == "gamma_deg" ? formation::Parameter::kGamma
-                    : param == "distance_m" ? formation::Parameter::kDistance
-                                            : formation::Parameter::kBeta;
-      const bool inc = r.has(k + "increment"), set = r.has(k + "set");
-      if (inc == set) r.addError(k.substr(0, k.size() - 1), "needs exactly one of increment, set");
-      q.kind = set ? formation::CommandKind::kSet : formation::CommandKind::kIncrement;
-      r.readDouble(k + (set ? "set" : "increment"), q.amount, Range::any());
-      if (i > 0 && q.t_s < c.requests.back().t_s) r.addError(k + "t_s", "requests must be in time order");
-      c.requests.push_back(q);
-    }
-  }
+  checkUavCount(r, m, c);
+  readRequests(r, m, c.formation.params.uavCount(), c.requests);
 
   for (const auto& e : c.worker.validate(m + "worker.")) r.addError(m + "worker", e);
   c.duration_s = c.worker.routeDuration();

@@ -5,18 +5,14 @@
 #include <string>
 #include <vector>
 
-namespace gesture_formation::sim::detail {
+#include "gesture_formation/common/format_number.hpp"
 
-inline std::string num(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
+namespace gesture_formation::sim::detail {
 
 /// Appends "<prefix><name> must be <rule>, got <v>" when !(ok && finite).
 inline void check(std::vector<std::string>& e, bool ok, double v, const std::string& prefix, const char* name,
                   const char* rule) {
-  if (!(ok && std::isfinite(v))) e.push_back(prefix + name + " must be " + rule + ", got " + num(v));
+  if (!(ok && std::isfinite(v))) e.push_back(prefix + name + " must be " + rule + ", got " + common::formatNumber(v));
 }
 
 }  // namespace gesture_formation::sim::detail

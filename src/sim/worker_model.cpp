@@ -16,7 +16,7 @@ namespace gesture_formation::sim {
 using common::degToRad;
 using common::radToDeg;
 using detail::check;
-using detail::num;
+using common::formatNumber;
 
 const char* toString(RouteLeg::Kind k) {
   switch (k) {
@@ -92,14 +92,14 @@ std::vector<std::string> WorkerConfig::validate(const std::string& prefix) const
     const auto& g = gestures[i];
     const std::string p = prefix + "gestures[" + std::to_string(i) + "].";
     if (g.gesture_id < 1 || g.gesture_id > 4) e.push_back(p + "gesture must be in [1, 4], got " + std::to_string(g.gesture_id));
-    if (i > 0 && !(g.t_s > gestures[i - 1].t_s)) e.push_back(p + "t_s must increase, got " + num(g.t_s));
+    if (i > 0 && !(g.t_s > gestures[i - 1].t_s)) e.push_back(p + "t_s must increase, got " + formatNumber(g.t_s));
     if (i > 0 && g.t_s - gestures[i - 1].t_s < longest) {
-      e.push_back(p + "t_s " + num(g.t_s) + " is within " + num(longest) + " s of the previous gesture");
+      e.push_back(p + "t_s " + formatNumber(g.t_s) + " is within " + formatNumber(longest) + " s of the previous gesture");
     }
     bool inside = false;
     for (const auto& [a, b] : stationary) inside = inside || (g.t_s >= a && g.t_s + longest <= b);
     if (!inside) {
-      e.push_back(p + "t_s " + num(g.t_s) + " must lie in a work or wait leg with " + num(longest) +
+      e.push_back(p + "t_s " + formatNumber(g.t_s) + " must lie in a work or wait leg with " + formatNumber(longest) +
                   " s left (the worker stands still while gesturing)");
     }
   }

@@ -54,13 +54,17 @@ constexpr std::uint8_t kMaxMessageType = 6;
 const char* toString(MessageType type);
 bool isKnownMessageType(std::uint8_t value);
 
-/// \brief A decoded (and, from Verifier, authenticated) envelope.
-struct Envelope {
+/// \brief The header fields of an envelope (what the tag authenticates besides the payload).
+struct EnvelopeHeader {
   MessageType type = MessageType::kHeartbeat;
   std::uint16_t sender_id = 0;
   std::uint8_t key_id = 0;
   std::uint64_t sequence = 0;
   double stamp_s = 0.0;
+};
+
+/// \brief A decoded (and, from Verifier, authenticated) envelope.
+struct Envelope : EnvelopeHeader {
   std::vector<std::uint8_t> payload;
 };
 
@@ -79,12 +83,7 @@ enum class EnvelopeError {
 const char* toString(EnvelopeError e);
 
 /// \brief A structurally valid envelope, borrowing the input buffer (not yet authenticated).
-struct EnvelopeView {
-  MessageType type = MessageType::kHeartbeat;
-  std::uint16_t sender_id = 0;
-  std::uint8_t key_id = 0;
-  std::uint64_t sequence = 0;
-  double stamp_s = 0.0;
+struct EnvelopeView : EnvelopeHeader {
   const std::uint8_t* payload = nullptr;
   std::size_t payload_bytes = 0;
   const std::uint8_t* signed_bytes = nullptr;  ///< header + payload (what the tag covers)

@@ -141,6 +141,12 @@ class SkeletonSynthesizer {
   SynthSequence project(const Script& script, int id, const View& view, std::mt19937_64& rng) const;
   std::vector<SynthSequence> renderViews(Motion motion, const std::vector<View>& views);
   void drawShape();
+  // pose() in steps: the arms of a static arm motion (false: not one), of a moving one (walking,
+  // climbing, holding, lunging, idle), then the lunge's stance and lean.
+  struct ArmTargets;
+  bool staticArms(Motion motion, ArmTargets& arms) const;
+  void movingArms(Motion motion, double s, double phase, ArmTargets& arms, Body3D& body) const;
+  void lungeStance(Motion motion, double s, bool left_arm, Body3D& body) const;
 
   SynthConfig config_;
   estimation::CameraModel camera_;

@@ -157,7 +157,26 @@ class UavPlanner {
   const TrajectoryQpProblem* lastQp() const { return last_qp_.get(); }
 
  private:
-  struct Stage2;
+  /// One replanning's working state, handed from stage to stage (defined in uav_planner.cpp).
+  struct PlanContext;
+  // The stages of plan(), in order (docs/planning.md §5–§8); a non-empty string is the reason
+  // to fall back.
+  std::string runStages(PlanContext& c, PlanResult& result);
+  void projectReferences(PlanContext& c, PlanResult& result) const;
+  void planPath(PlanContext& c, PlanResult& result) const;
+  std::string buildCorridors(PlanContext& c) const;
+  std::unique_ptr<CorridorBuilder> firstCorridorBuilder(const PlanContext& c) const;
+  void setUpQp(PlanContext& c) const;
+  static void guideAlongPath(PlanContext& c);
+  void addCorridorRows(PlanContext& c, PlanResult& result) const;
+  void addRecoveryRows(PlanContext& c, PlanResult& result) const;
+  void addSeparationRows(PlanContext& c) const;
+  void addBrakeEnvelopeRows(PlanContext& c, const PlannedTrajectory& other) const;
+  Eigen::Vector3d linearisationPoint(const PlanContext& c, int k) const;
+  std::string solveQp(PlanContext& c, PlanResult& result);
+  std::string infeasibilityCause(const PlanContext& c, PlanResult& result);
+  std::string planCamera(PlanContext& c) const;
+  std::string verifyAndAccept(PlanContext& c, PlanResult& result);
   PlanResult fallback(const PlanRequest& request, PlanResult result, const std::string& reason);
   PlannedTrajectory brakePlan(const PlanRequest& request) const;
   /// The brake plan `hold` with its stop point moved away from the other UAVs' plans and the
