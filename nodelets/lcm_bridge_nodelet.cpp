@@ -88,12 +88,25 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
       if (!t) params.addError("lcm_url: " + t.reason());
       else transport_ = std::move(*t);
     }
+    std::optional<comm::Verifier> verifier;
+    if (params.ok()) {
+      auto v = comm::Verifier::create(vcfg, *keys);
+      if (v) verifier.emplace(std::move(*v));
+      else params.addError("key_file/known_senders: " + v.reason());
+      if (keys->perSender() && keys->active().sender_id != sender_id) {
+        params.addError("key_file: its signing key belongs to sender " + std::to_string(keys->active().sender_id) +
+                        ", not to sender_id " + std::to_string(sender_id));
+      }
+    }
     if (!params.ok()) {
       NODELET_ERROR_STREAM("LcmBridge refuses to start; fix these parameters:\n" << params.report());
       return;
     }
     NODELET_INFO_STREAM("LcmBridge loaded:\n" << params.loaded());
-    auto verifier = comm::Verifier::create(vcfg, *keys);
+    if (!keys->perSender()) {
+      NODELET_WARN_STREAM("LcmBridge: key_file holds a group key: any holder can speak for any sender; use per-sender "
+                          "keys (tools/make_fleet_keys.sh, docs/security.md §5)");
+    }
     const auto first_sequence = static_cast<std::uint64_t>(ros::WallTime::now().toNSec() / 1000);
     link_ = std::make_unique<lcm_bridge::SecureLink>(*transport_,
                                                      comm::Signer(static_cast<std::uint16_t>(sender_id), *keys, first_sequence),
