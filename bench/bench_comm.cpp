@@ -43,6 +43,7 @@ Verifier receiver(bool per_sender) {
   c.known_senders = {1};
   c.own_sender_id = 2;
   c.max_age_s = 1e9;  // the benchmark reuses one stamp
+  c.burst = 1e15;     // and one instant: no rate limit here (BM_RejectRateLimited has it)
   return Verifier::create(c, per_sender ? perSenderRing(2, true) : groupRing()).value();
 }
 
@@ -87,6 +88,19 @@ void BM_RejectForged(benchmark::State& state) {
   state.SetLabel(per_sender ? "ed25519" : "hmac-sha256");
 }
 
+/// A forgery of a known sender once its budget is spent: refused before any cryptography.
+void BM_RejectRateLimited(benchmark::State& state) {
+  Signer s(1, perSenderRing(1, false), 1);
+  auto b = s.seal(MessageType::kWorkerState, std::vector<std::uint8_t>(113, 0x5A), 1.0).value();
+  b.back() ^= 1;
+  VerifierConfig c;
+  c.known_senders = {1};
+  c.own_sender_id = 2;
+  c.burst = 1.0;
+  Verifier v = Verifier::create(c, perSenderRing(2, true)).value();
+  for (auto _ : state) benchmark::DoNotOptimize(v.verify(b.data(), b.size(), 1.0));
+}
+
 /// Garbage from an unknown sender: refused before any cryptography.
 void BM_RejectUnknownSender(benchmark::State& state) {
   Signer s(7, perSenderRing(7, false), 1);
@@ -100,5 +114,6 @@ void BM_RejectUnknownSender(benchmark::State& state) {
 BENCHMARK(BM_Seal)->ArgsProduct({{0, 1}, {113, 4424}})->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Verify)->ArgsProduct({{0, 1}, {113, 4424}})->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_RejectForged)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_RejectRateLimited)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_RejectUnknownSender)->Unit(benchmark::kMicrosecond);
 BENCHMARK_MAIN();

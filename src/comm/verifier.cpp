@@ -125,16 +125,16 @@ void Verifier::restoreHighWaterMarks(const std::map<std::uint16_t, std::uint64_t
   }
 }
 
-bool Verifier::takeToken(SenderState& sender, double now_s) const {
+bool Verifier::takeToken(Budget& budget, double now_s) const {
   if (std::isfinite(now_s)) {
     // A clock that jumps back (simulation restart) only restarts the refill.
-    if (std::isfinite(sender.refilled_at_s) && now_s > sender.refilled_at_s) {
-      sender.tokens = std::min(config_.burst, sender.tokens + (now_s - sender.refilled_at_s) * config_.max_rate_hz);
+    if (std::isfinite(budget.refilled_at_s) && now_s > budget.refilled_at_s) {
+      budget.tokens = std::min(config_.burst, budget.tokens + (now_s - budget.refilled_at_s) * config_.max_rate_hz);
     }
-    sender.refilled_at_s = now_s;
+    budget.refilled_at_s = now_s;
   }
-  if (sender.tokens < 1.0) return false;
-  sender.tokens -= 1.0;
+  if (budget.tokens < 1.0) return false;
+  budget.tokens -= 1.0;
   return true;
 }
 
@@ -158,7 +158,11 @@ VerifyResult Verifier::checkTag(const EnvelopeView& view, double now_s, SenderSt
   if (key == nullptr) return reject(Verdict::kUnknownKey, per_sender ? "no such key id for this sender" : "key id not in the key ring", &sender);
   // (A NaN now_s passes here and fails the age check after the tag.)
   if (now_s > key->accept_until_s) return reject(Verdict::kExpiredKey, "key past its accept_until_s", &sender);
-  if (!takeToken(sender, now_s)) return reject(Verdict::kRateLimited, "sender's verification budget spent", &sender);
+  const ReplayWindow& w = sender.window;
+  const bool near = !w.empty() && view.sequence <= w.highest() + kNearLane && view.sequence + w.size() > w.highest();
+  if (!takeToken(near ? sender.near : sender.far, now_s)) {
+    return reject(Verdict::kRateLimited, "sender's verification budget spent", &sender);
+  }
   if (per_sender) {
     if (!ed25519Verify(key->public_key, view.signed_bytes, view.signed_size, view.tag)) {
       return reject(Verdict::kForged, "signature does not verify with the sender's key", &sender);

@@ -11,9 +11,12 @@
 ///   4. key: a group ring takes version 1 only and looks the key id up; a per-sender ring
 ///      takes version 2 only and looks up (sender id, key id) among the verifying keys —
 ///      otherwise kUnknownKey; still accepted at now (accept_until_s): kExpiredKey
-///   4b. per-sender budget (token bucket, max_rate_hz / burst) for envelopes that reach the
-///      tag check: kRateLimited — a flood claiming a sender costs one cheap refusal, not a
-///      signature verification, once the sender's budget is spent
+///   4b. per-sender budget (token buckets, max_rate_hz / burst each) for envelopes that reach
+///      the tag check: kRateLimited — a flood claiming a sender costs one cheap refusal, not a
+///      signature verification, once the budget is spent. Two lanes per sender: sequence
+///      numbers near the window (≤ kNearLane above the highest accepted, or inside the window:
+///      where the sender's next envelopes are) and all others, so a flood with numbers that
+///      are not the sender's next ones does not spend the budget its real envelopes use
 ///   5. tag: HMAC-SHA256 with constant-time compare (version 1) or the Ed25519 signature
 ///      with the claimed sender's public key (version 2): kForged
 ///   6. stamp age: now − stamp > max age of the type → kTooOld; stamp − now > max_future_s
@@ -64,6 +67,8 @@ enum class Verdict : std::uint8_t {
   kRateLimited,     ///< the claimed sender's verification budget is spent (flood)
 };
 constexpr std::size_t kVerdictCount = 16;
+/// \brief Sequence numbers up to this far above a sender's highest accepted one use its near lane.
+constexpr std::uint64_t kNearLane = 64;
 const char* toString(Verdict v);
 
 /// \brief One counter per verdict.
@@ -138,15 +143,23 @@ class Verifier {
 
  private:
   Verifier(const VerifierConfig& config, KeyRing keys);
-  struct SenderState {
-    explicit SenderState(const VerifierConfig& c) : window(c.replay_window), tokens(c.burst) {}
-    ReplayWindow window;
-    SenderCounters counters;
-    double tokens;                 ///< budget left [envelopes]
+  /// A token bucket of verification budget.
+  struct Budget {
+    double tokens = 0.0;  ///< left [envelopes]
     double refilled_at_s = std::numeric_limits<double>::quiet_NaN();
   };
+  struct SenderState {
+    explicit SenderState(const VerifierConfig& c) : window(c.replay_window) {
+      near.tokens = c.burst;
+      far.tokens = c.burst;
+    }
+    ReplayWindow window;
+    SenderCounters counters;
+    Budget near;  ///< sequence numbers within the window or at most kNearLane above it
+    Budget far;   ///< all others (a blind flood; a sender's first envelope after a restart)
+  };
   VerifyResult reject(Verdict v, const char* detail, SenderState* sender = nullptr);
-  bool takeToken(SenderState& sender, double now_s) const;
+  bool takeToken(Budget& budget, double now_s) const;
   /// Checks 4–5: key lookup (group: by key id; per-sender: by (sender, key id)) and tag.
   VerifyResult checkTag(const EnvelopeView& view, double now_s, SenderState& sender);
 

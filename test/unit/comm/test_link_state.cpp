@@ -120,6 +120,40 @@ TEST(CommLinkCountersTest, AFloodSpendsOnlyItsClaimedSendersBudget) {
   EXPECT_TRUE(v.verify(l.data(), l.size(), now + 0.05).accepted());
 }
 
+TEST(CommLinkCountersTest, ABlindFloodDoesNotSpendTheBudgetOfTheSendersNextNumbers) {
+  VerifierConfig c = config();
+  c.max_rate_hz = 100.0;
+  c.burst = 20.0;
+  Verifier v = makeVerifier(c);
+  double now = 10.0;
+  auto first = seal(0, kLeader, 1000, now);
+  ASSERT_TRUE(v.verify(first.data(), first.size(), now).accepted());
+  // 5000 forgeries claiming the leader with numbers far above its window, interleaved with the
+  // leader's real envelopes 1001, 1002, ...: every real one is accepted.
+  std::uint64_t next = 1001;
+  int accepted = 0;
+  for (int i = 0; i < 5000; ++i) {
+    now = 10.0 + 1e-4 * i;
+    auto f = seal(0, kFollower, (std::uint64_t{1} << 60) + static_cast<std::uint64_t>(i), now);
+    const Verdict r = v.verify(f.data(), f.size(), now).verdict;
+    ASSERT_TRUE(r == Verdict::kForged || r == Verdict::kRateLimited) << toString(r);
+    if (i % 200 == 0) {  // 50 per second, within the budget
+      auto real = seal(0, kLeader, next++, now);
+      accepted += v.verify(real.data(), real.size(), now).accepted();
+    }
+  }
+  EXPECT_EQ(accepted, 25);
+  EXPECT_GT(v.senderCounters().at(0).count(Verdict::kRateLimited), 4900u);
+  // Forgeries with the leader's next numbers spend the near lane: then real ones are refused too
+  // (the documented limit against an attacker who reads the traffic).
+  for (int i = 0; i < 100; ++i) {
+    auto f = seal(0, kFollower, next + 1 + static_cast<std::uint64_t>(i % 32), now);
+    v.verify(f.data(), f.size(), now);
+  }
+  auto real = seal(0, kLeader, next, now);
+  EXPECT_EQ(v.verify(real.data(), real.size(), now).verdict, Verdict::kRateLimited);
+}
+
 TEST(CommLinkCountersTest, ConfigValidationNamesTheBudgetFields) {
   VerifierConfig c = config();
   c.max_rate_hz = 0.0;
