@@ -3,7 +3,7 @@
 # the cost per message of HMAC-SHA256 and Ed25519 envelopes (gf_bench_comm) and the legitimate
 # messages delivered while a keyless flood saturates the loopback inside a private network
 # namespace (tools/link_flood.py: two LcmBridges, 20 Hz worker states, flood processes).
-#   tools/security_figures.sh [BUILD_DIR]     (root: unshare -n; FLOOD_SECONDS, FLOODERS)
+#   tools/security_figures.sh [BUILD_DIR]     (root: unshare -n; FLOOD_SECONDS (10), FLOOD_PROCS ("2 4"): one run per count of flood processes)
 case "${1:-}" in -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;; esac
 set -eo pipefail
 cd "$(dirname "$0")/.."
@@ -29,7 +29,10 @@ rc=\$?
 kill %1 2>/dev/null; wait
 exit \$rc
 INNER
-flood=$(unshare -n bash "$T/inner.sh")
+flood=""
+for n in ${FLOOD_PROCS:-2 4}; do
+  flood+="$n flood processes:"$'\n'"$(FLOODERS=$n unshare -n bash "$T/inner.sh")"$'\n\n'
+done
 rmem=$(cat /proc/sys/net/core/rmem_max)
 buf=$(grep -ho "LCM UDP receive buffer size ([0-9]*)\|receive buffer is [0-9]* bytes" "$T"/r_bridge.log | head -1 || true)
 out=docs/results/security.md
@@ -52,12 +55,17 @@ out=docs/results/security.md
   echo
   echo "Private network namespace, loopback multicast (ttl 0); leader bridge (sender 0) forwards worker"
   echo "states at 20 Hz for ${FLOOD_SECONDS:-10} s to the follower bridge (sender 2), per-sender Ed25519 keys;"
-  echo "${FLOODERS:-2} flood processes send as fast as they can on the same channel. net.core.rmem_max = $rmem"
+  echo "flood processes (Python, one socket each) send as fast as they can on the same channel; they share the"
+  echo "2 cores with the bridges, so more of them also means less CPU for the receiver. net.core.rmem_max = $rmem"
   echo "bytes; the bridge asks for a 4 MiB receive buffer (${buf:-LCM printed no buffer warning})."
   echo
   echo '```'
-  echo "$flood"
+  printf '%s' "$flood"
   echo '```'
+  echo
+  echo "Columns: flood datagrams sent (as counted by the senders; ENOBUFS drops included), and the"
+  echo "receiving bridge's counters over the same interval. When the counters add up to the datagrams"
+  echo "sent, the receiver kept up with the flood and nothing was lost in its socket or LCM queue."
 } > "$out"
 echo "security_figures.sh: wrote $out"
 cat "$out"
