@@ -12,8 +12,8 @@
 // Operator / gesture commands are single events, not a stream: one lost datagram would lose the
 // request (found by the multi-host test, docs/safety.md §5). The sender therefore sends each
 // command ~command_repeats times, ~command_repeat_period_s apart (new envelopes: new sequence and
-// stamp); the receiver forwards only the first copy of each command id (sender, sequence) to ROS
-// and counts the others. The leader's FormationState would apply a copy once anyway.
+// stamp); the receiver forwards only the first copy of each command id (envelope sender, command
+// sender name, sequence) to ROS and counts the others. The leader's FormationState would apply a copy once anyway.
 // A plan's fallback flag travels in a heartbeat sent just before the plan (status degraded,
 // last_plan_sequence = the plan's sequence); the receiver marks that plan `fallback`.
 // Stamps and freshness use ROS time (sim time in simulation: every process shares /clock).
@@ -41,6 +41,7 @@
 #include <map>
 #include <mutex>
 #include <set>
+#include <tuple>
 
 #include <diagnostic_msgs/DiagnosticArray.h>
 
@@ -298,16 +299,19 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
         formation::FormationCommand c;
         if (!decoder_.decode(e, c)) break;
         // The sender repeats each command: forward its first copy only (ids of the last 256).
-        const auto id = std::make_pair(c.id.sender, c.id.sequence);
+        // Keyed by the envelope's (authenticated) sender too, 256 per sender: a peer cannot
+        // pre-fill or flush another sender's command ids.
+        const CommandId id{e.sender_id, c.id.sender, c.id.sequence};
         if (commands_seen_.count(id) != 0) {
           ++command_copies_dropped_;
           break;
         }
         commands_seen_.insert(id);
-        commands_seen_order_.push_back(id);
-        if (commands_seen_order_.size() > 256) {
-          commands_seen_.erase(commands_seen_order_.front());
-          commands_seen_order_.pop_front();
+        auto& order = commands_seen_order_[e.sender_id];
+        order.push_back(id);
+        if (order.size() > 256) {
+          commands_seen_.erase(order.front());
+          order.pop_front();
         }
         auto m = toMsg(c);
         m.header.stamp = ros::Time(e.stamp_s);
@@ -439,8 +443,9 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
   std::map<std::uint16_t, comm::Heartbeat> peers_;
   int command_repeats_ = 1;
   std::deque<std::pair<formation::FormationCommand, int>> repeating_;  ///< commands still to repeat, copies left
-  std::set<std::pair<std::string, std::uint64_t>> commands_seen_;     ///< received command ids (bounded)
-  std::deque<std::pair<std::string, std::uint64_t>> commands_seen_order_;
+  using CommandId = std::tuple<std::uint16_t, std::string, std::uint64_t>;  ///< envelope sender, command id
+  std::set<CommandId> commands_seen_;                                  ///< received command ids (bounded)
+  std::map<std::uint16_t, std::deque<CommandId>> commands_seen_order_;  ///< per known sender, ≤ 256 each
   std::uint64_t command_copies_dropped_ = 0;  ///< repeated copies of an already forwarded command
   std::uint64_t observations_refused_ = 0;  ///< decoded gesture observations with a bad sender / stamp
   static constexpr int kMaxDrainPerTick = 2000;  ///< LCM messages handled per 5 ms drain

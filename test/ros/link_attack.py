@@ -313,11 +313,20 @@ def phase_replay_after_restart(wire, ros, receiver):
     msg.sender, msg.sequence, msg.source, msg.target = "op", 7, "operator", "all"
     msg.parameter, msg.kind, msg.amount = "distance_m", "increment", 0.5
     ch = PREFIX + "FORMATION_COMMAND"
+    # The captured follower first sends, with its own valid key, a command carrying the id the
+    # operator will use next ("op", 7): it must not make R drop the leader's real one as a copy.
+    prefill = bytes([2]) + b"op" + struct.pack(">QBBB", 7, 0, 2, 0) + struct.pack(">BBd", 2, 0, 0.5)
+    wire.send_envelope(ch, envelope(COMMAND, 1, 2**52, ros.now(), prefill))
+    time.sleep(0.3)
+    check(len(ros.commands) - n0 == 1, "follower 1's own command with id op/7 forwarded by R (it is a known sender; "
+          "which senders may command is not restricted yet)")
+    n0 = len(ros.commands)
     wait_for(lambda: ros.command_pub.get_num_connections() > 0, 5.0)
     ros.command_pub.publish(msg)
     time.sleep(1.0)  # 5 copies, 0.1 s apart
     recorded = [c for c in wire.take(lambda c: c[0] == ch and c[3] > t_cmd) if struct.unpack(">H", c[2][4:6])[0] == 0]
-    check(len(ros.commands) - n0 == 1, "the leader's real command delivered once by R (%d)" % (len(ros.commands) - n0))
+    check(len(ros.commands) - n0 == 1, "the leader's real command delivered once by R (%d), although follower 1 "
+          "had sent a command with the same id first" % (len(ros.commands) - n0))
     check(len(recorded) == 5, "the attacker recorded the leader's %d command copies (5 expected)" % len(recorded))
     stop(receiver)
     receiver = bridge("r_bridge", 2, [0, 1], "sender_2.key", ["formation_command_out:=/r/formation_command"])
