@@ -30,7 +30,9 @@
 //     a restart of this receiver are refused without relying on the clocks;
 //   ~recv_buf_bytes (4194304): UDP receive buffer requested for udpm:// URLs without
 //     recv_buf_size (the kernel caps it at net.core.rmem_max);
-//   ~max_rate_hz (400), ~burst (200): per-sender budget of envelopes reaching the signature check.
+//   ~max_rate_hz (400), ~burst (200): per-sender budget of envelopes reaching the signature check;
+//   ~command_senders, ~params_senders (int lists; absent: any known sender): who may send formation
+//     commands (the ground station, the leader) and formation parameters (the leader).
 // Diagnostics: diagnostic_msgs/DiagnosticArray on /diagnostics at 1 Hz, one status for the link
 // (every rejection class in total) and one per known sender (its claimed-name rejections);
 // a throttled warning names the sender and the class of refused envelopes.
@@ -114,6 +116,18 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
       } else {
         params.addError("key_file: " + k.reason());
       }
+    }
+    for (const auto& [name, type] : {std::make_pair(std::string("command_senders"), comm::MessageType::kFormationCommand),
+                                     std::make_pair(std::string("params_senders"), comm::MessageType::kFormationParams)}) {
+      std::vector<int> ids;
+      if (!pnh.getParam(name, ids)) continue;
+      if (ids.empty()) params.addError(name + ": must list at least one sender id (omit it to allow every known sender)");
+      auto& list = vcfg.senders_by_type[type];  // own id only → empty: no one else may send it
+      for (const int id : ids) {
+        if (id < 0 || id > 65535) params.addError(name + ": " + std::to_string(id) + " out of range [0, 65535]");
+        else if (id != sender_id) list.push_back(static_cast<std::uint16_t>(id));  // own id: never received
+      }
+      params.note(name + ": " + std::to_string(ids.size()) + " id(s)");
     }
     for (const int s : known) {
       if (s < 0 || s > 65535) params.addError("known_senders: " + std::to_string(s) + " out of range [0, 65535]");

@@ -24,6 +24,7 @@ const char* toString(Verdict v) {
     case Verdict::kReplayed: return "replayed";
     case Verdict::kStale: return "stale";
     case Verdict::kRateLimited: return "rate_limited";
+    case Verdict::kNotPermitted: return "not_permitted";
   }
   return "unknown";
 }
@@ -61,6 +62,12 @@ std::vector<std::string> VerifierConfig::validate() const {
   }
   if (!(std::isfinite(max_rate_hz) && max_rate_hz > 0)) e.push_back("max_rate_hz must be > 0, got " + std::to_string(max_rate_hz));
   if (!(std::isfinite(burst) && burst >= 1)) e.push_back("burst must be >= 1, got " + std::to_string(burst));
+  for (const auto& [type, senders] : senders_by_type) {
+    const std::string field = std::string("senders_by_type.") + (isKnownMessageType(static_cast<std::uint8_t>(type)) ? toString(type) : "?");
+    for (std::uint16_t id : senders) {
+      if (!seen.count(id)) e.push_back(field + " lists sender id " + std::to_string(id) + ", which is not in known_senders");
+    }
+  }
   if (replay_window < 64 || replay_window > kMaxReplayWindow) {
     e.push_back("replay_window must be in [64, " + std::to_string(kMaxReplayWindow) + "], got " +
                 std::to_string(replay_window));
@@ -201,6 +208,11 @@ VerifyResult Verifier::verify(const std::uint8_t* data, std::size_t size, double
   SenderState& sender = sender_it->second;
   const VerifyResult keyed = checkTag(view, now_s, sender);
   if (keyed.verdict != Verdict::kAccepted) return keyed;
+  const auto allowed = config_.senders_by_type.find(view.type);
+  if (allowed != config_.senders_by_type.end() &&
+      std::find(allowed->second.begin(), allowed->second.end(), view.sender_id) == allowed->second.end()) {
+    return reject(Verdict::kNotPermitted, "this sender may not send this message type", &sender);
+  }
 
   // Written so that a NaN now_s fails the checks (counted too old).
   const double age_s = now_s - view.stamp_s;

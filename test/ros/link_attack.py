@@ -181,6 +181,8 @@ def bridge(name, sender_id, known, key, remaps, env_prefix=()):
         "_world_frame:=world", "_command_repeats:=5", "_command_repeat_period_s:=0.1",
         "_sequence_file:=%s/%s.boot" % (T, name), "_high_water_file:=%s/%s.marks" % (T, name)] + remaps
     subprocess.run(["rosparam", "set", "/%s/known_senders" % name, str(known)], check=True)
+    if name == "r_bridge":  # formation commands only from the leader
+        subprocess.run(["rosparam", "set", "/r_bridge/command_senders", "[0]"], check=True)
     log = open(os.path.join(T, name + ".log"), "a")
     return subprocess.Popen(args, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
 
@@ -314,19 +316,21 @@ def phase_replay_after_restart(wire, ros, receiver):
     msg.parameter, msg.kind, msg.amount = "distance_m", "increment", 0.5
     ch = PREFIX + "FORMATION_COMMAND"
     # The captured follower first sends, with its own valid key, a command carrying the id the
-    # operator will use next ("op", 7): it must not make R drop the leader's real one as a copy.
+    # operator will use next ("op", 7): R takes commands from the leader only (command_senders),
+    # and the id must not make R drop the leader's real one as a copy.
+    before1 = ros.fresh_counts(from_sender(1)) or {}
     prefill = bytes([2]) + b"op" + struct.pack(">QBBB", 7, 0, 2, 0) + struct.pack(">BBd", 2, 0, 0.5)
     wire.send_envelope(ch, envelope(COMMAND, 1, 2**52, ros.now(), prefill))
-    time.sleep(0.3)
-    check(len(ros.commands) - n0 == 1, "follower 1's own command with id op/7 forwarded by R (it is a known sender; "
-          "which senders may command is not restricted yet)")
-    n0 = len(ros.commands)
+    sent_at = time.time()
+    after1 = ros.fresh_counts(from_sender(1), sent_at + 1.0) or {}
+    check(len(ros.commands) == n0 and after1.get("not_permitted", 0) - before1.get("not_permitted", 0) == 1,
+          "follower 1's own, authentic command refused as not_permitted (command_senders [0]), not forwarded")
     wait_for(lambda: ros.command_pub.get_num_connections() > 0, 5.0)
     ros.command_pub.publish(msg)
     time.sleep(1.0)  # 5 copies, 0.1 s apart
     recorded = [c for c in wire.take(lambda c: c[0] == ch and c[3] > t_cmd) if struct.unpack(">H", c[2][4:6])[0] == 0]
-    check(len(ros.commands) - n0 == 1, "the leader's real command delivered once by R (%d), although follower 1 "
-          "had sent a command with the same id first" % (len(ros.commands) - n0))
+    check(len(ros.commands) - n0 == 1, "the leader's real command delivered once by R (%d), after follower 1 "
+          "sent one with the same id" % (len(ros.commands) - n0))
     check(len(recorded) == 5, "the attacker recorded the leader's %d command copies (5 expected)" % len(recorded))
     stop(receiver)
     receiver = bridge("r_bridge", 2, [0, 1], "sender_2.key", ["formation_command_out:=/r/formation_command"])

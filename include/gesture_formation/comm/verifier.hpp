@@ -19,6 +19,8 @@
 ///      are not the sender's next ones does not spend the budget its real envelopes use
 ///   5. tag: HMAC-SHA256 with constant-time compare (version 1) or the Ed25519 signature
 ///      with the claimed sender's public key (version 2): kForged
+///   5b. authorisation: an authentic envelope of a type with a senders_by_type list from a
+///      sender not on it: kNotPermitted
 ///   6. stamp age: now − stamp > max age of the type → kTooOld; stamp − now > max_future_s
 ///      (clock skew allowance) → kTooNew
 ///   7. replay window of the sender: duplicate → kReplayed; below the window → kStale
@@ -65,8 +67,9 @@ enum class Verdict : std::uint8_t {
   kReplayed,        ///< sequence already accepted (within the window)
   kStale,           ///< sequence below the replay window
   kRateLimited,     ///< the claimed sender's verification budget is spent (flood)
+  kNotPermitted,    ///< authentic, but this sender may not send this type (senders_by_type)
 };
-constexpr std::size_t kVerdictCount = 16;
+constexpr std::size_t kVerdictCount = 17;
 /// \brief Sequence numbers up to this far above a sender's highest accepted one use its near lane.
 constexpr std::uint64_t kNearLane = 64;
 const char* toString(Verdict v);
@@ -97,6 +100,9 @@ struct VerifierConfig {
   /// Per-type overrides of max_age_s [s], each > 0 (e.g. heartbeat 2 s, command 5 s).
   std::map<MessageType, double> max_age_s_by_type;
   std::size_t replay_window = 1024;  ///< per sender [sequence numbers], 64..kMaxReplayWindow
+  /// Who may send a type (e.g. commands: the ground station; parameters: the leader); a type
+  /// not listed may come from any known sender; an empty list: from none. Known senders only.
+  std::map<MessageType, std::vector<std::uint16_t>> senders_by_type;
   /// Per-sender budget of envelopes that reach the tag check [1/s], > 0. Default 400: ten
   /// times a UAV's normal rate (heartbeat, plan, worker state, observations, command copies).
   double max_rate_hz = 400.0;

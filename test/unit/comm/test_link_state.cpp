@@ -154,6 +154,35 @@ TEST(CommLinkCountersTest, ABlindFloodDoesNotSpendTheBudgetOfTheSendersNextNumbe
   EXPECT_EQ(v.verify(real.data(), real.size(), now).verdict, Verdict::kRateLimited);
 }
 
+TEST(CommLinkCountersTest, OnlyPermittedSendersMaySendATypeThatHasAList) {
+  VerifierConfig c = config();
+  c.senders_by_type[MessageType::kFormationCommand] = {0};
+  Verifier v = makeVerifier(c);
+  auto from_follower = seal(1, kFollower, 1, 10.0, MessageType::kFormationCommand);
+  EXPECT_EQ(v.verify(from_follower.data(), from_follower.size(), 10.0).verdict, Verdict::kNotPermitted);
+  EXPECT_EQ(v.senderCounters().at(1).count(Verdict::kNotPermitted), 1u);
+  auto from_leader = seal(0, kLeader, 1, 10.0, MessageType::kFormationCommand);
+  EXPECT_TRUE(v.verify(from_leader.data(), from_leader.size(), 10.0).accepted());
+  auto heartbeat = seal(1, kFollower, 2, 10.0);  // no list for heartbeats: any known sender
+  EXPECT_TRUE(v.verify(heartbeat.data(), heartbeat.size(), 10.0).accepted());
+  // The refused command changed no window: the follower's number 1 is still new.
+  auto again = seal(1, kFollower, 1, 10.0);
+  EXPECT_TRUE(v.verify(again.data(), again.size(), 10.0).accepted());
+
+  // An empty list: nobody may send the type.
+  VerifierConfig none = config();
+  none.senders_by_type[MessageType::kFormationParams] = {};
+  Verifier w = makeVerifier(none);
+  auto params = seal(0, kLeader, 1, 10.0, MessageType::kFormationParams);
+  EXPECT_EQ(w.verify(params.data(), params.size(), 10.0).verdict, Verdict::kNotPermitted);
+
+  VerifierConfig bad = config();
+  bad.senders_by_type[MessageType::kFormationCommand] = {5};
+  const auto e = bad.validate();
+  ASSERT_EQ(e.size(), 1u);
+  EXPECT_EQ(e[0], "senders_by_type.formation_command lists sender id 5, which is not in known_senders");
+}
+
 TEST(CommLinkCountersTest, ConfigValidationNamesTheBudgetFields) {
   VerifierConfig c = config();
   c.max_rate_hz = 0.0;
