@@ -12,24 +12,47 @@
 // Operator / gesture commands are single events, not a stream: one lost datagram would lose the
 // request (found by the multi-host test, docs/safety.md §5). The sender therefore sends each
 // command ~command_repeats times, ~command_repeat_period_s apart (new envelopes: new sequence and
-// stamp); the receiver forwards only the first copy of each command id (sender, sequence) to ROS
-// and counts the others. The leader's FormationState would apply a copy once anyway.
+// stamp); the receiver forwards only the first copy of each command id (envelope sender, command
+// sender name, sequence) to ROS and counts the others. The leader's FormationState would apply a copy once anyway.
 // A plan's fallback flag travels in a heartbeat sent just before the plan (status degraded,
 // last_plan_sequence = the plan's sequence); the receiver marks that plan `fallback`.
 // Stamps and freshness use ROS time (sim time in simulation: every process shares /clock).
 // Parameters (required): ~sender_id, ~known_senders (int list: the fleet's ids, own id ignored), ~lcm_url, ~channel_prefix,
 //   ~key_file (owner-only permissions), ~max_age_s, ~heartbeat_rate_hz, ~world_frame,
 //   ~command_repeats (1..20), ~command_repeat_period_s.
+// Optional, with their defaults (docs/security.md §4, §7):
+//   ~command_max_age_s (5.0): the age limit of formation commands (others: ~max_age_s, heartbeats ≥ 2 s);
+//   ~sequence_file ($ROS_HOME/gesture_formation/lcm_bridge_<sender_id>.boot): the boot counter in the
+//     high bits of this sender's sequence numbers (created 0600), so a restart with the clock set
+//     back is not refused as stale;
+//   ~high_water_file ($ROS_HOME/gesture_formation/lcm_bridge_<sender_id>.marks): the highest sequence
+//     accepted per sender, saved every second and on shutdown, restored at start: replays after
+//     a restart of this receiver are refused without relying on the clocks;
+//   ~recv_buf_bytes (4194304): UDP receive buffer requested for udpm:// URLs without
+//     recv_buf_size (the kernel caps it at net.core.rmem_max);
+//   ~max_rate_hz (400), ~burst (200): per-sender budget of envelopes reaching the signature check;
+//   ~command_senders, ~params_senders (int lists; absent: any known sender): who may send formation
+//     commands (the ground station, the leader) and formation parameters (the leader).
+// Diagnostics: diagnostic_msgs/DiagnosticArray on /diagnostics at 1 Hz, one status for the link
+// (every rejection class in total) and one per known sender (its claimed-name rejections);
+// a throttled warning names the sender and the class of refused envelopes.
+#include <sys/stat.h>
+
+#include <cstdlib>
 #include <deque>
 #include <map>
 #include <mutex>
 #include <set>
+#include <tuple>
+
+#include <diagnostic_msgs/DiagnosticArray.h>
 
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
 #include <ros/ros.h>
 
 #include "conversions.hpp"
+#include "gesture_formation/comm/sequence_store.hpp"
 #include "gesture_formation/lcm_bridge/lcm_transport.hpp"
 #include "param_loader.hpp"
 
@@ -40,6 +63,7 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
   ~LcmBridgeNodelet() override {
     std::lock_guard<std::mutex> lock(mutex_);
     drain_timer_.stop();
+    saveMarks();
     link_.reset();
     transport_.reset();
   }
@@ -63,6 +87,27 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     double repeat_period_s = 0.0;
     params.load("command_repeats", command_repeats_, 1, 20);
     params.load("command_repeat_period_s", repeat_period_s, 0.01, 1.0);
+    ros::NodeHandle& pnh = getPrivateNodeHandle();
+    const std::string state_dir = defaultStateDir();
+    const std::string id_text = std::to_string(sender_id);
+    std::string sequence_file, marks_file;
+    params.loadOptional("sequence_file", sequence_file, state_dir + "/lcm_bridge_" + id_text + ".boot");
+    params.loadOptional("high_water_file", marks_file, state_dir + "/lcm_bridge_" + id_text + ".marks");
+    const double command_max_age_s = pnh.param("command_max_age_s", 5.0);
+    const int recv_buf_bytes = pnh.param("recv_buf_bytes", 4194304);
+    comm::VerifierConfig vcfg;
+    vcfg.max_rate_hz = pnh.param("max_rate_hz", vcfg.max_rate_hz);
+    vcfg.burst = pnh.param("burst", vcfg.burst);
+    params.note("command_max_age_s: " + std::to_string(command_max_age_s) + ", recv_buf_bytes: " +
+                std::to_string(recv_buf_bytes) + ", max_rate_hz: " + std::to_string(vcfg.max_rate_hz) +
+                ", burst: " + std::to_string(vcfg.burst));
+    if (!(command_max_age_s > 0.0 && command_max_age_s <= 60.0)) {
+      params.addError("command_max_age_s: must be in (0, 60] s, got " + std::to_string(command_max_age_s));
+    }
+    if (recv_buf_bytes < 65536) params.addError("recv_buf_bytes: must be >= 65536, got " + std::to_string(recv_buf_bytes));
+    if (url.rfind("udpm://", 0) == 0 && url.find("recv_buf_size") == std::string::npos && recv_buf_bytes >= 65536) {
+      url += (url.find('?') == std::string::npos ? "?" : "&") + std::string("recv_buf_size=") + std::to_string(recv_buf_bytes);
+    }
     std::optional<comm::KeyRing> keys;
     if (!key_file.empty()) {
       auto k = comm::loadKeyFile(key_file);
@@ -72,7 +117,18 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
         params.addError("key_file: " + k.reason());
       }
     }
-    comm::VerifierConfig vcfg;
+    for (const auto& [name, type] : {std::make_pair(std::string("command_senders"), comm::MessageType::kFormationCommand),
+                                     std::make_pair(std::string("params_senders"), comm::MessageType::kFormationParams)}) {
+      std::vector<int> ids;
+      if (!pnh.getParam(name, ids)) continue;
+      if (ids.empty()) params.addError(name + ": must list at least one sender id (omit it to allow every known sender)");
+      auto& list = vcfg.senders_by_type[type];  // own id only → empty: no one else may send it
+      for (const int id : ids) {
+        if (id < 0 || id > 65535) params.addError(name + ": " + std::to_string(id) + " out of range [0, 65535]");
+        else if (id != sender_id) list.push_back(static_cast<std::uint16_t>(id));  // own id: never received
+      }
+      params.note(name + ": " + std::to_string(ids.size()) + " id(s)");
+    }
     for (const int s : known) {
       if (s < 0 || s > 65535) params.addError("known_senders: " + std::to_string(s) + " out of range [0, 65535]");
       else if (s != sender_id) vcfg.known_senders.push_back(static_cast<std::uint16_t>(s));  // the fleet's ids; own ignored
@@ -80,6 +136,7 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     vcfg.own_sender_id = static_cast<std::uint16_t>(sender_id);
     vcfg.max_age_s = max_age_s;
     vcfg.max_age_s_by_type[comm::MessageType::kHeartbeat] = std::max(max_age_s, 2.0);
+    vcfg.max_age_s_by_type[comm::MessageType::kFormationCommand] = command_max_age_s;
     if (params.ok()) {
       for (const auto& e : vcfg.validate()) params.addError("known_senders/max_age_s: " + e);
     }
@@ -88,32 +145,71 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
       if (!t) params.addError("lcm_url: " + t.reason());
       else transport_ = std::move(*t);
     }
+    std::optional<comm::Verifier> verifier;
+    std::uint32_t boot = 0;
+    std::map<std::uint16_t, std::uint64_t> marks;
+    if (params.ok()) {
+      ensureDirectory(state_dir, sequence_file, marks_file);
+      auto b = comm::advanceBootCounter(sequence_file);
+      if (b) boot = b.value();
+      else params.addError("sequence_file: " + b.reason());
+      auto m = comm::loadHighWaterMarks(marks_file);
+      if (m) marks = m.value();
+      else params.addError("high_water_file: " + m.reason());
+      marks_file_ = marks_file;
+    }
+    if (params.ok()) {
+      auto v = comm::Verifier::create(vcfg, *keys);
+      if (v) verifier.emplace(std::move(*v));
+      else params.addError("key_file/known_senders: " + v.reason());
+      if (keys->perSender() && keys->active().sender_id != sender_id) {
+        params.addError("key_file: its signing key belongs to sender " + std::to_string(keys->active().sender_id) +
+                        ", not to sender_id " + std::to_string(sender_id));
+      }
+    }
     if (!params.ok()) {
       NODELET_ERROR_STREAM("LcmBridge refuses to start; fix these parameters:\n" << params.report());
       return;
     }
     NODELET_INFO_STREAM("LcmBridge loaded:\n" << params.loaded());
-    auto verifier = comm::Verifier::create(vcfg, *keys);
-    const auto first_sequence = static_cast<std::uint64_t>(ros::WallTime::now().toNSec() / 1000);
+    if (!keys->perSender()) {
+      NODELET_WARN_STREAM("LcmBridge: key_file holds a group key: any holder can speak for any sender; use per-sender "
+                          "keys (tools/make_fleet_keys.sh, docs/security.md: Keys)");
+    }
+    verifier->restoreHighWaterMarks(marks);
+    NODELET_INFO_STREAM("LcmBridge: boot " << boot << " (sequence numbers from " << comm::firstSequenceOfBoot(boot)
+                                           << "), restored high-water marks of " << marks.size() << " sender(s)");
+    const std::uint64_t first_sequence = comm::firstSequenceOfBoot(boot);
     link_ = std::make_unique<lcm_bridge::SecureLink>(*transport_,
                                                      comm::Signer(static_cast<std::uint16_t>(sender_id), *keys, first_sequence),
                                                      std::move(*verifier), [] { return ros::Time::now().toSec(); });
     link_->setHandler([this](const comm::Envelope& e) { onEnvelope(e); });
+    link_->setRejectHandler([this](const comm::VerifyResult& r, std::optional<std::uint16_t> claimed) {
+      onRejected(r, claimed);
+    });
     heartbeat_.uav_index = static_cast<std::uint16_t>(std::min(sender_id, comm::kMaxUavIndex));
 
-    worker_pub_ = nh.advertise<gesture_formation::WorkerState>("worker_state_out", 10);
-    plans_pub_ = nh.advertise<gesture_formation::PlannedTrajectory>("plans_out", 10);
-    params_pub_ = nh.advertise<gesture_formation::FormationParams>("formation_params_out", 5, true);
-    command_pub_ = nh.advertise<gesture_formation::FormationCommand>("formation_command_out", 20);
-    worker_sub_ = nh.subscribe("worker_state_in", 5, &LcmBridgeNodelet::onWorker, this);
-    plan_sub_ = nh.subscribe("plan_in", 5, &LcmBridgeNodelet::onPlan, this);
-    params_sub_ = nh.subscribe("formation_params_in", 5, &LcmBridgeNodelet::onParams, this);
-    command_sub_ = nh.subscribe("formation_command_in", 20, &LcmBridgeNodelet::onCommand, this);
-    observations_pub_ = nh.advertise<gesture_formation::GestureObservation>("gesture_observations_out", 50);
-    observation_sub_ = nh.subscribe("gesture_observation_in", 20, &LcmBridgeNodelet::onObservation, this);
+    // Queues hold a burst: every peer's messages of ~1 s (several UAVs, 10–30 Hz each).
+    worker_pub_ = nh.advertise<gesture_formation::WorkerState>("worker_state_out", 100);
+    plans_pub_ = nh.advertise<gesture_formation::PlannedTrajectory>("plans_out", 100);
+    params_pub_ = nh.advertise<gesture_formation::FormationParams>("formation_params_out", 20, true);
+    command_pub_ = nh.advertise<gesture_formation::FormationCommand>("formation_command_out", 100);
+    worker_sub_ = nh.subscribe("worker_state_in", 50, &LcmBridgeNodelet::onWorker, this);
+    plan_sub_ = nh.subscribe("plan_in", 50, &LcmBridgeNodelet::onPlan, this);
+    params_sub_ = nh.subscribe("formation_params_in", 20, &LcmBridgeNodelet::onParams, this);
+    command_sub_ = nh.subscribe("formation_command_in", 100, &LcmBridgeNodelet::onCommand, this);
+    observations_pub_ = nh.advertise<gesture_formation::GestureObservation>("gesture_observations_out", 200);
+    observation_sub_ = nh.subscribe("gesture_observation_in", 100, &LcmBridgeNodelet::onObservation, this);
+    diagnostics_pub_ = nh.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 10);
     drain_timer_ = nh.createWallTimer(ros::WallDuration(0.005), [this](const ros::WallTimerEvent&) {
       std::lock_guard<std::mutex> lock(mutex_);
-      if (transport_) transport_->drain();
+      // Bounded: a flood must not keep the mutex from heartbeats and publishing.
+      if (transport_) transport_->drain(kMaxDrainPerTick);
+    });
+    diagnostics_timer_ = nh.createWallTimer(ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      publishDiagnostics();
+      saveMarks();
     });
     repeat_timer_ = nh.createTimer(ros::Duration(repeat_period_s), [this](const ros::TimerEvent&) {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -217,16 +313,19 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
         formation::FormationCommand c;
         if (!decoder_.decode(e, c)) break;
         // The sender repeats each command: forward its first copy only (ids of the last 256).
-        const auto id = std::make_pair(c.id.sender, c.id.sequence);
+        // Keyed by the envelope's (authenticated) sender too, 256 per sender: a peer cannot
+        // pre-fill or flush another sender's command ids.
+        const CommandId id{e.sender_id, c.id.sender, c.id.sequence};
         if (commands_seen_.count(id) != 0) {
           ++command_copies_dropped_;
           break;
         }
         commands_seen_.insert(id);
-        commands_seen_order_.push_back(id);
-        if (commands_seen_order_.size() > 256) {
-          commands_seen_.erase(commands_seen_order_.front());
-          commands_seen_order_.pop_front();
+        auto& order = commands_seen_order_[e.sender_id];
+        order.push_back(id);
+        if (order.size() > 256) {
+          commands_seen_.erase(order.front());
+          order.pop_front();
         }
         auto m = toMsg(c);
         m.header.stamp = ros::Time(e.stamp_s);
@@ -249,8 +348,104 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
       }
     }
     if (!decoder_.lastReason().empty()) {
-      NODELET_WARN_STREAM_THROTTLE(1.0, "LcmBridge: payload refused: " << decoder_.lastReason());
+      link_->verifier().countDecodeFailure(e.sender_id);
+      NODELET_WARN_STREAM_THROTTLE(1.0, "LcmBridge: payload from sender " << e.sender_id << " refused (decode_failure): "
+                                                                         << decoder_.lastReason());
     }
+  }
+
+  // Called from drain() (mutex held).
+  void onRejected(const comm::VerifyResult& r, std::optional<std::uint16_t> claimed) {
+    const std::string who = claimed ? "sender " + std::to_string(*claimed) : std::string("an unparsable datagram");
+    NODELET_WARN_STREAM_THROTTLE(1.0, "LcmBridge: refused " << comm::toString(r.verdict) << " from " << who << " ("
+                                                         << r.detail << "; " << link_->verifierCounters().rejected()
+                                                         << " refused in all; /diagnostics has the counts)");
+  }
+
+  static std::string defaultStateDir() {
+    const char* ros_home = std::getenv("ROS_HOME");
+    const char* home = std::getenv("HOME");
+    const std::string base = ros_home && *ros_home ? ros_home : std::string(home && *home ? home : "/tmp") + "/.ros";
+    return base + "/gesture_formation";
+  }
+
+  /// Creates the default state directory (0700) when a state file lives in it.
+  static void ensureDirectory(const std::string& dir, const std::string& a, const std::string& b) {
+    if (a.rfind(dir + "/", 0) != 0 && b.rfind(dir + "/", 0) != 0) return;
+    const std::string parent = dir.substr(0, dir.rfind('/'));
+    ::mkdir(parent.c_str(), 0700);  // $ROS_HOME may not exist yet; errors show when the files are opened
+    ::mkdir(dir.c_str(), 0700);
+  }
+
+  // Mutex held.
+  void saveMarks() {
+    if (!link_ || marks_file_.empty()) return;
+    const auto marks = link_->verifier().highWaterMarks();
+    if (marks.empty() || marks == saved_marks_) return;
+    const auto r = comm::saveHighWaterMarks(marks_file_, marks);
+    if (r) saved_marks_ = marks;
+    else NODELET_WARN_STREAM_THROTTLE(10.0, "LcmBridge: high_water_file not saved: " << r.reason());
+  }
+
+  // Mutex held.
+  void publishDiagnostics() {
+    if (!link_) return;
+    diagnostic_msgs::DiagnosticArray array;
+    array.header.stamp = ros::Time::now();
+    array.status.push_back(linkStatus());
+    for (const auto& [sender, counters] : link_->verifier().senderCounters()) array.status.push_back(senderStatus(sender, counters));
+    diagnostics_pub_.publish(array);
+  }
+
+  static void addValue(diagnostic_msgs::DiagnosticStatus& s, const std::string& key, std::uint64_t value) {
+    diagnostic_msgs::KeyValue kv;
+    kv.key = key;
+    kv.value = std::to_string(value);
+    s.values.push_back(kv);
+  }
+
+  diagnostic_msgs::DiagnosticStatus linkStatus() {
+    diagnostic_msgs::DiagnosticStatus s;
+    s.name = "LcmBridge sender " + std::to_string(link_->signer().senderId()) + ": link";
+    s.hardware_id = "lcm";
+    const comm::VerifierCounters& c = link_->verifierCounters();
+    for (std::size_t v = 0; v < comm::kVerdictCount; ++v) addValue(s, comm::toString(static_cast<comm::Verdict>(v)), c.by_verdict[v]);
+    std::uint64_t decode_failures = 0;
+    for (const auto& [sender, sc] : link_->verifier().senderCounters()) decode_failures += sc.decode_failures;
+    addValue(s, "decode_failure", decode_failures);
+    addValue(s, "channel_mismatch", link_->channelMismatches());
+    addValue(s, "undecodable_lcm", transport_->counters().undecodable);
+    addValue(s, "received_lcm", transport_->counters().received);
+    addValue(s, "published", transport_->counters().published);
+    addValue(s, "publish_failed", transport_->counters().publish_failed);
+    addValue(s, "command_copies_dropped", command_copies_dropped_);
+    addValue(s, "observations_refused", observations_refused_);
+    const std::uint64_t rejected = c.rejected() + decode_failures + link_->channelMismatches() + transport_->counters().undecodable;
+    s.level = rejected > last_rejected_ ? diagnostic_msgs::DiagnosticStatus::WARN : diagnostic_msgs::DiagnosticStatus::OK;
+    s.message = rejected > last_rejected_ ? std::to_string(rejected - last_rejected_) + " refused in the last second"
+                                          : "no refusals in the last second";
+    last_rejected_ = rejected;
+    return s;
+  }
+
+  diagnostic_msgs::DiagnosticStatus senderStatus(std::uint16_t sender, const comm::SenderCounters& c) {
+    diagnostic_msgs::DiagnosticStatus s;
+    s.name = "LcmBridge sender " + std::to_string(link_->signer().senderId()) + ": from sender " + std::to_string(sender);
+    s.hardware_id = "lcm";
+    std::uint64_t rejected = c.decode_failures;
+    for (std::size_t v = 0; v < comm::kVerdictCount; ++v) {
+      const auto verdict = static_cast<comm::Verdict>(v);
+      if (verdict == comm::Verdict::kOwnMessage) continue;
+      addValue(s, comm::toString(verdict), c.by_verdict[v]);
+      if (verdict != comm::Verdict::kAccepted) rejected += c.by_verdict[v];
+    }
+    addValue(s, "decode_failure", c.decode_failures);
+    std::uint64_t& last = last_rejected_by_sender_[sender];
+    s.level = rejected > last ? diagnostic_msgs::DiagnosticStatus::WARN : diagnostic_msgs::DiagnosticStatus::OK;
+    s.message = rejected > last ? std::to_string(rejected - last) + " refused in the last second (claimed sender id)"
+                                : "no refusals in the last second";
+    last = rejected;
+    return s;
   }
 
   std::mutex mutex_;
@@ -262,13 +457,19 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
   std::map<std::uint16_t, comm::Heartbeat> peers_;
   int command_repeats_ = 1;
   std::deque<std::pair<formation::FormationCommand, int>> repeating_;  ///< commands still to repeat, copies left
-  std::set<std::pair<std::string, std::uint64_t>> commands_seen_;     ///< received command ids (bounded)
-  std::deque<std::pair<std::string, std::uint64_t>> commands_seen_order_;
+  using CommandId = std::tuple<std::uint16_t, std::string, std::uint64_t>;  ///< envelope sender, command id
+  std::set<CommandId> commands_seen_;                                  ///< received command ids (bounded)
+  std::map<std::uint16_t, std::deque<CommandId>> commands_seen_order_;  ///< per known sender, ≤ 256 each
   std::uint64_t command_copies_dropped_ = 0;  ///< repeated copies of an already forwarded command
   std::uint64_t observations_refused_ = 0;  ///< decoded gesture observations with a bad sender / stamp
-  ros::Publisher worker_pub_, plans_pub_, params_pub_, command_pub_, observations_pub_;
+  static constexpr int kMaxDrainPerTick = 2000;  ///< LCM messages handled per 5 ms drain
+  std::string marks_file_;
+  std::map<std::uint16_t, std::uint64_t> saved_marks_;
+  std::uint64_t last_rejected_ = 0;
+  std::map<std::uint16_t, std::uint64_t> last_rejected_by_sender_;
+  ros::Publisher worker_pub_, plans_pub_, params_pub_, command_pub_, observations_pub_, diagnostics_pub_;
   ros::Subscriber worker_sub_, plan_sub_, params_sub_, command_sub_, observation_sub_;
-  ros::WallTimer drain_timer_;
+  ros::WallTimer drain_timer_, diagnostics_timer_;
   ros::Timer heartbeat_timer_, repeat_timer_;
 };
 

@@ -58,15 +58,17 @@ EnvelopeError parseEnvelope(const std::uint8_t* data, std::size_t size, Envelope
   r.u32(length);
   if (r.failed()) return EnvelopeError::kTruncated;
   if (m0 != kMagic0 || m1 != kMagic1) return EnvelopeError::kBadMagic;
-  if (version != kEnvelopeVersion) return EnvelopeError::kBadVersion;
+  const std::size_t tag_bytes = tagBytes(version);
+  if (tag_bytes == 0) return EnvelopeError::kBadVersion;
   if (!isKnownMessageType(type)) return EnvelopeError::kBadType;
   if (flags != 0) return EnvelopeError::kBadFlags;
   if (length > kMaxPayloadBytes) return EnvelopeError::kOversize;
-  const std::size_t expected = kHeaderBytes + static_cast<std::size_t>(length) + kTagBytes;
+  const std::size_t expected = kHeaderBytes + static_cast<std::size_t>(length) + tag_bytes;
   if (size < expected) return EnvelopeError::kTruncated;
   if (size > expected) return EnvelopeError::kLengthMismatch;
   if (!std::isfinite(stamp)) return EnvelopeError::kBadStamp;
 
+  view.version = version;
   view.type = static_cast<MessageType>(type);
   view.sender_id = sender;
   view.key_id = key_id;
@@ -80,20 +82,22 @@ EnvelopeError parseEnvelope(const std::uint8_t* data, std::size_t size, Envelope
   return EnvelopeError::kNone;
 }
 
-common::Result<std::vector<std::uint8_t>> sealEnvelope(const Envelope& envelope, const std::uint8_t* key,
-                                                       std::size_t key_bytes) {
-  using R = common::Result<std::vector<std::uint8_t>>;
+namespace {
+
+using SealResult = common::Result<std::vector<std::uint8_t>>;
+
+/// Checks the fields and writes header + payload (what the tag covers) with `version`.
+SealResult serialiseSigned(const Envelope& envelope, std::uint8_t version) {
   if (envelope.payload.size() > kMaxPayloadBytes) {
-    return R::fail("payload of " + std::to_string(envelope.payload.size()) + " bytes exceeds " +
-                   std::to_string(kMaxPayloadBytes));
+    return SealResult::fail("payload of " + std::to_string(envelope.payload.size()) + " bytes exceeds " +
+                            std::to_string(kMaxPayloadBytes));
   }
-  if (!std::isfinite(envelope.stamp_s)) return R::fail("stamp_s is not finite");
-  if (!isKnownMessageType(static_cast<std::uint8_t>(envelope.type))) return R::fail("unknown message type");
-  if (key == nullptr || key_bytes == 0) return R::fail("no key");
+  if (!std::isfinite(envelope.stamp_s)) return SealResult::fail("stamp_s is not finite");
+  if (!isKnownMessageType(static_cast<std::uint8_t>(envelope.type))) return SealResult::fail("unknown message type");
   ByteWriter w;
   w.u8(kMagic0);
   w.u8(kMagic1);
-  w.u8(kEnvelopeVersion);
+  w.u8(version);
   w.u8(static_cast<std::uint8_t>(envelope.type));
   w.u16(envelope.sender_id);
   w.u8(envelope.key_id);
@@ -102,10 +106,31 @@ common::Result<std::vector<std::uint8_t>> sealEnvelope(const Envelope& envelope,
   w.f64(envelope.stamp_s);
   w.u32(static_cast<std::uint32_t>(envelope.payload.size()));
   w.bytes(envelope.payload.data(), envelope.payload.size());
+  return SealResult::ok(w.release());
+}
+
+}  // namespace
+
+SealResult sealEnvelope(const Envelope& envelope, const std::uint8_t* key, std::size_t key_bytes) {
+  if (key == nullptr || key_bytes == 0) return SealResult::fail("no key");
+  SealResult bytes = serialiseSigned(envelope, kEnvelopeVersionHmac);
+  if (!bytes) return bytes;
+  std::vector<std::uint8_t> out = std::move(bytes.value());
   Tag tag{};
-  if (!hmacSha256(key, key_bytes, w.buffer().data(), w.size(), tag)) return R::fail("HMAC-SHA256 failed (OpenSSL)");
-  w.bytes(tag.data(), tag.size());
-  return R::ok(w.release());
+  if (!hmacSha256(key, key_bytes, out.data(), out.size(), tag)) return SealResult::fail("HMAC-SHA256 failed (OpenSSL)");
+  out.insert(out.end(), tag.begin(), tag.end());
+  return SealResult::ok(std::move(out));
+}
+
+SealResult sealEnvelopeEd25519(const Envelope& envelope, const std::uint8_t* seed) {
+  if (seed == nullptr) return SealResult::fail("no key");
+  SealResult bytes = serialiseSigned(envelope, kEnvelopeVersionEd25519);
+  if (!bytes) return bytes;
+  std::vector<std::uint8_t> out = std::move(bytes.value());
+  Signature signature{};
+  if (!ed25519Sign(seed, out.data(), out.size(), signature)) return SealResult::fail("Ed25519 signing failed (OpenSSL)");
+  out.insert(out.end(), signature.begin(), signature.end());
+  return SealResult::ok(std::move(out));
 }
 
 }  // namespace gesture_formation::comm

@@ -4,11 +4,13 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -16,19 +18,94 @@ namespace gesture_formation::comm {
 
 using common::Result;
 
+const char* toString(KeyKind kind) {
+  switch (kind) {
+    case KeyKind::kGroupHmac: return "group";
+    case KeyKind::kSigning: return "signing";
+    case KeyKind::kVerifying: return "verifying";
+  }
+  return "unknown";
+}
+
+Result<KeyEntry> signingKey(std::uint8_t id, std::uint16_t sender_id, const std::array<std::uint8_t, kKeyBytes>& seed) {
+  KeyEntry e;
+  e.id = id;
+  e.kind = KeyKind::kSigning;
+  e.sender_id = sender_id;
+  e.key = SecretKey(seed);
+  if (!ed25519PublicFromSeed(e.key.data(), e.public_key)) {
+    return Result<KeyEntry>::fail("key " + std::to_string(id) + ": Ed25519 public key derivation failed (OpenSSL)");
+  }
+  return Result<KeyEntry>::ok(std::move(e));
+}
+
+KeyEntry verifyingKeyOf(const KeyEntry& signing, double accept_until_s) {
+  KeyEntry e;
+  e.id = signing.id;
+  e.kind = KeyKind::kVerifying;
+  e.sender_id = signing.sender_id;
+  e.public_key = signing.public_key;
+  e.accept_until_s = accept_until_s;
+  return e;
+}
+
+namespace {
+
+std::string keyName(const KeyEntry& k) {
+  if (k.kind == KeyKind::kGroupHmac) return "key " + std::to_string(k.id);
+  return std::string(toString(k.kind)) + " key " + std::to_string(k.id) + " of sender " + std::to_string(k.sender_id);
+}
+
+/// Per-sender rules: no group key, signing keys of one sender, verifying ids unique per sender.
+std::optional<std::string> perSenderProblem(const std::vector<KeyEntry>& keys) {
+  std::set<std::pair<int, int>> verifying;
+  std::optional<std::uint16_t> signer;
+  std::size_t signing_count = 0;
+  for (const KeyEntry& k : keys) {
+    if (k.kind == KeyKind::kGroupHmac) {
+      return std::string("group key ") + std::to_string(k.id) +
+             " mixed with per-sender keys (it would let any holder speak for every sender)";
+    }
+    if (k.kind == KeyKind::kVerifying) {
+      if (!verifying.insert({k.sender_id, k.id}).second) {
+        return "duplicate verifying key " + std::to_string(k.id) + " of sender " + std::to_string(k.sender_id);
+      }
+      continue;
+    }
+    ++signing_count;
+    if (signer && *signer != k.sender_id) {
+      return "signing keys of two senders (" + std::to_string(*signer) + " and " + std::to_string(k.sender_id) +
+             "): a node holds only its own";
+    }
+    signer = k.sender_id;
+    if (std::isfinite(k.accept_until_s)) return keyName(k) + ": accept_until_s applies to verifying keys only";
+  }
+  if (signing_count == 0) return std::string("no signing key (a 'signing sender=<id>' line for this node)");
+  if (verifying.size() > kMaxVerifyingKeys) {
+    return "too many verifying keys: " + std::to_string(verifying.size()) + " (at most " +
+           std::to_string(kMaxVerifyingKeys) + ")";
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
 Result<KeyRing> KeyRing::create(std::vector<KeyEntry> keys, std::uint8_t active_id) {
   if (keys.empty()) return Result<KeyRing>::fail("no keys");
-  if (keys.size() > kMaxKeys) {
-    return Result<KeyRing>::fail("too many keys: " + std::to_string(keys.size()) + " (at most " +
-                                 std::to_string(kMaxKeys) + ")");
+  const bool per_sender = std::any_of(keys.begin(), keys.end(), [](const KeyEntry& k) { return k.kind != KeyKind::kGroupHmac; });
+  if (per_sender) {
+    if (const auto problem = perSenderProblem(keys)) return Result<KeyRing>::fail(*problem);
   }
   std::set<int> ids;
   bool have_active = false;
   for (const KeyEntry& k : keys) {
-    if (!ids.insert(k.id).second) return Result<KeyRing>::fail("duplicate key id " + std::to_string(k.id));
-    if (std::isnan(k.accept_until_s)) {
-      return Result<KeyRing>::fail("key " + std::to_string(k.id) + ": accept_until_s is NaN");
+    if (std::isnan(k.accept_until_s)) return Result<KeyRing>::fail(keyName(k) + ": accept_until_s is NaN");
+    if (k.kind == KeyKind::kVerifying) continue;
+    if (ids.size() >= kMaxKeys) {
+      return Result<KeyRing>::fail("too many " + std::string(per_sender ? "signing" : "") + (per_sender ? " " : "") +
+                                   "keys: more than " + std::to_string(kMaxKeys));
     }
+    if (!ids.insert(k.id).second) return Result<KeyRing>::fail("duplicate key id " + std::to_string(k.id));
     if (k.id == active_id) {
       have_active = true;
       if (std::isfinite(k.accept_until_s)) {
@@ -43,9 +120,21 @@ Result<KeyRing> KeyRing::create(std::vector<KeyEntry> keys, std::uint8_t active_
 
 const KeyEntry* KeyRing::find(std::uint8_t id) const {
   for (const KeyEntry& k : keys_) {
-    if (k.id == id) return &k;
+    if (k.id == id && k.kind != KeyKind::kVerifying) return &k;
   }
   return nullptr;
+}
+
+const KeyEntry* KeyRing::findVerifying(std::uint16_t sender_id, std::uint8_t id) const {
+  for (const KeyEntry& k : keys_) {
+    if (k.kind == KeyKind::kVerifying && k.id == id && k.sender_id == sender_id) return &k;
+  }
+  return nullptr;
+}
+
+bool KeyRing::hasVerifyingKeyFor(std::uint16_t sender_id) const {
+  return std::any_of(keys_.begin(), keys_.end(),
+                     [&](const KeyEntry& k) { return k.kind == KeyKind::kVerifying && k.sender_id == sender_id; });
 }
 
 namespace {
@@ -90,6 +179,8 @@ bool parseKeyId(const std::string& s, std::uint8_t& id) {
 Result<KeyRing> parseKeyFileText(const std::string& text, const std::string& source) {
   std::vector<KeyEntry> keys;
   int active_count = 0;
+  std::size_t own_count = 0;        // group or signing keys
+  std::size_t verifying_count = 0;
   std::uint8_t active_id = 0;
   std::istringstream in(text);
   std::string line;
@@ -101,8 +192,7 @@ Result<KeyRing> parseKeyFileText(const std::string& text, const std::string& sou
     if (hash != std::string::npos) line.erase(hash);
     const std::vector<std::string> words = splitWords(line);
     if (words.empty()) continue;
-    if (keys.size() >= kMaxKeys) return fail("more than " + std::to_string(kMaxKeys) + " keys");
-    if (words.size() < 2) return fail("expected '<key_id> <64 hex digits> [active] [accept_until_s=<s>]'");
+    if (words.size() < 2) return fail("expected '<key_id> <64 hex digits> [signing|verifying sender=<id>] [active] [accept_until_s=<s>]'");
     KeyEntry entry;
     if (!parseKeyId(words[0], entry.id)) return fail("key id must be a decimal number 0..255");
     const std::string& hex = words[1];
@@ -121,27 +211,78 @@ Result<KeyRing> parseKeyFileText(const std::string& text, const std::string& sou
       }
       bytes[i] = static_cast<std::uint8_t>(hi * 16 + lo);
     }
-    entry.key = SecretKey(bytes);
-    secureZero(bytes.data(), bytes.size());
+    bool active = false;
+    bool have_sender = false;
     for (std::size_t w = 2; w < words.size(); ++w) {
       const std::string& opt = words[w];
       static const std::string kUntil = "accept_until_s=";
+      static const std::string kSender = "sender=";
       if (opt == "active") {
-        ++active_count;
-        active_id = entry.id;
+        active = true;
+      } else if (opt == "signing" || opt == "verifying") {
+        if (entry.kind != KeyKind::kGroupHmac) {
+          secureZero(bytes.data(), bytes.size());
+          return fail("key " + std::to_string(entry.id) + ": 'signing' or 'verifying' given twice");
+        }
+        entry.kind = opt == "signing" ? KeyKind::kSigning : KeyKind::kVerifying;
+      } else if (opt.compare(0, kSender.size(), kSender) == 0) {
+        const std::string value = opt.substr(kSender.size());
+        char* end = nullptr;
+        errno = 0;
+        const unsigned long id = value.empty() || value[0] == '-' ? 70000UL : std::strtoul(value.c_str(), &end, 10);
+        if (value.empty() || end != value.c_str() + value.size() || id > 65535UL || errno == ERANGE) {
+          secureZero(bytes.data(), bytes.size());
+          return fail("key " + std::to_string(entry.id) + ": sender must be a decimal id 0..65535");
+        }
+        entry.sender_id = static_cast<std::uint16_t>(id);
+        have_sender = true;
       } else if (opt.compare(0, kUntil.size(), kUntil) == 0) {
         const std::string value = opt.substr(kUntil.size());
         char* end = nullptr;
         errno = 0;
         const double t = value.empty() ? std::nan("") : std::strtod(value.c_str(), &end);
         if (value.empty() || end != value.c_str() + value.size() || !std::isfinite(t) || errno == ERANGE) {
+          secureZero(bytes.data(), bytes.size());
           return fail("key " + std::to_string(entry.id) + ": accept_until_s must be a finite number of seconds");
         }
         entry.accept_until_s = t;
       } else {
         // Not echoed: a mangled line may hold key material (found by fuzz_key_file).
-        return fail("unknown option in word " + std::to_string(w + 1) + " (expected 'active' or 'accept_until_s=<s>')");
+        secureZero(bytes.data(), bytes.size());
+        return fail("unknown option in word " + std::to_string(w + 1) +
+                    " (expected 'active', 'signing', 'verifying', 'sender=<id>' or 'accept_until_s=<s>')");
       }
+    }
+    const std::string name = "key " + std::to_string(entry.id);
+    if ((entry.kind != KeyKind::kGroupHmac) != have_sender) {
+      secureZero(bytes.data(), bytes.size());
+      return fail(name + ": 'sender=<id>' goes with 'signing' or 'verifying', and they need it");
+    }
+    if (entry.kind == KeyKind::kVerifying) {
+      std::copy(bytes.begin(), bytes.end(), entry.public_key.begin());
+      secureZero(bytes.data(), bytes.size());
+      if (active) return fail(name + ": a verifying key cannot be 'active' (a node signs with its own signing key)");
+      if (++verifying_count > kMaxVerifyingKeys) return fail("more than " + std::to_string(kMaxVerifyingKeys) + " verifying keys");
+      keys.push_back(std::move(entry));
+      continue;
+    }
+    if (++own_count > kMaxKeys) {
+      secureZero(bytes.data(), bytes.size());
+      return fail("more than " + std::to_string(kMaxKeys) + " keys");
+    }
+    if (entry.kind == KeyKind::kSigning) {
+      auto signing = signingKey(entry.id, entry.sender_id, bytes);
+      secureZero(bytes.data(), bytes.size());
+      if (!signing) return fail(signing.reason());
+      signing.value().accept_until_s = entry.accept_until_s;
+      entry = std::move(signing.value());
+    } else {
+      entry.key = SecretKey(bytes);
+      secureZero(bytes.data(), bytes.size());
+    }
+    if (active) {
+      ++active_count;
+      active_id = entry.id;
     }
     keys.push_back(std::move(entry));
   }
@@ -150,8 +291,10 @@ Result<KeyRing> parseKeyFileText(const std::string& text, const std::string& sou
   if (keys.empty()) return failFile("no keys");
   if (active_count > 1) return failFile("more than one key marked 'active'");
   if (active_count == 0) {
-    if (keys.size() != 1) return failFile("several keys but none marked 'active'");
-    active_id = keys.front().id;
+    if (own_count > 1) return failFile("several keys but none marked 'active'");
+    for (const KeyEntry& k : keys) {
+      if (k.kind != KeyKind::kVerifying) active_id = k.id;
+    }
   }
   Result<KeyRing> ring = KeyRing::create(std::move(keys), active_id);
   if (!ring) return failFile(ring.reason());

@@ -49,4 +49,12 @@ void ReplayWindow::accept(std::uint64_t s) {
   setBit(s);
 }
 
+void ReplayWindow::markSeenUpTo(std::uint64_t sequence) {
+  if (any_ && sequence <= highest_) return;
+  // Conservative: numbers not actually accepted before the mark are refused too.
+  std::fill(bits_.begin(), bits_.end(), ~std::uint64_t{0});
+  any_ = true;
+  highest_ = sequence;
+}
+
 }  // namespace gesture_formation::comm

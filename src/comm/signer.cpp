@@ -1,6 +1,7 @@
 #include "gesture_formation/comm/signer.hpp"
 
 #include <limits>
+#include <string>
 
 namespace gesture_formation::comm {
 
@@ -17,7 +18,13 @@ common::Result<std::vector<std::uint8_t>> Signer::seal(MessageType type, const s
   e.stamp_s = stamp_s;
   e.payload = payload;
   const KeyEntry& key = keys_.active();
-  auto sealed = sealEnvelope(e, key.key.data(), key.key.size());
+  if (key.kind == KeyKind::kSigning && key.sender_id != sender_id_) {
+    return common::Result<std::vector<std::uint8_t>>::fail(
+        "the active signing key " + std::to_string(key.id) + " belongs to sender " + std::to_string(key.sender_id) +
+        ", not to this node's sender id " + std::to_string(sender_id_));
+  }
+  auto sealed = key.kind == KeyKind::kSigning ? sealEnvelopeEd25519(e, key.key.data())
+                                              : sealEnvelope(e, key.key.data(), key.key.size());
   if (sealed) {
     if (next_sequence_ == std::numeric_limits<std::uint64_t>::max()) {
       exhausted_ = true;

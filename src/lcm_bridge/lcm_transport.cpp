@@ -25,6 +25,8 @@ constexpr ChannelSuffix kChannels[] = {
 
 /// LCM's fixed part of gf_lcm::envelope_t: 8-byte fingerprint + int32 length.
 constexpr std::size_t kLcmOverheadBytes = 12;
+/// Undispatched messages LCM keeps for our subscription (LCM's default: 30).
+constexpr int kQueueCapacity = 2000;
 
 }  // namespace
 
@@ -99,8 +101,11 @@ common::Result<std::unique_ptr<LcmTransport>> LcmTransport::create(const std::st
   std::unique_ptr<LcmTransport> t(new LcmTransport(std::move(impl), channel_prefix));
   t->impl_->owner = t.get();
   // One regex subscription for our channels (LCM anchors it with ^...$).
-  t->impl_->lcm.subscribe(channel_prefix + "(HEARTBEAT|WORKER_STATE|PLANNED_TRAJECTORY|FORMATION_PARAMS|FORMATION_COMMAND|GESTURE_OBSERVATION)",
-                          &Impl::onMessage, t->impl_.get());
+  lcm::Subscription* sub = t->impl_->lcm.subscribe(
+      channel_prefix + "(HEARTBEAT|WORKER_STATE|PLANNED_TRAJECTORY|FORMATION_PARAMS|FORMATION_COMMAND|GESTURE_OBSERVATION)",
+      &Impl::onMessage, t->impl_.get());
+  // LCM's default holds 30 undispatched messages and drops the rest unseen: room for a burst.
+  if (sub != nullptr) sub->setQueueCapacity(kQueueCapacity);
   return R::ok(std::move(t));
 }
 
@@ -124,9 +129,9 @@ void LcmTransport::setHandler(Handler handler) { handler_ = std::move(handler); 
 
 int LcmTransport::handle(int timeout_ms) { return impl_->lcm.handleTimeout(timeout_ms); }
 
-int LcmTransport::drain() {
+int LcmTransport::drain(int max_messages) {
   int n = 0;
-  while (impl_->lcm.handleTimeout(0) > 0) ++n;
+  while (n < max_messages && impl_->lcm.handleTimeout(0) > 0) ++n;
   return n;
 }
 
@@ -158,7 +163,13 @@ void SecureLink::onSealed(comm::MessageType channel_type, const std::vector<std:
     return;
   }
   comm::VerifyResult r = verifier_.verify(sealed.data(), sealed.size(), clock_());
-  if (r.accepted() && handler_) handler_(r.envelope);
+  if (r.accepted()) {
+    if (handler_) handler_(r.envelope);
+  } else if (r.verdict != comm::Verdict::kOwnMessage && reject_handler_) {
+    comm::EnvelopeView claimed;
+    const bool parsed = comm::parseEnvelope(sealed.data(), sealed.size(), claimed) == comm::EnvelopeError::kNone;
+    reject_handler_(r, parsed ? std::optional<std::uint16_t>(claimed.sender_id) : std::nullopt);
+  }
 }
 
 }  // namespace gesture_formation::lcm_bridge

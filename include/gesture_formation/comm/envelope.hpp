@@ -6,7 +6,7 @@
 /// ```
 /// offset size field
 ///      0    2 magic 'G' 'F' (0x47 0x46)
-///      2    1 version (kEnvelopeVersion = 1)
+///      2    1 version: 1 = group HMAC tag (32 B), 2 = per-sender Ed25519 signature (64 B)
 ///      3    1 message type (MessageType, 1..6)
 ///      4    2 sender id
 ///      6    1 key id (which pre-shared key made the tag)
@@ -15,14 +15,16 @@
 ///     16    8 stamp [s] (sender clock; finite)
 ///     24    4 payload length N ≤ kMaxPayloadBytes
 ///     28    N payload (MessageType-specific, payloads.hpp)
-///   28+N   32 tag = HMAC-SHA256(key[key id], bytes 0 .. 28+N−1)
+///   28+N    T tag over bytes 0 .. 28+N−1: version 1 HMAC-SHA256(group key[key id]) (T = 32),
+///             version 2 Ed25519(sender's secret key[key id]) (T = 64)
 /// ```
-/// Total size = 60 + N bytes; the length field must match the datagram size exactly.
+/// Total size = 28 + N + T bytes; the length field must match the datagram size exactly.
 
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
+#include "gesture_formation/comm/ed25519.hpp"
 #include "gesture_formation/comm/hmac.hpp"
 #include "gesture_formation/common/result.hpp"
 
@@ -30,13 +32,25 @@ namespace gesture_formation::comm {
 
 constexpr std::uint8_t kMagic0 = 0x47;  // 'G'
 constexpr std::uint8_t kMagic1 = 0x46;  // 'F'
+/// Version 1: tag = HMAC-SHA256 with a group key (any key holder can claim any sender id).
 constexpr std::uint8_t kEnvelopeVersion = 1;
+constexpr std::uint8_t kEnvelopeVersionHmac = 1;
+/// Version 2: tag = Ed25519 signature with the sender's own key (docs/security.md §5).
+constexpr std::uint8_t kEnvelopeVersionEd25519 = 2;
 constexpr std::size_t kHeaderBytes = 28;
+/// Largest tag of any version [bytes].
+constexpr std::size_t kMaxTagBytes = kEd25519SignatureBytes;
+/// \brief Tag length of an envelope version [bytes]; 0 for an unknown version.
+constexpr std::size_t tagBytes(std::uint8_t version) {
+  return version == kEnvelopeVersionHmac ? kTagBytes : version == kEnvelopeVersionEd25519 ? kEd25519SignatureBytes : 0;
+}
 /// Largest payload [bytes]: fits a planned trajectory of kMaxTrajectorySamples samples and
 /// stays below LCM's 64 KiB single-datagram limit with the header and tag.
 constexpr std::size_t kMaxPayloadBytes = 60000;
+/// Smallest envelope of any version (version 1, empty payload) [bytes].
 constexpr std::size_t kMinEnvelopeBytes = kHeaderBytes + kTagBytes;
-constexpr std::size_t kMaxEnvelopeBytes = kHeaderBytes + kMaxPayloadBytes + kTagBytes;
+/// Largest envelope of any version (version 2, largest payload) [bytes].
+constexpr std::size_t kMaxEnvelopeBytes = kHeaderBytes + kMaxPayloadBytes + kMaxTagBytes;
 
 /// \brief What a payload holds (payloads.hpp). Values are wire constants: never renumber.
 enum class MessageType : std::uint8_t {
@@ -56,6 +70,7 @@ bool isKnownMessageType(std::uint8_t value);
 
 /// \brief The header fields of an envelope (what the tag authenticates besides the payload).
 struct EnvelopeHeader {
+  std::uint8_t version = kEnvelopeVersionHmac;  ///< set by the sealing function / parser
   MessageType type = MessageType::kHeartbeat;
   std::uint16_t sender_id = 0;
   std::uint8_t key_id = 0;
@@ -88,17 +103,22 @@ struct EnvelopeView : EnvelopeHeader {
   std::size_t payload_bytes = 0;
   const std::uint8_t* signed_bytes = nullptr;  ///< header + payload (what the tag covers)
   std::size_t signed_size = 0;
-  const std::uint8_t* tag = nullptr;           ///< kTagBytes
+  const std::uint8_t* tag = nullptr;           ///< tagBytes(version) bytes
 };
 
 /// \brief Checks the structure (sizes, magic, version, type, flags, length, stamp) and fills
 /// `view`; `view` is untouched on error. Never reads outside [data, data + size).
 EnvelopeError parseEnvelope(const std::uint8_t* data, std::size_t size, EnvelopeView& view);
 
-/// \brief Serialises and tags an envelope with `key` (whose id must be envelope.key_id).
+/// \brief Version 1: serialises and tags an envelope with the group HMAC `key` (whose id must
+/// be envelope.key_id; envelope.version is ignored).
 /// Fails on a payload above kMaxPayloadBytes, a non-finite stamp, an unknown type, or an
 /// OpenSSL failure. Signer is the normal way in; this is the primitive.
 common::Result<std::vector<std::uint8_t>> sealEnvelope(const Envelope& envelope, const std::uint8_t* key,
                                                        std::size_t key_bytes);
+
+/// \brief Version 2: serialises and signs an envelope with the sender's Ed25519 secret `seed`
+/// (kEd25519SeedBytes; its id must be envelope.key_id). Same failures as sealEnvelope.
+common::Result<std::vector<std::uint8_t>> sealEnvelopeEd25519(const Envelope& envelope, const std::uint8_t* seed);
 
 }  // namespace gesture_formation::comm

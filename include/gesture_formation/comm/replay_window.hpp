@@ -33,6 +33,11 @@ class ReplayWindow {
   /// \brief Records `sequence` (precondition: check(sequence) == kNew; otherwise no-op).
   void accept(std::uint64_t sequence);
 
+  /// \brief Treats every number ≤ `sequence` as seen (a receiver restoring its persisted
+  /// high-water mark): highest = max(highest, sequence), and the window's bits all set when
+  /// the mark moves it. A mark below the current highest changes nothing.
+  void markSeenUpTo(std::uint64_t sequence);
+
   bool empty() const { return !any_; }
   std::uint64_t highest() const { return highest_; }
   std::size_t size() const { return bits_.size() * 64; }

@@ -1,7 +1,9 @@
 #pragma once
 /// \file
 /// \brief The sending half of authenticated messaging: stamps, numbers and tags envelopes
-/// with this node's sender id and the key ring's active key (docs/security.md §3–5).
+/// with this node's sender id and the key ring's active key (docs/security.md §3–5): a group
+/// ring gives version-1 envelopes (HMAC-SHA256), a per-sender ring version-2 envelopes
+/// (Ed25519 with this node's signing key, which must belong to its sender id).
 ///
 /// Sequence numbers are strictly increasing over all message types of one sender. A node
 /// that restarts must not reuse numbers its peers have seen (they would be refused as
@@ -26,7 +28,8 @@ class Signer {
       : sender_id_(sender_id), keys_(std::move(keys)), next_sequence_(first_sequence) {}
 
   /// \brief Serialises and tags one envelope; the sequence advances only on success.
-  /// Fails on an oversize payload, a non-finite stamp, or sequence exhaustion.
+  /// Fails on an oversize payload, a non-finite stamp, sequence exhaustion, or an active
+  /// signing key of another sender id.
   common::Result<std::vector<std::uint8_t>> seal(MessageType type, const std::vector<std::uint8_t>& payload,
                                                  double stamp_s);
 

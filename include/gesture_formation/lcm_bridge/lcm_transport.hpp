@@ -12,6 +12,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -66,8 +67,9 @@ class LcmTransport {
   /// \brief Dispatches at most one pending LCM message, waiting up to timeout_ms.
   /// Returns > 0 when one was handled, 0 on timeout, < 0 on error.
   int handle(int timeout_ms);
-  /// \brief Handles every message already queued (non-blocking); returns how many.
-  int drain();
+  /// \brief Handles the messages already queued (non-blocking), at most `max_messages`, so a
+  /// flood cannot hold the caller forever; returns how many.
+  int drain(int max_messages = std::numeric_limits<int>::max());
   const Counters& counters() const { return counters_; }
   const std::string& prefix() const { return prefix_; }
 
@@ -86,6 +88,9 @@ class LcmTransport {
 class SecureLink {
  public:
   using EnvelopeHandler = std::function<void(const comm::Envelope&)>;
+  /// Called with every refused envelope (not our own echoes) and the sender id it claims,
+  /// when the datagram was well-formed enough to carry one.
+  using RejectHandler = std::function<void(const comm::VerifyResult&, std::optional<std::uint16_t> claimed_sender)>;
   using Clock = std::function<double()>;  ///< now [s], same clock as the stamps
 
   /// `transport` must outlive the link.
@@ -105,6 +110,7 @@ class SecureLink {
 
   /// \brief Called with every accepted envelope (payload still to decode: comm::PayloadDecoder).
   void setHandler(EnvelopeHandler handler) { handler_ = std::move(handler); }
+  void setRejectHandler(RejectHandler handler) { reject_handler_ = std::move(handler); }
 
   const comm::VerifierCounters& verifierCounters() const { return verifier_.counters(); }
   std::uint64_t channelMismatches() const { return channel_mismatch_; }
@@ -119,6 +125,7 @@ class SecureLink {
   comm::Verifier verifier_;
   Clock clock_;
   EnvelopeHandler handler_;
+  RejectHandler reject_handler_;
   std::uint64_t channel_mismatch_ = 0;
 };
 

@@ -32,6 +32,22 @@ inline KeyRing ring(std::vector<KeyEntry> keys, std::uint8_t active) {
   return r.value();
 }
 
+/// This node's Ed25519 signing key `id` for `sender` from a seed pattern.
+inline KeyEntry signingEntry(std::uint8_t id, std::uint16_t sender, std::uint8_t fill) {
+  auto e = signingKey(id, sender, keyBytes(fill));
+  if (!e) throw std::runtime_error(e.reason());
+  return e.value();
+}
+
+/// A per-sender ring: `own`'s signing key (seed fill own_fill) + the verifying keys of
+/// `peers` (sender id → seed fill), key id 1 each.
+inline KeyRing perSenderRing(std::uint16_t own, std::uint8_t own_fill,
+                             const std::vector<std::pair<std::uint16_t, std::uint8_t>>& peers) {
+  std::vector<KeyEntry> keys{signingEntry(1, own, own_fill)};
+  for (const auto& [sender, fill] : peers) keys.push_back(verifyingKeyOf(signingEntry(1, sender, fill)));
+  return ring(std::move(keys), 1);
+}
+
 inline std::vector<std::uint8_t> randomBytes(std::mt19937_64& rng, std::size_t n) {
   std::vector<std::uint8_t> v(n);
   std::uint64_t bits = 0;

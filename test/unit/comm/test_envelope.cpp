@@ -108,7 +108,7 @@ TEST(CommEnvelopeTest, StructuralErrorsAreNamed) {
   b[0] = 'X';
   check(b, EnvelopeError::kBadMagic);
   b = good;
-  b[2] = 2;
+  b[2] = 3;  // 1 and 2 are versions
   check(b, EnvelopeError::kBadVersion);
   b = good;
   b[3] = 0;
@@ -139,7 +139,8 @@ TEST(CommEnvelopeTest, SealRefusesWhatReceiversWouldRefuse) {
   e.payload.assign(kMaxPayloadBytes, 0);
   auto max = sealEnvelope(e, k.data(), k.size());
   ASSERT_TRUE(max);
-  EXPECT_EQ(max->size(), kMaxEnvelopeBytes);
+  EXPECT_EQ(max->size(), kHeaderBytes + kMaxPayloadBytes + kTagBytes);  // version 1
+  EXPECT_EQ(kMaxEnvelopeBytes, kHeaderBytes + kMaxPayloadBytes + kEd25519SignatureBytes);
   e.payload.clear();
   e.stamp_s = std::numeric_limits<double>::infinity();
   EXPECT_FALSE(sealEnvelope(e, k.data(), k.size()));
