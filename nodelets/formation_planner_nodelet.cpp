@@ -95,21 +95,21 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
                     ", faults.* limits, controller.brake_accel_mps2, formation, planner");
       }
     } else {
-      params.load("replanning_period_s", period_s_, 0.05, 5.0);
-      params.load("horizon_dt_s", horizon_dt_s_, 0.02, 1.0);
-      params.load("horizon_steps", horizon_steps_, 2, formation::kMaxHorizonSteps);
-      params.load("max_share_age_s", freshness_.max_share_age_s, 0.1, 10.0);
+      params.load("replanning_period_s", period_s_, onboard::ranges::kReplanningPeriodS);
+      params.load("horizon_dt_s", horizon_dt_s_, onboard::ranges::kHorizonDtS);
+      params.load("horizon_steps", horizon_steps_, onboard::ranges::kHorizonSteps);
+      params.load("max_share_age_s", freshness_.max_share_age_s, onboard::ranges::kMaxShareAgeS);
       params.load("formation_config", formation_file);
       params.load("planner_config", planner_file);
       params.load("avoid_all_plans", rule_.avoid_all_plans);
-      params.load("max_plan_age_s", rule_.max_plan_age_s, 0.01, 60.0);
-      params.load("max_worker_age_s", freshness_.max_worker_age_s, 0.1, 60.0);
-      params.load("brake_accel_mps2", brake_accel_mps2_, 0.1, 20.0);
-      params.load("search_timeout_s", search_.timeout_s, 0.0, 3600.0);
-      params.load("search_height_m", search_.height_m, 0.1, 100.0);
-      params.load("search_vertical_speed_mps", search_.vertical_speed_mps, 0.01, 10.0);
-      params.load("search_period_s", search_.period_s, 0.5, 120.0);
-      params.load("search_horizontal_speed_mps", search_.horizontal_speed_mps, 0.0, 10.0);
+      params.load("max_plan_age_s", rule_.max_plan_age_s, onboard::ranges::kMaxPlanAgeS);
+      params.load("max_worker_age_s", freshness_.max_worker_age_s, onboard::ranges::kMaxWorkerAgeS);
+      params.load("brake_accel_mps2", brake_accel_mps2_, onboard::ranges::kBrakeAccelMps2);
+      params.load("search_timeout_s", search_.timeout_s, onboard::ranges::kSearchTimeoutS);
+      params.load("search_height_m", search_.height_m, onboard::ranges::kSearchHeightM);
+      params.load("search_vertical_speed_mps", search_.vertical_speed_mps, onboard::ranges::kSearchVerticalSpeedMps);
+      params.load("search_period_s", search_.period_s, onboard::ranges::kSearchPeriodS);
+      params.load("search_horizontal_speed_mps", search_.horizontal_speed_mps, onboard::ranges::kSearchHorizontalSpeedMps);
       formation_loaded = !formation_file.empty() && loadFormation(formation_file, params, fcfg);
       if (!planner_file.empty()) loadPlanner(planner_file, params, pcfg);
     }

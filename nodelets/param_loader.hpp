@@ -8,6 +8,8 @@
 
 #include <ros/node_handle.h>
 
+#include "gesture_formation/common/config_reader.hpp"
+
 namespace gesture_formation::nodelets {
 
 class ParamLoader {
@@ -42,6 +44,29 @@ class ParamLoader {
       errors_.push_back(os.str());
     }
     loaded_ << "  " << name << " = " << value << "\n";
+  }
+  /// \brief A number with the range the core declares for it (e.g. onboard::ranges): one range
+  /// per setting, whichever source it comes from.
+  void load(const std::string& name, double& value, const common::Range& range) {
+    if (!nh_.getParam(name, value)) {
+      missing(name);
+      return;
+    }
+    if (!range.contains(value)) {
+      std::ostringstream os;
+      os << nh_.resolveName(name) << ": value " << value << " out of range " << range.describe();
+      errors_.push_back(os.str());
+    }
+    loaded_ << "  " << name << " = " << value << "\n";
+  }
+  void load(const std::string& name, int& value, const common::Range& range) {
+    double v = 0.0;
+    load(name, v, range);
+    if (v != static_cast<double>(static_cast<int>(v))) {
+      errors_.push_back(nh_.resolveName(name) + ": not an integer");
+      return;
+    }
+    value = static_cast<int>(v);
   }
   void load(const std::string& name, bool& value) {
     if (!nh_.getParam(name, value)) missing(name);

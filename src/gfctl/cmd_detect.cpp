@@ -35,16 +35,6 @@ const Registrar kRegistrar{
 
 constexpr float kDrawMinConfidence = 0.3f;
 
-/// --models default: $GF_MODELS_DIR, else the source tree's third_party_models (set by CMake).
-std::string defaultModelsRoot() {
-  const char* env = std::getenv("GF_MODELS_DIR");
-  if (env != nullptr && *env != '\0') return env;
-#ifdef GF_DEFAULT_MODELS_DIR
-  return GF_DEFAULT_MODELS_DIR;
-#else
-  return "third_party_models";
-#endif
-}
 
 cv::Point px(const Keypoint& k) { return {cvRound(k.x), cvRound(k.y)}; }
 
@@ -135,7 +125,7 @@ int cmdDetect(const Args& args) {
   const std::string in_path = video ? args.get("video") : args.get("image");
 
   PerceptionConfig cfg;
-  cfg.models_root = args.has("models") ? args.get("models") : defaultModelsRoot();
+  cfg.models_root = modelsRoot(args);
   if (args.has("detector")) {
     const auto k = parseDetectorKind(args.get("detector"));
     if (!k) return badInput(args, "--detector: " + k.reason());
@@ -262,5 +252,16 @@ int cmdDetect(const Args& args) {
 }
 
 }  // namespace
+
+std::string modelsRoot(const Args& args) {
+  if (args.has("models")) return args.get("models");
+  const char* env = std::getenv("GF_MODELS_DIR");
+  if (env != nullptr && *env != '\0') return env;
+#ifdef GF_DEFAULT_MODELS_DIR
+  return GF_DEFAULT_MODELS_DIR;
+#else
+  return "third_party_models";
+#endif
+}
 
 }  // namespace gesture_formation::gfctl

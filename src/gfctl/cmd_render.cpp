@@ -36,17 +36,6 @@ using Eigen::Vector3d;
 constexpr int kExitNoRenderer = 1;  ///< no EGL display or OpenGL 3.3 context here
 using Poses = std::vector<Eigen::Isometry3d, Eigen::aligned_allocator<Eigen::Isometry3d>>;
 
-std::string modelsRoot(const Args& args) {
-  if (args.has("models")) return args.get("models");
-  const char* env = std::getenv("GF_MODELS_DIR");
-  if (env != nullptr && *env != '\0') return env;
-#ifdef GF_DEFAULT_MODELS_DIR
-  return GF_DEFAULT_MODELS_DIR;
-#else
-  return "third_party_models";
-#endif
-}
-
 bool parseNonNegInt(const std::string& s, long max, long& v) {
   if (s.empty() || s.size() > 18 || s.find_first_not_of("0123456789") != std::string::npos) return false;
   v = std::stol(s);

@@ -32,10 +32,8 @@ const std::array<const char*, kNumNamed> kJointNames{
     "R_Foot", "Neck", "L_Collar", "R_Collar", "Head", "L_Shoulder", "R_Shoulder", "L_Elbow", "R_Elbow", "L_Wrist",
     "R_Wrist"};
 
-/// Orthonormal frame with x along a and z along the part of b orthogonal to a.
-Matrix3d frameXZ(const Vector3d& a, const Vector3d& b) {
-  const Vector3d x = a.normalized();
-  const Vector3d z = (b - b.dot(x) * x).normalized();
+/// The right-handed frame of orthonormal x and z.
+Matrix3d frameOf(const Vector3d& x, const Vector3d& z) {
   Matrix3d F;
   F.col(0) = x;
   F.col(1) = z.cross(x);
@@ -43,15 +41,16 @@ Matrix3d frameXZ(const Vector3d& a, const Vector3d& b) {
   return F;
 }
 
+/// Orthonormal frame with x along a and z along the part of b orthogonal to a.
+Matrix3d frameXZ(const Vector3d& a, const Vector3d& b) {
+  const Vector3d x = a.normalized();
+  return frameOf(x, (b - b.dot(x) * x).normalized());
+}
+
 /// Orthonormal frame with z along `up` and x along the part of `lateral` orthogonal to it.
 Matrix3d frameUp(const Vector3d& up, const Vector3d& lateral) {
   const Vector3d z = up.normalized();
-  const Vector3d x = (lateral - lateral.dot(z) * z).normalized();
-  Matrix3d F;
-  F.col(0) = x;
-  F.col(1) = z.cross(x);
-  F.col(2) = z;
-  return F;
+  return frameOf((lateral - lateral.dot(z) * z).normalized(), z);
 }
 
 Matrix3d slerp(const Matrix3d& a, const Matrix3d& b, double t) {

@@ -29,6 +29,24 @@
 
 namespace gesture_formation::onboard {
 
+/// \brief The one range of each replanning setting, for the mission keys and the FormationPlanner
+/// nodelet's parameters of the same names alike.
+namespace ranges {
+inline const common::Range kReplanningPeriodS = common::Range::openClosed(0.0, 5.0);
+inline const common::Range kHorizonDtS = common::Range::openClosed(0.0, 2.0);
+inline const common::Range kHorizonSteps = common::Range::closed(2, formation::kMaxHorizonSteps);
+inline const common::Range kBrakeAccelMps2 = common::Range::openClosed(0.0, 50.0);
+inline const common::Range kMaxShareAgeS = common::Range::positive();
+inline const common::Range kMaxWorkerAgeS = common::Range::positive();
+inline const common::Range kMaxCommandAgeS = common::Range::positive();
+inline const common::Range kMaxPlanAgeS = common::Range::positive();
+inline const common::Range kSearchTimeoutS = common::Range::nonNegative();
+inline const common::Range kSearchHeightM = common::Range::positive();
+inline const common::Range kSearchVerticalSpeedMps = common::Range::positive();
+inline const common::Range kSearchPeriodS = common::Range::positive();
+inline const common::Range kSearchHorizontalSpeedMps = common::Range::nonNegative();
+}  // namespace ranges
+
 /// \brief The onboard settings of a mission (see the file comment for the keys).
 struct OnboardSettings {
   double replanning_period_s = 0.4;  ///< per UAV, staggered by period·i/n, (0, 5]
