@@ -74,6 +74,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     params.load("params_rate_hz", params_rate_hz, 0.1, 50.0);
     formation::FormationConfig fcfg;
     planning::PlannerConfig pcfg;
+    planning::ReplanConfig rc;  ///< the replanning step's settings, from either source
     bool formation_loaded = false;
     if (!mission_file.empty()) {
       // Simulation: the mission file's settings — the very values gfctl simulate runs with —
@@ -84,32 +85,32 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
         fcfg = mission.formation;
         pcfg = mission.planner;
         period_s_ = mission.replanning_period_s;
-        horizon_dt_s_ = mission.horizon_dt_s;
-        horizon_steps_ = mission.horizon_steps;
-        freshness_ = mission.freshness;
-        rule_ = mission.rule;
-        search_ = mission.search;
-        brake_accel_mps2_ = mission.brake_accel_mps2;
+        rc.dt_s = mission.horizon_dt_s;
+        rc.steps = mission.horizon_steps;
+        rc.freshness = mission.freshness;
+        rc.rule = mission.rule;
+        rc.search = mission.search;
+        rc.brake_accel_mps2 = mission.brake_accel_mps2;
         params.note("from mission_file: replanning_period_s " + std::to_string(period_s_) + ", horizon_dt_s " +
-                    std::to_string(horizon_dt_s_) + ", horizon_steps " + std::to_string(horizon_steps_) +
+                    std::to_string(rc.dt_s) + ", horizon_steps " + std::to_string(rc.steps) +
                     ", faults.* limits, controller.brake_accel_mps2, formation, planner");
       }
     } else {
       params.load("replanning_period_s", period_s_, onboard::ranges::kReplanningPeriodS);
-      params.load("horizon_dt_s", horizon_dt_s_, onboard::ranges::kHorizonDtS);
-      params.load("horizon_steps", horizon_steps_, onboard::ranges::kHorizonSteps);
-      params.load("max_share_age_s", freshness_.max_share_age_s, onboard::ranges::kMaxShareAgeS);
+      params.load("horizon_dt_s", rc.dt_s, onboard::ranges::kHorizonDtS);
+      params.load("horizon_steps", rc.steps, onboard::ranges::kHorizonSteps);
+      params.load("max_share_age_s", rc.freshness.max_share_age_s, onboard::ranges::kMaxShareAgeS);
       params.load("formation_config", formation_file);
       params.load("planner_config", planner_file);
-      params.load("avoid_all_plans", rule_.avoid_all_plans);
-      params.load("max_plan_age_s", rule_.max_plan_age_s, onboard::ranges::kMaxPlanAgeS);
-      params.load("max_worker_age_s", freshness_.max_worker_age_s, onboard::ranges::kMaxWorkerAgeS);
-      params.load("brake_accel_mps2", brake_accel_mps2_, onboard::ranges::kBrakeAccelMps2);
-      params.load("search_timeout_s", search_.timeout_s, onboard::ranges::kSearchTimeoutS);
-      params.load("search_height_m", search_.height_m, onboard::ranges::kSearchHeightM);
-      params.load("search_vertical_speed_mps", search_.vertical_speed_mps, onboard::ranges::kSearchVerticalSpeedMps);
-      params.load("search_period_s", search_.period_s, onboard::ranges::kSearchPeriodS);
-      params.load("search_horizontal_speed_mps", search_.horizontal_speed_mps, onboard::ranges::kSearchHorizontalSpeedMps);
+      params.load("avoid_all_plans", rc.rule.avoid_all_plans);
+      params.load("max_plan_age_s", rc.rule.max_plan_age_s, onboard::ranges::kMaxPlanAgeS);
+      params.load("max_worker_age_s", rc.freshness.max_worker_age_s, onboard::ranges::kMaxWorkerAgeS);
+      params.load("brake_accel_mps2", rc.brake_accel_mps2, onboard::ranges::kBrakeAccelMps2);
+      params.load("search_timeout_s", rc.search.timeout_s, onboard::ranges::kSearchTimeoutS);
+      params.load("search_height_m", rc.search.height_m, onboard::ranges::kSearchHeightM);
+      params.load("search_vertical_speed_mps", rc.search.vertical_speed_mps, onboard::ranges::kSearchVerticalSpeedMps);
+      params.load("search_period_s", rc.search.period_s, onboard::ranges::kSearchPeriodS);
+      params.load("search_horizontal_speed_mps", rc.search.horizontal_speed_mps, onboard::ranges::kSearchHorizontalSpeedMps);
       formation_loaded = !formation_file.empty() && loadFormation(formation_file, params, fcfg);
       if (!planner_file.empty()) loadPlanner(planner_file, params, pcfg);
     }
@@ -131,14 +132,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
       auto st = formation::FormationState::create(fcfg.params, fcfg.limits, fcfg.duplicates);
       state_.emplace(std::move(*st));  // the config was validated by its loader
     }
-    planning::ReplanConfig rc;
     rc.uav_index = uav_index_;
-    rc.dt_s = horizon_dt_s_;
-    rc.steps = horizon_steps_;
-    rc.freshness = freshness_;
-    rc.rule = rule_;
-    rc.search = search_;
-    rc.brake_accel_mps2 = brake_accel_mps2_;
     rc.worker_heading = fcfg.worker_heading;
     step_ = std::make_unique<planning::ReplanStep>(
         rc, std::make_unique<planning::UavPlannerAdapter>(std::make_unique<planning::UavPlanner>(pcfg, world.map, world.field)));
@@ -309,9 +303,9 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   }
 
   std::mutex mutex_;
-  int uav_index_ = 0, uav_count_ = 0, horizon_steps_ = 0;
+  int uav_index_ = 0, uav_count_ = 0;
   std::string world_frame_;
-  double period_s_ = 0.0, horizon_dt_s_ = 0.0, offset_s_ = 0.0, next_plan_s_ = -1.0;
+  double period_s_ = 0.0, offset_s_ = 0.0, next_plan_s_ = -1.0;
   static constexpr double kMaxWindMps = 60.0;  ///< a larger wind estimate is garbage
   double max_wind_age_s_ = 0.0, wind_stamp_s_ = 0.0;
   std::optional<Eigen::Vector3d> wind_;
@@ -320,10 +314,6 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   std::optional<formation::FormationState> state_;
   std::uint64_t version_ = 0;           ///< leader: the parameters' version
   std::uint64_t received_version_ = 0;  ///< followers: the version received (0 over LCM: not carried)
-  planning::AvoidanceRule rule_;
-  planning::FreshnessLimits freshness_;
-  double brake_accel_mps2_ = 0.0;
-  planning::SearchConfig search_;
   std::string mode_ = "track";             ///< track | hold | search (logged on change)
   std::string last_command_, last_outcome_, last_source_, last_status_;
   ros::Time last_stamp_;
