@@ -42,6 +42,7 @@
 #include <deque>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <tuple>
 
@@ -52,6 +53,7 @@
 #include <ros/ros.h>
 
 #include "conversions.hpp"
+#include "gesture_formation/comm/rejection_report.hpp"
 #include "gesture_formation/comm/sequence_store.hpp"
 #include "gesture_formation/lcm_bridge/lcm_transport.hpp"
 #include "param_loader.hpp"
@@ -387,64 +389,39 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     else NODELET_WARN_STREAM_THROTTLE(10.0, "LcmBridge: high_water_file not saved: " << r.reason());
   }
 
-  // Mutex held.
+  // Mutex held. The counts and what was refused since the last report: comm::RejectionReport.
   void publishDiagnostics() {
     if (!link_) return;
+    if (!report_) report_.emplace("LcmBridge sender " + std::to_string(link_->signer().senderId()));
+    const auto senders = link_->verifier().senderCounters();
+    const auto& t = transport_->counters();
     diagnostic_msgs::DiagnosticArray array;
     array.header.stamp = ros::Time::now();
-    array.status.push_back(linkStatus());
-    for (const auto& [sender, counters] : link_->verifier().senderCounters()) array.status.push_back(senderStatus(sender, counters));
+    array.status.push_back(toStatus(report_->link(link_->verifierCounters(), senders,
+                                               {{"channel_mismatch", link_->channelMismatches()},
+                                                {"undecodable_lcm", t.undecodable},
+                                                {"received_lcm", t.received},
+                                                {"published", t.published},
+                                                {"publish_failed", t.publish_failed},
+                                                {"command_copies_dropped", command_copies_dropped_},
+                                                {"observations_refused", observations_refused_}},
+                                               {"channel_mismatch", "undecodable_lcm"})));
+    for (const auto& [sender, counters] : senders) array.status.push_back(toStatus(report_->sender(sender, counters)));
     diagnostics_pub_.publish(array);
   }
 
-  static void addValue(diagnostic_msgs::DiagnosticStatus& s, const std::string& key, std::uint64_t value) {
-    diagnostic_msgs::KeyValue kv;
-    kv.key = key;
-    kv.value = std::to_string(value);
-    s.values.push_back(kv);
-  }
-
-  diagnostic_msgs::DiagnosticStatus linkStatus() {
+  static diagnostic_msgs::DiagnosticStatus toStatus(const comm::DiagnosticEntry& e) {
     diagnostic_msgs::DiagnosticStatus s;
-    s.name = "LcmBridge sender " + std::to_string(link_->signer().senderId()) + ": link";
+    s.name = e.name;
     s.hardware_id = "lcm";
-    const comm::VerifierCounters& c = link_->verifierCounters();
-    for (std::size_t v = 0; v < comm::kVerdictCount; ++v) addValue(s, comm::toString(static_cast<comm::Verdict>(v)), c.by_verdict[v]);
-    std::uint64_t decode_failures = 0;
-    for (const auto& [sender, sc] : link_->verifier().senderCounters()) decode_failures += sc.decode_failures;
-    addValue(s, "decode_failure", decode_failures);
-    addValue(s, "channel_mismatch", link_->channelMismatches());
-    addValue(s, "undecodable_lcm", transport_->counters().undecodable);
-    addValue(s, "received_lcm", transport_->counters().received);
-    addValue(s, "published", transport_->counters().published);
-    addValue(s, "publish_failed", transport_->counters().publish_failed);
-    addValue(s, "command_copies_dropped", command_copies_dropped_);
-    addValue(s, "observations_refused", observations_refused_);
-    const std::uint64_t rejected = c.rejected() + decode_failures + link_->channelMismatches() + transport_->counters().undecodable;
-    s.level = rejected > last_rejected_ ? diagnostic_msgs::DiagnosticStatus::WARN : diagnostic_msgs::DiagnosticStatus::OK;
-    s.message = rejected > last_rejected_ ? std::to_string(rejected - last_rejected_) + " refused in the last second"
-                                          : "no refusals in the last second";
-    last_rejected_ = rejected;
-    return s;
-  }
-
-  diagnostic_msgs::DiagnosticStatus senderStatus(std::uint16_t sender, const comm::SenderCounters& c) {
-    diagnostic_msgs::DiagnosticStatus s;
-    s.name = "LcmBridge sender " + std::to_string(link_->signer().senderId()) + ": from sender " + std::to_string(sender);
-    s.hardware_id = "lcm";
-    std::uint64_t rejected = c.decode_failures;
-    for (std::size_t v = 0; v < comm::kVerdictCount; ++v) {
-      const auto verdict = static_cast<comm::Verdict>(v);
-      if (verdict == comm::Verdict::kOwnMessage) continue;
-      addValue(s, comm::toString(verdict), c.by_verdict[v]);
-      if (verdict != comm::Verdict::kAccepted) rejected += c.by_verdict[v];
+    s.level = e.warn ? diagnostic_msgs::DiagnosticStatus::WARN : diagnostic_msgs::DiagnosticStatus::OK;
+    s.message = e.message;
+    for (const auto& [key, value] : e.values) {
+      diagnostic_msgs::KeyValue kv;
+      kv.key = key;
+      kv.value = std::to_string(value);
+      s.values.push_back(kv);
     }
-    addValue(s, "decode_failure", c.decode_failures);
-    std::uint64_t& last = last_rejected_by_sender_[sender];
-    s.level = rejected > last ? diagnostic_msgs::DiagnosticStatus::WARN : diagnostic_msgs::DiagnosticStatus::OK;
-    s.message = rejected > last ? std::to_string(rejected - last) + " refused in the last second (claimed sender id)"
-                                : "no refusals in the last second";
-    last = rejected;
     return s;
   }
 
@@ -465,8 +442,7 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
   static constexpr int kMaxDrainPerTick = 2000;  ///< LCM messages handled per 5 ms drain
   std::string marks_file_;
   std::map<std::uint16_t, std::uint64_t> saved_marks_;
-  std::uint64_t last_rejected_ = 0;
-  std::map<std::uint16_t, std::uint64_t> last_rejected_by_sender_;
+  std::optional<comm::RejectionReport> report_;  ///< /diagnostics: counts and refusals since the last report
   ros::Publisher worker_pub_, plans_pub_, params_pub_, command_pub_, observations_pub_, diagnostics_pub_;
   ros::Subscriber worker_sub_, plan_sub_, params_sub_, command_sub_, observation_sub_;
   ros::WallTimer drain_timer_, diagnostics_timer_;

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "comm_test_util.hpp"
+#include "gesture_formation/comm/rejection_report.hpp"
 #include "gesture_formation/comm/sequence_store.hpp"
 #include "gesture_formation/comm/signer.hpp"
 #include "gesture_formation/comm/verifier.hpp"
@@ -277,4 +278,35 @@ TEST(CommReplayWindowTest, MarkSeenUpToRefusesEverythingBelowTheMark) {
   EXPECT_EQ(w.check(999), ReplayWindow::Check::kDuplicate);
   EXPECT_EQ(w.check(10), ReplayWindow::Check::kTooOld);
   EXPECT_EQ(w.check(1001), ReplayWindow::Check::kNew);
+}
+
+// comm::RejectionReport: the counts of /diagnostics and what was refused since the last report.
+TEST(RejectionReportTest, ReportsCountsAndRefusalsSinceThePreviousReport) {
+  using namespace gesture_formation::comm;
+  RejectionReport report("LcmBridge sender 1");
+  VerifierCounters link;
+  std::map<std::uint16_t, SenderCounters> senders;
+  senders[2].by_verdict[static_cast<std::size_t>(Verdict::kAccepted)] = 10;
+  link.by_verdict[static_cast<std::size_t>(Verdict::kAccepted)] = 10;
+  DiagnosticEntry e = report.link(link, senders, {{"channel_mismatch", 0}, {"published", 7}}, {"channel_mismatch"});
+  EXPECT_EQ(e.name, "LcmBridge sender 1: link");
+  EXPECT_FALSE(e.warn);
+  EXPECT_EQ(e.message, "no refusals in the last second");
+  EXPECT_EQ(e.values.size(), kVerdictCount + 3);
+  EXPECT_EQ(e.values.back(), (std::pair<std::string, std::uint64_t>("published", 7)));
+  // Two replays from sender 2, one decode failure, one channel mismatch: 4 refused since.
+  senders[2].by_verdict[static_cast<std::size_t>(Verdict::kReplayed)] = 2;
+  senders[2].decode_failures = 1;
+  link.by_verdict[static_cast<std::size_t>(Verdict::kReplayed)] = 2;
+  e = report.link(link, senders, {{"channel_mismatch", 1}, {"published", 9}}, {"channel_mismatch"});
+  EXPECT_TRUE(e.warn);
+  EXPECT_EQ(e.message, "4 refused in the last second");
+  const DiagnosticEntry s = report.sender(2, senders[2]);
+  EXPECT_EQ(s.name, "LcmBridge sender 1: from sender 2");
+  EXPECT_TRUE(s.warn);
+  EXPECT_EQ(s.message, "3 refused in the last second (claimed sender id)");
+  EXPECT_EQ(s.values.size(), kVerdictCount);  // without kOwnMessage, with decode_failure
+  // Nothing new: ok again.
+  EXPECT_FALSE(report.sender(2, senders[2]).warn);
+  EXPECT_FALSE(report.link(link, senders, {{"channel_mismatch", 1}}, {"channel_mismatch"}).warn);
 }
