@@ -283,9 +283,8 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     }
     if (res.qp_sparse_timeouts > 0) {
       NODELET_ERROR_STREAM("FormationPlanner UAV " << uav_index_ << ": " << res.qp_sparse_timeouts
-                                                   << " sparse QP solve(s) abandoned after qp.solve_timeout_s (dense backend used; "
-                                                   << planning::TrajectoryQp::abandonedSolves()
-                                                   << " abandoned solve(s) still running in this process, docs/safety.md 4.5)");
+                                                   << " QP solve(s) stopped (deadline qp.solve_timeout_s, or ProxQP's "
+                                                   << "sparse solver broke an invariant: dense backend; docs/safety.md 4.5)");
     }
     auto msg = toMsg(res);
     msg.fallback = out.fallback;  // a holding UAV or a fallback plan has right of way (rule 3)

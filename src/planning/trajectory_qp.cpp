@@ -1,17 +1,14 @@
 #include "gesture_formation/planning/trajectory_qp.hpp"
 
+// First: ProxQP with its invariant checks on (before any other ProxQP header).
+#include "gesture_formation/planning/detail/proxqp_checked.hpp"
+
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <condition_variable>
-#include <mutex>
 #include <sstream>
-#include <thread>
 
 #include <Eigen/Sparse>
-#include <proxsuite/proxqp/dense/dense.hpp>
-#include <proxsuite/proxqp/sparse/sparse.hpp>
 
 namespace gesture_formation::planning {
 
@@ -384,8 +381,7 @@ namespace {
 
 namespace pq = proxsuite::proxqp;
 using Status = TrajectoryQpSolution::Status;
-
-std::atomic<int> g_abandoned_solves{0};
+using Clock = std::chrono::steady_clock;
 
 Status statusOf(pq::QPSolverOutput s) {
   switch (s) {
@@ -401,111 +397,105 @@ Status statusOf(pq::QPSolverOutput s) {
   }
 }
 
+/// ProxQP in rounds of at most limits.iterations_per_check outer iterations, each round
+/// continuing from the previous one's iterate, proximal parameters and factorisation, until it
+/// stops for another reason than the round's limit, limits.max_iterations outer iterations have
+/// run, or `deadline` has passed (checked between rounds: the cooperative time bound).
 template <class Qp>
-void runSolver(Qp& qp, const Eigen::VectorXd* x0, double eps_abs, int max_iterations, QpMatricesSolution& out) {
-  qp.settings.eps_abs = eps_abs;
+void runSolver(Qp& qp, const Eigen::VectorXd* x0, const QpSolveLimits& limits, Clock::time_point deadline,
+               QpMatricesSolution& out) {
+  qp.settings.eps_abs = limits.eps_abs;
   qp.settings.eps_rel = 0.0;
-  qp.settings.max_iter = max_iterations;
   qp.settings.verbose = false;
   qp.settings.compute_timings = false;
-  if (x0 != nullptr) {
-    qp.solve(*x0, proxsuite::nullopt, proxsuite::nullopt);
-  } else {
-    qp.solve();
+  int outer = 0;
+  out.iterations = 0;
+  for (int round = 0;; ++round) {
+    qp.settings.max_iter = std::min(limits.iterations_per_check, limits.max_iterations - outer);
+    if (round > 0) {
+      qp.settings.initial_guess = pq::InitialGuessStatus::WARM_START_WITH_PREVIOUS_RESULT;
+      qp.solve();
+    } else if (x0 != nullptr) {
+      qp.solve(*x0, proxsuite::nullopt, proxsuite::nullopt);
+    } else {
+      qp.solve();
+    }
+    outer += static_cast<int>(qp.settings.max_iter);
+    out.iterations += static_cast<int>(qp.results.info.iter);
+    out.status = statusOf(qp.results.info.status);
+    out.rounds = round + 1;
+    if (out.status != Status::kMaxIterations || outer >= limits.max_iterations) break;
+    if (Clock::now() >= deadline) {
+      out.status = Status::kTimeLimit;
+      break;
+    }
   }
-  out.status = statusOf(qp.results.info.status);
-  out.iterations = static_cast<int>(qp.results.info.iter);
   out.x = qp.results.x;
 }
 
-QpMatricesSolution solveSparse(const QpMatrices& m, const Eigen::VectorXd* x0, double eps_abs, int max_iterations) {
-  QpMatricesSolution out;
+void solveSparse(const QpMatrices& m, const Eigen::VectorXd* x0, const QpSolveLimits& limits, Clock::time_point deadline,
+                 QpMatricesSolution& out) {
   pq::sparse::QP<double, int> qp(static_cast<int>(m.H.rows()), static_cast<int>(m.A.rows()), static_cast<int>(m.C.rows()));
   qp.init(m.H, m.g, m.A, m.b, m.C, m.l, m.u);
-  runSolver(qp, x0, eps_abs, max_iterations, out);
-  return out;
+  runSolver(qp, x0, limits, deadline, out);
 }
 
-QpMatricesSolution solveDense(const QpMatrices& m, const Eigen::VectorXd* x0, double eps_abs, int max_iterations) {
-  QpMatricesSolution out;
+void solveDense(const QpMatrices& m, const Eigen::VectorXd* x0, const QpSolveLimits& limits, Clock::time_point deadline,
+                QpMatricesSolution& out) {
   out.dense_backend = true;
   pq::dense::QP<double> qp(m.H.rows(), m.A.rows(), m.C.rows());
   const Eigen::MatrixXd H(m.H), A(m.A), C(m.C);
   qp.init(H, m.g, A, m.b, C, m.l, m.u);
-  runSolver(qp, x0, eps_abs, max_iterations, out);
-  return out;
+  runSolver(qp, x0, limits, deadline, out);
 }
-
-/// The sparse solve's state, shared by the waiting caller and the worker thread (which may
-/// outlive the caller when abandoned).
-struct SparseJob {
-  std::shared_ptr<const QpMatrices> m;
-  Eigen::VectorXd x0;
-  bool warm = false;
-  double eps_abs = 0.0;
-  int max_iterations = 0;
-  std::mutex mutex;
-  std::condition_variable cv;
-  bool done = false;
-  bool abandoned = false;  ///< the caller stopped waiting (counted in g_abandoned_solves until done)
-  QpMatricesSolution result;
-};
 
 }  // namespace
 
-int TrajectoryQp::abandonedSolves() { return g_abandoned_solves.load(); }
+std::string QpSolveLimits::validate() const {
+  std::ostringstream e;
+  if (!(eps_abs > 0.0) || !std::isfinite(eps_abs)) e << "eps_abs must be > 0, got " << eps_abs << "; ";
+  if (max_iterations < 1) e << "max_iterations must be >= 1, got " << max_iterations << "; ";
+  if (!(timeout_s > 0.0) || !std::isfinite(timeout_s)) e << "solve_timeout_s must be > 0, got " << timeout_s << "; ";
+  if (iterations_per_check < 1) e << "iterations_per_check must be >= 1, got " << iterations_per_check << "; ";
+  return e.str();
+}
 
-QpMatricesSolution TrajectoryQp::solveMatrices(std::shared_ptr<const QpMatrices> m, const Eigen::VectorXd* x0,
-                                               double eps_abs, int max_iterations, double timeout_s) {
-  const auto guarded = [](auto&& f) {
-    try {
-      return f();
-    } catch (const std::exception&) {  // ProxQP throws on inconsistent dimensions / allocation
-      return QpMatricesSolution{};
-    }
-  };
-  if (g_abandoned_solves.load() >= kMaxAbandonedSolves) {
-    return guarded([&] { return solveDense(*m, x0, eps_abs, max_iterations); });
+QpMatricesSolution TrajectoryQp::solveMatrices(const QpMatrices& m, const Eigen::VectorXd* x0,
+                                               const QpSolveLimits& limits) {
+  QpMatricesSolution out;
+  const std::string bad = limits.validate();
+  if (!bad.empty()) {
+    out.status = Status::kBadInput;
+    out.reason = "QP limits: " + bad.substr(0, bad.size() - 2);
+    return out;
   }
-  auto job = std::make_shared<SparseJob>();
-  job->m = m;
-  job->warm = x0 != nullptr;
-  if (x0 != nullptr) job->x0 = *x0;
-  job->eps_abs = eps_abs;
-  job->max_iterations = max_iterations;
+  const auto timeout = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(limits.timeout_s));
   try {
-    std::thread([job, guarded] {
-      QpMatricesSolution r =
-          guarded([&] { return solveSparse(*job->m, job->warm ? &job->x0 : nullptr, job->eps_abs, job->max_iterations); });
-      {
-        std::lock_guard<std::mutex> lock(job->mutex);
-        job->result = std::move(r);
-        job->done = true;
-        if (job->abandoned) g_abandoned_solves.fetch_sub(1);  // it was only slow (a loaded machine)
-      }
-      job->cv.notify_all();
-    }).detach();
-  } catch (const std::system_error&) {  // no thread available: the bounded backend, inline
-    return guarded([&] { return solveDense(*m, x0, eps_abs, max_iterations); });
+    solveSparse(m, x0, limits, Clock::now() + timeout, out);
+    return out;
+  } catch (const detail::ProxqpInvariantError& e) {
+    out = QpMatricesSolution{};  // the sparse solver's state is void: the same QP on the dense backend
+    out.sparse_invariant_broken = true;
+    out.reason = e.what();
+  } catch (const std::exception& e) {  // ProxQP throws on inconsistent dimensions / allocation
+    out = QpMatricesSolution{};
+    out.reason = std::string("QP solver threw: ") + e.what();
+    return out;
   }
-  {
-    std::unique_lock<std::mutex> lock(job->mutex);
-    if (job->cv.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return job->done; })) {
-      return std::move(job->result);
-    }
-    job->abandoned = true;
-    g_abandoned_solves.fetch_add(1);
+  try {
+    solveDense(m, x0, limits, Clock::now() + timeout, out);
+  } catch (const std::exception& e) {
+    out.x.resize(0);
+    out.status = Status::kNumerical;
+    out.reason += std::string("; dense backend threw: ") + e.what();
   }
-  QpMatricesSolution out = guarded([&] { return solveDense(*m, x0, eps_abs, max_iterations); });
-  out.sparse_timed_out = true;
-  out.dense_backend = true;
   return out;
 }
 
 namespace {
 
 /// ProxQP dense on the condensed form; x (size 3N) empty when the solver threw.
-QpMatricesSolution solveCondensedDense(const Condensed& q, const Eigen::VectorXd* x0, double eps_abs, int max_iterations) {
+QpMatricesSolution solveCondensedDense(const Condensed& q, const Eigen::VectorXd* x0, const QpSolveLimits& limits) {
   QpMatricesSolution out;
   out.dense_backend = true;
   try {
@@ -513,7 +503,7 @@ QpMatricesSolution solveCondensedDense(const Condensed& q, const Eigen::VectorXd
     // No Ruiz equilibration: ProxQP's dense one costs ~4 ms on the ~900 × 120 rows here, 5× the
     // rest of the solve, and the condensed rows are already of order one (docs/planning.md §6.4).
     qp.init(q.H, q.g, proxsuite::nullopt, proxsuite::nullopt, q.C, q.l, q.u, /*compute_preconditioner=*/false);
-    runSolver(qp, x0, eps_abs, max_iterations, out);
+    runSolver(qp, x0, limits, Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(limits.timeout_s)), out);
   } catch (const std::exception&) {
     out = QpMatricesSolution{};
   }
@@ -527,6 +517,18 @@ void integrate(const TrajectoryQpProblem& pr, TrajectoryQpSolution& out) {
     out.p[k + 1] = out.p[k] + out.v[k] * dt + out.a[k] * (dt * dt / 3.0) + out.a[k + 1] * (dt * dt / 6.0);
     out.v[k + 1] = out.v[k] + (out.a[k] + out.a[k + 1]) * (dt / 2.0);
   }
+}
+
+}  // namespace
+
+namespace {
+
+QpSolveLimits limitsOf(const TrajectoryQpProblem& pr) {
+  QpSolveLimits l;
+  l.eps_abs = pr.eps_abs;
+  l.max_iterations = pr.max_iterations;
+  l.timeout_s = pr.solve_timeout_s;
+  return l;
 }
 
 }  // namespace
@@ -560,8 +562,9 @@ TrajectoryQpSolution TrajectoryQp::solve(const TrajectoryQpProblem& pr, const Tr
     // A bounded attempt: solved replannings take ≤ 20 dense iterations (power-tower mission, max
     // seen 17); a QP that needs more is handed to the sparse form instead of running to
     // max_iterations here (each dense iteration costs ~1 ms on ~1400 rows).
-    r = solveCondensedDense(q, x0.size() == 3 * N ? &x0 : nullptr, pr.eps_abs,
-                            std::min(pr.max_iterations, kCondensedMaxIterations));
+    QpSolveLimits limits = limitsOf(pr);
+    limits.max_iterations = std::min(pr.max_iterations, kCondensedMaxIterations);
+    r = solveCondensedDense(q, x0.size() == 3 * N ? &x0 : nullptr, limits);
     if (r.x.size() == 3 * N && r.x.allFinite()) {
       out.condensed = true;
       out.warm_started = x0.size() == 3 * N;
@@ -585,10 +588,10 @@ TrajectoryQpSolution TrajectoryQp::solve(const TrajectoryQpProblem& pr, const Tr
 
   if (!out.condensed) {  // the sparse form (asked for, or the condensed solve did not solve it)
     const int n = 9 * N;
-    auto m = std::make_shared<QpMatrices>(assemble(pr));
+    const QpMatrices m = assemble(pr);
     out.variables = n;
-    out.equalities = static_cast<int>(m->b.size());
-    out.inequalities = static_cast<int>(m->l.size());
+    out.equalities = static_cast<int>(m.b.size());
+    out.inequalities = static_cast<int>(m.l.size());
     Eigen::VectorXd x0;
     if (have_warm) {
       x0.resize(n);
@@ -600,11 +603,11 @@ TrajectoryQpSolution TrajectoryQp::solve(const TrajectoryQpProblem& pr, const Tr
       if (!x0.allFinite()) x0.resize(0);
     }
     out.warm_started = x0.size() == n;
-    r = solveMatrices(m, out.warm_started ? &x0 : nullptr, pr.eps_abs, pr.max_iterations, pr.solve_timeout_s);
+    r = solveMatrices(m, out.warm_started ? &x0 : nullptr, limitsOf(pr));
     if (r.x.size() != n) {
       out.status = TrajectoryQpSolution::Status::kNumerical;
-      out.reason = "QP solver failed (threw)";
-      out.sparse_timed_out = r.sparse_timed_out;
+      out.reason = r.reason.empty() ? "QP solver failed (threw)" : r.reason;
+      out.sparse_invariant_broken = r.sparse_invariant_broken;
       out.dense_backend = r.dense_backend;
       return out;
     }
@@ -619,7 +622,7 @@ TrajectoryQpSolution TrajectoryQp::solve(const TrajectoryQpProblem& pr, const Tr
       out.a[k] = r.x.segment<3>(var(k, 2, 0));
     }
   }
-  out.sparse_timed_out = r.sparse_timed_out;
+  out.sparse_invariant_broken = r.sparse_invariant_broken;
   out.dense_backend = r.dense_backend;
   out.iterations = r.iterations;
   out.primal_residual = maxViolation(pr, out.p, out.v, out.a);
@@ -634,14 +637,19 @@ TrajectoryQpSolution TrajectoryQp::solve(const TrajectoryQpProblem& pr, const Tr
     case Status::kMaxIterations:
       out.reason = "QP reached " + std::to_string(pr.max_iterations) + " iterations";
       break;
+    case Status::kTimeLimit: {
+      std::ostringstream os;
+      os << "QP stopped at its deadline (solve_timeout_s " << pr.solve_timeout_s << " s) after " << r.iterations
+         << " iterations";
+      out.reason = os.str();
+      break;
+    }
     default:
       out.reason = "QP solver failed";
       break;
   }
-  if (out.sparse_timed_out) {
-    std::ostringstream os;
-    os << " (sparse solve abandoned after " << pr.solve_timeout_s << " s, dense backend)";
-    if (!out.reason.empty()) out.reason += os.str();
+  if (out.sparse_invariant_broken && !out.reason.empty()) {
+    out.reason += " (dense backend: the sparse solver broke an invariant)";
   }
   // ProxQP's criterion is on the equilibrated problem; insist on the original scale too.
   if (out.solved() && !(out.primal_residual <= 100.0 * pr.eps_abs + 1e-9)) {

@@ -21,6 +21,11 @@ namespace gesture_formation::planning {
 
 namespace {
 
+/// A QP whose sparse solve was stopped: its deadline passed or ProxQP broke an invariant.
+bool stoppedSparse(const TrajectoryQpSolution& s) {
+  return s.sparse_invariant_broken || s.status == TrajectoryQpSolution::Status::kTimeLimit;
+}
+
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
@@ -962,7 +967,7 @@ std::string UavPlanner::solveQp(PlanContext& c, PlanResult& result) {
   result.qp_variables = c.sol.variables;
   result.qp_constraints = c.sol.equalities + c.sol.inequalities;
   result.qp_iterations = c.sol.iterations;
-  result.qp_sparse_timeouts += c.sol.sparse_timed_out ? 1 : 0;
+  result.qp_sparse_timeouts += stoppedSparse(c.sol) ? 1 : 0;
   if (c.sol.solved()) return {};
   return c.sol.reason + infeasibilityCause(c, result);
 }
@@ -989,7 +994,7 @@ std::string UavPlanner::infeasibilityCause(const PlanContext& c, PlanResult& res
                               relaxed.constraints.end());
     if (relaxed.constraints.size() == before) continue;
     const TrajectoryQpSolution relaxed_sol = qp_->solve(relaxed, nullptr);
-    result.qp_sparse_timeouts += relaxed_sol.sparse_timed_out ? 1 : 0;
+    result.qp_sparse_timeouts += stoppedSparse(relaxed_sol) ? 1 : 0;
     if (relaxed_sol.solved()) return std::string(" (feasible without the ") + name + " constraints)";
   }
   return " (infeasible even without any single family: dynamics vs the initial state)";

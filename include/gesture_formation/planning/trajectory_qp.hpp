@@ -26,12 +26,15 @@
 ///   - kSparse (default): the 9N-variable form above, solved by ProxQP's sparse backend with the
 ///     time bound below; it also decides every QP the condensed form does not solve.
 ///
-/// Time bound: ProxQP's sparse solver can loop forever (0.7.2–0.8.0: its LDLᵀ row update corrupts
-/// the elimination tree; `max_iter` does not bound it; docs/safety.md §4.5). So the sparse solve
-/// runs on its own thread and is waited for at most `solve_timeout_s`; past that it is abandoned
-/// (the thread cannot be stopped: a looping one keeps a core until the process exits) and the same
-/// QP is solved by ProxQP's dense backend (no elimination tree; ~7× slower, bounded by max_iter).
-/// While kMaxAbandonedSolves abandoned threads are still running, every QP goes to the dense backend.
+/// Time bound, without threads: ProxQP's sparse solver can loop forever (0.7.2–0.8.0: its LDLᵀ
+/// row deletion breaks its own precondition and then walks a corrupted elimination tree, a loop
+/// `max_iter` does not bound; docs/safety.md §4.5). ProxQP is compiled with its invariant checks on
+/// (detail/proxqp_checked.hpp), so that QP stops with an exception the moment the invariant breaks
+/// and is solved again by ProxQP's dense backend (no elimination tree; ~13× slower on the
+/// mission's QPs). Every solve also runs in rounds of QpSolveLimits::iterations_per_check outer
+/// iterations and checks its deadline (`solve_timeout_s`, per backend) between rounds: past it the
+/// QP reports kTimeLimit and the planner falls back like on any failed QP. Replannings of the
+/// power-tower mission need at most ~80 iterations, so a round is never cut in them.
 /// Thread safety: solve() may be called from several threads (each call has its own solver).
 
 #include <memory>
@@ -77,13 +80,14 @@ struct TrajectoryQpProblem {
   double w_reference = 1.0, w_acceleration = 0.05, w_jerk = 0.01, w_terminal_velocity = 1.0;
   double eps_abs = 1e-6;
   int max_iterations = 4000;
-  /// Wall-clock bound (s) of the sparse solve before the dense fallback, > 0.
+  /// Cooperative wall-clock bound (s) of each backend's solve, > 0 (checked between rounds of
+  /// QpSolveLimits::kIterationsPerCheck outer iterations; past it: kTimeLimit).
   double solve_timeout_s = 2.0;
   enum class Formulation { kCondensed, kSparse } formulation = Formulation::kSparse;
 };
 
 struct TrajectoryQpSolution {
-  enum class Status { kSolved, kInfeasible, kMaxIterations, kNumerical, kBadInput } status = Status::kBadInput;
+  enum class Status { kSolved, kInfeasible, kMaxIterations, kTimeLimit, kNumerical, kBadInput } status = Status::kBadInput;
   std::string reason;  ///< empty when solved
   /// p, v, a for k = 0..N (index 0 = the initial state).
   std::vector<Eigen::Vector3d> p, v, a;
@@ -91,9 +95,9 @@ struct TrajectoryQpSolution {
   double primal_residual = 0.0;  ///< max constraint violation of the returned x (ProxQP's scale)
   double objective = 0.0;
   bool warm_started = false;
-  /// The sparse solve did not return within solve_timeout_s (abandoned) / the dense backend
-  /// produced this solution (after a timeout, or because sparse solves are disabled).
-  bool sparse_timed_out = false;
+  /// The sparse solver broke one of its invariants (the QP was then given to the dense backend)
+  /// / the dense backend produced this solution (condensed form, or after a broken invariant).
+  bool sparse_invariant_broken = false;
   bool dense_backend = false;
   /// Solved in the condensed form (accelerations only; `variables` = 3N, `equalities` = 0).
   bool condensed = false;
@@ -109,13 +113,28 @@ struct QpMatrices {
   double cost_constant = 0.0;
 };
 
+/// \brief How long ProxQP may run on one QP (TrajectoryQp::solveMatrices).
+struct QpSolveLimits {
+  /// Outer iterations between two deadline checks; a round of them is bounded by ProxQP's
+  /// own iteration limits, not by the clock.
+  static constexpr int kIterationsPerCheck = 100;
+  double eps_abs = 1e-6;                         ///< > 0
+  int max_iterations = 4000;                     ///< outer iterations in all, ≥ 1
+  double timeout_s = 2.0;                        ///< per backend, > 0
+  int iterations_per_check = kIterationsPerCheck;  ///< ≥ 1
+  /// Problems as "field must …, got …; " (empty: valid).
+  std::string validate() const;
+};
+
 /// \brief What ProxQP returned for assembled matrices (TrajectoryQp::solveMatrices).
 struct QpMatricesSolution {
   TrajectoryQpSolution::Status status = TrajectoryQpSolution::Status::kNumerical;
   Eigen::VectorXd x;  ///< the primal solution (size of H), empty if the solver threw
-  int iterations = 0;
-  bool sparse_timed_out = false;
+  int iterations = 0;  ///< ProxQP's (inner) iterations, all rounds
+  int rounds = 0;      ///< rounds of QpSolveLimits::iterations_per_check run (by the backend that answered)
+  bool sparse_invariant_broken = false;
   bool dense_backend = false;
+  std::string reason;  ///< why there is no solution / why the dense backend answered
 };
 
 /// \brief Assembles and solves the QP. `warm` (optional): a guess of p, v, a for k = 0..N
@@ -128,14 +147,11 @@ class TrajectoryQp {
   /// \brief The condensed form's matrices (dense; A, b empty; x = [a_x(1..N) a_y(1..N) a_z(1..N)])
   /// in the same form as QpMatrices, with H, C as sparse views for inspection and tests.
   static QpMatrices assembleCondensed(const TrajectoryQpProblem& problem);
-  /// \brief ProxQP on assembled matrices with the time bound above: sparse on a worker thread,
-  /// waited for `timeout_s`, then dense. `x0` (optional, size of H): primal warm start.
-  static QpMatricesSolution solveMatrices(std::shared_ptr<const QpMatrices> matrices, const Eigen::VectorXd* x0,
-                                          double eps_abs, int max_iterations, double timeout_s);
-  /// \brief Abandoned sparse solves still running (one that finishes late — a loaded machine —
-  /// is no longer counted); from kMaxAbandonedSolves on, only the dense backend is used.
-  static int abandonedSolves();
-  static constexpr int kMaxAbandonedSolves = 2;
+  /// \brief ProxQP on assembled matrices with the bounds above: the sparse backend; if it breaks
+  /// an invariant, the dense backend on the same QP. `x0` (optional, size of H): primal warm
+  /// start. Invalid limits: kBadInput with the fields named in `reason`.
+  static QpMatricesSolution solveMatrices(const QpMatrices& matrices, const Eigen::VectorXd* x0,
+                                          const QpSolveLimits& limits);
   /// Dense iterations allowed to the condensed form before the sparse form takes the QP over.
   static constexpr int kCondensedMaxIterations = 100;
 

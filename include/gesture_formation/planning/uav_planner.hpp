@@ -87,8 +87,9 @@ struct PlanResult {
   int qp_variables = 0;
   int qp_constraints = 0;
   int qp_iterations = 0;
-  /// QP solves of this replanning whose sparse ProxQP solve was abandoned after
-  /// qp.solve_timeout_s and re-solved by the dense backend (TrajectoryQp, docs/safety.md §4.5).
+  /// QP solves of this replanning that were stopped: past their deadline qp.solve_timeout_s
+  /// (kTimeLimit), or the sparse solver broke an invariant and the dense backend answered
+  /// (TrajectoryQp, docs/safety.md §4.5).
   int qp_sparse_timeouts = 0;
   double min_obstacle_clearance_m = 0.0;  ///< verified clearance of the returned plan
   // --- added by the planner implementation (fields may be added, never renamed) ---------

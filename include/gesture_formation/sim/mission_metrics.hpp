@@ -72,7 +72,7 @@ struct MissionMetrics {
   int gestures_performed = 0;
   int gestures_successful = 0;
   int plans = 0, plans_fallback_previous = 0, plans_fallback_brake = 0, plans_skipped = 0;
-  int qp_sparse_timeouts = 0;  ///< sparse QP solves abandoned (dense fallback), docs/safety.md §4.5
+  int qp_sparse_timeouts = 0;  ///< QP solves stopped (deadline, or the sparse solver broke an invariant), docs/safety.md §4.5
   int plans_hold = 0;          ///< replannings in hold mode (stale data, docs/safety.md)
   int commands_stale = 0;      ///< operator commands older than faults.max_command_age_s on arrival (rejected)
   int commands_duplicate = 0;  ///< duplicate command copies (ignored by the FormationState)

@@ -2,7 +2,8 @@
 // this test proves the headers, CMake config and Debian's Eigen work together.
 #include <gtest/gtest.h>
 
-#include <proxsuite/proxqp/dense/dense.hpp>
+// ProxQP as the project includes it (invariant checks on; one definition per binary).
+#include "gesture_formation/planning/detail/proxqp_checked.hpp"
 
 TEST(ProxsuiteToolchainTest, SolvesProjectionOntoHalfPlane) {
   // min (x1 − 1)² + (x2 − 2)²  s.t.  x1 + x2 ≤ 1  → x* = (0, 1) (projection onto the line).
