@@ -4,6 +4,7 @@
 // the planner's own verifier (brute-force distances to occupied voxel centres).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -169,6 +170,29 @@ TEST(UavPlannerTest, YamlListsEveryBadKeyAtOnce) {
   EXPECT_NE(report.find("qp.mutual_distance_m"), std::string::npos) << report;
   EXPECT_NE(report.find("weights.reference"), std::string::npos) << report;  // missing
   EXPECT_NE(report.find("verify.substeps"), std::string::npos) << report;    // missing
+}
+
+// Rules between keys run even when a single key is already wrong (every problem at once), and
+// each key's range is the same whether the value comes from YAML or from code.
+TEST(UavPlannerTest, YamlReportsRulesBetweenKeysBesideABadKey) {
+  auto r = common::ConfigReader::fromString(
+      "limits: {max_speed_mps: -3}\npath: {obstacle_clearance_m: 1.0, path_clearance_m: 0.5}\n"
+      "qp: {corridor_box_margin_m: 0.005}\n",
+      "p.yaml", common::ConfigReader::MissingKeys::kUseDefaults);
+  readPlannerConfig(r);
+  std::vector<std::string> keys;
+  for (const auto& p : r.problems()) keys.push_back(p.key);
+  const auto has = [&keys](const std::string& k) { return std::find(keys.begin(), keys.end(), k) != keys.end(); };
+  EXPECT_TRUE(has("limits.max_speed_mps"));
+  EXPECT_TRUE(has("path.path_clearance_m"));     // the rule path >= obstacle clearance
+  EXPECT_TRUE(has("qp.corridor_box_margin_m"));  // (0.01, inf), as validate() has it
+  EXPECT_EQ(keys.size(), 3u) << r.errorReport();
+  PlannerConfig c;
+  c.corridor_box_margin_m = 0.005;
+  c.corridor_margin_m = 0.0;  // else also the rule corridor_margin < corridor_box_margin
+  ASSERT_EQ(c.validate().size(), 1u);
+  EXPECT_EQ(c.validate().front().rfind("qp.corridor_box_margin_m must be in (0.01, inf), got 0.005", 0), 0u)
+      << c.validate().front();
 }
 
 TEST(UavPlannerTest, FreeSpacePlanFollowsReferenceAndVerifies) {
