@@ -13,7 +13,8 @@
 // request (found by the multi-host test, docs/safety.md §5). The sender therefore sends each
 // command ~command_repeats times, ~command_repeat_period_s apart (new envelopes: new sequence and
 // stamp); the receiver forwards only the first copy of each command id (envelope sender, command
-// sender name, sequence) to ROS and counts the others. The leader's FormationState would apply a copy once anyway.
+// sender name, sequence) to ROS, with the name bound to the sender as NAME@ID (comm::CommandIntake),
+// and counts the others. The leader's FormationState would apply a copy once anyway.
 // A plan's fallback flag travels in a heartbeat sent just before the plan (status degraded,
 // last_plan_sequence = the plan's sequence); the receiver marks that plan `fallback`.
 // Stamps and freshness use ROS time (sim time in simulation: every process shares /clock).
@@ -43,8 +44,6 @@
 #include <map>
 #include <mutex>
 #include <optional>
-#include <set>
-#include <tuple>
 
 #include <diagnostic_msgs/DiagnosticArray.h>
 
@@ -53,6 +52,7 @@
 #include <ros/ros.h>
 
 #include "conversions.hpp"
+#include "gesture_formation/comm/command_intake.hpp"
 #include "gesture_formation/comm/rejection_report.hpp"
 #include "gesture_formation/comm/sequence_store.hpp"
 #include "gesture_formation/lcm_bridge/lcm_transport.hpp"
@@ -314,22 +314,11 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
       case comm::MessageType::kFormationCommand: {
         formation::FormationCommand c;
         if (!decoder_.decode(e, c)) break;
-        // The sender repeats each command: forward its first copy only (ids of the last 256).
-        // Keyed by the envelope's (authenticated) sender too, 256 per sender: a peer cannot
-        // pre-fill or flush another sender's command ids.
-        const CommandId id{e.sender_id, c.id.sender, c.id.sequence};
-        if (commands_seen_.count(id) != 0) {
-          ++command_copies_dropped_;
-          break;
-        }
-        commands_seen_.insert(id);
-        auto& order = commands_seen_order_[e.sender_id];
-        order.push_back(id);
-        if (order.size() > 256) {
-          commands_seen_.erase(order.front());
-          order.pop_front();
-        }
-        auto m = toMsg(c);
+        // The sender repeats each command: forward its first copy only, its name bound to the
+        // envelope's authenticated sender (NAME@ID; comm/command_intake.hpp).
+        const auto forwarded = command_intake_.accept(e.sender_id, std::move(c));
+        if (!forwarded) break;
+        auto m = toMsg(*forwarded);
         m.header.stamp = ros::Time(e.stamp_s);
         command_pub_.publish(m);
         break;
@@ -403,7 +392,7 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
                                                 {"received_lcm", t.received},
                                                 {"published", t.published},
                                                 {"publish_failed", t.publish_failed},
-                                                {"command_copies_dropped", command_copies_dropped_},
+                                                {"command_copies_dropped", command_intake_.copiesDropped()},
                                                 {"observations_refused", observations_refused_}},
                                                {"channel_mismatch", "undecodable_lcm"})));
     for (const auto& [sender, counters] : senders) array.status.push_back(toStatus(report_->sender(sender, counters)));
@@ -434,10 +423,7 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
   std::map<std::uint16_t, comm::Heartbeat> peers_;
   int command_repeats_ = 1;
   std::deque<std::pair<formation::FormationCommand, int>> repeating_;  ///< commands still to repeat, copies left
-  using CommandId = std::tuple<std::uint16_t, std::string, std::uint64_t>;  ///< envelope sender, command id
-  std::set<CommandId> commands_seen_;                                  ///< received command ids (bounded)
-  std::map<std::uint16_t, std::deque<CommandId>> commands_seen_order_;  ///< per known sender, ≤ 256 each
-  std::uint64_t command_copies_dropped_ = 0;  ///< repeated copies of an already forwarded command
+  comm::CommandIntake command_intake_;  ///< first copies forwarded, names bound to the envelope sender
   std::uint64_t observations_refused_ = 0;  ///< decoded gesture observations with a bad sender / stamp
   static constexpr int kMaxDrainPerTick = 2000;  ///< LCM messages handled per 5 ms drain
   std::string marks_file_;

@@ -71,9 +71,8 @@ cleanup() {
 }
 trap cleanup EXIT
 trap 'exit 1' INT TERM
-umask 077
-printf '1 %s active\n' "$(od -An -N32 -tx1 /dev/urandom | tr -d ' \n')" > "$T/keys"
-umask 022
+# Per-sender Ed25519 keys (docs/security.md §5): each host's bridge gets its own file.
+tools/make_fleet_keys.sh "$T/keys" 0 1 2 100 > /dev/null
 
 # Switch namespace; host k = HOSTS[k] on 10.77.k.2/24, its switch port 10.77.k.1.
 ip netns add "${P}_sw"
@@ -112,7 +111,7 @@ in_host $WORLD "exec roscore -p 11311" > "$OUT/logs/roscore.log" 2>&1 &
 pids+=($!)
 for _ in $(seq 100); do in_host 0 "rosparam list > /dev/null 2>&1" && break; sleep 0.2; done
 in_host 0 "rosparam list > /dev/null 2>&1" || { echo "$0: uav0 cannot reach the master at $MASTER" >&2; exit 1; }
-common="mission:=$MISSION seed:=$SEED key_file:=$T/keys lcm_url:=udpm://239.255.76.67:7667?ttl=1"
+common="mission:=$MISSION seed:=$SEED key_dir:=$T/keys lcm_url:=udpm://239.255.76.67:7667?ttl=1"
 for k in 0 1 2; do
   in_host $k "exec roslaunch gesture_formation simulation.launch part:=${HOSTS[$k]} $common" > "$OUT/logs/${HOSTS[$k]}.log" 2>&1 &
   pids+=($!)

@@ -49,10 +49,9 @@ rm -f "$OUT/metrics.json" "$OUT/mission.bag" "$OUT/mission.bag.active"
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 BUILD_ABS=$(realpath "$BUILD")
-# A fresh pre-shared key for this run (owner-only permissions, docs/security.md §5).
-umask 077
-printf '1 %s active\n' "$(od -An -N32 -tx1 /dev/urandom | tr -d ' \n')" > "$T/keys"
-umask 022
+# Fresh per-sender Ed25519 keys for this run: one owner-only file per bridge (UAVs 0-2, the
+# ground station 100), each with its signing key and the others' verifying keys (docs/security.md §5).
+tools/make_fleet_keys.sh "$T/keys" 0 1 2 100 > /dev/null
 export PATH=/usr/bin:/bin:$PATH
 # shellcheck disable=SC1091
 source "$BUILD/devel/setup.bash"
@@ -71,7 +70,7 @@ export ROS_MASTER_URI=http://127.0.0.1:11311 ROS_IP=127.0.0.1 ROS_HOME=$T/ros RO
 export DISPLAY=${DISPLAY:-} XAUTHORITY=${XAUTHORITY:-${HOME:-/root}/.Xauthority}
 source "$BUILD_ABS/devel/setup.bash"
 roslaunch --screen -p 11311 gesture_formation simulation.launch mission:=$MISSION seed:=$SEED \
-  real_time_factor:=$RTF duration:=$DURATION output_dir:=$OUT key_file:=$T/keys record:=true \
+  real_time_factor:=$RTF duration:=$DURATION output_dir:=$OUT key_dir:=$T/keys record:=true \
   bag:=$OUT/mission.bag rviz:=$RVIZ faults:=$FAULTS > "$T/launch.log" 2>&1 &
 launch=\$!
 # The world writes metrics.json when the mission ends; then stop everything (rosbag closes the bag).
