@@ -12,7 +12,7 @@
 #   tools/fuzz/run_fuzzers.sh --seeds                 # (re)write the generated seeds into fuzz/corpus/
 #
 # Environment: GF_FUZZ_BUILD_DIR (default <repo>/build-fuzz), GF_FUZZ_JOBS (default 2).
-# Targets: envelope payloads lcm_envelope key_file config csv (fuzz/fuzz_<name>.cpp).
+# Targets: envelope envelope_v2 payloads lcm_envelope key_file config csv (fuzz/fuzz_<name>.cpp).
 set -eo pipefail
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 export PATH=/usr/bin:/bin:$PATH
@@ -34,7 +34,7 @@ while [ $# -gt 0 ]; do
   esac
 done
 if [ ${#TARGETS[@]} -eq 0 ]; then
-  TARGETS=(envelope payloads lcm_envelope key_file config csv)
+  TARGETS=(envelope envelope_v2 payloads lcm_envelope key_file config csv)
 fi
 command -v clang++ >/dev/null || { echo "run_fuzzers: clang++ not found; run tools/setup.sh (installs clang, libclang-rt-14-dev)" >&2; exit 2; }
 
