@@ -1,0 +1,28 @@
+#!/bin/bash
+# Every launch file answers `roslaunch --ros-args` (exit 0; a file whose arguments cannot even be
+# listed is broken for a user) and documents every argument (no "undocumented"). onboard.launch
+# then resolves with a non-default world_frame and puts it into every nodelet that has one.
+set -o pipefail
+source "$(dirname "$0")/common.bash"
+n=0
+for f in "$SRC"/launch/*.launch; do
+  n=$((n + 1))
+  name=$(basename "$f")
+  if ! out=$(timeout 30 roslaunch --ros-args "$f" 2>&1); then
+    fail "$name: roslaunch --ros-args failed: $(echo "$out" | tail -3)"
+    continue
+  fi
+  undocumented=$(echo "$out" | grep -E ': undocumented$' | sed 's/^ *//; s/:.*//' | tr '\n' ' ')
+  [ -z "$undocumented" ] || fail "$name: arguments without a doc string: $undocumented"
+done
+[ "$n" -ge 5 ] || fail "only $n launch files found under $SRC/launch"
+# world_frame:=map reaches every nodelet of onboard.launch that has a world frame.
+params=$(timeout 30 roslaunch --dump-params "$SRC/launch/onboard.launch" key_file:=/dev/null scenario_file:=/dev/null \
+  world_frame:=map 2>&1) || fail "onboard.launch --dump-params failed: $(echo "$params" | tail -3)"
+for node in formation_planner lcm_bridge view_observer worker_estimator; do
+  echo "$params" | grep -q "^/$node/world_frame: map$" || fail "onboard.launch world_frame:=map not given to $node"
+done
+echo "$params" | grep -E "/world_frame: " | grep -vq ": map$" && fail "a world_frame other than map remains: $(echo "$params" | grep world_frame)"
+[ "$fails" -eq 0 ] && echo "launch_args: $n launch files, all arguments documented, world_frame reaches every nodelet" \
+  || echo "launch_args: $fails failures"
+exit $((fails > 0))
