@@ -53,6 +53,7 @@
 
 #include "conversions.hpp"
 #include "gesture_formation/comm/command_intake.hpp"
+#include "gesture_formation/comm/link_settings.hpp"
 #include "gesture_formation/comm/rejection_report.hpp"
 #include "gesture_formation/comm/sequence_store.hpp"
 #include "gesture_formation/lcm_bridge/lcm_transport.hpp"
@@ -95,52 +96,38 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     std::string sequence_file, marks_file;
     params.loadOptional("sequence_file", sequence_file, state_dir + "/lcm_bridge_" + id_text + ".boot");
     params.loadOptional("high_water_file", marks_file, state_dir + "/lcm_bridge_" + id_text + ".marks");
-    const double command_max_age_s = pnh.param("command_max_age_s", 5.0);
-    const int recv_buf_bytes = pnh.param("recv_buf_bytes", 4194304);
-    comm::VerifierConfig vcfg;
-    vcfg.max_rate_hz = pnh.param("max_rate_hz", vcfg.max_rate_hz);
-    vcfg.burst = pnh.param("burst", vcfg.burst);
-    params.note("command_max_age_s: " + std::to_string(command_max_age_s) + ", recv_buf_bytes: " +
-                std::to_string(recv_buf_bytes) + ", max_rate_hz: " + std::to_string(vcfg.max_rate_hz) +
-                ", burst: " + std::to_string(vcfg.burst));
-    if (!(command_max_age_s > 0.0 && command_max_age_s <= 60.0)) {
-      params.addError("command_max_age_s: must be in (0, 60] s, got " + std::to_string(command_max_age_s));
+    comm::LinkSettings link;
+    link.sender_id = sender_id;
+    link.known_senders = known;
+    link.max_age_s = max_age_s;
+    link.command_max_age_s = pnh.param("command_max_age_s", link.command_max_age_s);
+    link.recv_buf_bytes = pnh.param("recv_buf_bytes", link.recv_buf_bytes);
+    link.max_rate_hz = pnh.param("max_rate_hz", link.max_rate_hz);
+    link.burst = pnh.param("burst", link.burst);
+    for (auto [name, list] : {std::make_pair("command_senders", &link.command_senders),
+                              std::make_pair("params_senders", &link.params_senders)}) {
+      std::vector<int> ids;
+      if (pnh.getParam(name, ids)) *list = ids;
     }
-    if (recv_buf_bytes < 65536) params.addError("recv_buf_bytes: must be >= 65536, got " + std::to_string(recv_buf_bytes));
-    if (url.rfind("udpm://", 0) == 0 && url.find("recv_buf_size") == std::string::npos && recv_buf_bytes >= 65536) {
-      url += (url.find('?') == std::string::npos ? "?" : "&") + std::string("recv_buf_size=") + std::to_string(recv_buf_bytes);
-    }
+    params.note("command_max_age_s: " + std::to_string(link.command_max_age_s) + ", recv_buf_bytes: " +
+                std::to_string(link.recv_buf_bytes) + ", max_rate_hz: " + std::to_string(link.max_rate_hz) +
+                ", burst: " + std::to_string(link.burst) + ", command_senders: " +
+                std::to_string(link.command_senders ? link.command_senders->size() : 0) + " id(s), params_senders: " +
+                std::to_string(link.params_senders ? link.params_senders->size() : 0) + " id(s)");
+    // Every problem of the link's settings at once (comm/link_settings.hpp).
+    std::vector<common::ConfigError> link_problems;
+    const comm::VerifierConfig vcfg = comm::verifierConfigOf(link, link_problems);
+    for (const auto& e : link_problems) params.addError(e.key + ": " + e.message);
+    url = comm::withReceiveBuffer(url, link.recv_buf_bytes);
     std::optional<comm::KeyRing> keys;
     if (!key_file.empty()) {
       auto k = comm::loadKeyFile(key_file);
       if (k) {
         keys.emplace(std::move(*k));
+        if (const auto e = comm::keyRingOwnerProblem(*keys, sender_id)) params.addError(e->key + ": " + e->message);
       } else {
         params.addError("key_file: " + k.reason());
       }
-    }
-    for (const auto& [name, type] : {std::make_pair(std::string("command_senders"), comm::MessageType::kFormationCommand),
-                                     std::make_pair(std::string("params_senders"), comm::MessageType::kFormationParams)}) {
-      std::vector<int> ids;
-      if (!pnh.getParam(name, ids)) continue;
-      if (ids.empty()) params.addError(name + ": must list at least one sender id (omit it to allow every known sender)");
-      auto& list = vcfg.senders_by_type[type];  // own id only → empty: no one else may send it
-      for (const int id : ids) {
-        if (id < 0 || id > 65535) params.addError(name + ": " + std::to_string(id) + " out of range [0, 65535]");
-        else if (id != sender_id) list.push_back(static_cast<std::uint16_t>(id));  // own id: never received
-      }
-      params.note(name + ": " + std::to_string(ids.size()) + " id(s)");
-    }
-    for (const int s : known) {
-      if (s < 0 || s > 65535) params.addError("known_senders: " + std::to_string(s) + " out of range [0, 65535]");
-      else if (s != sender_id) vcfg.known_senders.push_back(static_cast<std::uint16_t>(s));  // the fleet's ids; own ignored
-    }
-    vcfg.own_sender_id = static_cast<std::uint16_t>(sender_id);
-    vcfg.max_age_s = max_age_s;
-    vcfg.max_age_s_by_type[comm::MessageType::kHeartbeat] = std::max(max_age_s, 2.0);
-    vcfg.max_age_s_by_type[comm::MessageType::kFormationCommand] = command_max_age_s;
-    if (params.ok()) {
-      for (const auto& e : vcfg.validate()) params.addError("known_senders/max_age_s: " + e);
     }
     if (params.ok()) {
       auto t = lcm_bridge::LcmTransport::create(url, prefix);
@@ -164,10 +151,6 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
       auto v = comm::Verifier::create(vcfg, *keys);
       if (v) verifier.emplace(std::move(*v));
       else params.addError("key_file/known_senders: " + v.reason());
-      if (keys->perSender() && keys->active().sender_id != sender_id) {
-        params.addError("key_file: its signing key belongs to sender " + std::to_string(keys->active().sender_id) +
-                        ", not to sender_id " + std::to_string(sender_id));
-      }
     }
     if (!params.ok()) {
       NODELET_ERROR_STREAM("LcmBridge refuses to start; fix these parameters:\n" << params.report());

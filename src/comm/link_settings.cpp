@@ -1,0 +1,61 @@
+#include "gesture_formation/comm/link_settings.hpp"
+
+#include <algorithm>
+
+#include "gesture_formation/common/format_number.hpp"
+
+namespace gesture_formation::comm {
+
+namespace {
+
+bool senderId(int id) { return id >= 0 && id <= 65535; }
+
+/// The ids of `list` other than `own` into `out`; a problem per id out of range.
+void senderList(const std::string& key, const std::vector<int>& list, int own, std::vector<std::uint16_t>& out,
+                std::vector<common::ConfigError>& problems) {
+  for (const int id : list) {
+    if (!senderId(id)) problems.push_back({key, std::to_string(id) + " out of range [0, 65535]"});
+    else if (id != own) out.push_back(static_cast<std::uint16_t>(id));  // own id: never received
+  }
+}
+
+}  // namespace
+
+VerifierConfig verifierConfigOf(const LinkSettings& s, std::vector<common::ConfigError>& problems) {
+  VerifierConfig c;
+  if (!senderId(s.sender_id)) problems.push_back({"sender_id", "must be in [0, 65535], got " + std::to_string(s.sender_id)});
+  if (!(s.command_max_age_s > 0.0 && s.command_max_age_s <= 60.0)) {
+    problems.push_back({"command_max_age_s", "must be in (0, 60] s, got " + common::formatNumber(s.command_max_age_s)});
+  }
+  if (s.recv_buf_bytes < 65536) {
+    problems.push_back({"recv_buf_bytes", "must be >= 65536, got " + std::to_string(s.recv_buf_bytes)});
+  }
+  senderList("known_senders", s.known_senders, s.sender_id, c.known_senders, problems);
+  for (const auto& [key, list, type] : {std::make_tuple(std::string("command_senders"), &s.command_senders, MessageType::kFormationCommand),
+                                        std::make_tuple(std::string("params_senders"), &s.params_senders, MessageType::kFormationParams)}) {
+    if (!list->has_value()) continue;
+    if ((*list)->empty()) problems.push_back({key, "must list at least one sender id (omit it to allow every known sender)"});
+    senderList(key, **list, s.sender_id, c.senders_by_type[type], problems);  // own id only → empty: no one else
+  }
+  c.own_sender_id = static_cast<std::uint16_t>(std::clamp(s.sender_id, 0, 65535));
+  c.max_age_s = s.max_age_s;
+  c.max_age_s_by_type[MessageType::kHeartbeat] = std::max(s.max_age_s, 2.0);
+  c.max_age_s_by_type[MessageType::kFormationCommand] = s.command_max_age_s;
+  c.max_rate_hz = s.max_rate_hz;
+  c.burst = s.burst;
+  for (const auto& e : c.validate()) problems.push_back({"known_senders/max_age_s/max_rate_hz/burst", e});
+  return c;
+}
+
+std::optional<common::ConfigError> keyRingOwnerProblem(const KeyRing& keys, int sender_id) {
+  if (!keys.perSender() || keys.active().sender_id == sender_id) return std::nullopt;
+  return common::ConfigError{"key_file", "its signing key belongs to sender " + std::to_string(keys.active().sender_id) +
+                                             ", not to sender_id " + std::to_string(sender_id)};
+}
+
+std::string withReceiveBuffer(const std::string& url, int bytes) {
+  if (url.rfind("udpm://", 0) != 0 || url.find("recv_buf_size") != std::string::npos || bytes < 65536) return url;
+  return url + (url.find('?') == std::string::npos ? "?" : "&") + "recv_buf_size=" + std::to_string(bytes);
+}
+
+}  // namespace gesture_formation::comm

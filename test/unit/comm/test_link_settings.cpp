@@ -1,0 +1,65 @@
+// comm::verifierConfigOf (docs/security.md §4, §7): the link's settings as the LcmBridge gets
+// them, every problem reported at once, and the VerifierConfig the bridge runs with.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include "gesture_formation/comm/link_settings.hpp"
+
+using namespace gesture_formation::comm;
+using gesture_formation::common::ConfigError;
+
+namespace {
+
+bool names(const std::vector<ConfigError>& problems, const std::string& key) {
+  return std::any_of(problems.begin(), problems.end(), [&](const ConfigError& e) { return e.key.find(key) != std::string::npos; });
+}
+
+}  // namespace
+
+TEST(LinkSettingsTest, AGoodSettingGivesTheBridgesVerifier) {
+  LinkSettings s;
+  s.sender_id = 2;
+  s.known_senders = {0, 1, 2, 100};
+  s.max_age_s = 1.0;
+  s.command_senders = std::vector<int>{100};
+  s.params_senders = std::vector<int>{0, 2};  // own id: never received, dropped
+  std::vector<ConfigError> problems;
+  const VerifierConfig c = verifierConfigOf(s, problems);
+  EXPECT_TRUE(problems.empty()) << problems.front().key << ": " << problems.front().message;
+  EXPECT_EQ(c.known_senders, (std::vector<std::uint16_t>{0, 1, 100}));
+  EXPECT_EQ(c.own_sender_id, 2);
+  EXPECT_EQ(c.senders_by_type.at(MessageType::kFormationCommand), (std::vector<std::uint16_t>{100}));
+  EXPECT_EQ(c.senders_by_type.at(MessageType::kFormationParams), (std::vector<std::uint16_t>{0}));
+  EXPECT_DOUBLE_EQ(c.max_age_s_by_type.at(MessageType::kHeartbeat), 2.0);
+  EXPECT_DOUBLE_EQ(c.max_age_s_by_type.at(MessageType::kFormationCommand), 5.0);
+}
+
+// Every field is checked, and the verifier's own rules run too (no known sender), in one pass.
+TEST(LinkSettingsTest, EveryProblemAtOnce) {
+  LinkSettings s;
+  s.sender_id = 70000;
+  s.known_senders = {};
+  s.command_max_age_s = 0.0;
+  s.recv_buf_bytes = 100;
+  s.command_senders = std::vector<int>{};
+  s.params_senders = std::vector<int>{-1};
+  std::vector<ConfigError> problems;
+  verifierConfigOf(s, problems);
+  for (const char* key : {"sender_id", "command_max_age_s", "recv_buf_bytes", "command_senders", "params_senders",
+                          "known_senders"}) {
+    EXPECT_TRUE(names(problems, key)) << key << " not reported";
+  }
+  EXPECT_GE(problems.size(), 6u);
+}
+
+TEST(LinkSettingsTest, ReceiveBufferIsAddedToMulticastUrlsOnly) {
+  EXPECT_EQ(withReceiveBuffer("udpm://239.255.76.67:7667?ttl=0", 4194304),
+            "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304");
+  EXPECT_EQ(withReceiveBuffer("udpm://239.255.76.67:7667", 65536), "udpm://239.255.76.67:7667?recv_buf_size=65536");
+  EXPECT_EQ(withReceiveBuffer("udpm://239.255.76.67:7667?recv_buf_size=1000", 4194304),
+            "udpm://239.255.76.67:7667?recv_buf_size=1000");  // the user's own value wins
+  EXPECT_EQ(withReceiveBuffer("memq://", 4194304), "memq://");
+}
