@@ -3,7 +3,8 @@
 # replay (rosbag play --clock); the screenshot must show the Visualizer's colours: leader red,
 # follower 1 green, follower 2 blue, the worker's covariance yellow, the map grey.
 # Optional third argument: a bag to replay instead of the synthetic one (e.g. a mission bag);
-# GF_RVIZ_SHOT=path keeps the screenshot.
+# GF_RVIZ_SHOT=path keeps the screenshot; GF_RVIZ_SCENARIO=scenario.yaml replays a bag without
+# markers (record.launch) through the Visualizer with that site's map.
 set -o pipefail
 source "$(dirname "$0")/common.bash"
 BAG=${3:+$(realpath "$3")}
@@ -43,7 +44,7 @@ PY
 # rviz needs a few seconds to load and draw (longer on a busy computer): a screenshot every 2 s
 # from GF_RVIZ_WAIT (10 s) on, until the colours are there or 40 s have passed; the last one is judged.
 xvfb-run -a -s "-screen 0 1200x800x24" bash -c "
-  roslaunch -p $PORT gesture_formation replay.launch bag:=$BAG start:=$START loop:=true > '$T/replay.log' 2>&1 &
+  roslaunch -p $PORT gesture_formation replay.launch bag:=$BAG start:=$START loop:=true ${GF_RVIZ_SCENARIO:+scenario_file:=$GF_RVIZ_SCENARIO} > '$T/replay.log' 2>&1 &
   l=\$!
   sleep ${GF_RVIZ_WAIT:-10}
   for _ in \$(seq 16); do
