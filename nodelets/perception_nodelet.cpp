@@ -17,6 +17,8 @@
 //   (a depth image further than this from the colour image's stamp is not used; the nodelet keeps the
 //   last kDepthBuffer depth images and uses the one nearest the colour image's stamp — the two
 //   topics are not delivered in order, and a colour image processed late must still find its depth).
+// Optional: ~dnn_device (cpu): where the networks run — cpu, opencl, opencl_fp16, cuda, cuda_fp16
+//   (refused at start, naming what this OpenCV can use, when it cannot run there).
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -53,6 +55,10 @@ class PerceptionNodelet : public nodelet::Nodelet {
     params.load("max_depth_m", stereo_.max_depth_m, 0.01, 100.0);
     params.load("depth_scale_m", stereo_.depth_scale_m, 1e-6, 1.0);
     params.load("max_depth_dt_s", max_depth_dt_s_, 0.0, 1.0);
+    std::string dnn_device;
+    params.loadOptional("dnn_device", dnn_device, "cpu");
+    if (const auto d = perception::parseDnnDevice(dnn_device)) cfg.dnn_device = *d;
+    else params.addError("dnn_device: " + d.reason());
     if (!detector.empty()) {
       const auto k = perception::parseDetectorKind(detector);
       if (k) cfg.detector = *k;

@@ -1,6 +1,7 @@
 // gfctl detect --image FILE|--video FILE --out annotated.png|.mp4 --csv boxes_keypoints.csv
 //              [--models DIR] [--max-frames N] [--detector movenet_multipose|blazepose]
 //              [--skeleton movenet_lightning|blazepose_landmark] [--tracker kcf|csrt] [--detect-every K]
+//              [--dnn-device cpu|opencl|opencl_fp16|cuda|cuda_fp16]
 // Runs the perception pipeline (docs/perception.md) and writes the skeleton CSV of design.md §8.7.
 #include <algorithm>
 #include <cctype>
@@ -30,7 +31,7 @@ const Registrar kRegistrar{
     "detect",
     "--image FILE|--video FILE --out annotated.png|.mp4 --csv boxes_keypoints.csv [--models DIR] [--max-frames N] "
     "[--detector movenet_multipose|blazepose] [--skeleton movenet_lightning|blazepose_landmark] [--tracker kcf|csrt] "
-    "[--detect-every K]   worker box + COCO-17 skeleton per frame (docs/design.md §8.7)",
+    "[--detect-every K] [--dnn-device cpu|opencl|opencl_fp16|cuda|cuda_fp16]   worker box + COCO-17 skeleton per frame (docs/design.md §8.7)",
     cmdDetect};
 
 constexpr float kDrawMinConfidence = 0.3f;
@@ -117,7 +118,7 @@ void writeCsvRow(std::ostream& out, double t, const PerceptionFrame& f) {
 
 int cmdDetect(const Args& args) {
   if (!checkOptions(args, {"out", "csv"},
-                    {"image", "video", "models", "max-frames", "detector", "skeleton", "tracker", "detect-every"})) {
+                    {"image", "video", "models", "max-frames", "detector", "skeleton", "tracker", "detect-every", "dnn-device"})) {
     return kExitBadInput;
   }
   if (args.has("image") == args.has("video")) return badInput(args, "give exactly one of --image FILE or --video FILE");
@@ -135,6 +136,12 @@ int cmdDetect(const Args& args) {
     const auto k = parseSkeletonKind(args.get("skeleton"));
     if (!k) return badInput(args, "--skeleton: " + k.reason());
     cfg.skeleton = *k;
+  }
+  if (args.has("dnn-device")) {
+    const auto d = parseDnnDevice(args.get("dnn-device"));
+    if (!d) return badInput(args, "--dnn-device: " + d.reason());
+    cfg.dnn_device = *d;
+    if (const std::string p = dnnDeviceProblem(*d); !p.empty()) return badInput(args, "--dnn-device: " + p);
   }
   if (args.has("tracker")) {
     const auto k = parseTrackerKind(args.get("tracker"));

@@ -121,7 +121,7 @@ common::Result<std::unique_ptr<BlazePoseDetector>> BlazePoseDetector::create(con
   using R = common::Result<std::unique_ptr<BlazePoseDetector>>;
   const auto problems = config.validate();
   if (!problems.empty()) return R::fail(problems.front());
-  auto net = loadOnnxModel(resolveModelPath(models_root, config.model_path), {"regressors", "classificators"});
+  auto net = loadOnnxModel(resolveModelPath(models_root, config.model_path), {"regressors", "classificators"}, config.device);
   if (!net) return R::fail(net.reason());
   return R::ok(std::unique_ptr<BlazePoseDetector>(new BlazePoseDetector(config, *net)));
 }

@@ -13,8 +13,69 @@ std::string resolveModelPath(const std::string& models_root, const std::string& 
   return models_root.back() == '/' ? models_root + path : models_root + "/" + path;
 }
 
-common::Result<cv::dnn::Net> loadOnnxModel(const std::string& path, const std::vector<std::string>& required_outputs) {
+namespace {
+
+struct DeviceSpec {
+  DnnDevice device;
+  const char* name;
+  cv::dnn::Backend backend;
+  cv::dnn::Target target;
+};
+
+constexpr DeviceSpec kDevices[] = {
+    {DnnDevice::kCpu, "cpu", cv::dnn::DNN_BACKEND_OPENCV, cv::dnn::DNN_TARGET_CPU},
+    {DnnDevice::kOpenCl, "opencl", cv::dnn::DNN_BACKEND_OPENCV, cv::dnn::DNN_TARGET_OPENCL},
+    {DnnDevice::kOpenClFp16, "opencl_fp16", cv::dnn::DNN_BACKEND_OPENCV, cv::dnn::DNN_TARGET_OPENCL_FP16},
+    {DnnDevice::kCuda, "cuda", cv::dnn::DNN_BACKEND_CUDA, cv::dnn::DNN_TARGET_CUDA},
+    {DnnDevice::kCudaFp16, "cuda_fp16", cv::dnn::DNN_BACKEND_CUDA, cv::dnn::DNN_TARGET_CUDA_FP16},
+};
+
+const DeviceSpec& specOf(DnnDevice device) {
+  for (const auto& d : kDevices) {
+    if (d.device == device) return d;
+  }
+  return kDevices[0];
+}
+
+bool available(const DeviceSpec& d) {
+  try {
+    const std::vector<cv::dnn::Target> targets = cv::dnn::getAvailableTargets(d.backend);
+    return std::find(targets.begin(), targets.end(), d.target) != targets.end();
+  } catch (const cv::Exception&) {
+    return false;
+  }
+}
+
+}  // namespace
+
+const char* toString(DnnDevice device) { return specOf(device).name; }
+
+common::Result<DnnDevice> parseDnnDevice(const std::string& name) {
+  std::string names;
+  for (const auto& d : kDevices) {
+    if (name == d.name) return common::Result<DnnDevice>::ok(d.device);
+    names += (names.empty() ? "" : ", ") + std::string(d.name);
+  }
+  return common::Result<DnnDevice>::fail("dnn_device must be one of " + names + ", got '" + name + "'");
+}
+
+std::string dnnDeviceProblem(DnnDevice device) {
+  const DeviceSpec& spec = specOf(device);
+  if (available(spec)) return {};
+  std::string usable;
+  for (const auto& d : kDevices) {
+    if (available(d)) usable += (usable.empty() ? "" : ", ") + std::string(d.name);
+  }
+  return std::string("dnn_device '") + spec.name + "': this OpenCV (" + CV_VERSION + ") cannot run networks there" +
+         (device == DnnDevice::kCuda || device == DnnDevice::kCudaFp16 ? " (it was built without CUDA)" : "") +
+         "; usable here: " + (usable.empty() ? "none" : usable);
+}
+
+common::Result<cv::dnn::Net> loadOnnxModel(const std::string& path, const std::vector<std::string>& required_outputs,
+                                           DnnDevice device) {
   using R = common::Result<cv::dnn::Net>;
+  const std::string device_problem = dnnDeviceProblem(device);
+  if (!device_problem.empty()) return R::fail(path + ": " + device_problem);
   std::ifstream probe(path, std::ios::binary);
   if (!probe) return R::fail(path + ": model file missing or unreadable");
   probe.seekg(0, std::ios::end);
@@ -29,8 +90,8 @@ common::Result<cv::dnn::Net> loadOnnxModel(const std::string& path, const std::v
     return R::fail(path + ": not a loadable ONNX model: " + e.what());
   }
   if (net.empty()) return R::fail(path + ": ONNX model loaded as an empty network");
-  net.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
-  net.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
+  net.setPreferableBackend(specOf(device).backend);
+  net.setPreferableTarget(specOf(device).target);
   const std::vector<std::string> outs = net.getUnconnectedOutLayersNames();
   std::string missing;
   for (const auto& name : required_outputs) {

@@ -155,7 +155,7 @@ common::Result<std::unique_ptr<MoveNetMultiposeDetector>> MoveNetMultiposeDetect
   using R = common::Result<std::unique_ptr<MoveNetMultiposeDetector>>;
   const auto problems = config.validate();
   if (!problems.empty()) return R::fail(problems.front());
-  auto net = loadOnnxModel(resolveModelPath(models_root, config.model_path), outputNames());
+  auto net = loadOnnxModel(resolveModelPath(models_root, config.model_path), outputNames(), config.device);
   if (!net) return R::fail(net.reason());
   return R::ok(std::unique_ptr<MoveNetMultiposeDetector>(new MoveNetMultiposeDetector(config, *net)));
 }

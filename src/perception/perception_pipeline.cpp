@@ -23,17 +23,22 @@ std::vector<std::string> PerceptionConfig::validate() const {
   add(blazepose_landmark.validate());
   add(tracker.validate());
   if (fifo_frames < 1) e.push_back("fifo_frames must be >= 1, got " + std::to_string(fifo_frames));
+  if (const std::string d = dnnDeviceProblem(dnn_device); !d.empty()) e.push_back(d);
   return e;
 }
 
 common::Result<std::unique_ptr<PersonDetector>> makePersonDetector(const PerceptionConfig& c) {
   using R = common::Result<std::unique_ptr<PersonDetector>>;
   if (c.detector == DetectorKind::kBlazePose) {
-    auto d = BlazePoseDetector::create(c.blazepose_detector, c.models_root);
+    BlazePoseDetectorConfig dc = c.blazepose_detector;
+    dc.device = c.dnn_device;
+    auto d = BlazePoseDetector::create(dc, c.models_root);
     if (!d) return R::fail(d.reason());
     return R::ok(std::move(d.value()));
   }
-  auto d = MoveNetMultiposeDetector::create(c.multipose, c.models_root);
+  MoveNetMultiposeConfig mc = c.multipose;
+  mc.device = c.dnn_device;
+  auto d = MoveNetMultiposeDetector::create(mc, c.models_root);
   if (!d) return R::fail(d.reason());
   return R::ok(std::move(d.value()));
 }
@@ -41,11 +46,15 @@ common::Result<std::unique_ptr<PersonDetector>> makePersonDetector(const Percept
 common::Result<std::unique_ptr<SkeletonExtractor>> makeSkeletonExtractor(const PerceptionConfig& c) {
   using R = common::Result<std::unique_ptr<SkeletonExtractor>>;
   if (c.skeleton == SkeletonKind::kBlazePoseLandmark) {
-    auto s = BlazePoseLandmarkExtractor::create(c.blazepose_landmark, c.models_root);
+    BlazePoseLandmarkConfig bc = c.blazepose_landmark;
+    bc.device = c.dnn_device;
+    auto s = BlazePoseLandmarkExtractor::create(bc, c.models_root);
     if (!s) return R::fail(s.reason());
     return R::ok(std::move(s.value()));
   }
-  auto s = MoveNetLightningExtractor::create(c.lightning, c.models_root);
+  MoveNetLightningConfig lc = c.lightning;
+  lc.device = c.dnn_device;
+  auto s = MoveNetLightningExtractor::create(lc, c.models_root);
   if (!s) return R::fail(s.reason());
   return R::ok(std::move(s.value()));
 }

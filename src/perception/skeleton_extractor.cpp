@@ -111,7 +111,7 @@ common::Result<std::unique_ptr<MoveNetLightningExtractor>> MoveNetLightningExtra
   using R = common::Result<std::unique_ptr<MoveNetLightningExtractor>>;
   const auto problems = config.validate();
   if (!problems.empty()) return R::fail(problems.front());
-  auto net = loadOnnxModel(resolveModelPath(models_root, config.model_path), outputNames());
+  auto net = loadOnnxModel(resolveModelPath(models_root, config.model_path), outputNames(), config.device);
   if (!net) return R::fail(net.reason());
   return R::ok(std::unique_ptr<MoveNetLightningExtractor>(new MoveNetLightningExtractor(config, *net)));
 }
@@ -198,7 +198,7 @@ common::Result<std::unique_ptr<BlazePoseLandmarkExtractor>> BlazePoseLandmarkExt
   using R = common::Result<std::unique_ptr<BlazePoseLandmarkExtractor>>;
   const auto problems = config.validate();
   if (!problems.empty()) return R::fail(problems.front());
-  auto net = loadOnnxModel(resolveModelPath(models_root, config.model_path), outputNames());
+  auto net = loadOnnxModel(resolveModelPath(models_root, config.model_path), outputNames(), config.device);
   if (!net) return R::fail(net.reason());
   return R::ok(std::unique_ptr<BlazePoseLandmarkExtractor>(new BlazePoseLandmarkExtractor(config, *net)));
 }

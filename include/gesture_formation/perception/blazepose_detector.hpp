@@ -19,6 +19,7 @@
 #include <opencv2/dnn.hpp>
 
 #include "gesture_formation/common/result.hpp"
+#include "gesture_formation/perception/dnn_model.hpp"
 #include "gesture_formation/perception/person_detector.hpp"
 
 namespace gesture_formation::perception {
@@ -54,6 +55,7 @@ std::vector<BlazePoseRaw> weightedNms(const std::vector<BlazePoseRaw>& sorted, f
 struct BlazePoseDetectorConfig {
   /// ONNX file, relative to the models root unless absolute.
   std::string model_path = "blazepose_detector/pose_detection.onnx";
+  DnnDevice device = DnnDevice::kCpu;  ///< where the network runs (PerceptionConfig::dnn_device sets it)
   float min_score = 0.5f;      ///< anchors below are dropped, (0, 1); MediaPipe 0.5
   float nms_iou = 0.3f;        ///< weighted-NMS IoU threshold, (0, 1); MediaPipe 0.3
   int max_detections = 5;      ///< people kept after NMS, ≥ 1 (MediaPipe keeps 1)

@@ -18,11 +18,24 @@ namespace gesture_formation::perception {
 /// to `models_root` (normally `<source>/third_party_models`).
 std::string resolveModelPath(const std::string& models_root, const std::string& path);
 
-/// \brief Loads an ONNX file with `cv::dnn::readNetFromONNX` (backend OpenCV, target CPU) and
-/// checks that the network has every output named in `required_outputs`.
+/// \brief Where OpenCV DNN runs a network (config key `dnn_device`): OpenCV's own backend on the
+/// CPU (default) or through OpenCL (an integrated or discrete GPU), or the CUDA backend (a
+/// Jetson's GPU; needs an OpenCV built with CUDA, which Debian's is not). *_fp16: half precision.
+enum class DnnDevice { kCpu, kOpenCl, kOpenClFp16, kCuda, kCudaFp16 };
+/// "cpu", "opencl", "opencl_fp16", "cuda", "cuda_fp16".
+const char* toString(DnnDevice device);
+/// \brief The device named `name`; a reason listing the names otherwise.
+common::Result<DnnDevice> parseDnnDevice(const std::string& name);
+/// \brief Empty when this OpenCV build can run networks on `device`; otherwise why, naming the
+/// devices it can use (cv::dnn::getAvailableTargets).
+std::string dnnDeviceProblem(DnnDevice device);
+
+/// \brief Loads an ONNX file with `cv::dnn::readNetFromONNX` onto `device` and checks that the
+/// network has every output named in `required_outputs`.
 /// Fails with a reason naming the file for: missing/unreadable file, parse error (corrupt
-/// file), missing outputs. Never throws.
-common::Result<cv::dnn::Net> loadOnnxModel(const std::string& path, const std::vector<std::string>& required_outputs);
+/// file), missing outputs, a device this OpenCV cannot use. Never throws.
+common::Result<cv::dnn::Net> loadOnnxModel(const std::string& path, const std::vector<std::string>& required_outputs,
+                                           DnnDevice device = DnnDevice::kCpu);
 
 /// \brief Empty when `image` is a non-empty 8-bit 3-channel (BGR) image; otherwise a reason
 /// naming `what`, the channel count and depth found.

@@ -13,6 +13,7 @@
 #include <opencv2/dnn.hpp>
 
 #include "gesture_formation/common/result.hpp"
+#include "gesture_formation/perception/dnn_model.hpp"
 #include "gesture_formation/perception/person_detector.hpp"
 
 namespace gesture_formation::perception {
@@ -43,6 +44,7 @@ std::vector<MultiposeCandidate> decodeMultipose(const MultiposeHeads& heads);
 struct MoveNetMultiposeConfig {
   /// ONNX file, relative to the models root unless absolute. Input size is fixed at 256.
   std::string model_path = "movenet_multipose/movenet_multipose.onnx";
+  DnnDevice device = DnnDevice::kCpu;  ///< where the network runs (PerceptionConfig::dnn_device sets it)
   float min_person_score = 0.2f;  ///< candidates below are not people, (0, 1)
   float min_box_px = 4.0f;        ///< boxes narrower or lower than this [image px] are dropped, ≥ 0
   float keypoint_min_score = 0.0f;  ///< keypoint confidences below are set to 0, [0, 1)

@@ -12,6 +12,7 @@
 #include "gesture_formation/common/result.hpp"
 #include "gesture_formation/perception/blazepose_detector.hpp"
 #include "gesture_formation/perception/movenet_multipose_detector.hpp"
+#include "gesture_formation/perception/dnn_model.hpp"
 #include "gesture_formation/perception/skeleton_extractor.hpp"
 #include "gesture_formation/perception/skeleton_fifo.hpp"
 #include "gesture_formation/perception/worker_tracker.hpp"
@@ -30,6 +31,7 @@ struct PerceptionConfig {
   BlazePoseLandmarkConfig blazepose_landmark;
   WorkerTrackerConfig tracker;
   int fifo_frames = kDefaultFifoFrames;  ///< N, ≥ 1
+  DnnDevice dnn_device = DnnDevice::kCpu;  ///< where every network of the pipeline runs (dnn_model.hpp)
 
   /// Every problem of every sub-config, each naming the field and value.
   std::vector<std::string> validate() const;

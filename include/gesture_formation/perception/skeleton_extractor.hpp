@@ -13,6 +13,7 @@
 #include <opencv2/dnn.hpp>
 
 #include "gesture_formation/common/result.hpp"
+#include "gesture_formation/perception/dnn_model.hpp"
 #include "gesture_formation/perception/types.hpp"
 
 namespace gesture_formation::perception {
@@ -60,6 +61,7 @@ std::array<std::array<float, 3>, kNumKeypoints> decodeLightning(const LightningH
 /// \brief Configuration of `MoveNetLightningExtractor`.
 struct MoveNetLightningConfig {
   std::string model_path = "movenet_lightning/movenet_lightning.onnx";  ///< relative to the models root
+  DnnDevice device = DnnDevice::kCpu;  ///< where the network runs (PerceptionConfig::dnn_device sets it)
   /// Side of the square crop as a multiple of max(box w, box h), ≥ 1; MoveNet's own
   /// cropping uses a margin of about 1.2–1.3.
   float crop_scale = 1.25f;
@@ -101,6 +103,7 @@ const std::array<int, kNumKeypoints>& blazePoseToCoco();
 /// \brief Configuration of `BlazePoseLandmarkExtractor`.
 struct BlazePoseLandmarkConfig {
   std::string model_path = "blazepose_landmark_full/pose_landmark_full.onnx";  ///< relative to the models root
+  DnnDevice device = DnnDevice::kCpu;  ///< where the network runs (PerceptionConfig::dnn_device sets it)
   /// ROI side as a multiple of max(box w, box h) when called with a box, ≥ 1.
   float crop_scale = 1.25f;
   float min_pose_flag = 0.5f;  ///< below: no person in the ROI → all confidences 0, [0, 1)
