@@ -15,6 +15,7 @@
 #include <tf2_ros/transform_listener.h>
 
 #include "conversions.hpp"
+#include "diagnostics.hpp"
 #include "gesture_formation/estimation/estimator_config.hpp"
 #include "param_loader.hpp"
 
@@ -53,6 +54,33 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
     detection_sub_ = nh.subscribe("detection_in", 10, &WorkerEstimatorNodelet::onDetection, this);
     uwb_sub_ = nh.subscribe("uwb_in", 10, &WorkerEstimatorNodelet::onUwb, this);
     timer_ = nh.createTimer(ros::Duration(1.0 / rate_hz), &WorkerEstimatorNodelet::onTimer, this);
+    diagnostics_.start(nh, 1.0, [this] { return health(); });
+  }
+
+  /// The estimator on /diagnostics: WARN before the first track, while the worker is lost, when
+  /// detections were rejected since the last report; values: rates and the ages that decide hold.
+  std::vector<diagnostic_msgs::DiagnosticStatus> health() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const ros::WallTime now = ros::WallTime::now();
+    const double since_s = report_wall_.isZero() ? 1.0 : (now - report_wall_).toSec();
+    const double t = ros::Time::now().toSec();
+    const double fused_age_s = last_fused_.isZero() ? -1.0 : t - last_fused_.toSec();
+    const double uwb_age_s = last_uwb_stamp_.isZero() ? -1.0 : t - last_uwb_stamp_.toSec();
+    const bool lost = filter_.confirmed() && filter_.lost(t);
+    Health h("WorkerEstimator", "leader");
+    h.warn(!filter_.confirmed(), "no confirmed track of the worker")
+        .warn(lost, "worker lost (no measurement fused for " + std::to_string(fused_age_s) + " s)")
+        .warn(rejected_since_report_ > 0, std::to_string(rejected_since_report_) + " detection(s) rejected")
+        .value("confirmed", filter_.confirmed() ? 1 : 0)
+        .value("lost", lost ? 1 : 0)
+        .value("fused_per_s", fused_since_report_ / since_s)
+        .value("rejected", rejected_since_report_)
+        .value("last_fused_age_s", fused_age_s)
+        .value("last_uwb_age_s", uwb_age_s)
+        .value("published_per_s", published_since_report_ / since_s);
+    fused_since_report_ = rejected_since_report_ = published_since_report_ = 0;
+    report_wall_ = now;
+    return {h.status()};
   }
 
   void onUwb(const sensor_msgs::Range::ConstPtr& msg) {
@@ -79,11 +107,17 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
     const auto m = estimation::makeMeasurement(camera_, toCameraPose(T_world_camera), toBox(*msg), d_uwb,
                                                msg->stereo_distance_m, config_.human_height_m, config_.noise);
     if (!m) {
+      ++rejected_since_report_;
       NODELET_WARN_STREAM_THROTTLE(1.0, "WorkerEstimator: detection rejected: " << m.reason());
       return;
     }
     const auto outcome = filter_.step(t, *m);
-    if (estimation::accepted(outcome)) last_fused_ = msg->header.stamp;
+    if (estimation::accepted(outcome)) {
+      last_fused_ = msg->header.stamp;
+      ++fused_since_report_;
+    } else {
+      ++rejected_since_report_;
+    }
     if (!filter_.confirmed()) return;  // a tentative track is not published (docs/estimation.md)
     auto out = toWorkerState(filter_.state(), filter_.covariance());
     out.header.stamp = ros::Time(filter_.time());
@@ -94,6 +128,7 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
     out.predicted = false;
     out.last_fused = last_fused_;
     state_pub_.publish(out);
+    ++published_since_report_;
   }
 
   void onTimer(const ros::TimerEvent& event) {
@@ -114,9 +149,13 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
     out.predicted = true;
     out.last_fused = last_fused_;
     state_pub_.publish(out);
+    ++published_since_report_;
   }
 
   std::mutex mutex_;
+  DiagnosticsPublisher diagnostics_;
+  int fused_since_report_ = 0, rejected_since_report_ = 0, published_since_report_ = 0;
+  ros::WallTime report_wall_;
   estimation::EstimatorConfig config_;
   estimation::CameraModel camera_;
   estimation::HumanKalman filter_;

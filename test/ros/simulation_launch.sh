@@ -3,6 +3,7 @@
 # every stream publishes at its rate (sim time); a gesture injected at 1 of the 3 UAVs' classifiers
 # changes nothing, injected at 2 of 3 (the followers: votes over LCM) it changes the followers'
 # formation parameters and planned references through LCM (test/ros/sim_check.py);
+# every planner, the estimator and every bridge report on /diagnostics at ~1 Hz (diagnostics_check.py);
 # at the end (40 s) SimWorld's metrics.json / events.csv / timeline.csv carry gfctl simulate's
 # metrics, with the requests followed to their adaptation (test/ros/check_sim_metrics.py).
 set -o pipefail
@@ -18,6 +19,7 @@ launch=\$!
 for _ in \$(seq 50); do rosparam get /use_sim_time > /dev/null 2>&1 && break; sleep 0.2; done
 timeout 80 python3 "$SRC/test/ros/sim_check.py"
 rc=\$?
+timeout 20 python3 "$SRC/test/ros/diagnostics_check.py" || rc=\$((rc+1))
 # The operator's CLI: a valid command is sent (and reaches follower 2 over LCM), a bad one refused.
 # The mission's own request at t = 20 s (all.distance_m -1) changes the distances too: the command
 # is sent once that request has been applied (sim time >= 21 s; the next request is at 40 s), and
