@@ -29,6 +29,7 @@
 
 #include "config_sources.hpp"
 #include "conversions.hpp"
+#include "diagnostics.hpp"
 #include "gesture_formation/GestureObservation.h"
 #include "gesture_formation/GestureStatus.h"
 #include "gesture_formation/gesture/gesture_frames.hpp"
@@ -78,6 +79,7 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
       return;
     }
     frames_.emplace(fcfg, vcfg, mapping, uav_count, frame_wait_s_);
+    last_seen_s_.assign(static_cast<std::size_t>(frames_->views()), -1e9);
     NODELET_INFO_STREAM("GestureCommander loaded:\n"
                         << params.loaded() << "  view_fusion: " << frames_->views() << " camera(s), min_agreeing_views "
                         << vcfg.min_agreeing_views << ", max_age_s " << vcfg.max_age_s << ", envelope "
@@ -94,6 +96,28 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
       std::lock_guard<std::mutex> lock(mutex_);
       for (const auto& f : frames_->closeDue(ros::Time::now().toSec())) publishFrame(f);
     });
+    diagnostics_.start(nh, 1.0, [this] { return health(); });
+  }
+
+  /// The vote and filter on /diagnostics: WARN when observations were rejected since the last
+  /// report or a camera has not reported for 2 s; values: frames, views, what fired last.
+  std::vector<diagnostic_msgs::DiagnosticStatus> health() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const double t = ros::Time::now().toSec();
+    Health h("GestureCommander", "leader");
+    std::string silent;
+    for (std::size_t v = 0; v < last_seen_s_.size(); ++v) {
+      if (!(t - last_seen_s_[v] <= 2.0)) silent += (silent.empty() ? "" : ", ") + std::to_string(v);
+    }
+    h.warn(rejected_since_report_ > 0, std::to_string(rejected_since_report_) + " observation(s) rejected")
+        .warn(!silent.empty(), "no observation for 2 s from UAV(s) " + silent)
+        .value("frames", frames_since_report_)
+        .value("observations", observations_since_report_)
+        .value("rejected", rejected_since_report_)
+        .value("fired", fired_since_report_)
+        .value("last_fired", last_fired_.empty() ? std::string("none") : last_fired_);
+    frames_since_report_ = observations_since_report_ = rejected_since_report_ = fired_since_report_ = 0;
+    return {h.status()};
   }
 
   void onObservation(const gesture_formation::GestureObservation::ConstPtr& msg) {
@@ -108,6 +132,9 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
     bool accepted = false;
     std::string reason;
     const auto closed = frames_->observe(o, &accepted, &reason);
+    ++observations_since_report_;
+    if (accepted) last_seen_s_[msg->uav_index] = ros::Time::now().toSec();
+    else ++rejected_since_report_;
     if (!accepted) {
       NODELET_WARN_STREAM_THROTTLE(1.0, "GestureCommander: observation of UAV " << int(msg->uav_index) << " rejected: " << reason);
     }
@@ -116,6 +143,8 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
 
   /// One closed frame (gesture::GestureFrames): its status, and the command when it fired.
   void publishFrame(const gesture::GestureFrame& f) {
+    ++frames_since_report_;
+    if (f.filter.fired) ++fired_since_report_;
     gesture_formation::GestureStatus st;
     st.header.stamp = ros::Time(f.t_s);
     st.gesture_id = f.fused.gesture_id;
@@ -152,6 +181,9 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
   }
 
   std::mutex mutex_;
+  DiagnosticsPublisher diagnostics_;
+  int frames_since_report_ = 0, observations_since_report_ = 0, rejected_since_report_ = 0, fired_since_report_ = 0;
+  std::vector<double> last_seen_s_;  ///< per camera: ROS time of its last accepted observation
   std::string sender_;
   double frame_wait_s_ = 0.0;
   std::optional<gesture::GestureFrames> frames_;  ///< vote, filter, mapping (shared with gfctl simulate)

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """/diagnostics of a running simulation.launch (test/ros/simulation_launch.sh): every UAV's
-FormationPlanner, the leader's WorkerEstimator and every LcmBridge report about once a second
+FormationPlanner, the leader's WorkerEstimator and GestureCommander and every LcmBridge report about once a second
 (wall clock) with their values; the planners and the estimator are not in ERROR."""
 import sys
 import time
@@ -10,11 +10,12 @@ import rospy
 from diagnostic_msgs.msg import DiagnosticArray
 
 WALL_S = 5.0
-WANT = ["FormationPlanner uav0", "FormationPlanner uav1", "FormationPlanner uav2", "WorkerEstimator",
+WANT = ["FormationPlanner uav0", "FormationPlanner uav1", "FormationPlanner uav2", "WorkerEstimator", "GestureCommander",
         "LcmBridge sender 0: link", "LcmBridge sender 1: link", "LcmBridge sender 2: link",
         "LcmBridge sender 100: link"]
 KEYS = {"FormationPlanner": {"mode", "plans_per_s", "fallbacks", "last_planning_ms", "last_plan_age_s"},
-        "WorkerEstimator": {"confirmed", "lost", "fused_per_s", "last_fused_age_s", "published_per_s"}}
+        "WorkerEstimator": {"confirmed", "lost", "fused_per_s", "last_fused_age_s", "published_per_s"},
+        "GestureCommander": {"frames", "observations", "rejected", "fired", "last_fired"}}
 
 
 def main():
