@@ -55,6 +55,8 @@
 #include "conversions.hpp"
 #include "gesture_formation/comm/rejection_report.hpp"
 #include "gesture_formation/comm/sequence_store.hpp"
+#include "gesture_formation/comm/verifier.hpp"
+#include "gesture_formation/common/config_fields.hpp"
 #include "gesture_formation/lcm_bridge/lcm_transport.hpp"
 #include "param_loader.hpp"
 
@@ -83,7 +85,8 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     params.load("lcm_url", url);
     params.load("channel_prefix", prefix);
     params.load("key_file", key_file);
-    params.load("max_age_s", max_age_s, 0.01, 60.0);
+    const common::Range& age_range = *comm::verifierFields().rangeOf("max_age_s");  // one range per setting
+    params.load("max_age_s", max_age_s, age_range);
     params.load("heartbeat_rate_hz", heartbeat_hz, 0.1, 50.0);
     params.load("world_frame", world_frame_);
     double repeat_period_s = 0.0;
@@ -95,7 +98,8 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     std::string sequence_file, marks_file;
     params.loadOptional("sequence_file", sequence_file, state_dir + "/lcm_bridge_" + id_text + ".boot");
     params.loadOptional("high_water_file", marks_file, state_dir + "/lcm_bridge_" + id_text + ".marks");
-    const double command_max_age_s = pnh.param("command_max_age_s", 5.0);
+    constexpr double kDefaultCommandMaxAgeS = 5.0;
+    const double command_max_age_s = pnh.param("command_max_age_s", kDefaultCommandMaxAgeS);
     const int recv_buf_bytes = pnh.param("recv_buf_bytes", 4194304);
     comm::VerifierConfig vcfg;
     vcfg.max_rate_hz = pnh.param("max_rate_hz", vcfg.max_rate_hz);
@@ -103,8 +107,8 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     params.note("command_max_age_s: " + std::to_string(command_max_age_s) + ", recv_buf_bytes: " +
                 std::to_string(recv_buf_bytes) + ", max_rate_hz: " + std::to_string(vcfg.max_rate_hz) +
                 ", burst: " + std::to_string(vcfg.burst));
-    if (!(command_max_age_s > 0.0 && command_max_age_s <= 60.0)) {
-      params.addError("command_max_age_s: must be in (0, 60] s, got " + std::to_string(command_max_age_s));
+    if (!age_range.contains(command_max_age_s)) {
+      params.addError("command_max_age_s: " + common::rangeProblem(age_range, command_max_age_s));
     }
     if (recv_buf_bytes < 65536) params.addError("recv_buf_bytes: must be >= 65536, got " + std::to_string(recv_buf_bytes));
     if (url.rfind("udpm://", 0) == 0 && url.find("recv_buf_size") == std::string::npos && recv_buf_bytes >= 65536) {
@@ -136,12 +140,13 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
       else if (s != sender_id) vcfg.known_senders.push_back(static_cast<std::uint16_t>(s));  // the fleet's ids; own ignored
     }
     vcfg.own_sender_id = static_cast<std::uint16_t>(sender_id);
-    vcfg.max_age_s = max_age_s;
-    vcfg.max_age_s_by_type[comm::MessageType::kHeartbeat] = std::max(max_age_s, 2.0);
-    vcfg.max_age_s_by_type[comm::MessageType::kFormationCommand] = command_max_age_s;
-    if (params.ok()) {
-      for (const auto& e : vcfg.validate()) params.addError("known_senders/max_age_s: " + e);
-    }
+    // A value outside its range (reported above) keeps its default, so that the verifier's own
+    // check, which always runs, adds only what is new.
+    if (age_range.contains(max_age_s)) vcfg.max_age_s = max_age_s;
+    vcfg.max_age_s_by_type[comm::MessageType::kHeartbeat] = std::max(vcfg.max_age_s, 2.0);
+    vcfg.max_age_s_by_type[comm::MessageType::kFormationCommand] =
+        age_range.contains(command_max_age_s) ? command_max_age_s : kDefaultCommandMaxAgeS;
+    for (const auto& e : vcfg.validate()) params.addError("verifier: " + e);
     if (params.ok()) {
       auto t = lcm_bridge::LcmTransport::create(url, prefix);
       if (!t) params.addError("lcm_url: " + t.reason());
