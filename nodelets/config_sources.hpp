@@ -98,8 +98,6 @@ inline bool loadGestures(const std::string& path, int follower_count, ParamLoade
     for (const auto& e : reader.errors()) params.addError("gesture_config: " + e);
     return false;
   }
-  for (const auto& e : filter.validate()) params.addError("gesture_config: " + path + ": " + e);
-  for (const auto& e : fusion.validate()) params.addError("gesture_config: " + path + ": " + e);
   if (fusion.min_agreeing_views > follower_count + 1) {
     params.addError("gesture_config: " + path + ": view_fusion.min_agreeing_views: value " +
                     std::to_string(fusion.min_agreeing_views) + " exceeds the number of UAVs (cameras) " +

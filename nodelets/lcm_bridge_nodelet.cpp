@@ -56,6 +56,7 @@
 #include "gesture_formation/comm/link_settings.hpp"
 #include "gesture_formation/comm/rejection_report.hpp"
 #include "gesture_formation/comm/sequence_store.hpp"
+#include "gesture_formation/comm/verifier.hpp"
 #include "gesture_formation/lcm_bridge/lcm_transport.hpp"
 #include "param_loader.hpp"
 
@@ -84,7 +85,7 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     params.load("lcm_url", url);
     params.load("channel_prefix", prefix);
     params.load("key_file", key_file);
-    params.load("max_age_s", max_age_s, 0.01, 60.0);
+    params.load("max_age_s", max_age_s);  // range: the verifier's, checked with the link's settings below
     params.load("heartbeat_rate_hz", heartbeat_hz, 0.1, 50.0);
     params.load("world_frame", world_frame_);
     double repeat_period_s = 0.0;

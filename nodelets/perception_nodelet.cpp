@@ -32,9 +32,11 @@
 
 #include "conversions.hpp"
 #include "gesture_formation/Gesture.h"
+#include "gesture_formation/common/config_fields.hpp"
 #include "gesture_formation/estimation/stereo_distance.hpp"
 #include "gesture_formation/gesture/gesture_classifier.hpp"
 #include "gesture_formation/perception/perception_pipeline.hpp"
+#include "gesture_formation/perception/worker_tracker.hpp"
 #include "param_loader.hpp"
 
 namespace gesture_formation::nodelets {
@@ -50,10 +52,13 @@ class PerceptionNodelet : public nodelet::Nodelet {
     params.load("gesture_model", gesture_model);
     params.load("detector", detector);
     params.load("skeleton", skeleton);
-    params.load("detect_every_k", cfg.tracker.detect_every_k, 1, 1000);
-    params.load("min_depth_m", stereo_.min_depth_m, 0.0, 100.0);
-    params.load("max_depth_m", stereo_.max_depth_m, 0.01, 100.0);
-    params.load("depth_scale_m", stereo_.depth_scale_m, 1e-6, 1.0);
+    // One range per setting: the core's tables.
+    params.load("detect_every_k", cfg.tracker.detect_every_k,
+                *perception::workerTrackerFields().rangeOf("tracker.detect_every_k"));
+    const auto& stereo = estimation::stereoDistanceFields();
+    params.load("min_depth_m", stereo_.min_depth_m, *stereo.rangeOf("min_depth_m"));
+    params.load("max_depth_m", stereo_.max_depth_m, *stereo.rangeOf("max_depth_m"));
+    params.load("depth_scale_m", stereo_.depth_scale_m, *stereo.rangeOf("depth_scale_m"));
     params.load("max_depth_dt_s", max_depth_dt_s_, 0.0, 1.0);
     std::string dnn_device;
     params.loadOptional("dnn_device", dnn_device, "cpu");
@@ -69,7 +74,7 @@ class PerceptionNodelet : public nodelet::Nodelet {
       if (k) cfg.skeleton = *k;
       else params.addError("skeleton: " + k.reason());
     }
-    if (!(stereo_.max_depth_m > stereo_.min_depth_m)) params.addError("max_depth_m: must exceed min_depth_m");
+    for (const auto& p : estimation::stereoDistanceProblems(stereo_)) params.addError(p.key + ": " + p.message);
     for (const auto& e : cfg.validate()) params.addError(e);
     if (params.ok()) {
       auto p = perception::PerceptionPipeline::create(cfg);

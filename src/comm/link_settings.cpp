@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "gesture_formation/common/format_number.hpp"
+#include "gesture_formation/common/config_fields.hpp"
 
 namespace gesture_formation::comm {
 
@@ -24,8 +24,13 @@ void senderList(const std::string& key, const std::vector<int>& list, int own, s
 VerifierConfig verifierConfigOf(const LinkSettings& s, std::vector<common::ConfigError>& problems) {
   VerifierConfig c;
   if (!senderId(s.sender_id)) problems.push_back({"sender_id", "must be in [0, 65535], got " + std::to_string(s.sender_id)});
-  if (!(s.command_max_age_s > 0.0 && s.command_max_age_s <= 60.0)) {
-    problems.push_back({"command_max_age_s", "must be in (0, 60] s, got " + common::formatNumber(s.command_max_age_s)});
+  // Ages: the verifier's own range (one range per setting). A value outside it is reported
+  // here and keeps its default in the config, so that the verifier's rules add only what is new.
+  const common::Range& age = *verifierFields().rangeOf("max_age_s");
+  const LinkSettings defaults;
+  if (!age.contains(s.max_age_s)) problems.push_back({"max_age_s", common::rangeProblem(age, s.max_age_s)});
+  if (!age.contains(s.command_max_age_s)) {
+    problems.push_back({"command_max_age_s", common::rangeProblem(age, s.command_max_age_s)});
   }
   if (s.recv_buf_bytes < 65536) {
     problems.push_back({"recv_buf_bytes", "must be >= 65536, got " + std::to_string(s.recv_buf_bytes)});
@@ -38,12 +43,13 @@ VerifierConfig verifierConfigOf(const LinkSettings& s, std::vector<common::Confi
     senderList(key, **list, s.sender_id, c.senders_by_type[type], problems);  // own id only → empty: no one else
   }
   c.own_sender_id = static_cast<std::uint16_t>(std::clamp(s.sender_id, 0, 65535));
-  c.max_age_s = s.max_age_s;
-  c.max_age_s_by_type[MessageType::kHeartbeat] = std::max(s.max_age_s, 2.0);
-  c.max_age_s_by_type[MessageType::kFormationCommand] = s.command_max_age_s;
+  c.max_age_s = age.contains(s.max_age_s) ? s.max_age_s : defaults.max_age_s;
+  c.max_age_s_by_type[MessageType::kHeartbeat] = std::max(c.max_age_s, 2.0);
+  c.max_age_s_by_type[MessageType::kFormationCommand] =
+      age.contains(s.command_max_age_s) ? s.command_max_age_s : defaults.command_max_age_s;
   c.max_rate_hz = s.max_rate_hz;
   c.burst = s.burst;
-  for (const auto& e : c.validate()) problems.push_back({"known_senders/max_age_s/max_rate_hz/burst", e});
+  for (const auto& e : c.validate()) problems.push_back({"verifier", e});
   return c;
 }
 

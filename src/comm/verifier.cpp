@@ -4,6 +4,8 @@
 #include <cmath>
 #include <set>
 
+#include "gesture_formation/common/config_fields.hpp"
+
 namespace gesture_formation::comm {
 
 const char* toString(Verdict v) {
@@ -39,6 +41,18 @@ std::uint64_t VerifierCounters::rejected() const {
   return total() - count(Verdict::kAccepted) - count(Verdict::kOwnMessage);
 }
 
+const common::FieldTable<VerifierConfig>& verifierFields() {
+  using C = VerifierConfig;
+  using common::Range;
+  static const common::FieldTable<VerifierConfig> t{{
+      {"max_age_s", Range::closed(0.01, 60.0), [](C& c) { return &c.max_age_s; }},
+      {"max_future_s", Range::nonNegative(), [](C& c) { return &c.max_future_s; }},
+      {"max_rate_hz", Range::positive(), [](C& c) { return &c.max_rate_hz; }},
+      {"burst", Range::atLeast(1.0), [](C& c) { return &c.burst; }},
+  }};
+  return t;
+}
+
 std::vector<std::string> VerifierConfig::validate() const {
   std::vector<std::string> e;
   if (known_senders.empty()) e.push_back("known_senders must list at least one sender id");
@@ -49,19 +63,15 @@ std::vector<std::string> VerifierConfig::validate() const {
       e.push_back("known_senders must not contain own_sender_id " + std::to_string(s));
     }
   }
-  if (!(std::isfinite(max_age_s) && max_age_s > 0)) e.push_back("max_age_s must be > 0, got " + std::to_string(max_age_s));
-  if (!(std::isfinite(max_future_s) && max_future_s >= 0)) {
-    e.push_back("max_future_s must be >= 0, got " + std::to_string(max_future_s));
-  }
+  for (auto& line : common::problemLines(verifierFields().rangeProblems(*this))) e.push_back(line);
+  const common::Range& age_range = *verifierFields().rangeOf("max_age_s");
   for (const auto& [type, age] : max_age_s_by_type) {
     if (!isKnownMessageType(static_cast<std::uint8_t>(type))) {
       e.push_back("max_age_s_by_type has an unknown message type");
-    } else if (!(std::isfinite(age) && age > 0)) {
-      e.push_back(std::string("max_age_s_by_type.") + toString(type) + " must be > 0, got " + std::to_string(age));
+    } else if (!age_range.contains(age)) {
+      e.push_back(std::string("max_age_s_by_type.") + toString(type) + " " + common::rangeProblem(age_range, age));
     }
   }
-  if (!(std::isfinite(max_rate_hz) && max_rate_hz > 0)) e.push_back("max_rate_hz must be > 0, got " + std::to_string(max_rate_hz));
-  if (!(std::isfinite(burst) && burst >= 1)) e.push_back("burst must be >= 1, got " + std::to_string(burst));
   for (const auto& [type, senders] : senders_by_type) {
     const std::string field = std::string("senders_by_type.") + (isKnownMessageType(static_cast<std::uint8_t>(type)) ? toString(type) : "?");
     for (std::uint16_t id : senders) {

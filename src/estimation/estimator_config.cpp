@@ -2,26 +2,42 @@
 
 #include <cmath>
 
+#include "gesture_formation/common/config_fields.hpp"
+
 namespace gesture_formation::estimation {
 
 using common::ConfigReader;
 using common::Range;
 
+namespace {
+
+/// EstimatorConfig's own numbers (the camera's, filter's and stereo's have their own tables):
+/// key, range — the only place it is written — and place.
+const common::FieldTable<EstimatorConfig>& fields() {
+  using C = EstimatorConfig;
+  static const common::FieldTable<EstimatorConfig> t{{
+      {"human_height_m", Range::openClosed(0.5, 2.5), [](C& c) { return &c.human_height_m; }},
+      {"measurement_noise.sigma_xy_m", Range::positive(), [](C& c) { return &c.noise.sigma_xy_m; }},
+      {"measurement_noise.sigma_z_uwb_m", Range::positive(), [](C& c) { return &c.noise.sigma_z_uwb_m; }},
+      {"measurement_noise.sigma_z_stereo_m", Range::positive(), [](C& c) { return &c.noise.sigma_z_stereo_m; }},
+      {"measurement_noise.sigma_z_apparent_m", Range::positive(), [](C& c) { return &c.noise.sigma_z_apparent_m; }},
+  }};
+  return t;
+}
+
+/// Every problem of `c` but the camera's: each field outside its range, the rules between fields.
+std::vector<common::ConfigError> ownProblems(const EstimatorConfig& c) {
+  std::vector<common::ConfigError> e = fields().rangeProblems(c);
+  for (auto& p : humanKalmanFields().rangeProblems(c.filter)) e.push_back(p);
+  for (auto& p : stereoDistanceProblems(c.stereo)) e.push_back({"stereo." + p.key, p.message});
+  return e;
+}
+
+}  // namespace
+
 std::vector<std::string> EstimatorConfig::validate() const {
   std::vector<std::string> e = camera.validate();
-  if (!(human_height_m > 0.5 && human_height_m <= 2.5)) {
-    e.push_back("human_height_m must be in (0.5, 2.5], got " + std::to_string(human_height_m));
-  }
-  const double s[] = {noise.sigma_xy_m, noise.sigma_z_uwb_m, noise.sigma_z_stereo_m, noise.sigma_z_apparent_m};
-  const char* names[] = {"measurement_noise.sigma_xy_m", "measurement_noise.sigma_z_uwb_m",
-                         "measurement_noise.sigma_z_stereo_m", "measurement_noise.sigma_z_apparent_m"};
-  for (int i = 0; i < 4; ++i) {
-    if (!(std::isfinite(s[i]) && s[i] > 0)) e.push_back(std::string(names[i]) + " must be > 0, got " + std::to_string(s[i]));
-  }
-  for (auto& f : filter.validate()) e.push_back(f);
-  if (!(stereo.max_depth_m > stereo.min_depth_m)) {
-    e.push_back("stereo.max_depth_m must be > stereo.min_depth_m, got " + std::to_string(stereo.max_depth_m));
-  }
+  for (auto& line : common::problemLines(ownProblems(*this))) e.push_back(line);
   return e;
 }
 
@@ -71,10 +87,9 @@ EstimatorConfig readEstimatorConfig(ConfigReader& r) {
       r.addError("camera_info_file", "cannot load '" + file + "': " + k.reason());
     }
   } else {
-    r.readDouble("camera.fx", c.camera.fx, Range::positive());
-    r.readDouble("camera.fy", c.camera.fy, Range::positive());
-    r.readDouble("camera.cx", c.camera.cx, Range::any());
-    r.readDouble("camera.cy", c.camera.cy, Range::any());
+    for (const char* key : {"camera.fx", "camera.fy", "camera.cx", "camera.cy"}) {
+      cameraIntrinsicsFields().readField(r, "", c.camera, key);
+    }
     std::vector<double> d(c.camera.distortion.begin(), c.camera.distortion.end());
     r.readDoubleList("camera.distortion", d, 5, 5, Range::any());
     for (std::size_t i = 0; i < 5; ++i) c.camera.distortion[i] = d[i];
@@ -82,35 +97,19 @@ EstimatorConfig readEstimatorConfig(ConfigReader& r) {
     c.camera.width_px = static_cast<int>(std::lround(2.0 * c.camera.cx));
     c.camera.height_px = static_cast<int>(std::lround(2.0 * c.camera.cy));
     if (r.has("camera.width") || r.mode() == ConfigReader::MissingKeys::kError) {
-      r.readInt("camera.width", c.camera.width_px, Range::atLeast(1));
+      cameraIntrinsicsFields().readField(r, "", c.camera, "camera.width");
     }
     if (r.has("camera.height") || r.mode() == ConfigReader::MissingKeys::kError) {
-      r.readInt("camera.height", c.camera.height_px, Range::atLeast(1));
+      cameraIntrinsicsFields().readField(r, "", c.camera, "camera.height");
     }
   }
-  r.readDouble("human_height_m", c.human_height_m, Range::openClosed(0.5, 2.5));
-  r.readDouble("process_noise.sigma_p_m", c.filter.sigma_p_m, Range::positive());
-  r.readDouble("process_noise.sigma_v_mps", c.filter.sigma_v_mps, Range::positive());
-  r.readDouble("measurement_noise.sigma_xy_m", c.noise.sigma_xy_m, Range::positive());
-  r.readDouble("measurement_noise.sigma_z_uwb_m", c.noise.sigma_z_uwb_m, Range::positive());
-  r.readDouble("measurement_noise.sigma_z_stereo_m", c.noise.sigma_z_stereo_m, Range::positive());
-  r.readDouble("measurement_noise.sigma_z_apparent_m", c.noise.sigma_z_apparent_m, Range::positive());
-  r.readDouble("initial_velocity_std_mps", c.filter.initial_velocity_std_mps, Range::positive());
-  r.readDouble("gate_chi2", c.filter.gate_chi2, Range::positive());
-  r.readInt("max_consecutive_rejections", c.filter.max_consecutive_rejections, Range::atLeast(1));
-  r.readDouble("lost_timeout_s", c.filter.lost_timeout_s, Range::positive());
-  r.readInt("confirm_measurements", c.filter.confirm_measurements, Range::atLeast(1));
-  r.readDouble("stereo.min_depth_m", c.stereo.min_depth_m, Range::nonNegative());
-  r.readDouble("stereo.max_depth_m", c.stereo.max_depth_m, Range::positive());
-  r.readInt("stereo.min_valid_pixels", c.stereo.min_valid_pixels, Range::atLeast(1));
-  r.readDouble("stereo.min_valid_fraction", c.stereo.min_valid_fraction, Range::closed(0.0, 1.0));
-  r.readDouble("stereo.depth_scale_m", c.stereo.depth_scale_m, Range::positive());
-  for (const auto& e : c.validate()) {
-    // Range checks above already caught single-key problems; add cross-field ones only.
-    if (e.rfind("stereo.max_depth_m", 0) == 0 || e.rfind("camera.width", 0) == 0 || e.rfind("camera.height", 0) == 0) {
-      r.addError(e.substr(0, e.find(' ')), e.substr(e.find(' ') + 1));
-    }
-  }
+  fields().readFields(r, "", c);
+  humanKalmanFields().readFields(r, "", c.filter);
+  stereoDistanceFields().readFields(r, "stereo.", c.stereo);
+  // The rules between fields, always (a key outside its range kept its default while reading):
+  // the image size derived from the principal point, the stereo depth interval.
+  common::addProblems(r, "", cameraIntrinsicsFields().rangeProblems(c.camera));
+  common::addProblems(r, "", ownProblems(c));
   return c;
 }
 

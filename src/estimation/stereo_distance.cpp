@@ -4,7 +4,30 @@
 #include <cmath>
 #include <vector>
 
+#include "gesture_formation/common/config_fields.hpp"
+
 namespace gesture_formation::estimation {
+
+const common::FieldTable<StereoDistanceConfig>& stereoDistanceFields() {
+  using C = StereoDistanceConfig;
+  using common::Range;
+  static const common::FieldTable<StereoDistanceConfig> t{{
+      {"min_depth_m", Range::closed(0.0, 100.0), [](C& c) { return &c.min_depth_m; }},
+      {"max_depth_m", Range::closed(0.01, 100.0), [](C& c) { return &c.max_depth_m; }},
+      {"min_valid_pixels", Range::atLeast(1), [](C& c) { return &c.min_valid_pixels; }},
+      {"min_valid_fraction", Range::closed(0.0, 1.0), [](C& c) { return &c.min_valid_fraction; }},
+      {"depth_scale_m", Range::closed(1e-6, 1.0), [](C& c) { return &c.depth_scale_m; }},
+  }};
+  return t;
+}
+
+std::vector<common::ConfigError> stereoDistanceProblems(const StereoDistanceConfig& config) {
+  std::vector<common::ConfigError> e = stereoDistanceFields().rangeProblems(config);
+  common::checkRule(e, config.max_depth_m > config.min_depth_m, "max_depth_m", config.max_depth_m,
+                    "must be > min_depth_m");
+  stereoDistanceFields().sortByTableOrder(e);
+  return e;
+}
 
 common::Result<double> stereoDistance(const cv::Mat& depth, const Box& box, const CameraModel& camera,
                                       const StereoDistanceConfig& config) {

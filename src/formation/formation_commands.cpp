@@ -110,12 +110,20 @@ common::Result<std::pair<CommandTarget, Parameter>> parseParameterPath(const std
   return R::ok({target, parameter});
 }
 
-std::vector<std::string> DuplicateWindowConfig::validate() const {
-  std::vector<std::string> e;
-  if (window_per_sender < 1) e.push_back("duplicates.window_per_sender must be >= 1, got " + std::to_string(window_per_sender));
-  if (max_senders < 1) e.push_back("duplicates.max_senders must be >= 1, got " + std::to_string(max_senders));
-  return e;
+const common::FieldTable<DuplicateWindowConfig>& duplicateWindowFields() {
+  using C = DuplicateWindowConfig;
+  static const common::FieldTable<DuplicateWindowConfig> t{{
+      {"duplicates.window_per_sender", common::Range::atLeast(1), [](C& c) { return &c.window_per_sender; }},
+      {"duplicates.max_senders", common::Range::atLeast(1), [](C& c) { return &c.max_senders; }},
+  }};
+  return t;
 }
+
+std::vector<common::ConfigError> DuplicateWindowConfig::problems() const {
+  return duplicateWindowFields().rangeProblems(*this);
+}
+
+std::vector<std::string> DuplicateWindowConfig::validate() const { return common::problemLines(problems()); }
 
 DuplicateWindow::Check DuplicateWindow::check(const CommandId& id) const {
   for (const Sender& s : senders_) {

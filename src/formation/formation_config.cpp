@@ -6,40 +6,28 @@
 namespace gesture_formation::formation {
 
 using common::ConfigReader;
-using common::Range;
 
-std::vector<std::string> FormationConfig::validate() const {
-  std::vector<std::string> e = limits.validate();
-  for (auto& s : validateParams(params, limits)) e.push_back(s);
-  for (auto& s : worker_heading.validate()) e.push_back(s);
-  for (auto& s : duplicates.validate()) e.push_back(s);
+std::vector<common::ConfigError> FormationConfig::problems() const {
+  std::vector<common::ConfigError> e = limits.problems();
+  for (auto& p : paramsProblems(params, limits)) e.push_back(p);
+  for (auto& p : worker_heading.problems()) e.push_back(p);
+  for (auto& p : duplicates.problems()) e.push_back(p);
   return e;
 }
+
+std::vector<std::string> FormationConfig::validate() const { return common::problemLines(problems()); }
 
 namespace {
 
 void readUav(ConfigReader& r, const std::string& key, UavObservation& o) {
-  r.readDouble(key + ".beta_deg", o.beta_deg, Range::openClosed(-180.0, 180.0));
-  r.readDouble(key + ".gamma_deg", o.gamma_deg, Range::openClosed(-90.0, 90.0));
-  r.readDouble(key + ".distance_m", o.distance_m, Range::positive());
-}
-
-/// Records "key: message" for a validate() line "key message".
-void addValidationError(ConfigReader& r, const std::string& line) {
-  const auto sp = line.find(' ');
-  r.addError(line.substr(0, sp), sp == std::string::npos ? std::string("invalid") : line.substr(sp + 1));
+  uavObservationFields().readFields(r, key + ".", o);
 }
 
 }  // namespace
 
 FormationConfig readFormationConfig(ConfigReader& r) {
   FormationConfig c;
-  FormationLimits& l = c.limits;
-  r.readDouble("limits.gamma_min_deg", l.gamma_min_deg, Range{-90.0, 90.0, false, false});
-  r.readDouble("limits.gamma_max_deg", l.gamma_max_deg, Range{-90.0, 90.0, false, false});
-  r.readDouble("limits.distance_min_m", l.distance_min_m, Range::positive());
-  r.readDouble("limits.distance_max_m", l.distance_max_m, Range::positive());
-  r.readDouble("limits.safety_distance_m", l.safety_distance_m, Range::positive());
+  formationLimitsFields().readFields(r, "", c.limits);
 
   readUav(r, "leader", c.params.leader);
   if (r.has("followers") || r.mode() == ConfigReader::MissingKeys::kError) {
@@ -73,15 +61,12 @@ FormationConfig readFormationConfig(ConfigReader& r) {
   c.worker_heading.mode = mode == "motion"     ? WorkerHeadingMode::kMotion
                           : mode == "operator" ? WorkerHeadingMode::kOperator
                                                : WorkerHeadingMode::kConstant;
-  r.readDouble("worker_heading.constant_heading_deg", c.worker_heading.constant_heading_deg, Range::any());
-  r.readDouble("worker_heading.speed_low_mps", c.worker_heading.speed_low_mps, Range::nonNegative());
-  r.readDouble("worker_heading.speed_high_mps", c.worker_heading.speed_high_mps, Range::positive());
-  r.readInt("duplicates.window_per_sender", c.duplicates.window_per_sender, Range::atLeast(1));
-  r.readInt("duplicates.max_senders", c.duplicates.max_senders, Range::atLeast(1));
+  workerHeadingFields().readFields(r, "", c.worker_heading);
+  duplicateWindowFields().readFields(r, "", c.duplicates);
 
-  // Single-key ranges were checked while reading (a bad value keeps its default); add the
-  // cross-field rules: elevations and distances within the limits.
-  for (const auto& line : c.validate()) addValidationError(r, line);
+  // The rules between fields, always: a key outside its range was reported while reading and
+  // kept its default, so these add only what is new (elevations and distances within the limits).
+  common::addProblems(r, "", c.problems());
   return c;
 }
 

@@ -20,68 +20,86 @@ double elevationDeg(const FormationParams& params, UavIndex uav) {
   return uav == kLeader ? params.leader.gamma_deg : params.leader.gamma_deg + params.uav(uav).gamma_deg;
 }
 
-std::vector<std::string> FormationLimits::validate() const {
-  std::vector<std::string> e;
-  auto finite = [&](double v, const char* name) {
-    if (!std::isfinite(v)) e.push_back(std::string("limits.") + name + " must be finite, got " + common::formatNumber(v));
-    return std::isfinite(v);
-  };
-  const bool g_ok = finite(gamma_min_deg, "gamma_min_deg") & finite(gamma_max_deg, "gamma_max_deg");
-  const bool d_ok = finite(distance_min_m, "distance_min_m") & finite(distance_max_m, "distance_max_m") &
-                    finite(safety_distance_m, "safety_distance_m");
-  if (g_ok) {
-    if (!(gamma_min_deg > -90.0)) e.push_back("limits.gamma_min_deg must be > -90, got " + common::formatNumber(gamma_min_deg));
-    if (!(gamma_max_deg < 90.0)) e.push_back("limits.gamma_max_deg must be < 90, got " + common::formatNumber(gamma_max_deg));
-    if (!(gamma_min_deg <= gamma_max_deg)) {
-      e.push_back("limits.gamma_max_deg must be >= limits.gamma_min_deg (" + common::formatNumber(gamma_min_deg) + "), got " +
-                  common::formatNumber(gamma_max_deg));
+const common::FieldTable<FormationLimits>& formationLimitsFields() {
+  using C = FormationLimits;
+  using common::Range;
+  static const common::FieldTable<FormationLimits> t{{
+      {"limits.gamma_min_deg", Range{-90.0, 90.0, false, false}, [](C& c) { return &c.gamma_min_deg; }},
+      {"limits.gamma_max_deg", Range{-90.0, 90.0, false, false}, [](C& c) { return &c.gamma_max_deg; }},
+      {"limits.distance_min_m", Range::positive(), [](C& c) { return &c.distance_min_m; }},
+      {"limits.distance_max_m", Range::positive(), [](C& c) { return &c.distance_max_m; }},
+      {"limits.safety_distance_m", Range::positive(), [](C& c) { return &c.safety_distance_m; }},
+  }};
+  return t;
+}
+
+const common::FieldTable<UavObservation>& uavObservationFields() {
+  using C = UavObservation;
+  using common::Range;
+  static const common::FieldTable<UavObservation> t{{
+      {"beta_deg", Range::openClosed(-180.0, 180.0), [](C& c) { return &c.beta_deg; }},
+      {"gamma_deg", Range::openClosed(-90.0, 90.0), [](C& c) { return &c.gamma_deg; }},
+      {"distance_m", Range::positive(), [](C& c) { return &c.distance_m; }},
+  }};
+  return t;
+}
+
+std::vector<common::ConfigError> FormationLimits::problems() const {
+  std::vector<common::ConfigError> e = formationLimitsFields().rangeProblems(*this);
+  const auto n = [](double v) { return common::formatNumber(v); };
+  common::checkRule(e, gamma_max_deg >= gamma_min_deg, "limits.gamma_max_deg", gamma_max_deg,
+                    "must be >= limits.gamma_min_deg (" + n(gamma_min_deg) + ")");
+  common::checkRule(e, distance_min_m >= safety_distance_m, "limits.distance_min_m", distance_min_m,
+                    "must be >= limits.safety_distance_m (" + n(safety_distance_m) + ")");
+  common::checkRule(e, distance_max_m > distance_min_m, "limits.distance_max_m", distance_max_m,
+                    "must be > limits.distance_min_m (" + n(distance_min_m) + ")");
+  formationLimitsFields().sortByTableOrder(e);
+  return e;
+}
+
+std::vector<std::string> FormationLimits::validate() const { return common::problemLines(problems()); }
+
+namespace {
+
+/// The elevation and distance of UAV `u` within `limits` (its own ranges were checked before).
+void uavLimitProblems(const FormationParams& params, const FormationLimits& limits, UavIndex u, const std::string& key,
+                      std::vector<common::ConfigError>& e) {
+  const UavObservation& o = params.uav(u);
+  const auto n = [](double v) { return common::formatNumber(v); };
+  if (std::isfinite(o.gamma_deg) && std::isfinite(params.leader.gamma_deg)) {
+    const double el = elevationDeg(params, u);
+    // Tolerance: a clamped leader γ_L = gamma_min_deg − γ_i may miss the bound by an ulp.
+    constexpr double kTolDeg = 1e-9;
+    if (el < limits.gamma_min_deg - kTolDeg || el > limits.gamma_max_deg + kTolDeg) {
+      const std::string range = "[" + n(limits.gamma_min_deg) + ", " + n(limits.gamma_max_deg) + "]";
+      if (u == kLeader) {
+        e.push_back({key + ".gamma_deg", n(o.gamma_deg) + " is out of range " + range + " (limits.gamma_min_deg/gamma_max_deg)"});
+      } else {
+        e.push_back({key + ".gamma_deg", n(o.gamma_deg) + ": the follower's elevation leader.gamma_deg + gamma_deg = " +
+                                             n(el) + " is out of range " + range + " (limits.gamma_min_deg/gamma_max_deg)"});
+      }
     }
   }
-  if (d_ok) {
-    if (!(safety_distance_m > 0.0)) e.push_back("limits.safety_distance_m must be > 0, got " + common::formatNumber(safety_distance_m));
-    if (!(distance_min_m >= safety_distance_m)) {
-      e.push_back("limits.distance_min_m must be >= limits.safety_distance_m (" + common::formatNumber(safety_distance_m) + "), got " +
-                  common::formatNumber(distance_min_m));
-    }
-    if (!(distance_max_m > distance_min_m)) {
-      e.push_back("limits.distance_max_m must be > limits.distance_min_m (" + common::formatNumber(distance_min_m) + "), got " +
-                  common::formatNumber(distance_max_m));
-    }
+  if (std::isfinite(o.distance_m) && (o.distance_m < limits.distanceFloorM() || o.distance_m > limits.distance_max_m)) {
+    e.push_back({key + ".distance_m", n(o.distance_m) + " is out of range [" + n(limits.distanceFloorM()) + ", " +
+                                          n(limits.distance_max_m) + "] (limits.distance_min_m, safety_distance_m, distance_max_m)"});
+  }
+}
+
+}  // namespace
+
+std::vector<common::ConfigError> paramsProblems(const FormationParams& params, const FormationLimits& limits) {
+  std::vector<common::ConfigError> e;
+  for (UavIndex u = 0; u < params.uavCount(); ++u) {
+    const std::string key = u == kLeader ? std::string("leader") : "followers[" + std::to_string(u - 1) + "]";
+    for (auto& p : uavObservationFields().rangeProblems(params.uav(u))) e.push_back({key + "." + p.key, p.message});
+    uavLimitProblems(params, limits, u, key, e);
   }
   return e;
 }
 
 std::vector<std::string> validateParams(const FormationParams& params, const FormationLimits& limits) {
-  std::vector<std::string> e;
-  for (UavIndex u = 0; u < params.uavCount(); ++u) {
-    const UavObservation& o = params.uav(u);
-    const std::string key = u == kLeader ? std::string("leader") : "followers[" + std::to_string(u - 1) + "]";
-    if (!std::isfinite(o.beta_deg)) e.push_back(key + ".beta_deg must be finite, got " + common::formatNumber(o.beta_deg));
-    if (!std::isfinite(o.gamma_deg)) {
-      e.push_back(key + ".gamma_deg must be finite, got " + common::formatNumber(o.gamma_deg));
-    } else if (std::isfinite(params.leader.gamma_deg)) {
-      const double el = elevationDeg(params, u);
-      // Tolerance: a clamped leader γ_L = gamma_min_deg − γ_i may miss the bound by an ulp.
-      constexpr double kTolDeg = 1e-9;
-      if (el < limits.gamma_min_deg - kTolDeg || el > limits.gamma_max_deg + kTolDeg) {
-        const std::string range = "[" + common::formatNumber(limits.gamma_min_deg) + ", " + common::formatNumber(limits.gamma_max_deg) + "]";
-        if (u == kLeader) {
-          e.push_back(key + ".gamma_deg " + common::formatNumber(o.gamma_deg) + " is out of range " + range +
-                      " (limits.gamma_min_deg/gamma_max_deg)");
-        } else {
-          e.push_back(key + ".gamma_deg " + common::formatNumber(o.gamma_deg) + ": the follower's elevation leader.gamma_deg + gamma_deg = " +
-                      common::formatNumber(el) + " is out of range " + range + " (limits.gamma_min_deg/gamma_max_deg)");
-        }
-      }
-    }
-    if (!std::isfinite(o.distance_m)) {
-      e.push_back(key + ".distance_m must be finite, got " + common::formatNumber(o.distance_m));
-    } else if (o.distance_m < limits.distanceFloorM() || o.distance_m > limits.distance_max_m) {
-      e.push_back(key + ".distance_m " + common::formatNumber(o.distance_m) + " is out of range [" + common::formatNumber(limits.distanceFloorM()) + ", " +
-                  common::formatNumber(limits.distance_max_m) + "] (limits.distance_min_m, safety_distance_m, distance_max_m)");
-    }
-  }
-  return e;
+  return common::problemLines(paramsProblems(params, limits));
 }
 
 }  // namespace gesture_formation::formation

@@ -15,20 +15,26 @@ const char* toString(WorkerHeadingMode mode) {
   return "?";
 }
 
-std::vector<std::string> WorkerHeadingConfig::validate() const {
-  std::vector<std::string> e;
-  if (!std::isfinite(constant_heading_deg)) {
-    e.push_back("worker_heading.constant_heading_deg must be finite, got " + std::to_string(constant_heading_deg));
-  }
-  if (!(std::isfinite(speed_low_mps) && speed_low_mps >= 0.0)) {
-    e.push_back("worker_heading.speed_low_mps must be >= 0, got " + std::to_string(speed_low_mps));
-  }
-  if (!(std::isfinite(speed_high_mps) && speed_high_mps > 0.0 && speed_high_mps >= speed_low_mps)) {
-    e.push_back("worker_heading.speed_high_mps must be > 0 and >= worker_heading.speed_low_mps, got " +
-                std::to_string(speed_high_mps));
-  }
+const common::FieldTable<WorkerHeadingConfig>& workerHeadingFields() {
+  using C = WorkerHeadingConfig;
+  using common::Range;
+  static const common::FieldTable<WorkerHeadingConfig> t{{
+      {"worker_heading.constant_heading_deg", Range::any(), [](C& c) { return &c.constant_heading_deg; }},
+      {"worker_heading.speed_low_mps", Range::nonNegative(), [](C& c) { return &c.speed_low_mps; }},
+      {"worker_heading.speed_high_mps", Range::positive(), [](C& c) { return &c.speed_high_mps; }},
+  }};
+  return t;
+}
+
+std::vector<common::ConfigError> WorkerHeadingConfig::problems() const {
+  std::vector<common::ConfigError> e = workerHeadingFields().rangeProblems(*this);
+  common::checkRule(e, speed_high_mps >= speed_low_mps, "worker_heading.speed_high_mps", speed_high_mps,
+                    "must be >= worker_heading.speed_low_mps");
+  workerHeadingFields().sortByTableOrder(e);
   return e;
 }
+
+std::vector<std::string> WorkerHeadingConfig::validate() const { return common::problemLines(problems()); }
 
 WorkerHeading::WorkerHeading(const WorkerHeadingConfig& config)
     : config_(config),

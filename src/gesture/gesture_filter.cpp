@@ -4,6 +4,7 @@
 #include <limits>
 #include <sstream>
 
+#include "gesture_formation/common/config_fields.hpp"
 #include "gesture_formation/common/format_number.hpp"
 
 namespace gesture_formation::gesture {
@@ -25,42 +26,45 @@ const char* toString(FilterVerdict v) {
   return "?";
 }
 
-std::vector<std::string> GestureFilterConfig::validate() const {
-  std::vector<std::string> e;
-  if (window_size < 1) e.push_back("window_size must be >= 1, got " + std::to_string(window_size));
-  if (min_measurements < 1 || min_measurements > window_size) {
-    e.push_back("min_measurements must be in [1, window_size=" + std::to_string(window_size) + "], got " +
-                std::to_string(min_measurements));
-  }
-  if (!(std::isfinite(max_age_s) && max_age_s > 0.0)) e.push_back("max_age_s must be > 0, got " + common::formatNumber(max_age_s));
-  if (!(ratio_threshold >= 0.0 && ratio_threshold <= 1.0)) {
-    e.push_back("ratio_threshold must be in [0, 1], got " + common::formatNumber(ratio_threshold));
-  }
-  if (!(std::isfinite(cooldown_s) && cooldown_s >= 0.0)) e.push_back("cooldown_s must be >= 0, got " + common::formatNumber(cooldown_s));
-  if (!(std::isfinite(release_s) && release_s >= 0.0)) e.push_back("release_s must be >= 0, got " + common::formatNumber(release_s));
-  if (max_gesture_id < 1 || max_gesture_id > 1000) {
-    e.push_back("max_gesture_id must be in [1, 1000], got " + std::to_string(max_gesture_id));
-  }
+namespace {
+
+/// GestureFilterConfig's numbers: key, range — the only place it is written — and place.
+const common::FieldTable<GestureFilterConfig>& fields() {
+  using C = GestureFilterConfig;
+  static const common::FieldTable<GestureFilterConfig> t{{
+      {"window_size", Range::closed(1, 100000), [](C& c) { return &c.window_size; }},
+      {"min_measurements", Range::atLeast(1), [](C& c) { return &c.min_measurements; }},
+      {"max_age_s", Range::positive(), [](C& c) { return &c.max_age_s; }},
+      {"ratio_threshold", Range::closed(0.0, 1.0), [](C& c) { return &c.ratio_threshold; }},
+      {"cooldown_s", Range::nonNegative(), [](C& c) { return &c.cooldown_s; }},
+      {"max_gesture_id", Range::closed(1, 1000), [](C& c) { return &c.max_gesture_id; }},
+      {"release_s", Range::nonNegative(), [](C& c) { return &c.release_s; }},
+  }};
+  return t;
+}
+
+/// Each field outside its range, then the rule between fields.
+std::vector<common::ConfigError> problems(const GestureFilterConfig& c) {
+  std::vector<common::ConfigError> e = fields().rangeProblems(c);
+  common::checkRule(e, c.min_measurements <= c.window_size, "min_measurements", c.min_measurements,
+                    "must be <= window_size " + std::to_string(c.window_size) + " (the filter could never evaluate)");
+  fields().sortByTableOrder(e);
   return e;
 }
 
+}  // namespace
+
+std::vector<std::string> GestureFilterConfig::validate() const { return common::problemLines(problems(*this)); }
+
 GestureFilterConfig readGestureFilterConfig(ConfigReader& r) {
   GestureFilterConfig c;
-  r.readInt("window_size", c.window_size, Range::closed(1, 100000));
-  c.min_measurements = c.window_size;
-  r.readInt("min_measurements", c.min_measurements, Range::atLeast(1));
-  r.readDouble("max_age_s", c.max_age_s, Range::positive());
-  r.readDouble("ratio_threshold", c.ratio_threshold, Range::closed(0.0, 1.0));
-  r.readDouble("cooldown_s", c.cooldown_s, Range::nonNegative());
-  r.readInt("max_gesture_id", c.max_gesture_id, Range::closed(1, 1000));
   std::string rearm = c.rearm_on_release ? "release" : "cooldown";
   r.readString("rearm", rearm, {"release", "cooldown"});
   c.rearm_on_release = rearm == "release";
-  r.readDouble("release_s", c.release_s, Range::nonNegative());
-  if (c.min_measurements > c.window_size) {
-    r.addError("min_measurements", "value " + std::to_string(c.min_measurements) + " exceeds window_size " +
-                                       std::to_string(c.window_size) + " (the filter could never evaluate)");
-  }
+  fields().readFields(r, "", c);
+  if (!r.has("min_measurements")) c.min_measurements = c.window_size;  // default: K
+  // The rule between fields, always (a key outside its range kept its default while reading).
+  common::addProblems(r, "", problems(c));
   return c;
 }
 

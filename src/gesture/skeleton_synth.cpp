@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 
 #include "gesture_formation/common/angles.hpp"
+#include "gesture_formation/common/config_fields.hpp"
 #include "gesture_formation/common/csv.hpp"
 
 namespace gesture_formation::gesture {
@@ -78,27 +79,54 @@ int gestureIdOf(Motion m) {
   }
 }
 
-std::vector<std::string> SynthConfig::validate() const {
-  std::vector<std::string> e;
-  auto range = [&](double lo, double hi, const char* name, double min_allowed, double max_allowed) {
-    if (!(std::isfinite(lo) && std::isfinite(hi) && lo <= hi && lo >= min_allowed && hi <= max_allowed)) {
-      e.push_back(std::string(name) + " range [" + std::to_string(lo) + ", " + std::to_string(hi) + "] invalid (allowed [" +
-                  std::to_string(min_allowed) + ", " + std::to_string(max_allowed) + "])");
-    }
+const common::FieldTable<SynthConfig>& synthConfigFields() {
+  using C = SynthConfig;
+  using common::Range;
+  static const common::FieldTable<SynthConfig> t{{
+      {"fps", Range::openClosed(0.0, 120.0), [](C& c) { return &c.fps; }},
+      {"height_min_m", Range::closed(1.0, 2.3), [](C& c) { return &c.height_min_m; }},
+      {"height_max_m", Range::closed(1.0, 2.3), [](C& c) { return &c.height_max_m; }},
+      {"proportion_jitter", Range::closed(0.0, 0.3), [](C& c) { return &c.proportion_jitter; }},
+      {"distance_min_m", Range::closed(1.5, 100.0), [](C& c) { return &c.distance_min_m; }},
+      {"distance_max_m", Range::closed(1.5, 100.0), [](C& c) { return &c.distance_max_m; }},
+      {"elevation_min_deg", Range::closed(-30.0, 80.0), [](C& c) { return &c.elevation_min_deg; }},
+      {"elevation_max_deg", Range::closed(-30.0, 80.0), [](C& c) { return &c.elevation_max_deg; }},
+      {"azimuth_min_deg", Range::closed(-360.0, 360.0), [](C& c) { return &c.azimuth_min_deg; }},
+      {"azimuth_max_deg", Range::closed(-360.0, 360.0), [](C& c) { return &c.azimuth_max_deg; }},
+      {"tempo_min", Range::closed(0.1, 5.0), [](C& c) { return &c.tempo_min; }},
+      {"tempo_max", Range::closed(0.1, 5.0), [](C& c) { return &c.tempo_max; }},
+      {"hold_min_s", Range::closed(0.0, 30.0), [](C& c) { return &c.hold_min_s; }},
+      {"hold_max_s", Range::closed(0.0, 30.0), [](C& c) { return &c.hold_max_s; }},
+      {"lead_min_s", Range::closed(0.0, 30.0), [](C& c) { return &c.lead_min_s; }},
+      {"lead_max_s", Range::closed(0.0, 30.0), [](C& c) { return &c.lead_max_s; }},
+      {"keypoint_noise_min", Range::closed(0.0, 0.2), [](C& c) { return &c.keypoint_noise_min; }},
+      {"keypoint_noise_max", Range::closed(0.0, 0.2), [](C& c) { return &c.keypoint_noise_max; }},
+      {"dropout_max", Range::closed(0.0, 0.9), [](C& c) { return &c.dropout_max; }},
+      {"box_jitter", Range::closed(0.0, 0.3), [](C& c) { return &c.box_jitter; }},
+      {"gesture_fraction", Range::closed(0.0, 1.0), [](C& c) { return &c.gesture_fraction; }},
+  }};
+  return t;
+}
+
+std::vector<common::ConfigError> synthConfigProblems(const SynthConfig& c) {
+  std::vector<common::ConfigError> e = synthConfigFields().rangeProblems(c);
+  const auto interval = [&e](double lo, double hi, const std::string& name, const std::string& unit) {
+    common::checkRule(e, lo <= hi, name + "_max" + unit, hi, "must be >= " + name + "_min" + unit);
   };
-  if (!(fps > 0 && fps <= 120)) e.push_back("fps must be in (0, 120], got " + std::to_string(fps));
-  range(height_min_m, height_max_m, "height_m", 1.0, 2.3);
-  range(0.0, proportion_jitter, "proportion_jitter", 0.0, 0.3);
-  range(distance_min_m, distance_max_m, "distance_m", 1.5, 100.0);
-  range(elevation_min_deg, elevation_max_deg, "elevation_deg", -30.0, 80.0);
-  range(azimuth_min_deg, azimuth_max_deg, "azimuth_deg", -360.0, 360.0);
-  range(tempo_min, tempo_max, "tempo", 0.1, 5.0);
-  range(hold_min_s, hold_max_s, "hold_s", 0.0, 30.0);
-  range(lead_min_s, lead_max_s, "lead_s", 0.0, 30.0);
-  range(keypoint_noise_min, keypoint_noise_max, "keypoint_noise", 0.0, 0.2);
-  range(0.0, dropout_max, "dropout_max", 0.0, 0.9);
-  range(0.0, box_jitter, "box_jitter", 0.0, 0.3);
-  range(0.0, gesture_fraction, "gesture_fraction", 0.0, 1.0);
+  interval(c.height_min_m, c.height_max_m, "height", "_m");
+  interval(c.distance_min_m, c.distance_max_m, "distance", "_m");
+  interval(c.elevation_min_deg, c.elevation_max_deg, "elevation", "_deg");
+  interval(c.azimuth_min_deg, c.azimuth_max_deg, "azimuth", "_deg");
+  interval(c.tempo_min, c.tempo_max, "tempo", "");
+  interval(c.hold_min_s, c.hold_max_s, "hold", "_s");
+  interval(c.lead_min_s, c.lead_max_s, "lead", "_s");
+  interval(c.keypoint_noise_min, c.keypoint_noise_max, "keypoint_noise", "");
+  synthConfigFields().sortByTableOrder(e);
+  return e;
+}
+
+std::vector<std::string> SynthConfig::validate() const {
+  std::vector<std::string> e = common::problemLines(synthConfigProblems(*this));
   for (const auto& c : camera.validate()) e.push_back(c);
   return e;
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "gesture_formation/common/config_fields.hpp"
 #include "gesture_formation/common/csv.hpp"
 
 namespace gesture_formation::gesture {
@@ -10,72 +11,51 @@ namespace gesture_formation::gesture {
 using common::ConfigReader;
 using common::Range;
 
-std::vector<std::string> ViewFusionConfig::validate() const {
-  std::vector<std::string> e;
-  const auto num = [](double v) { return common::formatDouble(v); };
-  if (min_agreeing_views < 1 || min_agreeing_views > 16) {
-    e.push_back("view_fusion.min_agreeing_views must be in [1, 16], got " + std::to_string(min_agreeing_views));
-  }
-  if (!(std::isfinite(max_age_s) && max_age_s > 0.0)) e.push_back("view_fusion.max_age_s must be > 0, got " + num(max_age_s));
-  if (!(std::isfinite(distance_min_m) && distance_min_m >= 0.0)) {
-    e.push_back("view_fusion.distance_min_m must be >= 0, got " + num(distance_min_m));
-  }
-  if (!(std::isfinite(distance_max_m) && distance_max_m > distance_min_m)) {
-    e.push_back("view_fusion.distance_max_m must exceed distance_min_m=" + num(distance_min_m) + ", got " + num(distance_max_m));
-  }
-  if (!(elevation_min_deg >= -90.0 && elevation_min_deg <= 90.0)) {
-    e.push_back("view_fusion.elevation_min_deg must be in [-90, 90], got " + num(elevation_min_deg));
-  }
-  if (!(elevation_max_deg > elevation_min_deg && elevation_max_deg <= 90.0)) {
-    e.push_back("view_fusion.elevation_max_deg must be in (elevation_min_deg=" + num(elevation_min_deg) + ", 90], got " +
-                num(elevation_max_deg));
-  }
-  if (!(std::isfinite(vote_window_s) && vote_window_s >= 0.0 && vote_window_s <= 60.0)) {
-    e.push_back("view_fusion.vote_window_s must be in [0, 60], got " + num(vote_window_s));
-  }
-  if (!(vote_min_fraction > 0.0 && vote_min_fraction <= 1.0)) {
-    e.push_back("view_fusion.vote_min_fraction must be in (0, 1], got " + num(vote_min_fraction));
-  }
-  if (!(confirm_3d_min_fraction > 0.0 && confirm_3d_min_fraction <= 1.0)) {
-    e.push_back("view_fusion.confirm_3d_min_fraction must be in (0, 1], got " + num(confirm_3d_min_fraction));
-  }
-  if (confirm_3d_min_frames < 1 || confirm_3d_min_frames > 1000) {
-    e.push_back("view_fusion.confirm_3d_min_frames must be in [1, 1000], got " + std::to_string(confirm_3d_min_frames));
-  }
-  if (!(std::isfinite(confirm_3d_max_dt_s) && confirm_3d_max_dt_s > 0.0 && confirm_3d_max_dt_s <= 1.0)) {
-    e.push_back("view_fusion.confirm_3d_max_dt_s must be in (0, 1], got " + num(confirm_3d_max_dt_s));
-  }
-  if (!(std::isfinite(fusion_lag_s) && fusion_lag_s >= 0.0 && fusion_lag_s <= 2.0)) {
-    e.push_back("view_fusion.fusion_lag_s must be in [0, 2], got " + num(fusion_lag_s));
-  }
+namespace {
+
+/// ViewFusionConfig's numbers: key, range — the only place it is written — and place.
+const common::FieldTable<ViewFusionConfig>& fields() {
+  using C = ViewFusionConfig;
+  static const common::FieldTable<ViewFusionConfig> t{{
+      {"view_fusion.min_agreeing_views", Range::closed(1, 16), [](C& c) { return &c.min_agreeing_views; }},
+      {"view_fusion.max_age_s", Range::positive(), [](C& c) { return &c.max_age_s; }},
+      {"view_fusion.distance_min_m", Range::nonNegative(), [](C& c) { return &c.distance_min_m; }},
+      {"view_fusion.distance_max_m", Range::positive(), [](C& c) { return &c.distance_max_m; }},
+      {"view_fusion.elevation_min_deg", Range::closed(-90.0, 90.0), [](C& c) { return &c.elevation_min_deg; }},
+      {"view_fusion.elevation_max_deg", Range::closed(-90.0, 90.0), [](C& c) { return &c.elevation_max_deg; }},
+      {"view_fusion.vote_window_s", Range::closed(0.0, 60.0), [](C& c) { return &c.vote_window_s; }},
+      {"view_fusion.vote_min_fraction", Range::openClosed(0.0, 1.0), [](C& c) { return &c.vote_min_fraction; }},
+      {"view_fusion.confirm_3d_min_fraction", Range::openClosed(0.0, 1.0), [](C& c) { return &c.confirm_3d_min_fraction; }},
+      {"view_fusion.confirm_3d_min_frames", Range::closed(1, 1000), [](C& c) { return &c.confirm_3d_min_frames; }},
+      {"view_fusion.confirm_3d_max_dt_s", Range::openClosed(0.0, 1.0), [](C& c) { return &c.confirm_3d_max_dt_s; }},
+      {"view_fusion.fusion_lag_s", Range::closed(0.0, 2.0), [](C& c) { return &c.fusion_lag_s; }},
+  }};
+  return t;
+}
+
+/// Each field outside its range, then the rules between fields, in table order.
+std::vector<common::ConfigError> problems(const ViewFusionConfig& c) {
+  std::vector<common::ConfigError> e = fields().rangeProblems(c);
+  common::checkRule(e, c.distance_max_m > c.distance_min_m, "view_fusion.distance_max_m", c.distance_max_m,
+                    "must exceed view_fusion.distance_min_m " + common::formatDouble(c.distance_min_m));
+  common::checkRule(e, c.elevation_max_deg > c.elevation_min_deg, "view_fusion.elevation_max_deg", c.elevation_max_deg,
+                    "must exceed view_fusion.elevation_min_deg " + common::formatDouble(c.elevation_min_deg));
+  fields().sortByTableOrder(e);
   return e;
 }
+
+}  // namespace
+
+std::vector<std::string> ViewFusionConfig::validate() const { return common::problemLines(problems(*this)); }
 
 ViewFusionConfig readViewFusionConfig(ConfigReader& r) {
   ViewFusionConfig c;
   const std::string k = "view_fusion.";
-  r.readInt(k + "min_agreeing_views", c.min_agreeing_views, Range::closed(1, 16));
-  r.readDouble(k + "max_age_s", c.max_age_s, Range::positive());
   r.readBool(k + "gate_envelope", c.gate_envelope);
-  r.readDouble(k + "distance_min_m", c.distance_min_m, Range::nonNegative());
-  r.readDouble(k + "distance_max_m", c.distance_max_m, Range::positive());
-  r.readDouble(k + "elevation_min_deg", c.elevation_min_deg, Range::closed(-90.0, 90.0));
-  r.readDouble(k + "elevation_max_deg", c.elevation_max_deg, Range::closed(-90.0, 90.0));
-  r.readDouble(k + "vote_window_s", c.vote_window_s, Range::closed(0.0, 60.0));
-  r.readDouble(k + "vote_min_fraction", c.vote_min_fraction, Range::closed(1e-9, 1.0));
   r.readBool(k + "confirm_3d", c.confirm_3d);
-  r.readDouble(k + "confirm_3d_min_fraction", c.confirm_3d_min_fraction, Range::closed(1e-9, 1.0));
-  r.readInt(k + "confirm_3d_min_frames", c.confirm_3d_min_frames, Range::closed(1, 1000));
-  r.readDouble(k + "confirm_3d_max_dt_s", c.confirm_3d_max_dt_s, Range::closed(1e-9, 1.0));
-  r.readDouble(k + "fusion_lag_s", c.fusion_lag_s, Range::closed(0.0, 2.0));
-  if (c.distance_max_m <= c.distance_min_m) {
-    r.addError(k + "distance_max_m", "value " + common::formatDouble(c.distance_max_m) + " must exceed distance_min_m " +
-                                         common::formatDouble(c.distance_min_m));
-  }
-  if (c.elevation_max_deg <= c.elevation_min_deg) {
-    r.addError(k + "elevation_max_deg", "value " + common::formatDouble(c.elevation_max_deg) +
-                                            " must exceed elevation_min_deg " + common::formatDouble(c.elevation_min_deg));
-  }
+  fields().readFields(r, "", c);
+  // The rules between fields, always (a key outside its range kept its default while reading).
+  common::addProblems(r, "", problems(c));
   return c;
 }
 

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "commands.hpp"
+#include "gesture_formation/common/config_fields.hpp"
 #include "gesture_formation/common/csv.hpp"
 #include "gesture_formation/planning/corridor_builder.hpp"
 #include "gesture_formation/planning/occupancy_map.hpp"
@@ -23,11 +24,11 @@ const Registrar kRegistrar{
     cmdCorridor};
 
 /// Parses a finite number option; records the problem and returns false otherwise.
-bool numberOption(const Args& args, const std::string& name, double& value, double min_value) {
+bool numberOption(const Args& args, const std::string& name, double& value, const common::Range& range) {
   if (!args.has(name)) return true;
   const auto v = common::parseDouble(args.get(name));
-  if (!v || !std::isfinite(*v) || *v < min_value) {
-    badInput(args, "--" + name + ": expected a number >= " + common::formatDouble(min_value) + ", got '" + args.get(name) + "'");
+  if (!v || !range.contains(*v)) {
+    badInput(args, "--" + name + ": expected a number " + common::rangeRequirement(range) + ", got '" + args.get(name) + "'");
     return false;
   }
   value = *v;
@@ -40,8 +41,10 @@ int cmdCorridor(const Args& args) {
   if (!checkOptions(args, {"scenario", "path", "out"}, {"clearance", "box-margin"})) return kExitBadInput;
   planning::CorridorConfig config;
   double box_margin = config.local_box_margin_m.x();
-  if (!numberOption(args, "clearance", config.clearance_m, 0.0)) return kExitBadInput;
-  if (!numberOption(args, "box-margin", box_margin, 0.01)) return kExitBadInput;
+  if (!numberOption(args, "clearance", config.clearance_m, *planning::corridorConfigFields().rangeOf("clearance_m"))) {
+    return kExitBadInput;
+  }
+  if (!numberOption(args, "box-margin", box_margin, common::Range::atLeast(0.01))) return kExitBadInput;
   config.local_box_margin_m = Eigen::Vector3d::Constant(box_margin);
   const planning::CorridorBuilder builder(config);
   if (!builder.configError().empty()) return badInput(args, builder.configError());

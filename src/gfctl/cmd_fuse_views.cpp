@@ -63,7 +63,6 @@ int cmdFuseViews(const Args& args) {
     common::ConfigReader r = common::ConfigReader::fromFile(path, common::ConfigReader::MissingKeys::kUseDefaults);
     config = gesture::readViewFusionConfig(r);
     max_gesture_id = gesture::readGestureFilterConfig(r).max_gesture_id;
-    for (const auto& e : config.validate()) r.addError("view_fusion", e);
     if (!r.ok()) {
       std::cerr << "gfctl fuse-views: invalid configuration:\n" << r.errorReport();
       return kExitBadInput;

@@ -15,6 +15,7 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "gesture_formation/common/config_fields.hpp"
 #include "gesture_formation/common/config_reader.hpp"
 #include "gesture_formation/common/csv.hpp"
 #include "gesture_formation/gesture/skeleton_synth.hpp"
@@ -27,31 +28,13 @@ const Registrar kRegistrar{"synth-gestures",
                            "--seed S --count N --out DIR [--config FILE] [--views D1,D2]   synthetic gesture/work-motion skeletons (docs/design.md §8.7)",
                            cmdSynthGestures};
 
-/// Reads `<name>_min<unit>` and `<name>_max<unit>`, both within `range`.
-void readInterval(common::ConfigReader& r, const std::string& name, const std::string& unit, double& min_value,
-                  double& max_value, const common::Range& range) {
-  r.readDouble(name + "_min" + unit, min_value, range);
-  r.readDouble(name + "_max" + unit, max_value, range);
-}
-
 bool readSynthConfig(const std::string& path, gesture::SynthConfig& c, std::string& report) {
   using common::ConfigReader;
-  using common::Range;
   ConfigReader r = ConfigReader::fromFile(path, ConfigReader::MissingKeys::kUseDefaults);
-  r.readDouble("fps", c.fps, Range::openClosed(0, 120));
-  readInterval(r, "height", "_m", c.height_min_m, c.height_max_m, Range::closed(1.0, 2.3));
-  r.readDouble("proportion_jitter", c.proportion_jitter, Range::closed(0, 0.3));
-  readInterval(r, "distance", "_m", c.distance_min_m, c.distance_max_m, Range::closed(1.5, 100));
-  readInterval(r, "elevation", "_deg", c.elevation_min_deg, c.elevation_max_deg, Range::closed(-30, 80));
-  readInterval(r, "azimuth", "_deg", c.azimuth_min_deg, c.azimuth_max_deg, Range::closed(-360, 360));
-  readInterval(r, "tempo", "", c.tempo_min, c.tempo_max, Range::closed(0.1, 5));
-  readInterval(r, "hold", "_s", c.hold_min_s, c.hold_max_s, Range::closed(0, 30));
-  readInterval(r, "lead", "_s", c.lead_min_s, c.lead_max_s, Range::closed(0, 30));
-  readInterval(r, "keypoint_noise", "", c.keypoint_noise_min, c.keypoint_noise_max, Range::closed(0, 0.2));
-  r.readDouble("dropout_max", c.dropout_max, Range::closed(0, 0.9));
-  r.readDouble("box_jitter", c.box_jitter, Range::closed(0, 0.3));
-  r.readDouble("gesture_fraction", c.gesture_fraction, Range::closed(0, 1));
-  for (const auto& e : c.validate()) r.addError("(ranges)", e);
+  gesture::synthConfigFields().readFields(r, "", c);
+  // The rules between fields (each interval's min <= max), always: a key outside its range was
+  // reported while reading and kept its default, so these add only what is new.
+  common::addProblems(r, "", gesture::synthConfigProblems(c));
   report = r.errorReport();
   return r.ok();
 }

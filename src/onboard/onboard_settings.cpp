@@ -32,14 +32,12 @@ void readOnboardSettings(ConfigReader& r, const std::string& m, OnboardSettings&
 
   common::withSubReader(r, m + "formation", ConfigReader::MissingKeys::kUseDefaults,
                         [&](ConfigReader& s) { c.formation = formation::readFormationConfig(s); });
-  for (const auto& e : c.formation.validate()) r.addError(m + "formation", e);
   common::withSubReader(r, m + "gestures", ConfigReader::MissingKeys::kUseDefaults, [&](ConfigReader& s) {
     c.gesture_filter = gesture::readGestureFilterConfig(s);
     gesture::readGestureMapping(s, c.gesture_filter.max_gesture_id,
                                 static_cast<int>(c.formation.params.followers.size()), c.gesture_mapping);
     c.view_fusion = gesture::readViewFusionConfig(s);
   });
-  for (const auto& e : c.view_fusion.validate()) r.addError(m + "gestures", e);
   if (c.view_fusion.min_agreeing_views > c.formation.params.uavCount()) {
     r.addError(m + "gestures.view_fusion.min_agreeing_views",
                "value " + std::to_string(c.view_fusion.min_agreeing_views) + " exceeds the number of UAVs (cameras) " +

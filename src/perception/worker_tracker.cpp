@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "gesture_formation/common/config_fields.hpp"
 #include "gesture_formation/perception/dnn_model.hpp"
 
 namespace gesture_formation::perception {
@@ -73,33 +74,27 @@ std::string toString(BoxSource source) {
   return "none";
 }
 
+const common::FieldTable<WorkerTrackerConfig>& workerTrackerFields() {
+  using C = WorkerTrackerConfig;
+  using common::Range;
+  static const common::FieldTable<WorkerTrackerConfig> t{{
+      {"tracker.detect_every_k", Range::closed(1, 1000), [](C& c) { return &c.detect_every_k; }},
+      {"tracker.min_detection_score", Range{0.0, 1.0, true, false}, [](C& c) { return &c.min_detection_score; }},
+      {"tracker.associate_min_iou", Range::openClosed(0.0, 1.0), [](C& c) { return &c.associate_min_iou; }},
+      {"tracker.associate_gate", Range::positive(), [](C& c) { return &c.associate_gate; }},
+      {"tracker.drift_iou", Range::openClosed(0.0, 1.0), [](C& c) { return &c.drift_iou; }},
+      {"tracker.max_missed_detections", Range::nonNegative(), [](C& c) { return &c.max_missed_detections; }},
+      {"tracker.reacquire_frames", Range::nonNegative(), [](C& c) { return &c.reacquire_frames; }},
+      {"tracker.reacquire_gate", Range::positive(), [](C& c) { return &c.reacquire_gate; }},
+      {"tracker.min_box_px", Range::atLeast(1.0), [](C& c) { return &c.min_box_px; }},
+      {"tracker.roi_scale", Range::atLeast(1.0), [](C& c) { return &c.roi_scale; }},
+      {"tracker.roi_min_side_px", Range::atLeast(32.0), [](C& c) { return &c.roi_min_side_px; }},
+  }};
+  return t;
+}
+
 std::vector<std::string> WorkerTrackerConfig::validate() const {
-  std::vector<std::string> e;
-  const auto num = [](double v) { return std::to_string(v); };
-  if (detect_every_k < 1) e.push_back("tracker.detect_every_k must be >= 1, got " + std::to_string(detect_every_k));
-  if (!(min_detection_score >= 0.0f && min_detection_score < 1.0f)) {
-    e.push_back("tracker.min_detection_score must be in [0, 1), got " + num(min_detection_score));
-  }
-  if (!(associate_min_iou > 0.0f && associate_min_iou <= 1.0f)) {
-    e.push_back("tracker.associate_min_iou must be in (0, 1], got " + num(associate_min_iou));
-  }
-  if (!(associate_gate > 0.0f && std::isfinite(associate_gate))) {
-    e.push_back("tracker.associate_gate must be > 0, got " + num(associate_gate));
-  }
-  if (!(drift_iou > 0.0f && drift_iou <= 1.0f)) e.push_back("tracker.drift_iou must be in (0, 1], got " + num(drift_iou));
-  if (max_missed_detections < 0) {
-    e.push_back("tracker.max_missed_detections must be >= 0, got " + std::to_string(max_missed_detections));
-  }
-  if (reacquire_frames < 0) e.push_back("tracker.reacquire_frames must be >= 0, got " + std::to_string(reacquire_frames));
-  if (!(reacquire_gate > 0.0f && std::isfinite(reacquire_gate))) {
-    e.push_back("tracker.reacquire_gate must be > 0, got " + num(reacquire_gate));
-  }
-  if (!(min_box_px >= 1.0f && std::isfinite(min_box_px))) e.push_back("tracker.min_box_px must be >= 1, got " + num(min_box_px));
-  if (!(roi_scale >= 1.0f && std::isfinite(roi_scale))) e.push_back("tracker.roi_scale must be >= 1, got " + num(roi_scale));
-  if (!(roi_min_side_px >= 32.0f && std::isfinite(roi_min_side_px))) {
-    e.push_back("tracker.roi_min_side_px must be >= 32, got " + num(roi_min_side_px));
-  }
-  return e;
+  return common::problemLines(workerTrackerFields().rangeProblems(*this));
 }
 
 common::Result<std::unique_ptr<WorkerTracker>> WorkerTracker::create(const WorkerTrackerConfig& config,

@@ -5,25 +5,29 @@
 #include <limits>
 #include <sstream>
 
+#include "gesture_formation/common/config_fields.hpp"
+
 namespace gesture_formation::planning {
 
+const common::FieldTable<CorridorConfig>& corridorConfigFields() {
+  using C = CorridorConfig;
+  using common::Range;
+  static const common::FieldTable<CorridorConfig> t{{
+      {"clearance_m", Range::nonNegative(), [](C& c) { return &c.clearance_m; }},
+      {"seed_margin_m", Range::positive(), [](C& c) { return &c.seed_margin_m; }},
+      {"min_exclusion_m", Range::positive(), [](C& c) { return &c.min_exclusion_m; }},
+      {"min_segment_length_m", Range::positive(), [](C& c) { return &c.min_segment_length_m; }},
+  }};
+  return t;
+}
+
 std::vector<std::string> CorridorConfig::validate() const {
-  std::vector<std::string> e;
-  if (!(std::isfinite(clearance_m) && clearance_m >= 0.0)) e.push_back("clearance_m must be >= 0, got " + std::to_string(clearance_m));
-  if (!(std::isfinite(seed_margin_m) && seed_margin_m > 0.0)) e.push_back("seed_margin_m must be > 0, got " + std::to_string(seed_margin_m));
-  if (!(std::isfinite(min_exclusion_m) && min_exclusion_m > 0.0)) {
-    e.push_back("min_exclusion_m must be > 0, got " + std::to_string(min_exclusion_m));
-  }
-  if (!(std::isfinite(min_segment_length_m) && min_segment_length_m > 0.0)) {
-    e.push_back("min_segment_length_m must be > 0, got " + std::to_string(min_segment_length_m));
-  }
+  std::vector<common::ConfigError> e = corridorConfigFields().rangeProblems(*this);
   for (int i = 0; i < 3; ++i) {
-    if (!(std::isfinite(local_box_margin_m(i)) && local_box_margin_m(i) > seed_margin_m)) {
-      e.push_back("local_box_margin_m[" + std::to_string(i) + "] must be > seed_margin_m, got " +
-                  std::to_string(local_box_margin_m(i)));
-    }
+    common::checkRule(e, std::isfinite(local_box_margin_m(i)) && local_box_margin_m(i) > seed_margin_m,
+                      "local_box_margin_m[" + std::to_string(i) + "]", local_box_margin_m(i), "must be > seed_margin_m");
   }
-  return e;
+  return common::problemLines(e);
 }
 
 CorridorBuilder::CorridorBuilder(const CorridorConfig& config) : config_(config) {

@@ -7,25 +7,52 @@
 
 namespace gesture_formation::planning {
 
-std::vector<std::string> LatticeTowerSpec::validate() const {
-  std::vector<std::string> e;
-  const std::string p = name.empty() ? std::string("tower") : "tower '" + name + "'";
-  if (!base_world.allFinite()) e.push_back(p + ": base must be finite");
-  if (!std::isfinite(yaw_rad)) e.push_back(p + ": yaw must be finite");
-  if (!(height_m > 0.0 && std::isfinite(height_m))) e.push_back(p + ": height_m must be > 0");
-  if (!(base_width_m > 0.0 && std::isfinite(base_width_m))) e.push_back(p + ": base_width_m must be > 0");
-  if (!(top_width_m > 0.0 && top_width_m <= base_width_m)) e.push_back(p + ": top_width_m must be in (0, base_width_m]");
-  if (panels < 1) e.push_back(p + ": panels must be >= 1");
-  if (!(leg_radius_m > 0.0)) e.push_back(p + ": leg_radius_m must be > 0");
-  if (!(brace_radius_m > 0.0)) e.push_back(p + ": brace_radius_m must be > 0");
+const common::FieldTable<LatticeTowerSpec>& latticeTowerFields() {
+  using C = LatticeTowerSpec;
+  using common::Range;
+  static const common::FieldTable<LatticeTowerSpec> t{{
+      {"height_m", Range::positive(), [](C& c) { return &c.height_m; }},
+      {"base_width_m", Range::positive(), [](C& c) { return &c.base_width_m; }},
+      {"top_width_m", Range::positive(), [](C& c) { return &c.top_width_m; }},
+      {"panels", Range::closed(1, 1000), [](C& c) { return &c.panels; }},
+      {"leg_radius_m", Range::positive(), [](C& c) { return &c.leg_radius_m; }},
+      {"brace_radius_m", Range::positive(), [](C& c) { return &c.brace_radius_m; }},
+      {"keep_out_thickness_m", Range::positive(), [](C& c) { return &c.keep_out_thickness_m; }},
+  }};
+  return t;
+}
+
+const common::FieldTable<CrossArmSpec>& crossArmFields() {
+  using C = CrossArmSpec;
+  using common::Range;
+  static const common::FieldTable<CrossArmSpec> t{{
+      {"height_m", Range::positive(), [](C& c) { return &c.height_m; }},
+      {"half_length_m", Range::positive(), [](C& c) { return &c.half_length_m; }},
+      {"section_m", Range::positive(), [](C& c) { return &c.section_m; }},
+  }};
+  return t;
+}
+
+std::vector<common::ConfigError> LatticeTowerSpec::problems() const {
+  std::vector<common::ConfigError> e = latticeTowerFields().rangeProblems(*this);
+  if (!base_world.allFinite()) e.push_back({"base", "must be finite"});
+  common::checkRule(e, std::isfinite(yaw_rad), "yaw_deg", yaw_rad, "must be finite");
+  common::checkRule(e, top_width_m <= base_width_m, "top_width_m", top_width_m, "must be <= base_width_m");
+  latticeTowerFields().sortByTableOrder(e);
   for (std::size_t i = 0; i < cross_arms.size(); ++i) {
-    const auto& a = cross_arms[i];
-    const std::string q = p + ": cross_arms[" + std::to_string(i) + "]";
-    if (!(a.height_m > 0.0 && a.height_m <= height_m)) e.push_back(q + ".height_m must be in (0, height_m]");
-    if (!(a.half_length_m > 0.0)) e.push_back(q + ".half_length_m must be > 0");
-    if (!(a.section_m > 0.0)) e.push_back(q + ".section_m must be > 0");
+    const std::string q = "cross_arms[" + std::to_string(i) + "].";
+    for (const auto& p : crossArmFields().rangeProblems(cross_arms[i])) e.push_back({q + p.key, p.message});
+    common::checkRule(e, cross_arms[i].height_m <= height_m, q + "height_m", cross_arms[i].height_m,
+                      "must be <= the tower's height_m");
   }
   return e;
+}
+
+std::vector<std::string> LatticeTowerSpec::validate() const {
+  const std::string p = name.empty() ? std::string("tower") : "tower '" + name + "'";
+  std::vector<std::string> lines;
+  for (const auto& line : common::problemLines(problems())) lines.push_back(p + ": " + line);
+  return lines;
 }
 
 Eigen::Vector3d LatticeTowerSpec::armTip(std::size_t arm, int side, double drop_m) const {

@@ -15,27 +15,35 @@ namespace gesture_formation::planning {
 using common::ConfigReader;
 using common::Range;
 
-std::vector<std::string> MapConfig::validate() const {
-  std::vector<std::string> e;
-  if (!(resolution_m >= 0.01 && resolution_m <= 10.0)) {
-    e.push_back("map.resolution_m must be in [0.01, 10], got " + std::to_string(resolution_m));
-  }
+const common::FieldTable<MapConfig>& mapConfigFields() {
+  static const common::FieldTable<MapConfig> t{{
+      {"map.resolution_m", Range::closed(0.01, 10.0), [](MapConfig& m) { return &m.resolution_m; }},
+  }};
+  return t;
+}
+
+std::vector<common::ConfigError> MapConfig::problems() const {
+  std::vector<common::ConfigError> e = mapConfigFields().rangeProblems(*this);
   if (!bounds.min_world.allFinite() || !bounds.max_world.allFinite()) {
-    e.push_back("map.bounds must be finite");
-  } else {
-    for (int i = 0; i < 3; ++i) {
-      if (!(bounds.max_world(i) > bounds.min_world(i))) {
-        e.push_back("map.bounds: max[" + std::to_string(i) + "] must be > min[" + std::to_string(i) + "]");
-      }
+    e.push_back({"map.bounds", "must be finite"});
+    return e;
+  }
+  bool extent = true;
+  for (int i = 0; i < 3; ++i) {
+    if (!(bounds.max_world(i) > bounds.min_world(i))) {
+      e.push_back({"map.bounds", "max[" + std::to_string(i) + "] must be > min[" + std::to_string(i) + "]"});
+      extent = false;
     }
-    // Keep the dense grid (one byte per voxel, plus 4 for the distance field) bounded.
-    if (resolution_m > 0.0 && e.empty()) {
-      const Eigen::Vector3d n = (bounds.max_world - bounds.min_world) / resolution_m;
-      if (n.prod() > 1.0e8) e.push_back("map.bounds: more than 1e8 voxels at this resolution");
-    }
+  }
+  // Keep the dense grid (one byte per voxel, plus 4 for the distance field) bounded.
+  if (extent && mapConfigFields().rangeProblems(*this).empty()) {
+    const Eigen::Vector3d n = (bounds.max_world - bounds.min_world) / resolution_m;
+    if (n.prod() > 1.0e8) e.push_back({"map.bounds", "more than 1e8 voxels at this resolution"});
   }
   return e;
 }
+
+std::vector<std::string> MapConfig::validate() const { return common::problemLines(problems()); }
 
 PrimitiveSet Scenario::primitives() const {
   PrimitiveSet set;
@@ -138,9 +146,16 @@ class ScenarioReader {
   }
 
   Eigen::Vector3d readPoint(const std::string& key, const Range& range = Range::any()) {
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    readPointInto(key, p, range);
+    return p;
+  }
+
+  /// Reads `[x, y, z]` into `p`; a missing or malformed point keeps `p`.
+  void readPointInto(const std::string& key, Eigen::Vector3d& p, const Range& range = Range::any()) {
     std::vector<double> v;
     r_.readDoubleList(key, v, 3, 3, range);
-    return v.size() == 3 ? Eigen::Vector3d(v[0], v[1], v[2]) : Eigen::Vector3d::Zero();
+    if (v.size() == 3) p = Eigen::Vector3d(v[0], v[1], v[2]);
   }
 
   void readOptional(const std::string& key, double& value, const Range& range) {
@@ -148,20 +163,17 @@ class ScenarioReader {
   }
 
   void readMap(MapConfig& m) {
-    r_.readDouble("map.resolution_m", m.resolution_m, Range::closed(0.01, 10.0));
-    m.bounds.min_world = readPoint("map.bounds.min");
-    m.bounds.max_world = readPoint("map.bounds.max");
+    mapConfigFields().readFields(r_, "", m);
+    readPointInto("map.bounds.min", m.bounds.min_world);  // a bad point keeps the default
+    readPointInto("map.bounds.max", m.bounds.max_world);
     if (r_.has("map.octomap_file")) {
       r_.readString("map.octomap_file", m.octomap_file);
       if (!m.octomap_file.empty() && m.octomap_file.front() != '/' && !base_dir_.empty()) {
         m.octomap_file = base_dir_ + "/" + m.octomap_file;
       }
     }
-    if (r_.has("map.bounds.min") && r_.has("map.bounds.max") && r_.ok()) {
-      for (const auto& e : m.validate()) {
-        if (e.rfind("map.bounds", 0) == 0) r_.addError("map.bounds", e.substr(e.find(' ') + 1));
-      }
-    }
+    // The rules between fields, always (a bad value kept its default while reading).
+    common::addProblems(r_, "", m.problems());
   }
 
   OrientedBox readBox(const std::string& k) {
@@ -192,34 +204,24 @@ class ScenarioReader {
     if (!isMap(k)) return t;
     r_.readString(k + ".name", t.name);
     t.base_world = readPoint(k + ".base");
-    r_.readDouble(k + ".height_m", t.height_m, Range::positive());
     double yaw_deg = 0.0;
     readOptional(k + ".yaw_deg", yaw_deg, Range::closed(-360.0, 360.0));
     t.yaw_rad = yaw_deg * M_PI / 180.0;
-    readOptional(k + ".base_width_m", t.base_width_m, Range::positive());
-    readOptional(k + ".top_width_m", t.top_width_m, Range::positive());
-    if (r_.has(k + ".panels")) r_.readInt(k + ".panels", t.panels, Range::closed(1, 1000));
-    readOptional(k + ".leg_radius_m", t.leg_radius_m, Range::positive());
-    readOptional(k + ".brace_radius_m", t.brace_radius_m, Range::positive());
+    for (const auto& f : latticeTowerFields().fields) {  // height_m required, the rest optional
+      if (std::string(f.key) == "height_m" || r_.has(k + "." + f.key)) latticeTowerFields().readField(r_, k + ".", t, f.key);
+    }
     if (r_.has(k + ".keep_out")) r_.readBool(k + ".keep_out", t.keep_out);
-    readOptional(k + ".keep_out_thickness_m", t.keep_out_thickness_m, Range::positive());
     for (std::size_t i = 0, n = listSize(k + ".cross_arms"); i < n; ++i) {
       const std::string a = item(k + ".cross_arms", i);
       CrossArmSpec arm;
       if (!isMap(a)) continue;
-      r_.readDouble(a + ".height_m", arm.height_m, Range::positive());
-      r_.readDouble(a + ".half_length_m", arm.half_length_m, Range::positive());
-      readOptional(a + ".section_m", arm.section_m, Range::positive());
+      for (const auto& f : crossArmFields().fields) {  // section_m optional
+        if (std::string(f.key) != "section_m" || r_.has(a + "." + f.key)) crossArmFields().readField(r_, a + ".", arm, f.key);
+      }
       t.cross_arms.push_back(arm);
     }
-    for (const auto& e : t.validate()) {
-      // Single-field ranges were checked above; report the cross-field ones.
-      if (e.find("top_width_m") != std::string::npos) r_.addError(k + ".top_width_m", "must be in (0, base_width_m]");
-      if (e.find(".height_m must be in") != std::string::npos) {
-        const auto lb = e.find("cross_arms[");
-        r_.addError(k + "." + e.substr(lb, e.find(']', lb) - lb + 1) + ".height_m", "must be in (0, the tower's height_m]");
-      }
-    }
+    // The rules between fields, always (a bad value kept its default while reading).
+    common::addProblems(r_, k + ".", t.problems());
     return t;
   }
 

@@ -8,6 +8,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "gesture_formation/common/angles.hpp"
+#include "gesture_formation/common/config_fields.hpp"
 #include "gesture_formation/common/config_reader.hpp"
 #include "gesture_formation/formation/formation_geometry.hpp"
 #include "gesture_formation/onboard/onboard_settings.hpp"
@@ -242,11 +243,9 @@ void readWorker(ConfigReader& r, const std::string& m, WorkerConfig& w) {
   readRoute(r, wk, w);
   readScheduledGestures(r, wk, w);
   readWorkMotions(r, wk, w);
-  r.readDouble(wk + "synth.keypoint_noise_max", w.synth.keypoint_noise_max, Range::closed(0.0, 0.2));
-  r.readDouble(wk + "synth.dropout_max", w.synth.dropout_max, Range::closed(0.0, 0.9));
-  r.readDouble(wk + "synth.box_jitter", w.synth.box_jitter, Range::closed(0.0, 0.3));
-  r.readDouble(wk + "synth.tempo_min", w.synth.tempo_min, Range::closed(0.1, 5.0));
-  r.readDouble(wk + "synth.tempo_max", w.synth.tempo_max, Range::closed(0.1, 5.0));
+  for (const char* key : {"keypoint_noise_max", "dropout_max", "box_jitter", "tempo_min", "tempo_max"}) {
+    gesture::synthConfigFields().readField(r, wk + "synth.", w.synth, key);  // the synthesiser's ranges
+  }
 }
 
 /// mission.uavs: the leader first, then the followers.

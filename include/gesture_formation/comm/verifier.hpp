@@ -47,6 +47,11 @@
 #include "gesture_formation/comm/replay_window.hpp"
 #include "gesture_formation/common/result.hpp"
 
+namespace gesture_formation::common {
+template <class Config>
+struct FieldTable;
+}  // namespace gesture_formation::common
+
 namespace gesture_formation::comm {
 
 /// \brief The outcome of Verifier::verify. Values index Counters.
@@ -113,6 +118,11 @@ struct VerifierConfig {
   std::vector<std::string> validate() const;
   double maxAgeS(MessageType type) const;
 };
+
+/// \brief VerifierConfig's numbers (`max_age_s` — also the range of every max_age_s_by_type
+/// entry —, `max_future_s`, `max_rate_hz`, `burst`) with their ranges: the only place they are
+/// written, used by validate() and by the LcmBridge nodelet's parameters.
+const common::FieldTable<VerifierConfig>& verifierFields();
 
 struct VerifyResult {
   Verdict verdict = Verdict::kMalformed;

@@ -15,6 +15,11 @@
 #include <Eigen/Core>
 #include <Eigen/LU>
 
+namespace gesture_formation::common {
+template <class Config>
+struct FieldTable;
+}  // namespace gesture_formation::common
+
 namespace gesture_formation::estimation {
 
 /// \brief Intrinsics of a calibrated camera. Defaults: RealSense D435 colour camera,
@@ -28,22 +33,15 @@ struct CameraIntrinsics {
   int width_px = 640;   ///< image width [px], > 0
   int height_px = 480;  ///< image height [px], > 0
 
-  /// Every problem, each naming the field and value. Empty when valid.
-  std::vector<std::string> validate() const {
-    std::vector<std::string> e;
-    auto num = [](double v) { return std::to_string(v); };
-    if (!(std::isfinite(fx) && fx > 0)) e.push_back("camera.fx must be > 0, got " + num(fx));
-    if (!(std::isfinite(fy) && fy > 0)) e.push_back("camera.fy must be > 0, got " + num(fy));
-    if (!std::isfinite(cx)) e.push_back("camera.cx must be finite");
-    if (!std::isfinite(cy)) e.push_back("camera.cy must be finite");
-    for (std::size_t i = 0; i < distortion.size(); ++i) {
-      if (!std::isfinite(distortion[i])) e.push_back("camera.distortion[" + std::to_string(i) + "] must be finite");
-    }
-    if (width_px <= 0) e.push_back("camera.width must be > 0, got " + std::to_string(width_px));
-    if (height_px <= 0) e.push_back("camera.height must be > 0, got " + std::to_string(height_px));
-    return e;
-  }
+  /// Every problem, each naming the field and value. Empty when valid. Ranges:
+  /// cameraIntrinsicsFields() (keys `camera.*`), shared with the YAML reader.
+  std::vector<std::string> validate() const;
 };
+
+/// \brief CameraIntrinsics' numbers (keys `camera.fx`, `camera.fy`, `camera.cx`, `camera.cy`,
+/// `camera.width`, `camera.height`) with their ranges: the only place they are written, used by
+/// validate() and by the estimator's YAML reader (common/config_fields.hpp).
+const common::FieldTable<CameraIntrinsics>& cameraIntrinsicsFields();
 
 /// \brief Projection and back-projection through a plumb_bob camera.
 /// Thread safety: immutable after construction; all methods are const and reentrant.

@@ -29,6 +29,11 @@
 
 #include "gesture_formation/estimation/measurement_model.hpp"
 
+namespace gesture_formation::common {
+template <class Config>
+struct FieldTable;
+}  // namespace gesture_formation::common
+
 namespace gesture_formation::estimation {
 
 using Vector6d = Eigen::Matrix<double, 6, 1>;
@@ -44,25 +49,15 @@ struct HumanKalmanConfig {
   double lost_timeout_s = 5.0;            ///< no fused measurement for this long → lost, and no more extrapolation [s], > 0
   int confirm_measurements = 3;           ///< accepted measurements (the initialising one included) that confirm a track, ≥ 1
 
-  std::vector<std::string> validate() const {
-    std::vector<std::string> e;
-    auto pos = [&](double v, const char* name) {
-      if (!(std::isfinite(v) && v > 0)) e.push_back(std::string(name) + " must be > 0, got " + std::to_string(v));
-    };
-    pos(sigma_p_m, "process_noise.sigma_p_m");
-    pos(sigma_v_mps, "process_noise.sigma_v_mps");
-    pos(initial_velocity_std_mps, "initial_velocity_std_mps");
-    pos(gate_chi2, "gate_chi2");
-    pos(lost_timeout_s, "lost_timeout_s");
-    if (max_consecutive_rejections < 1) {
-      e.push_back("max_consecutive_rejections must be >= 1, got " + std::to_string(max_consecutive_rejections));
-    }
-    if (confirm_measurements < 1) {
-      e.push_back("confirm_measurements must be >= 1, got " + std::to_string(confirm_measurements));
-    }
-    return e;
-  }
+  /// \brief Every problem, each naming the YAML key (humanKalmanFields()); empty when valid.
+  std::vector<std::string> validate() const;
 };
+
+/// \brief HumanKalmanConfig's numbers (estimator YAML keys `process_noise.*`,
+/// `initial_velocity_std_mps`, `gate_chi2`, `max_consecutive_rejections`, `lost_timeout_s`,
+/// `confirm_measurements`) with their ranges: the only place they are written, used by validate()
+/// and by the estimator's YAML reader (common/config_fields.hpp).
+const common::FieldTable<HumanKalmanConfig>& humanKalmanFields();
 
 /// \brief What happened to one measurement.
 enum class UpdateOutcome {

@@ -5,12 +5,17 @@
 /// converted from optical-axis depth to range along the ray through the box centre.
 
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
 #include "gesture_formation/common/result.hpp"
 #include "gesture_formation/estimation/camera_model.hpp"
 #include "gesture_formation/estimation/measurement_model.hpp"
+
+namespace gesture_formation::common {
+struct ConfigError;
+}  // namespace gesture_formation::common
 
 namespace gesture_formation::estimation {
 
@@ -22,6 +27,15 @@ struct StereoDistanceConfig {
   double min_valid_fraction = 0.05;  ///< fewer than this fraction of the box's pixels valid → unavailable, [0, 1]
   double depth_scale_m = 0.001;    ///< metres per unit for 16-bit depth images (RealSense: mm), > 0
 };
+
+/// \brief StereoDistanceConfig's numbers (keys `min_depth_m`, `max_depth_m`, `min_valid_pixels`,
+/// `min_valid_fraction`, `depth_scale_m`) with their ranges: the only place they are written, used
+/// by the estimator's validate() and YAML reader (under `stereo.`) and by the Perception nodelet's
+/// parameters (common/config_fields.hpp).
+const common::FieldTable<StereoDistanceConfig>& stereoDistanceFields();
+/// \brief Every problem of `config` (keys as in stereoDistanceFields()): each field outside its
+/// range, and max_depth_m > min_depth_m.
+std::vector<common::ConfigError> stereoDistanceProblems(const StereoDistanceConfig& config);
 
 /// \brief Median valid depth in `box` (clipped to the image) of an aligned depth image
 /// (`CV_16UC1` scaled by `depth_scale_m`, or `CV_32FC1` in metres), converted to range

@@ -131,7 +131,13 @@ struct DuplicateWindowConfig {
   int window_per_sender = 64;  ///< sequence numbers remembered per sender, ≥ 1
   int max_senders = 16;        ///< senders remembered, ≥ 1
   std::vector<std::string> validate() const;
+  /// \brief The same problems, typed {key, message} (keys `duplicates.*`).
+  std::vector<common::ConfigError> problems() const;
 };
+
+/// \brief DuplicateWindowConfig's numbers (keys `duplicates.*`) with their ranges: the only place
+/// they are written, used by validate() and by the YAML reader.
+const common::FieldTable<DuplicateWindowConfig>& duplicateWindowFields();
 
 /// \brief Bounded memory of applied command ids (see the file comment).
 class DuplicateWindow {

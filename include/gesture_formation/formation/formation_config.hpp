@@ -37,6 +37,9 @@ struct FormationConfig {
 
   /// \brief Every problem, each naming the key; empty when valid.
   std::vector<std::string> validate() const;
+  /// \brief The same problems, typed {key, message}: each field outside its range and the rules
+  /// between fields (elevations and distances within the limits).
+  std::vector<common::ConfigError> problems() const;
 };
 
 /// \brief Reads a FormationConfig from `reader` starting from the defaults; problems are

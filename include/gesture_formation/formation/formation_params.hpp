@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "gesture_formation/common/config_fields.hpp"
+
 namespace gesture_formation::formation {
 
 /// \brief Index of a UAV in the formation: 0 = leader, i ≥ 1 = follower i.
@@ -80,6 +82,8 @@ struct FormationLimits {
 
   /// \brief Every problem, each naming the key (`limits.<field>`); empty when valid.
   std::vector<std::string> validate() const;
+  /// \brief The same problems, typed {key, message}.
+  std::vector<common::ConfigError> problems() const;
   /// \brief Effective lower bound of d: max(distance_min_m, safety_distance_m).
   double distanceFloorM() const { return distance_min_m > safety_distance_m ? distance_min_m : safety_distance_m; }
 };
@@ -89,5 +93,14 @@ struct FormationLimits {
 /// empty when valid. Non-finite values are errors. Elevations are checked to 1e-9 deg (a
 /// leader γ clamped to gamma_min_deg − γ_i can miss the bound by one rounding).
 std::vector<std::string> validateParams(const FormationParams& params, const FormationLimits& limits);
+/// \brief The same problems, typed {key, message}.
+std::vector<common::ConfigError> paramsProblems(const FormationParams& params, const FormationLimits& limits);
+
+/// \brief FormationLimits' numbers (keys `limits.*`) with their ranges: the only place they are
+/// written, used by validate() and by the YAML reader.
+const common::FieldTable<FormationLimits>& formationLimitsFields();
+/// \brief One UAV's numbers (keys `beta_deg` (−180, 180], `gamma_deg` (−90, 90], `distance_m` > 0,
+/// relative to `leader.` / `followers[i].`); the limits above narrow γ and d further.
+const common::FieldTable<UavObservation>& uavObservationFields();
 
 }  // namespace gesture_formation::formation

@@ -21,6 +21,8 @@
 
 #include <Eigen/Core>
 
+#include "gesture_formation/common/config_fields.hpp"
+
 namespace gesture_formation::formation {
 
 enum class WorkerHeadingMode { kConstant, kMotion, kOperator };
@@ -36,7 +38,13 @@ struct WorkerHeadingConfig {
   double speed_high_mps = 0.5;        ///< at or above: follow the motion [m/s], ≥ speed_low_mps, > 0
   /// \brief Every problem, each naming the key (`worker_heading.<field>`).
   std::vector<std::string> validate() const;
+  /// \brief The same problems, typed {key, message}.
+  std::vector<common::ConfigError> problems() const;
 };
+
+/// \brief WorkerHeadingConfig's numbers (keys `worker_heading.*`) with their ranges: the only
+/// place they are written, used by validate() and by the YAML reader.
+const common::FieldTable<WorkerHeadingConfig>& workerHeadingFields();
 
 /// \brief Tracks ^Hφ according to WorkerHeadingConfig.
 class WorkerHeading {

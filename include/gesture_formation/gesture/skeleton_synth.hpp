@@ -24,6 +24,12 @@
 #include "gesture_formation/estimation/camera_model.hpp"
 #include "gesture_formation/gesture/skeleton.hpp"
 
+namespace gesture_formation::common {
+template <class Config>
+struct FieldTable;
+struct ConfigError;
+}  // namespace gesture_formation::common
+
 namespace gesture_formation::gesture {
 
 /// \brief The kinds of motion, each with its ground-truth gesture id.
@@ -55,8 +61,16 @@ struct SynthConfig {
   double gesture_fraction = 0.5;              ///< share of sequences that are gestures (rest: none motions)
   estimation::CameraIntrinsics camera;        ///< D435 colour, 640×480 by default
 
+  /// \brief Every problem (synthConfigProblems() and the camera's), each naming the key.
   std::vector<std::string> validate() const;
 };
+
+/// \brief SynthConfig's numbers (keys as the member names: `fps`, `height_min_m`, …) with their
+/// ranges: the only place they are written, used by validate(), `gfctl synth-gestures --config`
+/// and the simulator's worker (`mission.worker.synth.*`).
+const common::FieldTable<SynthConfig>& synthConfigFields();
+/// \brief Each number outside its range, and each interval with min > max (key: its `_max`).
+std::vector<common::ConfigError> synthConfigProblems(const SynthConfig& config);
 
 /// \brief One generated frame: the skeleton and its ground-truth label.
 struct SynthFrame {

@@ -32,6 +32,11 @@
 #include "gesture_formation/common/result.hpp"
 #include "gesture_formation/perception/person_detector.hpp"
 
+namespace gesture_formation::common {
+template <class Config>
+struct FieldTable;
+}  // namespace gesture_formation::common
+
 namespace gesture_formation::perception {
 
 /// Visual tracker used between detections.
@@ -55,8 +60,13 @@ struct WorkerTrackerConfig {
   float roi_scale = 2.5f;             ///< window side / max(w, h) of the worker box, ≥ 1
   float roi_min_side_px = 256.0f;     ///< smallest window side [px], ≥ 32 (256 = multipose input)
 
+  /// \brief Every problem, each naming the key (`tracker.*`); empty when valid.
   std::vector<std::string> validate() const;
 };
+
+/// \brief WorkerTrackerConfig's numbers (keys `tracker.*`) with their ranges: the only place they
+/// are written, used by validate() and by the Perception nodelet's parameters.
+const common::FieldTable<WorkerTrackerConfig>& workerTrackerFields();
 
 /// \brief Where this frame's box came from.
 enum class BoxSource { kNone, kDetector, kTracker };

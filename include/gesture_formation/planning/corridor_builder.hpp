@@ -31,6 +31,11 @@
 #include "gesture_formation/planning/polytope.hpp"
 #include "gesture_formation/planning/shapes.hpp"
 
+namespace gesture_formation::common {
+template <class Config>
+struct FieldTable;
+}  // namespace gesture_formation::common
+
 namespace gesture_formation::planning {
 
 /// \brief Parameters of the decomposition.
@@ -52,6 +57,10 @@ struct CorridorConfig {
   /// Every problem, each naming the field; empty when valid.
   std::vector<std::string> validate() const;
 };
+
+/// \brief CorridorConfig's numbers (keys as the member names) with their ranges: the only place
+/// they are written, used by validate() and by `gfctl corridor`'s options.
+const common::FieldTable<CorridorConfig>& corridorConfigFields();
 
 /// \brief The corridor of one path segment.
 struct SegmentCorridor {

@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 
+#include "gesture_formation/common/config_fields.hpp"
 #include "gesture_formation/planning/shapes.hpp"
 
 namespace gesture_formation::planning {
@@ -43,11 +44,21 @@ struct LatticeTowerSpec {
 
   /// Every problem, each naming the field; empty when valid.
   std::vector<std::string> validate() const;
+  /// The same problems, typed {key, message}, keys relative to the tower (`height_m`,
+  /// `cross_arms[0].height_m`): ranges from latticeTowerFields() / crossArmFields() and the rules
+  /// between fields (top_width_m ≤ base_width_m, every arm at or below the tower's height).
+  std::vector<common::ConfigError> problems() const;
 
   /// \brief World position of a cross-arm tip (side +1: tower +y, −1: tower −y), lowered
   /// by `drop_m` (an insulator string). Requires a valid arm index.
   Eigen::Vector3d armTip(std::size_t arm, int side, double drop_m = 0.0) const;
 };
+
+/// \brief LatticeTowerSpec's numbers (keys relative to the tower) with their ranges: the only
+/// place they are written, used by validate() and by the scenario reader.
+const common::FieldTable<LatticeTowerSpec>& latticeTowerFields();
+/// \brief CrossArmSpec's numbers (keys relative to the arm), likewise.
+const common::FieldTable<CrossArmSpec>& crossArmFields();
 
 /// \brief The tower's members as primitives (legs and bracing: cylinders; arms: boxes).
 PrimitiveSet towerPrimitives(const LatticeTowerSpec& spec);

@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 
+#include "gesture_formation/common/config_fields.hpp"
 #include "gesture_formation/common/result.hpp"
 #include "gesture_formation/planning/catenary.hpp"
 #include "gesture_formation/planning/lattice_tower.hpp"
@@ -31,7 +32,14 @@ struct MapConfig {
 
   /// Every problem, each naming the field; empty when valid.
   std::vector<std::string> validate() const;
+  /// The same problems, typed {key, message}: `map.resolution_m` outside its range
+  /// (mapConfigFields()), `map.bounds` not finite, empty or over 1e8 voxels.
+  std::vector<common::ConfigError> problems() const;
 };
+
+/// \brief MapConfig's numbers (`map.resolution_m`) with their ranges: the only place they are
+/// written, used by validate() and by the scenario reader.
+const common::FieldTable<MapConfig>& mapConfigFields();
 
 /// \brief The ground: everything at or below `height_m` is solid (within the map bounds).
 struct GroundSpec {

@@ -14,7 +14,9 @@ using gesture_formation::common::ConfigError;
 namespace {
 
 bool names(const std::vector<ConfigError>& problems, const std::string& key) {
-  return std::any_of(problems.begin(), problems.end(), [&](const ConfigError& e) { return e.key.find(key) != std::string::npos; });
+  return std::any_of(problems.begin(), problems.end(), [&](const ConfigError& e) {
+    return e.key.find(key) != std::string::npos || e.message.find(key) != std::string::npos;
+  });
 }
 
 }  // namespace

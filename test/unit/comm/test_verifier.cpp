@@ -11,6 +11,7 @@
 #include "comm_test_util.hpp"
 #include "gesture_formation/comm/signer.hpp"
 #include "gesture_formation/comm/verifier.hpp"
+#include "gesture_formation/common/config_fields.hpp"
 
 using namespace gesture_formation::comm;
 namespace t = gesture_formation::comm::testing;
@@ -377,4 +378,21 @@ TEST(CommVerifierTest, HundredThousandHostilePacketsNoneAccepted) {
               static_cast<unsigned long long>(expected[Verdict::kBadVersion]),
               static_cast<unsigned long long>(expected[Verdict::kBadType]),
               static_cast<unsigned long long>(expected[Verdict::kMalformed]));
+}
+
+// One range per setting (issue 34): the LcmBridge nodelet reads max_age_s (and checks
+// command_max_age_s) with verifierFields()' range, and validate() refuses exactly what it refuses
+// (the nodelet had [0.01, 60], validate() (0, inf): both now [0.01, 60]).
+TEST(CommVerifierTest, ValidateAndTheBridgeParametersAgreeOnBoundaries) {
+  const gesture_formation::common::Range& range = *verifierFields().rangeOf("max_age_s");
+  for (const double age : {0.01, 60.0, 0.005, 60.5, 0.0}) {
+    VerifierConfig c = config();
+    c.max_age_s = age;
+    EXPECT_EQ(c.validate().empty(), range.contains(age)) << age;
+    c = config();
+    c.max_age_s_by_type[MessageType::kFormationCommand] = age;
+    EXPECT_EQ(c.validate().empty(), range.contains(age)) << age;
+  }
+  EXPECT_TRUE(range.contains(0.01));
+  EXPECT_FALSE(range.contains(60.5));
 }

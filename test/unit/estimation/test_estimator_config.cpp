@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <string>
 
 #include "gesture_formation/estimation/estimator_config.hpp"
 
@@ -94,4 +95,34 @@ TEST(EstimatorConfigTest, RosCameraInfoYaml) {
   EXPECT_NE(kb.reason().find("image_width"), std::string::npos);
   EXPECT_NE(kb.reason().find("camera_matrix.data"), std::string::npos);
   EXPECT_NE(kb.reason().find("image_height: missing"), std::string::npos);
+}
+
+// Issue 34: the rule between keys (stereo.max_depth_m > stereo.min_depth_m) is reported beside a
+// key already out of range, each naming key and value.
+TEST(EstimatorConfigTest, YamlReportsTheRuleBesideAnOutOfRangeKey) {
+  ConfigReader r = ConfigReader::fromString("gate_chi2: -1\nstereo: {min_depth_m: 5, max_depth_m: 4}\n", "e.yaml",
+                                            ConfigReader::MissingKeys::kUseDefaults);
+  estimation::readEstimatorConfig(r);
+  ASSERT_EQ(r.problems().size(), 2u) << r.errorReport();
+  EXPECT_EQ(r.problems()[0].key, "gate_chi2");
+  EXPECT_EQ(r.problems()[1].key, "stereo.max_depth_m");
+  EXPECT_NE(r.problems()[1].message.find("got 4"), std::string::npos) << r.problems()[1].message;
+}
+
+// One range per key: the YAML reader and validate() accept and refuse the same boundary values
+// (stereo.depth_scale_m: [1e-6, 1], as the Perception nodelet had it; the estimator had (0, inf)).
+TEST(EstimatorConfigTest, ValidateAndYamlAgreeOnBoundaries) {
+  struct Case {
+    const char* text;
+    bool valid;
+  };
+  for (const Case& k : {Case{"1", true}, Case{"1e-6", true}, Case{"1.5", false}, Case{"1e-7", false}}) {
+    const std::string yaml = std::string("stereo: {depth_scale_m: ") + k.text + "}\n";
+    ConfigReader r = ConfigReader::fromString(yaml, "e.yaml", ConfigReader::MissingKeys::kUseDefaults);
+    estimation::readEstimatorConfig(r);
+    EXPECT_EQ(r.ok(), k.valid) << yaml << r.errorReport();
+    estimation::EstimatorConfig c;
+    c.stereo.depth_scale_m = std::stod(k.text);
+    EXPECT_EQ(c.validate().empty(), k.valid) << yaml;
+  }
 }

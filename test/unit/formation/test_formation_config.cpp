@@ -1,5 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <string>
+#include <vector>
+
 #include "gesture_formation/formation/formation_config.hpp"
 
 using namespace gesture_formation::formation;
@@ -86,4 +89,36 @@ TEST(FormationConfigTest, ShippedConfigHasEveryKey) {
   EXPECT_TRUE(warnings.empty()) << warnings[0];
   EXPECT_EQ(c->params.followers.size(), 2u);
   EXPECT_EQ(c->params.leader.gamma_deg, 11.0);
+}
+
+// Issue 34: a rule between keys (distance_min_m >= safety_distance_m) is reported beside a key
+// already out of range, both naming key and value; typed, not re-parsed from text.
+TEST(FormationConfigTest, YamlReportsTheRuleBesideAnOutOfRangeKey) {
+  ConfigReader r = ConfigReader::fromString("limits: {gamma_min_deg: -95, safety_distance_m: 4.5}\n",
+                                            "f.yaml", ConfigReader::MissingKeys::kUseDefaults);
+  readFormationConfig(r);
+  std::vector<std::string> keys;
+  for (const auto& p : r.problems()) keys.push_back(p.key);
+  ASSERT_EQ(keys.size(), 2u) << r.errorReport();
+  EXPECT_EQ(keys[0], "limits.gamma_min_deg");
+  EXPECT_EQ(keys[1], "limits.distance_min_m");
+  EXPECT_NE(r.problems()[1].message.find("4.5"), std::string::npos) << r.problems()[1].message;
+}
+
+// One range per key: the YAML reader and validate() accept and refuse the same boundary values
+// (β: (−180, 180] in both; validate() used to accept any finite β).
+TEST(FormationConfigTest, ValidateAndYamlAgreeOnBoundaries) {
+  struct Case {
+    double beta_deg;
+    bool valid;
+  };
+  for (const Case& k : {Case{180.0, true}, Case{-179.5, true}, Case{-180.0, false}, Case{270.0, false}}) {
+    std::string errors;
+    read("followers: [{beta_deg: " + std::to_string(k.beta_deg) + "}, {beta_deg: -60}]\n",
+         ConfigReader::MissingKeys::kUseDefaults, &errors);
+    EXPECT_EQ(errors.empty(), k.valid) << k.beta_deg << ": " << errors;
+    FormationConfig c;
+    c.params.followers[0].beta_deg = k.beta_deg;
+    EXPECT_EQ(c.validate().empty(), k.valid) << k.beta_deg;
+  }
 }

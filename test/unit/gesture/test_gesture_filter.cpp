@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <random>
+#include <string>
 
 #include "gesture_formation/gesture/gesture_filter.hpp"
 
@@ -362,4 +363,42 @@ TEST(GestureFilterReleaseTest, ConfigKeysAreReadAndValidated) {
   v.release_s = std::nan("");
   ASSERT_EQ(v.validate().size(), 1u);
   EXPECT_NE(v.validate()[0].find("release_s"), std::string::npos);
+}
+
+// Issue 34: the rule between keys (min_measurements <= window_size) is reported beside a key
+// already out of range, both naming key and value.
+TEST(GestureFilterTest, YamlReportsTheRuleBesideAnOutOfRangeKey) {
+  ConfigReader r = ConfigReader::fromString("window_size: 5\nmin_measurements: 6\ncooldown_s: -1\n", "g.yaml",
+                                            ConfigReader::MissingKeys::kUseDefaults);
+  readGestureFilterConfig(r);
+  ASSERT_EQ(r.problems().size(), 2u) << r.errorReport();
+  EXPECT_EQ(r.problems()[0].key, "cooldown_s");
+  EXPECT_NE(r.problems()[0].message.find("-1"), std::string::npos);
+  EXPECT_EQ(r.problems()[1].key, "min_measurements");
+  EXPECT_NE(r.problems()[1].message.find("6"), std::string::npos);
+}
+
+// One range per key: the YAML reader and validate() accept and refuse the same boundary values.
+TEST(GestureFilterTest, ValidateAndYamlAgreeOnBoundaries) {
+  struct Case {
+    const char* key;
+    const char* text;
+    bool valid;
+  };
+  for (const Case& k : {Case{"window_size", "100000", true}, Case{"window_size", "100001", false},
+                        Case{"ratio_threshold", "1", true}, Case{"ratio_threshold", "1.0000001", false},
+                        Case{"cooldown_s", "0", true}, Case{"max_age_s", "0", false}}) {
+    const std::string yaml = std::string(k.key) + ": " + k.text + "\nmin_measurements: 1\n";
+    ConfigReader r = ConfigReader::fromString(yaml, "g.yaml", ConfigReader::MissingKeys::kUseDefaults);
+    readGestureFilterConfig(r);
+    EXPECT_EQ(r.ok(), k.valid) << yaml << r.errorReport();
+    GestureFilterConfig c;
+    c.min_measurements = 1;
+    const double v = std::stod(k.text);
+    if (std::string(k.key) == "window_size") c.window_size = static_cast<int>(v);
+    if (std::string(k.key) == "ratio_threshold") c.ratio_threshold = v;
+    if (std::string(k.key) == "cooldown_s") c.cooldown_s = v;
+    if (std::string(k.key) == "max_age_s") c.max_age_s = v;
+    EXPECT_EQ(c.validate().empty(), k.valid) << yaml;
+  }
 }

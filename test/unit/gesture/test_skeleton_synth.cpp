@@ -1,9 +1,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+#include <utility>
 
 #include <Eigen/Geometry>
 
+#include "gesture_formation/common/config_fields.hpp"
 #include "gesture_formation/gesture/skeleton_synth.hpp"
 
 using namespace gesture_formation::gesture;
@@ -203,4 +206,35 @@ TEST(SkeletonSynthTest, ValidateNamesBadRanges) {
   ASSERT_EQ(e.size(), 2u);
   EXPECT_NE(e[0].find("fps"), std::string::npos);
   EXPECT_NE(e[1].find("distance_m"), std::string::npos);
+}
+
+// Issue 34: `gfctl synth-gestures --config` reads with synthConfigFields() and adds
+// synthConfigProblems() always: an interval's rule is reported beside a key out of range.
+TEST(SkeletonSynthTest, YamlReportsTheRuleBesideAnOutOfRangeKey) {
+  using gesture_formation::common::ConfigReader;
+  ConfigReader r = ConfigReader::fromString("fps: 500\nhold_min_s: 4\nhold_max_s: 2\n", "s.yaml",
+                                            ConfigReader::MissingKeys::kUseDefaults);
+  SynthConfig c;
+  synthConfigFields().readFields(r, "", c);
+  gesture_formation::common::addProblems(r, "", synthConfigProblems(c));
+  ASSERT_EQ(r.problems().size(), 2u) << r.errorReport();
+  EXPECT_EQ(r.problems()[0].key, "fps");
+  EXPECT_EQ(r.problems()[1].key, "hold_max_s");
+  EXPECT_NE(r.problems()[1].message.find("got 2"), std::string::npos) << r.problems()[1].message;
+}
+
+// One range per key: the reader and validate() accept and refuse the same boundary values.
+TEST(SkeletonSynthTest, ValidateAndYamlAgreeOnBoundaries) {
+  using gesture_formation::common::ConfigReader;
+  for (const auto& [text, valid] : {std::pair<const char*, bool>{"0.9", true}, {"0.9000001", false}, {"0", true},
+                                    {"-0.1", false}}) {
+    ConfigReader r = ConfigReader::fromString(std::string("dropout_max: ") + text + "\n", "s.yaml",
+                                              ConfigReader::MissingKeys::kUseDefaults);
+    SynthConfig c;
+    synthConfigFields().readFields(r, "", c);
+    EXPECT_EQ(r.ok(), valid) << text << r.errorReport();
+    SynthConfig coded;
+    coded.dropout_max = std::stod(text);
+    EXPECT_EQ(coded.validate().empty(), valid) << text;
+  }
 }

@@ -301,3 +301,34 @@ TEST(ViewFusionTest, FusionLagIsValidated) {
   ASSERT_EQ(problems.size(), 1u);
   EXPECT_NE(problems[0].find("fusion_lag_s must be in [0, 2], got -0.1"), std::string::npos) << problems[0];
 }
+
+// Issue 34: the rules between keys (distance_max > distance_min, elevation_max > elevation_min)
+// are reported beside a key already out of range.
+TEST(ViewFusionTest, YamlReportsTheRuleBesideAnOutOfRangeKey) {
+  ConfigReader r = ConfigReader::fromString(
+      "view_fusion: {vote_window_s: 61, distance_min_m: 30, distance_max_m: 20}\n", "v.yaml",
+      ConfigReader::MissingKeys::kUseDefaults);
+  (void)readViewFusionConfig(r);
+  ASSERT_EQ(r.problems().size(), 2u) << r.errorReport();
+  EXPECT_EQ(r.problems()[0].key, "view_fusion.vote_window_s");
+  EXPECT_EQ(r.problems()[1].key, "view_fusion.distance_max_m");
+  EXPECT_NE(r.problems()[1].message.find("20"), std::string::npos) << r.problems()[1].message;
+}
+
+// One range per key: the YAML reader and validate() accept and refuse the same boundary values
+// (vote_min_fraction: (0, 1] in both; the reader's [1e-9, 1] is gone).
+TEST(ViewFusionTest, ValidateAndYamlAgreeOnBoundaries) {
+  struct Case {
+    const char* text;
+    bool valid;
+  };
+  for (const Case& k : {Case{"1", true}, Case{"1e-12", true}, Case{"0", false}, Case{"1.5", false}}) {
+    const std::string yaml = std::string("view_fusion: {vote_min_fraction: ") + k.text + "}\n";
+    ConfigReader r = ConfigReader::fromString(yaml, "v.yaml", ConfigReader::MissingKeys::kUseDefaults);
+    (void)readViewFusionConfig(r);
+    EXPECT_EQ(r.ok(), k.valid) << yaml << r.errorReport();
+    ViewFusionConfig c;
+    c.vote_min_fraction = std::stod(k.text);
+    EXPECT_EQ(c.validate().empty(), k.valid) << yaml;
+  }
+}

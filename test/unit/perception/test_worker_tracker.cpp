@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/videoio.hpp>
 
+#include "gesture_formation/common/config_fields.hpp"
 #include "gesture_formation/perception/perception_pipeline.hpp"
 #include "perception_test_util.hpp"
 
@@ -193,6 +194,19 @@ TEST(WorkerTrackerTest, ConfigValidateNamesEveryBadField) {
   EXPECT_FALSE(WorkerTracker::create(cfg, std::make_unique<ScriptedDetector>(std::vector<std::vector<Detection>>{{}})));
   EXPECT_FALSE(WorkerTracker::create(WorkerTrackerConfig{}, nullptr));
   EXPECT_FALSE(parseTrackerKind("mosse"));
+}
+
+// One range per setting (issue 34): the Perception nodelet reads detect_every_k with
+// workerTrackerFields()' range, and validate() refuses exactly what it refuses (the nodelet had
+// [1, 1000], validate() >= 1: both now [1, 1000]).
+TEST(WorkerTrackerTest, ValidateAndTheNodeletParameterAgreeOnBoundaries) {
+  const common::Range& range = *workerTrackerFields().rangeOf("tracker.detect_every_k");
+  for (const int k : {1, 1000, 0, 1001}) {
+    WorkerTrackerConfig c;
+    c.detect_every_k = k;
+    EXPECT_EQ(c.validate().empty(), range.contains(k)) << k;
+  }
+  EXPECT_FALSE(range.contains(1001));
 }
 
 }  // namespace

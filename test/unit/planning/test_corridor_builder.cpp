@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 
+#include "gesture_formation/common/config_fields.hpp"
 #include "gesture_formation/planning/corridor_builder.hpp"
 #include "gesture_formation/planning/occupancy_map.hpp"
 
@@ -237,4 +238,17 @@ TEST(CorridorBuilderTest, InvalidConfigIsNamed) {
   EXPECT_NE(builder.configError().find("clearance_m"), std::string::npos);
   EXPECT_NE(builder.configError().find("local_box_margin_m[1]"), std::string::npos);
   EXPECT_EQ(builder.config().clearance_m, CorridorConfig{}.clearance_m);
+}
+
+// One range per setting (issue 34): `gfctl corridor --clearance` is read with
+// corridorConfigFields()' range, and validate() refuses exactly what it refuses.
+TEST(CorridorBuilderTest, ValidateAndTheClearanceOptionAgreeOnBoundaries) {
+  const gesture_formation::common::Range& range = *corridorConfigFields().rangeOf("clearance_m");
+  for (const double clearance : {0.0, 3.0, -1e-9, std::nan("")}) {
+    CorridorConfig c;
+    c.clearance_m = clearance;
+    EXPECT_EQ(c.validate().empty(), range.contains(clearance)) << clearance;
+  }
+  EXPECT_TRUE(range.contains(0.0));
+  EXPECT_FALSE(range.contains(-1e-9));
 }

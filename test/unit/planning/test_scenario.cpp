@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <vector>
 
 #include "gesture_formation/planning/scenario.hpp"
 
@@ -114,4 +115,47 @@ TEST(ScenarioTest, MissingMapSectionIsAnError) {
   ASSERT_FALSE(s);
   EXPECT_NE(s.reason().find("map.resolution_m: missing"), std::string::npos) << s.reason();
   EXPECT_NE(s.reason().find("map.bounds.min: missing"), std::string::npos) << s.reason();
+}
+
+// Issue 34: the map's rule between keys (bounds max > min) is reported beside a key already out
+// of range (before, only once every single key was fine: a broken map showed on a second run),
+// and a tower's rules beside a bad tower key.
+TEST(ScenarioTest, RulesBetweenKeysBesideAnOutOfRangeKey) {
+  const auto s = parseScenario(
+      "map:\n  resolution_m: 20\n  bounds: {min: [0, 0, 0], max: [10, -1, 10]}\n"
+      "towers:\n  - {name: a, base: [0, 0, 0], height_m: 30, panels: 0, cross_arms: [{height_m: 31, half_length_m: 5}]}\n",
+      "two.yaml");
+  ASSERT_FALSE(s);
+  const std::vector<std::string> expected = {"two.yaml:2: map.resolution_m: value 20 is out of range [0.01, 10]",
+                                             "two.yaml:3: map.bounds: max[1] must be > min[1]",
+                                             "two.yaml:5: towers[0].panels: value 0 is out of range [1, 1000]",
+                                             "two.yaml:5: towers[0].cross_arms[0].height_m: must be <= the tower's "
+                                             "height_m, got 31"};
+  for (const auto& e : expected) EXPECT_NE(s.reason().find(e), std::string::npos) << e << " not in:\n" << s.reason();
+  EXPECT_EQ(countLines(s.reason()), expected.size()) << s.reason();
+}
+
+// One range per key: the scenario reader and MapConfig / LatticeTowerSpec::validate() accept and
+// refuse the same boundary values.
+TEST(ScenarioTest, ValidateAndYamlAgreeOnBoundaries) {
+  struct Case {
+    const char* resolution;
+    int panels;
+    bool valid;
+  };
+  for (const Case& k : {Case{"0.01", 1000, true}, Case{"10", 1, true}, Case{"0.0099", 8, false},
+                        Case{"0.2", 1001, false}}) {
+    const std::string yaml = std::string("map:\n  resolution_m: ") + k.resolution +
+                             "\n  bounds: {min: [0, 0, 0], max: [2, 2, 10]}\n"  // 4e7 voxels at 0.01 m
+                             "towers:\n  - {name: a, base: [1, 1, 0], height_m: 8, panels: " +
+                             std::to_string(k.panels) + "}\n";
+    EXPECT_EQ(static_cast<bool>(parseScenario(yaml, "b.yaml")), k.valid) << yaml;
+    MapConfig m;
+    m.bounds = Aabb{Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(2, 2, 10)};
+    m.resolution_m = std::stod(k.resolution);
+    LatticeTowerSpec t;
+    t.height_m = 8.0;
+    t.panels = k.panels;
+    EXPECT_EQ(m.validate().empty() && t.validate().empty(), k.valid) << yaml;
+  }
 }

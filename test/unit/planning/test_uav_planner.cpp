@@ -191,7 +191,7 @@ TEST(UavPlannerTest, YamlReportsRulesBetweenKeysBesideABadKey) {
   c.corridor_box_margin_m = 0.005;
   c.corridor_margin_m = 0.0;  // else also the rule corridor_margin < corridor_box_margin
   ASSERT_EQ(c.validate().size(), 1u);
-  EXPECT_EQ(c.validate().front().rfind("qp.corridor_box_margin_m must be in (0.01, inf), got 0.005", 0), 0u)
+  EXPECT_EQ(c.validate().front().rfind("qp.corridor_box_margin_m must be > 0.01, got 0.005", 0), 0u)
       << c.validate().front();
 }
 
