@@ -95,7 +95,7 @@ def load_campaign(path, root=ROOT):
     if not isinstance(c, dict):
         raise BadInput(f"{path}: expected a mapping of campaign fields, got {type(c).__name__}")
     known = {"name", "scenarios", "profiles", "seeds", "duration_s", "timeout_s", "threads_per_mission", "model",
-             "variants", "description"}
+             "variants", "camera", "description"}
     for k in c:
         if k not in known:
             raise BadInput(f"{path}: {k}: unknown field (known: {', '.join(sorted(known))})")
@@ -172,8 +172,13 @@ def _validate(c, root):
             raise BadInput(f"variants: {k}: expected a non-empty list of values, got {vals!r}")
         if k.startswith("faults.") and "none" in profiles:
             raise BadInput(f"variants: {k}: a faults. key needs a fault profile; profiles has 'none'")
+    cameras = c.get("camera", ["synthetic"])
+    if (not isinstance(cameras, list) or not cameras or len(set(map(str, cameras))) != len(cameras)
+            or not all(m in ("synthetic", "rendered") for m in cameras)):
+        raise BadInput(f"camera: expected a list of distinct modes from [synthetic, rendered] (gfctl simulate --camera), "
+                       f"got {cameras!r}")
     return {"name": name, "scenarios": scenarios, "profiles": profiles, "seeds": seeds, "duration_s": duration,
-            "timeout_s": timeout, "threads": threads, "model": model, "variants": variants}
+            "timeout_s": timeout, "threads": threads, "model": model, "variants": variants, "cameras": cameras}
 
 
 def faults_file(root, scenario, profile):
@@ -186,7 +191,10 @@ def variant_configs(c):
     combos = [{}]
     for k, vals in c["variants"].items():
         combos = [dict(combo, **{k: v}) for combo in combos for v in vals]
-    return [{"duration_s": c["duration_s"], "overrides": combo} for combo in combos]
+    # A camera other than the default one is part of the config (and of its hash); the synthetic
+    # camera's configs keep the hashes they always had.
+    return [dict({"duration_s": c["duration_s"], "overrides": combo}, **({} if cam == "synthetic" else {"camera": cam}))
+            for combo in combos for cam in c.get("cameras", ["synthetic"])]
 
 
 def set_key(doc, dotted, value, what):
@@ -300,7 +308,8 @@ def plan_missions(c, root, commit, gfctl, gfctl_sha, model_path, model_sha, work
                     missions.append({"key": key, "config_json": json.dumps(cfg, sort_keys=True), "gfctl": gfctl,
                                      "gfctl_sha256": gfctl_sha, "model": model_path, "model_sha256": model_sha,
                                      "scenario_text": scenario_text, "faults_text": faults_text,
-                                     "duration_s": cfg["duration_s"], "timeout_s": c["timeout_s"],
+                                     "duration_s": cfg["duration_s"], "camera": cfg.get("camera"),
+                                     "timeout_s": c["timeout_s"],
                                      "threads": c["threads"], "work_root": work_root, "keep_dir": keep})
     return missions
 

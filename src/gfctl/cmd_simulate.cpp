@@ -262,6 +262,16 @@ int runOne(const Args& args, Loaded& L, std::uint64_t seed, double duration, con
   return kExitOk;
 }
 
+/// --camera synthetic|rendered and the options only the rendered camera takes; the problem or empty.
+std::string checkCameraOptions(const Args& args, const std::string& mode) {
+  if (mode != "synthetic" && mode != "rendered") return "--camera: expected synthetic or rendered, got '" + mode + "'";
+  if (mode == "rendered") return "";
+  for (const char* o : {"camera-rate", "camera-video", "models"}) {
+    if (args.has(o)) return std::string("--") + o + " needs --camera rendered";
+  }
+  return "";
+}
+
 /// --camera rendered: the camera rate (--camera-rate may lower it), the rectified camera, the
 /// models folder. Returns the problem, empty when fine.
 std::string setUpRendered(const Args& args, Loaded& L) {
@@ -293,14 +303,7 @@ int cmdSimulate(const Args& args) {
     return kExitBadInput;
   }
   const std::string camera_mode = args.get("camera", "synthetic");
-  if (camera_mode != "synthetic" && camera_mode != "rendered") {
-    return badInput(args, "--camera: expected synthetic or rendered, got '" + camera_mode + "'");
-  }
-  if (camera_mode != "rendered") {
-    for (const char* o : {"camera-rate", "camera-video", "models"}) {
-      if (args.has(o)) return badInput(args, std::string("--") + o + " needs --camera rendered");
-    }
-  }
+  if (const std::string bad = checkCameraOptions(args, camera_mode); !bad.empty()) return badInput(args, bad);
   // A mission's simulation is one thread by design (deterministic; batches and the fault matrix
   // run missions in parallel processes); only the views of a camera frame are classified
   // concurrently (--threads: one network per thread, as each UAV classifies on its own
