@@ -26,13 +26,14 @@ load_after=$(cut -d' ' -f1-3 /proc/loadavg)
 mkdir -p docs/results
 MD=$(mktemp /tmp/gf-camera-loop-md.XXXXXX)
 /usr/bin/python3 - "$OUT" "$load_before" "$load_after" "$(git rev-parse --short HEAD)" "$SEED" > "$MD" <<'PY'
-import datetime, json, subprocess, sys
+import datetime, json, re, subprocess, sys
 out, before, after, commit, seed = sys.argv[1:6]
 r = json.load(open(out + "/rendered/metrics.json"))
 s = json.load(open(out + "/synthetic/metrics.json"))
 p = r["perception"]
 cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), "?")
-gl = next((l.split("(", 1)[1].split(")", 1)[0] for l in open(out + "/rendered.log") if "rendered camera (" in l), "?")
+gl = next((m.group(1) for m in map(re.compile(r"rendered camera \((.*)\), [0-9.]+ frames/s").search,
+                                   open(out + "/rendered.log")) if m), "?")
 per_s = r["wall_time_s"] / r["sim_time_s"]
 print("# The rendered closed loop: cost\n")
 print(f"Written by `tools/bench_camera_loop.sh` on {datetime.date.today().isoformat()} at commit {commit}: the power-tower "

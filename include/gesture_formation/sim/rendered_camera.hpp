@@ -13,6 +13,11 @@
 /// pipeline's output per frame and UAV (PerceptionRecord), and each UAV's annotated stream may
 /// be written as a video.
 ///
+/// What frame() returns differs from the synthetic camera in two fields: `sensors.visibility` is
+/// kVisible when the pipeline found the worker, kBlackout in an injected camera blackout (no frame),
+/// else kDropout (the pipeline did not find the worker); `skeleton` carries only the frame's truth
+/// label (its keypoints stay empty: no synthetic skeleton leaves this class).
+///
 /// Library gesture_formation_sim_render (sim + render + perception); the onboard nodelets
 /// never link it. Determinism: the same seed gives the same images and the same pipeline
 /// outputs on one machine (wall-clock timings aside).
