@@ -40,7 +40,8 @@ const Registrar kRegistrar{
     "[--camera-video DIR] [--models DIR]   closed-loop mission: metrics.json, timeline.csv, events.csv, modes.csv, "
     "timeline.png (docs/design.md §8.4); --faults replaces mission.faults with FILE's faults: section, --fault-profile NAME "
     "uses <scenario dir>/../faults/NAME.yaml (config/faults/; docs/safety.md); --threads N classifies the UAVs' "
-    "camera views of a frame on N threads (default: the UAV count, at most the cores; results do not depend on it); "
+    "camera views of a frame on N threads, with --camera rendered also runs their perception pipelines on them (default: "
+    "the UAV count, at most the cores; results do not depend on it); "
     "--camera rendered renders every UAV's camera and runs the real perception pipeline on the images (EGL; "
     "docs/simulation.md §8): perception.csv and a metrics.json perception section; --camera-rate lowers its frame "
     "rate, --camera-video writes each UAV's annotated stream (MJPG .avi)",
@@ -364,10 +365,11 @@ int cmdSimulate(const Args& args) {
     if (!bad.empty()) return badInput(args, bad);
   }
   const std::string model = args.has("model") ? args.get("model") : L.mission.gesture_model;
+  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const int threads = threads_arg > 0 ? static_cast<int>(threads_arg)
+                                      : std::clamp(L.mission.formation.params.uavCount(), 1, std::min(cores, sim::kMaxClassifierThreads));
+  L.camera.threads = threads;  // --camera rendered: the UAVs' perception pipelines of a frame, too
   if (!model.empty()) {
-    const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-    const int threads = threads_arg > 0 ? static_cast<int>(threads_arg)
-                                        : std::clamp(L.mission.formation.params.uavCount(), 1, std::min(cores, sim::kMaxClassifierThreads));
     auto c = sim::loadOnnxClassifier(model, threads);
     if (!c) return badInput(args, model + ": cannot load the gesture model: " + c.reason());
     L.classifier = std::move(*c);

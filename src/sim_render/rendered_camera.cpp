@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <thread>
 
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
@@ -45,7 +46,10 @@ struct RenderedCamera::Camera {
 
 /// What one camera made of one frame.
 struct CameraResult {
+  bool rendered = false;   ///< the image exists
   bool processed = false;  ///< rendered and through the pipeline
+  std::string error;       ///< why not
+  double render_ms = 0.0;
   bool found = false;      ///< the worker's box
   estimation::Box box;
   gesture::Skeleton2D skeleton;  ///< image pixels, on the tracker's box
@@ -160,6 +164,7 @@ void annotate(cv::Mat& img, const CameraResult& r, const std::optional<gesture::
 std::vector<std::string> RenderedCameraConfig::validate() const {
   std::vector<std::string> e;
   if (models_root.empty()) e.push_back("models_root: must not be empty");
+  if (threads < 1 || threads > 16) e.push_back("threads: must be in 1..16, got " + std::to_string(threads));
   for (const auto& p : perception.validate()) e.push_back("perception." + p);
   if (!(stereo.min_depth_m >= 0.0)) e.push_back("stereo.min_depth_m: must be >= 0, got " + std::to_string(stereo.min_depth_m));
   if (!stereo_max_from_mission && !(stereo.max_depth_m > stereo.min_depth_m)) {
@@ -247,8 +252,8 @@ common::Result<std::unique_ptr<RenderedCamera>> RenderedCamera::create(const Ren
   return R::ok(std::move(cam));
 }
 
-CameraResult RenderedCamera::processCamera(std::size_t i, double t, const Eigen::Isometry3d& T_world_camera,
-                                           const WorkerState& ws, double extra_render_ms) {
+CameraResult RenderedCamera::renderCamera(std::size_t i, double t, const Eigen::Isometry3d& T_world_camera,
+                                          double extra_render_ms) {
   Camera& c = *cameras_[i];
   CameraResult r;
   r.T_world_camera = T_world_camera;
@@ -262,21 +267,27 @@ CameraResult RenderedCamera::processCamera(std::size_t i, double t, const Eigen:
   view.T_world_camera = T_world_camera;
   auto rendered = renderer_->render(view, i);
   if (!rendered) {
-    if (error_.empty()) error_ = "t " + std::to_string(t) + " s, uav " + std::to_string(i) + ": render: " + rendered.reason();
+    r.error = "t " + std::to_string(t) + " s, uav " + std::to_string(i) + ": render: " + rendered.reason();
     return r;
   }
   cv::cvtColor(rendered->rgb, r.bgr, cv::COLOR_RGB2BGR);
-  const double render_ms = msSince(t0) + extra_render_ms;
+  r.render_ms = msSince(t0) + extra_render_ms;
+  r.truth = rendered->worker;
+  r.depth_m = rendered->depth_m;
+  r.rendered = true;
+  return r;
+}
+
+void RenderedCamera::runPipeline(std::size_t i, double t, CameraResult& r) {
+  if (!r.rendered) return;
+  Camera& c = *cameras_[i];
   auto pf = c.pipeline->step(r.bgr);
   if (!pf) {
-    if (error_.empty()) error_ = "t " + std::to_string(t) + " s, uav " + std::to_string(i) + ": perception: " + pf.reason();
-    return r;
+    r.error = "t " + std::to_string(t) + " s, uav " + std::to_string(i) + ": perception: " + pf.reason();
+    return;
   }
   r.processed = true;
   r.perception = std::move(*pf);
-  r.truth = rendered->worker;
-  r.depth_m = rendered->depth_m;
-  records_.push_back(makeRecord(t, i, T_world_camera.translation(), ws, r.perception, r.truth, render_ms));
   const perception::TrackStep& tr = r.perception.track;
   r.found = tr.found;
   if (r.found) {
@@ -285,7 +296,33 @@ CameraResult RenderedCamera::processCamera(std::size_t i, double t, const Eigen:
     r.skeleton = toSkeleton2D(r.perception.skeleton, tr.box_px);
     r.classify = r.perception.has_skeleton && r.perception.fifo_full;
   }
-  return r;
+}
+
+void RenderedCamera::processCameras(double t, const WorkerState& ws, std::vector<CameraResult>& results,
+                                    const std::vector<bool>& wanted, const CameraPoses& cameras, double pose_ms) {
+  // Rendering is serial (one GL context); the UAVs' pipelines are independent (each UAV runs its
+  // own) and run on up to config_.threads threads: the results do not depend on it.
+  std::vector<std::size_t> todo;
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    if (!wanted[i]) continue;
+    results[i] = renderCamera(i, t, cameras[i], i == 0 ? pose_ms : 0.0);
+    todo.push_back(i);
+  }
+  const std::size_t lanes = std::max<std::size_t>(1, std::min<std::size_t>(todo.size(), static_cast<std::size_t>(config_.threads)));
+  const auto lane = [&](std::size_t l) {
+    for (std::size_t k = l; k < todo.size(); k += lanes) runPipeline(todo[k], t, results[todo[k]]);
+  };
+  std::vector<std::thread> helpers;
+  for (std::size_t l = 1; l < lanes; ++l) helpers.emplace_back(lane, l);
+  lane(0);
+  for (auto& h : helpers) h.join();
+  for (const std::size_t i : todo) {  // in camera order: the records and the first error do not depend on the threads
+    const CameraResult& r = results[i];
+    if (!r.error.empty() && error_.empty()) error_ = r.error;
+    if (r.processed) {
+      records_.push_back(makeRecord(t, i, r.T_world_camera.translation(), ws, r.perception, r.truth, r.render_ms));
+    }
+  }
 }
 
 SensorFrame RenderedCamera::leaderSensors(double t, const CameraResult& leader, bool blackout, const MultirotorState& state,
@@ -316,7 +353,7 @@ LeaderCameraFrame RenderedCamera::frame(double t, const MultirotorState& leader,
   std::vector<const MultirotorState*> states{&leader};
   for (const MultirotorState& f : followers) states.push_back(&f);
   std::vector<Eigen::Vector3d> camera_world;
-  std::vector<Eigen::Isometry3d, Eigen::aligned_allocator<Eigen::Isometry3d>> bodies, cameras;
+  CameraPoses bodies, cameras;
   for (const MultirotorState* s : states) {
     camera_world.push_back(s->p_world);
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
@@ -337,14 +374,13 @@ LeaderCameraFrame RenderedCamera::frame(double t, const MultirotorState& leader,
   bool blackout = false;
   for (const auto& [a, b] : cfg_.faults.camera_blackouts) blackout = blackout || (t >= a && t < b);
   std::vector<CameraResult> results(states.size());
-  if (!blackout) results[0] = processCamera(0, t, cameras[0], ws, pose_ms);  // a blackout: the leader gets no frame
+  std::vector<bool> wanted(states.size(), true);
+  wanted[0] = !blackout;  // a blackout: the leader gets no frame
+  for (std::size_t i = 0; i < followers.size(); ++i) wanted[i + 1] = i >= online.size() || online[i];  // offline: none
+  processCameras(t, ws, results, wanted, cameras, pose_ms);
   out.sensors = leaderSensors(t, results[0], blackout, leader, ws, out.range_outliers);
   out.followers.resize(followers.size());
-  for (std::size_t i = 0; i < followers.size(); ++i) {
-    if (i < online.size() && !online[i]) continue;  // its computer is down: no frame
-    results[i + 1] = processCamera(i + 1, t, cameras[i + 1], ws, 0.0);
-    out.followers[i].visible = results[i + 1].found;
-  }
+  for (std::size_t i = 0; i < followers.size(); ++i) out.followers[i].visible = results[i + 1].found;
   // Every full window of the frame, classified together (MissionClassifier::classifyAll).
   std::vector<const gesture::SkeletonWindow*> windows;
   std::vector<std::optional<gesture::Classification>*> slots;

@@ -56,6 +56,9 @@ struct RenderedCameraConfig {
   estimation::StereoDistanceConfig stereo;
   bool stereo_max_from_mission = true;  ///< max_depth_m ← mission stereo.max_range_m
   std::string video_dir;  ///< non-empty: each UAV's annotated stream as DIR/uav<i>_<name>.avi (MJPG)
+  /// The UAVs' pipelines of one frame run on up to this many threads (each UAV runs its own
+  /// pipeline on its own computer), 1..16; the results do not depend on it.
+  int threads = 1;
   /// Every problem, each naming the field and value.
   std::vector<std::string> validate() const;
 };
@@ -93,9 +96,14 @@ class RenderedCamera : public CameraSource {
 
  private:
   RenderedCamera(const MissionConfig& mission, const planning::OccupancyMap* map, std::uint64_t seed);
-  /// Renders UAV `i`'s camera at `T_world_camera` and runs its pipeline; records the truth.
-  CameraResult processCamera(std::size_t i, double t_s, const Eigen::Isometry3d& T_world_camera, const WorkerState& ws,
-                             double extra_render_ms);
+  using CameraPoses = std::vector<Eigen::Isometry3d, Eigen::aligned_allocator<Eigen::Isometry3d>>;
+  /// Renders UAV `i`'s camera at `T_world_camera` (serial: one GL context).
+  CameraResult renderCamera(std::size_t i, double t_s, const Eigen::Isometry3d& T_world_camera, double extra_render_ms);
+  /// UAV `i`'s pipeline on its rendered image (touches only camera i and `r`: may run concurrently).
+  void runPipeline(std::size_t i, double t_s, CameraResult& r);
+  /// Every wanted camera: rendered, through its pipeline, recorded against the truth.
+  void processCameras(double t_s, const WorkerState& ws, std::vector<CameraResult>& results, const std::vector<bool>& wanted,
+                      const CameraPoses& cameras, double pose_ms);
   /// The leader's sensor frame: the pipeline's box, the stereo range in it, synthetic UWB, faults.
   SensorFrame leaderSensors(double t_s, const CameraResult& leader, bool blackout, const MultirotorState& state,
                             const WorkerState& ws, int& range_outliers);
