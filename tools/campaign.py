@@ -10,6 +10,7 @@ hash). A mission already stored is never run again, so any run resumes where the
   campaign.py report [CAMPAIGN.yaml] [--commit C] [--out MD] [--plot PNG]   fault-matrix report
   campaign.py compare A B [--campaign CAMPAIGN.yaml]                        commit A vs commit B
   campaign.py bench CAMPAIGN.yaml [--workers-list 1,2]                      throughput, overhead
+  campaign.py cameras [CAMPAIGN.yaml] [--commit C]                          synthetic vs rendered camera
   campaign.py import-csv RUNS.csv ...                                       legacy runs files
   campaign.py failures [--commit C]                                         failed attempts, log tails
 
@@ -554,6 +555,11 @@ def cmd_compare(args):
     return campaign_report.compare(args, load_campaign(args.campaign) if args.campaign else None)
 
 
+def cmd_cameras(args):
+    import campaign_report
+    return campaign_report.cameras(args, load_campaign(args.campaign) if args.campaign else None)
+
+
 def cmd_bench(args):
     import campaign_report
     return campaign_report.bench(args, run_campaign)
@@ -611,6 +617,11 @@ def main(argv=None):
     p.add_argument("--campaign", default=None, help="restrict to this campaign's scenarios, profiles and seeds")
     p.add_argument("--limit", type=int, default=25, help="differing missions listed (default 25)")
     p.set_defaults(func=cmd_compare)
+
+    p = sub.add_parser("cameras", help="synthetic vs rendered camera per seed (campaign field camera) from the store")
+    p.add_argument("campaign", nargs="?", default=None, help="restrict to this campaign's scenarios, profiles and seeds")
+    p.add_argument("--commit", help="commit (prefix) of the missions (default: the commit with the most missions)")
+    p.set_defaults(func=cmd_cameras)
 
     p = sub.add_parser("import-csv", help="import runs files of the former tools/run_fault_matrix.sh once")
     p.add_argument("csv", nargs="+")
