@@ -10,6 +10,7 @@ hash). A mission already stored is never run again, so any run resumes where the
   campaign.py report [CAMPAIGN.yaml] [--commit C] [--out MD] [--plot PNG]   fault-matrix report
   campaign.py compare A B [--campaign CAMPAIGN.yaml]                        commit A vs commit B
   campaign.py bench CAMPAIGN.yaml [--workers-list 1,2]                      throughput, overhead
+  campaign.py cameras [CAMPAIGN.yaml] [--commit C]                          synthetic vs rendered camera
   campaign.py import-csv RUNS.csv ...                                       legacy runs files
   campaign.py failures [--commit C]                                         failed attempts, log tails
 
@@ -95,7 +96,7 @@ def load_campaign(path, root=ROOT):
     if not isinstance(c, dict):
         raise BadInput(f"{path}: expected a mapping of campaign fields, got {type(c).__name__}")
     known = {"name", "scenarios", "profiles", "seeds", "duration_s", "timeout_s", "threads_per_mission", "model",
-             "variants", "description"}
+             "variants", "camera", "description"}
     for k in c:
         if k not in known:
             raise BadInput(f"{path}: {k}: unknown field (known: {', '.join(sorted(known))})")
@@ -172,8 +173,13 @@ def _validate(c, root):
             raise BadInput(f"variants: {k}: expected a non-empty list of values, got {vals!r}")
         if k.startswith("faults.") and "none" in profiles:
             raise BadInput(f"variants: {k}: a faults. key needs a fault profile; profiles has 'none'")
+    cameras = c.get("camera", ["synthetic"])
+    if (not isinstance(cameras, list) or not cameras or len(set(map(str, cameras))) != len(cameras)
+            or not all(m in ("synthetic", "rendered") for m in cameras)):
+        raise BadInput(f"camera: expected a list of distinct modes from [synthetic, rendered] (gfctl simulate --camera), "
+                       f"got {cameras!r}")
     return {"name": name, "scenarios": scenarios, "profiles": profiles, "seeds": seeds, "duration_s": duration,
-            "timeout_s": timeout, "threads": threads, "model": model, "variants": variants}
+            "timeout_s": timeout, "threads": threads, "model": model, "variants": variants, "cameras": cameras}
 
 
 def faults_file(root, scenario, profile):
@@ -186,7 +192,10 @@ def variant_configs(c):
     combos = [{}]
     for k, vals in c["variants"].items():
         combos = [dict(combo, **{k: v}) for combo in combos for v in vals]
-    return [{"duration_s": c["duration_s"], "overrides": combo} for combo in combos]
+    # A camera other than the default one is part of the config (and of its hash); the synthetic
+    # camera's configs keep the hashes they always had.
+    return [dict({"duration_s": c["duration_s"], "overrides": combo}, **({} if cam == "synthetic" else {"camera": cam}))
+            for combo in combos for cam in c.get("cameras", ["synthetic"])]
 
 
 def set_key(doc, dotted, value, what):
@@ -300,7 +309,8 @@ def plan_missions(c, root, commit, gfctl, gfctl_sha, model_path, model_sha, work
                     missions.append({"key": key, "config_json": json.dumps(cfg, sort_keys=True), "gfctl": gfctl,
                                      "gfctl_sha256": gfctl_sha, "model": model_path, "model_sha256": model_sha,
                                      "scenario_text": scenario_text, "faults_text": faults_text,
-                                     "duration_s": cfg["duration_s"], "timeout_s": c["timeout_s"],
+                                     "duration_s": cfg["duration_s"], "camera": cfg.get("camera"),
+                                     "timeout_s": c["timeout_s"],
                                      "threads": c["threads"], "work_root": work_root, "keep_dir": keep})
     return missions
 
@@ -545,6 +555,11 @@ def cmd_compare(args):
     return campaign_report.compare(args, load_campaign(args.campaign) if args.campaign else None)
 
 
+def cmd_cameras(args):
+    import campaign_report
+    return campaign_report.cameras(args, load_campaign(args.campaign) if args.campaign else None)
+
+
 def cmd_bench(args):
     import campaign_report
     return campaign_report.bench(args, run_campaign)
@@ -602,6 +617,11 @@ def main(argv=None):
     p.add_argument("--campaign", default=None, help="restrict to this campaign's scenarios, profiles and seeds")
     p.add_argument("--limit", type=int, default=25, help="differing missions listed (default 25)")
     p.set_defaults(func=cmd_compare)
+
+    p = sub.add_parser("cameras", help="synthetic vs rendered camera per seed (campaign field camera) from the store")
+    p.add_argument("campaign", nargs="?", default=None, help="restrict to this campaign's scenarios, profiles and seeds")
+    p.add_argument("--commit", help="commit (prefix) of the missions (default: the commit with the most missions)")
+    p.set_defaults(func=cmd_cameras)
 
     p = sub.add_parser("import-csv", help="import runs files of the former tools/run_fault_matrix.sh once")
     p.add_argument("csv", nargs="+")

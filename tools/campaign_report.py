@@ -9,6 +9,7 @@ bench:  the same small batch with 1, 2, ... local workers: missions per hour, sp
         docs/results/campaigns.md.
 """
 import datetime
+import json
 import os
 import shutil
 import statistics
@@ -388,6 +389,58 @@ def compare(args, campaign):
         what = ", ".join(f"{label} {_fmt(va)} → {_fmt(vb)}" for _, _, label, va, vb, _ in bad)
         print(f"  {os.path.basename(k[0])} {k[2]} seed {k[3]} config {k[1][:8]}: {what}"
               + ("  NEW SAFETY VIOLATION" if new_violation else ""))
+    return 0
+
+
+# ---- cameras: synthetic vs rendered ------------------------------------------------------------
+CAMERA_FIGURES = [  # (metrics.json key, label, format)
+    ("collisions", "collisions", "d"), ("min_mutual_distance_m", "min mutual [m]", ".2f"),
+    ("min_obstacle_distance_m", "min obstacle [m]", ".2f"), ("min_human_distance_m", "min human [m]", ".2f"),
+    ("requests_applied", "requests applied", "d"), ("gestures_successful", "gestures successful", "d"),
+    ("gestures_performed", "of performed", "d"), ("gesture_mean_latency_s", "latency [s]", ".2f"),
+    ("false_adaptations", "false adaptations", "d"), ("human_estimate_error_rms_m", "estimate error [m]", ".2f"),
+]
+
+
+def _camera_of(row):
+    return json.loads(row["config_json"]).get("camera", "synthetic")
+
+
+def cameras(args, campaign):
+    """Per seed and camera (gfctl simulate --camera; the campaign field `camera`): the safety and gesture
+    figures of one commit's missions side by side, and the rendered missions' perception by distance."""
+    store = Store(args.store, create=False)
+    try:
+        prefix = args.commit or (store.commits()[0][0] if store.commits() else "")
+        rows, err = _commit_rows(store, prefix, campaign)
+    finally:
+        store.close()
+    if err:
+        print(f"campaign.py cameras: {err}", file=sys.stderr)
+        return 2
+    by = {}
+    for r in rows:
+        by.setdefault((r["scenario"], r["profile"], r["seed"]), {})[_camera_of(r)] = json.loads(r["metrics_json"] or "{}")
+    modes = sorted({_camera_of(r) for r in rows}, key=lambda m: (m != "synthetic", m))
+    print(f"commit {rows[0]['source_commit'][:10]}: {len(rows)} missions; each cell: " + " | ".join(modes))
+    print("| scenario | profile | seed | " + " | ".join(label for _, label, _ in CAMERA_FIGURES) + " |")
+    print("|" + " --- |" * (3 + len(CAMERA_FIGURES)))
+    for (scenario, profile, seed), per in sorted(by.items()):
+        cells = []
+        for key, _, fmt in CAMERA_FIGURES:
+            vals = [per.get(m, {}).get(key) for m in modes]
+            cells.append(" / ".join("–" if v is None else format(v, fmt) for v in vals))
+        print(f"| {os.path.basename(scenario)} | {profile} | {seed} | " + " | ".join(cells) + " |")
+    rendered = [(k, per["rendered"]["perception"]) for k, per in sorted(by.items())
+                if "perception" in per.get("rendered", {})]
+    if rendered:
+        print("\nrendered camera, perception against the truth (detection rate, keypoint error as a fraction of the "
+              "figure) by distance:")
+        for (scenario, profile, seed), p in rendered:
+            bins = ", ".join(f"{b['bin']} m: {_fmt(b['detection_rate'])} / {_fmt(b['keypoint_error_fraction_median'])} "
+                             f"({b['frames']})" for b in p["by_distance_m"])
+            print(f"  {os.path.basename(scenario)} {profile} seed {seed}: {bins}; identity switches "
+                  f"{p['identity_switches']}")
     return 0
 
 

@@ -146,6 +146,8 @@ def run_mission(spec):
             cmd += ["--faults", faults]
         if spec.get("duration_s"):
             cmd += ["--duration", repr(float(spec["duration_s"]))]
+        if spec.get("camera"):  # gfctl simulate --camera rendered (docs/simulation.md §8)
+            cmd += ["--camera", spec["camera"]]
         log = os.path.join(work, "gfctl.log")
         t0 = time.time()
         with open(log, "wb") as logf:

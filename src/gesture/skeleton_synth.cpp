@@ -617,6 +617,7 @@ SynthSequence SkeletonSynthesizer::project(const Script& script, int id, const V
       sk.c[i] = conf;
     }
     seq.frames.push_back(frame);
+    seq.bodies.push_back(body);
   }
   return seq;
 }

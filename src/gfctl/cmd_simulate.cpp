@@ -1,5 +1,6 @@
 // gfctl simulate --scenario FILE --out DIR [--seed N] [--seeds A..B] [--duration S] [--model ONNX] [--no-plot]
 //                [--faults FILE | --fault-profile NAME] [--threads N]
+//                [--camera synthetic|rendered] [--camera-rate HZ] [--camera-video DIR] [--models DIR]
 // (docs/design.md §8.4; docs/simulation.md)
 #include <sys/stat.h>
 
@@ -23,6 +24,7 @@
 #include "gesture_formation/planning/occupancy_map.hpp"
 #include "gesture_formation/planning/scenario.hpp"
 #include "gesture_formation/sim/mission_runner.hpp"
+#include "gesture_formation/sim/rendered_camera.hpp"
 
 namespace gesture_formation::gfctl {
 
@@ -34,10 +36,15 @@ int cmdSimulate(const Args& args);
 const Registrar kRegistrar{
     "simulate",
     "--scenario FILE --out DIR [--seed N | --seeds A..B] [--duration S] [--model ONNX] [--no-plot] "
-    "[--faults FILE | --fault-profile NAME] [--threads N]   closed-loop mission: metrics.json, timeline.csv, events.csv, modes.csv, "
+    "[--faults FILE | --fault-profile NAME] [--threads N] [--camera synthetic|rendered] [--camera-rate HZ] "
+    "[--camera-video DIR] [--models DIR]   closed-loop mission: metrics.json, timeline.csv, events.csv, modes.csv, "
     "timeline.png (docs/design.md §8.4); --faults replaces mission.faults with FILE's faults: section, --fault-profile NAME "
     "uses <scenario dir>/../faults/NAME.yaml (config/faults/; docs/safety.md); --threads N classifies the UAVs' "
-    "camera views of a frame on N threads (default: the UAV count, at most the cores; results do not depend on it)",
+    "camera views of a frame on N threads, with --camera rendered also runs their perception pipelines on them (default: "
+    "the UAV count, at most the cores; results do not depend on it); "
+    "--camera rendered renders every UAV's camera and runs the real perception pipeline on the images (EGL; "
+    "docs/simulation.md §8): perception.csv and a metrics.json perception section; --camera-rate lowers its frame "
+    "rate, --camera-video writes each UAV's annotated stream (MJPG .avi)",
     cmdSimulate};
 
 bool makeDir(const std::string& path) {
@@ -128,6 +135,13 @@ std::string plotCommand(const std::string& dir) {
   return python + " " + script + " " + dir;
 }
 
+/// --camera-video DIR for one run: DIR itself, or DIR/seed_N for a batch (`run_dir` ends in seed_N).
+std::string videoDirFor(const std::string& dir, const std::string& run_dir, bool batch) {
+  if (!batch) return dir;
+  const auto slash = run_dir.find_last_of('/');
+  return dir + "/" + (slash == std::string::npos ? run_dir : run_dir.substr(slash + 1));
+}
+
 struct Loaded {
   planning::Scenario scenario;
   sim::MissionConfig mission;
@@ -135,7 +149,48 @@ struct Loaded {
   std::shared_ptr<const planning::DistanceField> field;
   std::unique_ptr<sim::MissionClassifier> classifier;
   planning::PrimitiveSet solids;  ///< exact geometry for the obstacle-distance metric
+  bool rendered = false;          ///< --camera rendered
+  sim::RenderedCameraConfig camera;  ///< its settings (video_dir: per run)
 };
+
+constexpr int kExitNoRenderer = 1;  ///< no EGL display / OpenGL 3.3 context, or a frame failed
+
+/// The rendered camera of one run; nullptr and `rc` set when it cannot be made.
+std::unique_ptr<sim::RenderedCamera> makeRenderedCamera(const Args& args, const Loaded& L, std::uint64_t seed,
+                                                        const std::string& video_dir, int& rc) {
+  sim::RenderedCameraConfig cc = L.camera;
+  cc.video_dir = video_dir;
+  if (!video_dir.empty() && !makeDir(video_dir)) {
+    rc = badInput(args, "--camera-video: cannot create directory " + video_dir);
+    return nullptr;
+  }
+  auto cam = sim::RenderedCamera::create(cc, L.mission, L.scenario, L.map.get(), seed);
+  if (cam) return std::move(*cam);
+  if (cam.reason().find("worker asset") != std::string::npos || cam.reason().find("perception networks") != std::string::npos ||
+      cam.reason().find("--camera-video") != std::string::npos) {
+    rc = badInput(args, cam.reason());
+  } else {  // no EGL device / OpenGL context: not the input's fault; never a fall-back to synthetic inputs
+    std::cerr << "gfctl simulate: --camera rendered: " << cam.reason() << "\n";
+    rc = kExitNoRenderer;
+  }
+  return nullptr;
+}
+
+void printPerception(const sim::PerceptionSummary& p) {
+  std::cout << "  perception: worker detected in " << p.detected_in_view << "/" << p.frames_in_view
+            << " frames in view (rate " << p.detection_rate << "), keypoint error median " << p.keypoint_error_px_median
+            << " px (" << p.keypoint_error_fraction_median << " of the figure), box IoU median " << p.iou_median
+            << ", identity switches " << p.identity_switches << "; per frame render " << p.render_ms_median
+            << " ms, detect " << p.detect_ms_median << " ms, track " << p.track_ms_median << " ms, skeleton "
+            << p.skeleton_ms_median << " ms\n";
+  for (const auto* bins : {&p.by_distance, &p.by_elevation}) {
+    std::cout << "    " << (bins == &p.by_distance ? "distance m " : "elevation deg ");
+    for (const auto& b : *bins) {
+      std::cout << " [" << b.label << ": " << b.detected << "/" << b.frames << ", " << b.keypoint_error_px_median << " px]";
+    }
+    std::cout << "\n";
+  }
+}
 
 int runOne(const Args& args, Loaded& L, std::uint64_t seed, double duration, const std::string& dir, bool plot,
            sim::MissionMetrics* metrics_out) {
@@ -146,7 +201,16 @@ int runOne(const Args& args, Loaded& L, std::uint64_t seed, double duration, con
   world.ground_height_m = L.scenario.ground.enabled ? L.scenario.ground.height_m : -1e9;
   world.solids = &L.solids;
   const auto planners = sim::uavPlannerFactory(L.mission.planner, L.map, L.field);
-  const auto out = sim::runMission(L.mission, world, planners, L.classifier.get(), seed, duration);
+  std::unique_ptr<sim::RenderedCamera> camera;
+  if (L.rendered) {
+    int rc = kExitOk;
+    const std::string video = args.has("camera-video") ? videoDirFor(args.get("camera-video"), dir, args.has("seeds")) : "";
+    camera = makeRenderedCamera(args, L, seed, video, rc);
+    if (!camera) return rc;
+    std::cout << "seed " << seed << ": rendered camera (" << camera->glRenderer() << "), " << L.mission.camera.rate_hz
+              << " frames/s per UAV" << (video.empty() ? "" : ", video in " + video) << "\n";
+  }
+  const auto out = sim::runMission(L.mission, world, planners, L.classifier.get(), seed, duration, camera.get());
   if (!out) return badInput(args, out.reason());
   const auto& m = out->metrics;
   std::string err;
@@ -171,6 +235,11 @@ int runOne(const Args& args, Loaded& L, std::uint64_t seed, double duration, con
             << m.commands_stale << ", duplicate commands " << m.commands_duplicate << ", range outliers "
             << m.range_outliers << ", inter-UAV messages " << m.messages_sent << " (lost " << m.messages_lost
             << ", duplicated " << m.messages_duplicated << ", reordered " << m.messages_reordered << ")\n";
+  if (m.perception) printPerception(*m.perception);
+  if (camera && !camera->error().empty()) {
+    std::cerr << "gfctl simulate: --camera rendered: a frame failed: " << camera->error() << "\n";
+    return kExitNoRenderer;
+  }
   {
     std::vector<std::pair<int, std::string>> reasons;
     for (const auto& [why, count] : m.plan_failure_reasons) reasons.emplace_back(count, why);
@@ -194,10 +263,48 @@ int runOne(const Args& args, Loaded& L, std::uint64_t seed, double duration, con
   return kExitOk;
 }
 
+/// --camera synthetic|rendered and the options only the rendered camera takes; the problem or empty.
+std::string checkCameraOptions(const Args& args, const std::string& mode) {
+  if (mode != "synthetic" && mode != "rendered") return "--camera: expected synthetic or rendered, got '" + mode + "'";
+  if (mode == "rendered") return "";
+  for (const char* o : {"camera-rate", "camera-video", "models"}) {
+    if (args.has(o)) return std::string("--") + o + " needs --camera rendered";
+  }
+  return "";
+}
+
+/// --camera rendered: the camera rate (--camera-rate may lower it), the rectified camera, the
+/// models folder. Returns the problem, empty when fine.
+std::string setUpRendered(const Args& args, Loaded& L) {
+  L.rendered = true;
+  if (args.has("camera-rate")) {
+    const auto hz = common::parseDouble(args.get("camera-rate"));
+    const double max_hz = L.mission.camera.rate_hz;
+    // Below 1 / LeaderCamera::kSkeletonGapS every frame would start a new FIFO.
+    if (!hz || !(*hz >= 3.0 && *hz <= max_hz)) {
+      return "--camera-rate: expected frames/s in [3, " + formatDouble(max_hz) + "] (the mission's camera.rate_hz), got '" +
+             args.get("camera-rate") + "'";
+    }
+    L.mission.camera.rate_hz = *hz;
+  }
+  // The rendered image is the rectified one: the estimator gets the camera without distortion.
+  auto& d = L.mission.estimator.camera.distortion;
+  if (std::any_of(d.begin(), d.end(), [](double k) { return k != 0.0; })) {
+    std::cerr << "gfctl simulate: note: --camera rendered: the rendered images are rectified; the estimator uses "
+                 "mission.estimator.camera without its distortion\n";
+    d.fill(0.0);
+  }
+  L.camera.models_root = modelsRoot(args);
+  return "";
+}
+
 int cmdSimulate(const Args& args) {
-  if (!checkOptions(args, {"scenario", "out"}, {"seed", "seeds", "duration", "model", "no-plot", "faults", "fault-profile", "threads"})) {
+  if (!checkOptions(args, {"scenario", "out"}, {"seed", "seeds", "duration", "model", "no-plot", "faults", "fault-profile", "threads",
+                                                 "camera", "camera-rate", "camera-video", "models"})) {
     return kExitBadInput;
   }
+  const std::string camera_mode = args.get("camera", "synthetic");
+  if (const std::string bad = checkCameraOptions(args, camera_mode); !bad.empty()) return badInput(args, bad);
   // A mission's simulation is one thread by design (deterministic; batches and the fault matrix
   // run missions in parallel processes); only the views of a camera frame are classified
   // concurrently (--threads: one network per thread, as each UAV classifies on its own
@@ -253,11 +360,16 @@ int cmdSimulate(const Args& args) {
   L.scenario = std::move(*sc);
   L.solids = L.scenario.primitives();
   L.mission = std::move(*mission);
+  if (camera_mode == "rendered") {
+    const std::string bad = setUpRendered(args, L);
+    if (!bad.empty()) return badInput(args, bad);
+  }
   const std::string model = args.has("model") ? args.get("model") : L.mission.gesture_model;
+  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const int threads = threads_arg > 0 ? static_cast<int>(threads_arg)
+                                      : std::clamp(L.mission.formation.params.uavCount(), 1, std::min(cores, sim::kMaxClassifierThreads));
+  L.camera.threads = threads;  // --camera rendered: the UAVs' perception pipelines of a frame, too
   if (!model.empty()) {
-    const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-    const int threads = threads_arg > 0 ? static_cast<int>(threads_arg)
-                                        : std::clamp(L.mission.formation.params.uavCount(), 1, std::min(cores, sim::kMaxClassifierThreads));
     auto c = sim::loadOnnxClassifier(model, threads);
     if (!c) return badInput(args, model + ": cannot load the gesture model: " + c.reason());
     L.classifier = std::move(*c);

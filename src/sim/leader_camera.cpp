@@ -118,6 +118,23 @@ common::Result<std::unique_ptr<MissionClassifier>> loadOnnxClassifier(const std:
   return R::ok(std::make_unique<OnnxClassifier>(std::move(nets)));
 }
 
+int applyRangeFaults(const FaultConfig& faults, double t, SensorFrame& frame, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  int outliers = 0;
+  if (inWindow(faults.uwb_dropouts, t)) frame.d_uwb_m = std::numeric_limits<double>::quiet_NaN();
+  if (inWindow(faults.stereo_dropouts, t)) frame.d_stereo_m = std::numeric_limits<double>::quiet_NaN();
+  for (double* d : {&frame.d_uwb_m, &frame.d_stereo_m}) {
+    const double u_hit = u01(rng), u_size = u01(rng), u_sign = u01(rng);  // fixed draws per frame
+    if (std::isfinite(*d) && u_hit < faults.range_outliers.probability) {
+      const RangeOutlierConfig& ro = faults.range_outliers;
+      const double err = ro.min_error_m + u_size * (ro.max_error_m - ro.min_error_m);
+      *d = std::max(0.1, *d + (u_sign < 0.5 ? -err : err));
+      ++outliers;
+    }
+  }
+  return outliers;
+}
+
 LeaderCamera::LeaderCamera(const MissionConfig& config, const planning::OccupancyMap* map, std::uint64_t seed)
     : cfg_(config),
       sensors_(config.camera, config.stereo, config.uwb, map, makeRng(seed, Stream::kCamera),
@@ -141,17 +158,7 @@ LeaderCameraFrame LeaderCamera::frame(double t, const MultirotorState& leader, c
   for (const auto& [a, b] : faults.camera_blackouts) blackout = blackout || (t >= a && t < b);
   SensorFrame& frame = out.sensors;
   frame = sensors_.observe(true_pose, ws.feet_world, ws.p_world, cfg_.worker.height_m, blackout);
-  if (inWindow(faults.uwb_dropouts, t)) frame.d_uwb_m = std::numeric_limits<double>::quiet_NaN();
-  if (inWindow(faults.stereo_dropouts, t)) frame.d_stereo_m = std::numeric_limits<double>::quiet_NaN();
-  for (double* d : {&frame.d_uwb_m, &frame.d_stereo_m}) {
-    const double u_hit = u01_(fault_rng_), u_size = u01_(fault_rng_), u_sign = u01_(fault_rng_);  // fixed draws per frame
-    if (std::isfinite(*d) && u_hit < faults.range_outliers.probability) {
-      const RangeOutlierConfig& ro = faults.range_outliers;
-      const double err = ro.min_error_m + u_size * (ro.max_error_m - ro.min_error_m);
-      *d = std::max(0.1, *d + (u_sign < 0.5 ? -err : err));
-      ++out.range_outliers;
-    }
-  }
+  out.range_outliers = applyRangeFaults(faults, t, frame, fault_rng_);
   std::vector<Eigen::Vector3d> cameras{true_pose.t_world_camera};
   std::vector<estimation::CameraPose> follower_poses;
   for (const MultirotorState& f : followers) {

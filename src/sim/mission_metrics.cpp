@@ -390,7 +390,14 @@ std::string metricsJson(const MissionMetrics& m) {
     for (std::size_t i = 0; i < m.not_measured.size(); ++i) os << (i ? ", " : "") << '"' << m.not_measured[i] << '"';
     os << "],\n";
   }
-  os << "  \"wall_clock_keys\": [\"planning_ms_median\", \"planning_ms_p99\", \"planning_ms_max\", \"wall_time_s\", \"real_time_factor\"]\n";
+  if (m.perception) os << "  \"perception\": " << perceptionJson(*m.perception, 2) << ",\n";
+  os << "  \"wall_clock_keys\": [\"planning_ms_median\", \"planning_ms_p99\", \"planning_ms_max\", \"wall_time_s\", \"real_time_factor\"";
+  if (m.perception) {
+    for (const char* k : {"render_ms_median", "detect_ms_median", "track_ms_median", "skeleton_ms_median", "frame_ms_median"}) {
+      os << ", \"perception." << k << '"';
+    }
+  }
+  os << "]\n";
   os << "}\n";
   return os.str();
 }
@@ -506,6 +513,11 @@ bool writeMissionFiles(const std::string& dir, const MissionOutput& out, int uav
                        std::string* error) {
   if (!writeTimelineCsv(dir + "/timeline.csv", out, uav_count, error) || !writeEventsCsv(dir + "/events.csv", out, error) ||
       (with_modes && !writeModesCsv(dir + "/modes.csv", out, error)) || !writePlansCsv(dir + "/plans.csv", out, error)) {
+    return false;
+  }
+  if (!out.perception.empty() && !writeTextFile(dir + "/perception.csv", error, [&](std::ostream& f) {
+        f << perceptionCsv(out.perception);
+      })) {
     return false;
   }
   const std::string tmp = dir + "/metrics.json.tmp", path = dir + "/metrics.json";

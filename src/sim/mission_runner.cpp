@@ -84,7 +84,7 @@ void addCounters(MissionMetrics& M, const LinkCounters& c) {
 class MissionRun {
  public:
   MissionRun(const MissionConfig& cfg, const MissionWorld& world, const PlannerFactory& planners,
-             MissionClassifier* classifier, std::uint64_t seed, formation::FormationState fstate)
+             MissionClassifier* classifier, std::uint64_t seed, formation::FormationState fstate, CameraSource* camera)
       : cfg_(cfg),
         world_(world),
         planners_(planners),
@@ -94,7 +94,8 @@ class MissionRun {
         fstate_(std::move(fstate)),
         worker_(cfg.worker, mixSeed(seed ^ static_cast<std::uint64_t>(Stream::kWorker))),
         wind_(cfg.wind, makeRng(seed, Stream::kWind)),
-        camera_(cfg, world.map, seed),
+        own_camera_(camera != nullptr ? nullptr : std::make_unique<LeaderCamera>(cfg, world.map, seed)),
+        camera_(camera != nullptr ? *camera : *own_camera_),
         kf_(cfg.estimator.filter),
         cam_model_(cfg.estimator.camera),
         // The formation's cameras vote (docs/gestures.md §4.1); min_agreeing_views 1 = the
@@ -141,7 +142,8 @@ class MissionRun {
   std::uint64_t params_version_ = 0;
   WorkerModel worker_;
   WindModel wind_;
-  LeaderCamera camera_;
+  std::unique_ptr<LeaderCamera> own_camera_;  ///< the synthetic camera, when no other was given
+  CameraSource& camera_;
   estimation::HumanKalman kf_;
   const estimation::CameraModel cam_model_;
   bool follower_views_;
@@ -259,6 +261,10 @@ MissionOutput MissionRun::run(double duration_s, std::chrono::steady_clock::time
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   MissionOutput out = metrics_.finish(worker_.episodes(), static_cast<double>(steps) * dt, wall_s);
   out.modes = std::move(modes_);
+  if (const std::vector<PerceptionRecord>* records = camera_.perceptionRecords()) {
+    out.perception = *records;
+    out.metrics.perception = summarizePerception(*records);
+  }
   return out;
 }
 
@@ -547,7 +553,7 @@ void MissionRun::setMode(int i, double t, const std::string& mode, const std::st
 
 common::Result<MissionOutput> runMission(const MissionConfig& cfg, const MissionWorld& world,
                                          const PlannerFactory& planners, MissionClassifier* classifier,
-                                         std::uint64_t seed, double duration_s) {
+                                         std::uint64_t seed, double duration_s, CameraSource* camera) {
   using R = common::Result<MissionOutput>;
   if (world.field == nullptr) return R::fail("runMission: a distance field is required");
   const auto wall0 = std::chrono::steady_clock::now();
@@ -556,7 +562,7 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
   if (static_cast<int>(cfg.uavs.size()) != n) return R::fail("runMission: uavs and formation disagree on the UAV count");
   auto fstate = formation::FormationState::create(cfg.formation.params, cfg.formation.limits, cfg.formation.duplicates);
   if (!fstate) return R::fail(fstate.reason());
-  MissionRun mission(cfg, world, planners, classifier, seed, std::move(*fstate));
+  MissionRun mission(cfg, world, planners, classifier, seed, std::move(*fstate), camera);
   const std::string bad_start = mission.addUavs();
   if (!bad_start.empty()) return R::fail(bad_start);
   mission.openLinks();

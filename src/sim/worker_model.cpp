@@ -251,8 +251,7 @@ std::vector<gesture::SynthFrame> WorkerModel::skeletonsAt(double t_s, const std:
              other_views_.size() + 1 != cameras.size()) {
     startMotion(t_s, motionFor(stateAt(t_s)), cameras, false, 0.0);
   }
-  const auto last = static_cast<long>(current_.frames.size()) - 1;
-  const auto k = static_cast<std::size_t>(std::clamp(static_cast<long>(std::floor((t_s - current_start_s_) * fps + 0.5)), 0L, last));
+  const std::size_t k = frameIndex(t_s);
   std::vector<gesture::SynthFrame> out;
   out.reserve(cameras.size());
   out.push_back(current_.frames[k]);
@@ -260,6 +259,14 @@ std::vector<gesture::SynthFrame> WorkerModel::skeletonsAt(double t_s, const std:
   for (auto& f : out) f.t_s = t_s;
   return out;
 }
+
+std::size_t WorkerModel::frameIndex(double t_s) const {
+  const auto last = static_cast<long>(current_.frames.size()) - 1;
+  return static_cast<std::size_t>(
+      std::clamp(static_cast<long>(std::floor((t_s - current_start_s_) * config_.synth.fps + 0.5)), 0L, last));
+}
+
+gesture::Body3D WorkerModel::bodyAt(double t_s) const { return current_.bodies.at(frameIndex(t_s)); }
 
 gesture::CalibratedSkeleton WorkerModel::calibrated(std::size_t view, const gesture::Skeleton2D& skeleton,
                                                     const WorkerState& ws) const {

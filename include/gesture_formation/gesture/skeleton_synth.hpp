@@ -72,6 +72,12 @@ const common::FieldTable<SynthConfig>& synthConfigFields();
 /// \brief Each number outside its range, and each interval with min > max (key: its `_max`).
 std::vector<common::ConfigError> synthConfigProblems(const SynthConfig& config);
 
+/// \brief A posed 3-D body: 17 keypoints in the body frame [m].
+struct Body3D {
+  std::array<Eigen::Vector3d, kNumKeypoints> p;
+  Eigen::Vector3d head_top;
+};
+
 /// \brief One generated frame: the skeleton and its ground-truth label.
 struct SynthFrame {
   double t_s = 0.0;
@@ -90,12 +96,9 @@ struct SynthSequence {
   /// (sequence time [s]); a gesture is "being performed" in between (issue 6/7 latency).
   double motion_start_s = 0.0, motion_end_s = 0.0;
   std::vector<SynthFrame> frames;
-};
-
-/// \brief A posed 3-D body: 17 keypoints in the body frame [m].
-struct Body3D {
-  std::array<Eigen::Vector3d, kNumKeypoints> p;
-  Eigen::Vector3d head_top;
+  /// The posed 3-D body of each frame (body frame, before projection and noise): what the
+  /// rendered camera poses the worker mesh from (sim::WorkerModel::bodyAt).
+  std::vector<Body3D> bodies;
 };
 
 /// \brief Generates sequences. Thread safety: none (owns its RNG).

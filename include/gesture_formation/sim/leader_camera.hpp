@@ -22,6 +22,7 @@
 
 #include "gesture_formation/common/result.hpp"
 #include "gesture_formation/gesture/gesture_classifier.hpp"
+#include "gesture_formation/sim/camera_source.hpp"
 #include "gesture_formation/sim/mission_config.hpp"
 #include "gesture_formation/sim/multirotor.hpp"
 #include "gesture_formation/sim/synthetic_sensors.hpp"
@@ -70,27 +71,15 @@ class StepSchedule {
   long next_k_ = 0, count_ = 0;
 };
 
-/// \brief One follower camera's view in the same frame (gesture voting, docs/gestures.md §4.1).
-struct FollowerView {
-  bool visible = false;  ///< the worker is in its field of view, not occluded, detected
-  std::optional<gesture::Classification> classification;  ///< as LeaderCameraFrame::classification
-  gesture::CalibratedSkeleton calibrated;  ///< its skeleton with the true pose of the camera that rendered it (visible, view_fusion.confirm_3d only)
-};
+/// \brief The leader's injected range faults of `faults` at `t_s` (UWB / stereo dropout windows,
+/// range outliers) applied to `frame`'s ranges; draws 6 numbers from `rng` every call (so the
+/// stream never depends on the outcome). Returns the number of outliers injected. Shared by
+/// every CameraSource.
+int applyRangeFaults(const FaultConfig& faults, double t_s, SensorFrame& frame, std::mt19937_64& rng);
 
-/// \brief One frame of the leader's camera.
-struct LeaderCameraFrame {
-  SensorFrame sensors;         ///< box (when visible) and ranges after the injected faults
-  gesture::SynthFrame skeleton;  ///< what the worker looked like from the camera
-  gesture::CalibratedSkeleton calibrated;  ///< skeleton with the true pose of the camera that rendered it (WorkerModel::calibrated; view_fusion.confirm_3d only)
-  int range_outliers = 0;      ///< gross range errors injected into this frame
-  /// The classifier's output: the worker was detected, the FIFO is full, a classifier was
-  /// given and it succeeded.
-  std::optional<gesture::Classification> classification;
-  /// The followers' cameras at the same instant (empty unless followers were given).
-  std::vector<FollowerView> followers;
-};
-
-class LeaderCamera {
+/// \brief The synthetic camera (the default CameraSource): boxes, ranges and skeletons from
+/// ground truth (SyntheticSensors, WorkerModel::skeletonsAt).
+class LeaderCamera : public CameraSource {
  public:
   /// \brief Time between skeletons after which the FIFO restarts (temporal consistency).
   static constexpr double kSkeletonGapS = 0.5;
@@ -112,16 +101,15 @@ class LeaderCamera {
   /// this is exactly frame() above. Pass the same number of followers at every call.
   LeaderCameraFrame frame(double t_s, const MultirotorState& leader, const std::vector<MultirotorState>& followers,
                           const std::vector<bool>& online, const WorkerState& worker_state, WorkerModel& worker,
-                          MissionClassifier* classifier);
+                          MissionClassifier* classifier) override;
 
   /// \brief Time of the last frame in which the worker was detected (−1e9: never).
-  double lastVisibleS() const { return last_visible_s_; }
+  double lastVisibleS() const override { return last_visible_s_; }
 
  private:
   const MissionConfig& cfg_;
   SyntheticSensors sensors_;
   std::mt19937_64 fault_rng_;
-  std::uniform_real_distribution<double> u01_{0.0, 1.0};
   gesture::SkeletonWindow window_;
   double last_visible_s_ = -1e9;
   struct FollowerCamera {

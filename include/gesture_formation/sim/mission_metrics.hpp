@@ -39,6 +39,7 @@
 #include "gesture_formation/planning/uav_planner.hpp"
 #include "gesture_formation/sim/mission_config.hpp"
 #include "gesture_formation/sim/multirotor.hpp"
+#include "gesture_formation/sim/perception_truth.hpp"
 #include "gesture_formation/sim/worker_model.hpp"
 
 namespace gesture_formation::planning {
@@ -89,6 +90,9 @@ struct MissionMetrics {
   /// `messages_sent`): written as null and listed in metrics.json `not_measured_keys`.
   /// Empty for gfctl simulate.
   std::vector<std::string> not_measured;
+  /// The rendered camera's perception against the truth (docs/simulation.md §8); absent for the
+  /// synthetic camera (metrics.json then has no `perception` key).
+  std::optional<PerceptionSummary> perception;
 };
 
 /// \brief One UAV's part of a timeline sample (docs/design.md §8.4 timeline.csv).
@@ -159,6 +163,7 @@ struct MissionOutput {
   std::vector<TimelineRow> timeline;
   std::vector<RequestRecord> requests;
   std::vector<GestureEpisode> gestures;  ///< performed by the worker
+  std::vector<PerceptionRecord> perception;  ///< rendered camera: per frame and UAV (perception.csv)
 };
 
 /// \brief The obstacle-distance metric (docs/simulation.md §4): within

@@ -39,6 +39,7 @@
 #include "gesture_formation/planning/shapes.hpp"
 #include "gesture_formation/planning/replan_step.hpp"
 #include "gesture_formation/planning/uav_planner.hpp"
+#include "gesture_formation/sim/camera_source.hpp"
 #include "gesture_formation/sim/leader_camera.hpp"
 #include "gesture_formation/sim/mission_config.hpp"
 #include "gesture_formation/sim/mission_metrics.hpp"
@@ -78,10 +79,13 @@ struct MissionWorld {
 };
 
 /// \brief Runs one mission. `classifier` may be null (no gesture pipeline: gestures are not
-/// recognised). `duration_s` ≤ 0 → the config's. Fails (with a reason) only for a setup
-/// problem (e.g. an initial position inside an obstacle).
+/// recognised). `duration_s` ≤ 0 → the config's. `camera`: the formation's cameras (e.g. a
+/// RenderedCamera, which must outlive the run); null → the synthetic camera (LeaderCamera for
+/// `config`, `world.map` and `seed`). A camera with perception records adds them to the output
+/// (perception.csv, metrics.json `perception`). Fails (with a reason) only for a setup problem
+/// (e.g. an initial position inside an obstacle).
 common::Result<MissionOutput> runMission(const MissionConfig& config, const MissionWorld& world,
                                          const PlannerFactory& planners, MissionClassifier* classifier,
-                                         std::uint64_t seed, double duration_s = 0.0);
+                                         std::uint64_t seed, double duration_s = 0.0, CameraSource* camera = nullptr);
 
 }  // namespace gesture_formation::sim

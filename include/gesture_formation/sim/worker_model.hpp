@@ -100,6 +100,12 @@ class WorkerModel {
   /// same number of cameras at every call (≥ 1).
   std::vector<gesture::SynthFrame> skeletonsAt(double t_s, const std::vector<Eigen::Vector3d>& cameras);
 
+  /// \brief The worker's posed 3-D body (body frame: x forward, y left, z up, feet at 0) of the
+  /// current motion at `t_s` — the body whose projection skeletonsAt(t_s, …) returned (the same
+  /// frame of the same motion, before the camera's keypoint noise). Call after skeletonsAt at
+  /// the same `t_s` (rendered camera: the worker mesh is posed from it, docs/simulation.md §8).
+  gesture::Body3D bodyAt(double t_s) const;
+
   /// \brief View `view`'s skeleton `skeleton` (of the current motion, as skeletonsAt returned it)
   /// with the pose of the camera that rendered it, in the world at the worker's true state `ws`:
   /// the motion's viewpoint (distance, elevation, azimuth around the body, fixed when the motion
@@ -118,6 +124,8 @@ class WorkerModel {
   void startMotion(double t_s, gesture::Motion motion, const std::vector<Eigen::Vector3d>& cameras, bool is_scheduled,
                    double scheduled_s);
   gesture::Motion motionFor(const WorkerState& s);
+  /// Index of the current motion's frame shown at `t_s`.
+  std::size_t frameIndex(double t_s) const;
 
   WorkerConfig config_;
   std::vector<double> leg_start_s_;

@@ -256,3 +256,55 @@ mission:
     EXPECT_NE(m.reason().find(want), std::string::npos) << "missing '" << want << "' in\n" << m.reason();
   }
 }
+
+// bodyAt is the 3-D body whose projection skeletonsAt returned (the rendered camera poses the
+// worker mesh from it): projected through the view's camera (WorkerModel::calibrated), it lies on
+// the synthetic skeleton to within its keypoint noise, and it performs the gesture (the extended
+// arm's wrist far to the side at shoulder height) during the episode.
+TEST(WorkerModelTest, BodyAtIsTheBodyTheSkeletonShows) {
+  gf::sim::WorkerModel w(simpleWorker(), 4);
+  const Eigen::Vector3d cam(10, 8, 7);
+  double max_median_frac = 0.0, max_shift_frac = 0.0;
+  int frames = 0;
+  double widest_wrist_m = 0.0;
+  for (int k = 0; k < 15 * 60; k += 7) {
+    const double t = k / 15.0;
+    const auto f = w.skeletonAt(t, cam);
+    const auto ws = w.stateAt(t);
+    const gf::gesture::Body3D body = w.bodyAt(t);
+    const auto cal = w.calibrated(0, f.skeleton, ws);
+    const gf::estimation::CameraModel model(cal.intrinsics);
+    const Eigen::Matrix3d R_world_body = Eigen::AngleAxisd(ws.heading_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    std::vector<Eigen::Vector2d> d;
+    for (std::size_t i = 0; i < body.p.size(); ++i) {
+      if (f.skeleton.c[i] <= 0.0) continue;
+      const Eigen::Vector3d p_world = ws.feet_world + R_world_body * body.p[i];
+      const auto px = model.project(cal.R_world_camera.transpose() * (p_world - cal.p_world_camera));
+      ASSERT_TRUE(px.has_value());
+      d.emplace_back(f.skeleton.x[i] - px->x(), f.skeleton.y[i] - px->y());
+    }
+    ASSERT_GE(d.size(), 8u);
+    // The generator's aim jitter (σ 3 % of the height, left out of `calibrated`) shifts the whole
+    // figure; what is left is the keypoint noise.
+    Eigen::Vector2d shift = Eigen::Vector2d::Zero();
+    for (const auto& v : d) shift += v / static_cast<double>(d.size());
+    std::vector<double> err;
+    for (const auto& v : d) err.push_back((v - shift).norm());
+    max_shift_frac = std::max(max_shift_frac, shift.norm() / f.skeleton.h);
+    std::nth_element(err.begin(), err.begin() + static_cast<long>(err.size() / 2), err.end());
+    max_median_frac = std::max(max_median_frac, err[err.size() / 2] / f.skeleton.h);
+    ++frames;
+    if (w.performingAt(t) == 2 && f.label == 2) {
+      for (const int wrist : {gf::gesture::kLeftWrist, gf::gesture::kRightWrist}) {
+        const auto& p = body.p[static_cast<std::size_t>(wrist)];
+        widest_wrist_m = std::max(widest_wrist_m, std::abs(p.y()));
+      }
+    }
+  }
+  EXPECT_GT(frames, 100);
+  // keypoint noise σ ≤ 2.5 % of the box height (SynthConfig defaults): the median 2-D error of a
+  // Gaussian is 1.18 σ ≤ 3 %; the shift is the aim jitter (σ 3 % of the height per axis)
+  EXPECT_LT(max_median_frac, 0.05);
+  EXPECT_LT(max_shift_frac, 0.15);
+  EXPECT_GT(widest_wrist_m, 0.5);  // the arm extended to the side
+}

@@ -1,0 +1,68 @@
+#pragma once
+/// \file
+/// \brief The formation's cameras as the mission runs them (docs/simulation.md §1 "sensing",
+/// §8): one call per camera frame gives the leader's box and ranges for the estimator, each
+/// camera's gesture classification for the vote, and the skeletons for the 3-D confirmation.
+/// Two implementations behind this one interface, so that sim::runMission has no camera
+/// branches: the synthetic camera (LeaderCamera, leader_camera.hpp: boxes and skeletons made
+/// from ground truth; the default) and the rendered camera (RenderedCamera,
+/// rendered_camera.hpp, library gesture_formation_sim_render: rendered images through the
+/// real perception pipeline).
+/// Thread safety: an implementation is used by one mission thread.
+
+#include <optional>
+#include <vector>
+
+#include "gesture_formation/gesture/gesture_classifier.hpp"
+#include "gesture_formation/gesture/skeleton_synth.hpp"
+#include "gesture_formation/gesture/view_triangulation.hpp"
+#include "gesture_formation/sim/multirotor.hpp"
+#include "gesture_formation/sim/perception_truth.hpp"
+#include "gesture_formation/sim/synthetic_sensors.hpp"
+#include "gesture_formation/sim/worker_model.hpp"
+
+namespace gesture_formation::sim {
+
+class MissionClassifier;
+
+/// \brief One follower camera's view in the same frame (gesture voting, docs/gestures.md §4.1).
+struct FollowerView {
+  bool visible = false;  ///< the worker is in its field of view, not occluded, detected
+  std::optional<gesture::Classification> classification;  ///< as LeaderCameraFrame::classification
+  gesture::CalibratedSkeleton calibrated;  ///< its skeleton with the true pose of the camera that rendered it (visible, view_fusion.confirm_3d only)
+};
+
+/// \brief One frame of the leader's camera.
+struct LeaderCameraFrame {
+  SensorFrame sensors;         ///< box (when visible) and ranges after the injected faults
+  gesture::SynthFrame skeleton;  ///< what the worker looked like from the camera
+  gesture::CalibratedSkeleton calibrated;  ///< skeleton with the true pose of the camera that rendered it (WorkerModel::calibrated; view_fusion.confirm_3d only)
+  int range_outliers = 0;      ///< gross range errors injected into this frame
+  /// The classifier's output: the worker was detected, the FIFO is full, a classifier was
+  /// given and it succeeded.
+  std::optional<gesture::Classification> classification;
+  /// The followers' cameras at the same instant (empty unless followers were given).
+  std::vector<FollowerView> followers;
+};
+
+/// \brief The formation's cameras (leader + followers' views) for sim::runMission.
+class CameraSource {
+ public:
+  virtual ~CameraSource() = default;
+  /// \brief The frame at `t_s` (called at the camera rate, times increasing) of the camera on
+  /// the leader's true state `leader`, and — when followers are given — of follower i+1's
+  /// camera on `followers[i]` (`online[i]` false: its computer is down, no view), of the worker
+  /// whose truth at t_s is `worker_state` (`worker` advances its motions: it must be the model
+  /// that gave worker_state). `classifier` may be null (no gesture pipeline). Pass the same
+  /// number of followers at every call.
+  virtual LeaderCameraFrame frame(double t_s, const MultirotorState& leader, const std::vector<MultirotorState>& followers,
+                                  const std::vector<bool>& online, const WorkerState& worker_state, WorkerModel& worker,
+                                  MissionClassifier* classifier) = 0;
+  /// \brief Time of the last frame in which the leader's camera found the worker (−1e9: never).
+  virtual double lastVisibleS() const = 0;
+  /// \brief Per-frame perception against the truth (rendered cameras); null when the camera
+  /// has none (the synthetic camera).
+  virtual const std::vector<PerceptionRecord>* perceptionRecords() const { return nullptr; }
+};
+
+}  // namespace gesture_formation::sim
