@@ -27,18 +27,25 @@ std::vector<std::string> PerceptionConfig::validate() const {
   return e;
 }
 
+namespace {
+
+/// A network's config on the pipeline's DNN device.
+template <class Config>
+Config onDevice(Config config, DnnDevice device) {
+  config.device = device;
+  return config;
+}
+
+}  // namespace
+
 common::Result<std::unique_ptr<PersonDetector>> makePersonDetector(const PerceptionConfig& c) {
   using R = common::Result<std::unique_ptr<PersonDetector>>;
   if (c.detector == DetectorKind::kBlazePose) {
-    BlazePoseDetectorConfig dc = c.blazepose_detector;
-    dc.device = c.dnn_device;
-    auto d = BlazePoseDetector::create(dc, c.models_root);
+    auto d = BlazePoseDetector::create(onDevice(c.blazepose_detector, c.dnn_device), c.models_root);
     if (!d) return R::fail(d.reason());
     return R::ok(std::move(d.value()));
   }
-  MoveNetMultiposeConfig mc = c.multipose;
-  mc.device = c.dnn_device;
-  auto d = MoveNetMultiposeDetector::create(mc, c.models_root);
+  auto d = MoveNetMultiposeDetector::create(onDevice(c.multipose, c.dnn_device), c.models_root);
   if (!d) return R::fail(d.reason());
   return R::ok(std::move(d.value()));
 }
@@ -46,15 +53,11 @@ common::Result<std::unique_ptr<PersonDetector>> makePersonDetector(const Percept
 common::Result<std::unique_ptr<SkeletonExtractor>> makeSkeletonExtractor(const PerceptionConfig& c) {
   using R = common::Result<std::unique_ptr<SkeletonExtractor>>;
   if (c.skeleton == SkeletonKind::kBlazePoseLandmark) {
-    BlazePoseLandmarkConfig bc = c.blazepose_landmark;
-    bc.device = c.dnn_device;
-    auto s = BlazePoseLandmarkExtractor::create(bc, c.models_root);
+    auto s = BlazePoseLandmarkExtractor::create(onDevice(c.blazepose_landmark, c.dnn_device), c.models_root);
     if (!s) return R::fail(s.reason());
     return R::ok(std::move(s.value()));
   }
-  MoveNetLightningConfig lc = c.lightning;
-  lc.device = c.dnn_device;
-  auto s = MoveNetLightningExtractor::create(lc, c.models_root);
+  auto s = MoveNetLightningExtractor::create(onDevice(c.lightning, c.dnn_device), c.models_root);
   if (!s) return R::fail(s.reason());
   return R::ok(std::move(s.value()));
 }
