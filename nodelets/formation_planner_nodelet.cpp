@@ -53,6 +53,7 @@
 #include "diagnostics.hpp"
 #include "gesture_formation/formation/formation_geometry.hpp"
 #include "gesture_formation/formation/worker_heading.hpp"
+#include "gesture_formation/planning/replan_health.hpp"
 #include "gesture_formation/planning/replan_step.hpp"
 #include "gesture_formation/planning/trajectory_qp.hpp"
 #include "param_loader.hpp"
@@ -279,11 +280,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
       mode_ = mode;
     }
     const planning::PlanResult& res = out.result;
-    ++plans_since_report_;
-    if (out.fallback) ++fallbacks_since_report_;
-    last_plan_s_ = t;
-    last_planning_ms_ = res.timings.total_ms;
-    last_status_name_ = planning::toString(res.status);
+    health_.record(out, t);
     if (res.status != planning::PlanStatus::kOptimized) {
       NODELET_WARN_STREAM_THROTTLE(2.0, "FormationPlanner UAV " << uav_index_ << ": " << planning::toString(res.status)
                                                                 << ": " << res.reason);
@@ -308,35 +305,28 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     traj_pub_.publish(toMultiDof(msg, "uav" + std::to_string(uav_index_)));
   }
 
-  /// This UAV's planner on /diagnostics: ERROR when no plan for 3 periods (after the first),
-  /// WARN while holding / searching or when a plan since the last report fell back.
+  /// This UAV's planner on /diagnostics (planning::ReplanHealth).
   std::vector<diagnostic_msgs::DiagnosticStatus> health() {
     std::lock_guard<std::mutex> lock(mutex_);
     const ros::WallTime now = ros::WallTime::now();
     const double since_s = report_wall_.isZero() ? 1.0 : (now - report_wall_).toSec();
-    const double plan_age_s = last_plan_s_ < 0.0 ? -1.0 : ros::Time::now().toSec() - last_plan_s_;  // ROS (sim) time
-    Health h("FormationPlanner uav" + std::to_string(uav_index_), "uav" + std::to_string(uav_index_));
-    h.error(plan_age_s > 3.0 * period_s_, "no plan for " + std::to_string(plan_age_s) + " s")
-        .warn(mode_ != "track", mode_)
-        .warn(fallbacks_since_report_ > 0, std::to_string(fallbacks_since_report_) + " fallback plan(s)")
-        .value("mode", mode_)
-        .value("plans_per_s", since_s > 0.0 ? plans_since_report_ / since_s : 0.0)
-        .value("fallbacks", fallbacks_since_report_)
-        .value("last_status", last_status_name_)
-        .value("last_planning_ms", last_planning_ms_)
-        .value("last_plan_age_s", plan_age_s);
-    plans_since_report_ = 0;
-    fallbacks_since_report_ = 0;
     report_wall_ = now;
+    const planning::ReplanHealthReport r = health_.report(ros::Time::now().toSec(), period_s_);  // ROS (sim) time
+    Health h("FormationPlanner uav" + std::to_string(uav_index_), "uav" + std::to_string(uav_index_));
+    h.error(r.level == planning::ReplanHealthReport::Level::kError, r.message)
+        .warn(r.level == planning::ReplanHealthReport::Level::kWarn, r.message)
+        .value("mode", r.mode)
+        .value("plans_per_s", since_s > 0.0 ? r.plans / since_s : 0.0)
+        .value("fallbacks", r.fallbacks)
+        .value("last_status", r.last_status)
+        .value("last_planning_ms", r.last_planning_ms)
+        .value("last_plan_age_s", r.last_plan_age_s);
     return {h.status()};
   }
 
   std::mutex mutex_;
   DiagnosticsPublisher diagnostics_;
-  int plans_since_report_ = 0, fallbacks_since_report_ = 0;
-  double last_planning_ms_ = 0.0;
-  std::string last_status_name_ = "none";
-  double last_plan_s_ = -1.0;  ///< ROS time of the last plan
+  planning::ReplanHealth health_;  ///< /diagnostics: plans, fallbacks, the last plan's age
   ros::WallTime report_wall_;
   int uav_index_ = 0, uav_count_ = 0;
   std::string world_frame_;
