@@ -22,13 +22,12 @@ class Health {
     status_.level = diagnostic_msgs::DiagnosticStatus::OK;
     status_.message = "ok";
   }
-  /// \brief Raises the level to `level` (never lowers it) with `message` (the most severe's wins).
+  /// \brief Raises the level to `level` with `message`; a condition no more severe than the
+  /// current one changes nothing (the first of the most severe conditions is the message).
   Health& raise(std::uint8_t level, const std::string& message) {
-    if (level > status_.level || status_.message == "ok") {
-      if (level >= status_.level) {
-        status_.level = level;
-        status_.message = message;
-      }
+    if (level > status_.level) {
+      status_.level = level;
+      status_.message = message;
     }
     return *this;
   }
@@ -53,23 +52,29 @@ class Health {
   diagnostic_msgs::DiagnosticStatus status_;
 };
 
-/// \brief Publishes `collect()` on /diagnostics every `period_s` of wall time.
+/// \brief Publishes `collect(since_s)` on /diagnostics every `period_s` of wall time; since_s:
+/// wall seconds since the previous report (period_s for the first), for rates.
 class DiagnosticsPublisher {
  public:
-  void start(ros::NodeHandle& nh, double period_s, std::function<std::vector<diagnostic_msgs::DiagnosticStatus>()> collect) {
+  using Collect = std::function<std::vector<diagnostic_msgs::DiagnosticStatus>(double since_s)>;
+  void start(ros::NodeHandle& nh, double period_s, Collect collect) {
     collect_ = std::move(collect);
     pub_ = nh.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 10);
-    timer_ = nh.createWallTimer(ros::WallDuration(period_s), [this](const ros::WallTimerEvent&) {
+    timer_ = nh.createWallTimer(ros::WallDuration(period_s), [this, period_s](const ros::WallTimerEvent&) {
+      const ros::WallTime now = ros::WallTime::now();
+      const double since_s = last_.isZero() ? period_s : (now - last_).toSec();
+      last_ = now;
       diagnostic_msgs::DiagnosticArray array;
       array.header.stamp = ros::Time::now();
-      array.status = collect_();
+      array.status = collect_(since_s);
       pub_.publish(array);
     });
   }
   void stop() { timer_.stop(); }
 
  private:
-  std::function<std::vector<diagnostic_msgs::DiagnosticStatus>()> collect_;
+  Collect collect_;
+  ros::WallTime last_;
   ros::Publisher pub_;
   ros::WallTimer timer_;
 };

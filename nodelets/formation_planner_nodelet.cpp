@@ -159,7 +159,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     // Staggered replanning: UAV i plans at k·period + i·period/n (as in gfctl simulate).
     offset_s_ = period_s_ * uav_index_ / uav_count_;
     timer_ = nh.createTimer(ros::Duration(period_s_ / 8.0), &FormationPlannerNodelet::onTimer, this);
-    diagnostics_.start(nh, 1.0, [this] { return health(); });
+    diagnostics_.start(nh, 1.0, [this](double since_s) { return health(since_s); });
   }
 
   void onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
@@ -306,11 +306,8 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   }
 
   /// This UAV's planner on /diagnostics (planning::ReplanHealth).
-  std::vector<diagnostic_msgs::DiagnosticStatus> health() {
+  std::vector<diagnostic_msgs::DiagnosticStatus> health(double since_s) {
     std::lock_guard<std::mutex> lock(mutex_);
-    const ros::WallTime now = ros::WallTime::now();
-    const double since_s = report_wall_.isZero() ? 1.0 : (now - report_wall_).toSec();
-    report_wall_ = now;
     const planning::ReplanHealthReport r = health_.report(ros::Time::now().toSec(), period_s_);  // ROS (sim) time
     Health h("FormationPlanner uav" + std::to_string(uav_index_), "uav" + std::to_string(uav_index_));
     h.error(r.level == planning::ReplanHealthReport::Level::kError, r.message)
@@ -327,7 +324,6 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   std::mutex mutex_;
   DiagnosticsPublisher diagnostics_;
   planning::ReplanHealth health_;  ///< /diagnostics: plans, fallbacks, the last plan's age
-  ros::WallTime report_wall_;
   int uav_index_ = 0, uav_count_ = 0;
   std::string world_frame_;
   double period_s_ = 0.0, offset_s_ = 0.0, next_plan_s_ = -1.0;

@@ -96,12 +96,12 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
       std::lock_guard<std::mutex> lock(mutex_);
       for (const auto& f : frames_->closeDue(ros::Time::now().toSec())) publishFrame(f);
     });
-    diagnostics_.start(nh, 1.0, [this] { return health(); });
+    diagnostics_.start(nh, 1.0, [this](double since_s) { return health(since_s); });
   }
 
   /// The vote and filter on /diagnostics: WARN when observations were rejected since the last
   /// report or a camera has not reported for 2 s; values: frames, views, what fired last.
-  std::vector<diagnostic_msgs::DiagnosticStatus> health() {
+  std::vector<diagnostic_msgs::DiagnosticStatus> health(double /*since_s*/) {
     std::lock_guard<std::mutex> lock(mutex_);
     const double t = ros::Time::now().toSec();
     Health h("GestureCommander", "leader");

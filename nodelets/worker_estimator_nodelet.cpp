@@ -54,15 +54,13 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
     detection_sub_ = nh.subscribe("detection_in", 10, &WorkerEstimatorNodelet::onDetection, this);
     uwb_sub_ = nh.subscribe("uwb_in", 10, &WorkerEstimatorNodelet::onUwb, this);
     timer_ = nh.createTimer(ros::Duration(1.0 / rate_hz), &WorkerEstimatorNodelet::onTimer, this);
-    diagnostics_.start(nh, 1.0, [this] { return health(); });
+    diagnostics_.start(nh, 1.0, [this](double since_s) { return health(since_s); });
   }
 
   /// The estimator on /diagnostics: WARN before the first track, while the worker is lost, when
   /// detections were rejected since the last report; values: rates and the ages that decide hold.
-  std::vector<diagnostic_msgs::DiagnosticStatus> health() {
+  std::vector<diagnostic_msgs::DiagnosticStatus> health(double since_s) {
     std::lock_guard<std::mutex> lock(mutex_);
-    const ros::WallTime now = ros::WallTime::now();
-    const double since_s = report_wall_.isZero() ? 1.0 : (now - report_wall_).toSec();
     const double t = ros::Time::now().toSec();
     const double fused_age_s = last_fused_.isZero() ? -1.0 : t - last_fused_.toSec();
     const double uwb_age_s = last_uwb_stamp_.isZero() ? -1.0 : t - last_uwb_stamp_.toSec();
@@ -79,7 +77,6 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
         .value("last_uwb_age_s", uwb_age_s)
         .value("published_per_s", published_since_report_ / since_s);
     fused_since_report_ = rejected_since_report_ = published_since_report_ = 0;
-    report_wall_ = now;
     return {h.status()};
   }
 
@@ -155,7 +152,6 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
   std::mutex mutex_;
   DiagnosticsPublisher diagnostics_;
   int fused_since_report_ = 0, rejected_since_report_ = 0, published_since_report_ = 0;
-  ros::WallTime report_wall_;
   estimation::EstimatorConfig config_;
   estimation::CameraModel camera_;
   estimation::HumanKalman filter_;
