@@ -87,32 +87,17 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
         fcfg = mission.formation;
         pcfg = mission.planner;
         period_s_ = mission.replanning_period_s;
-        rc.dt_s = mission.horizon_dt_s;
-        rc.steps = mission.horizon_steps;
-        rc.freshness = mission.freshness;
-        rc.rule = mission.rule;
-        rc.search = mission.search;
-        rc.brake_accel_mps2 = mission.brake_accel_mps2;
+        rc = mission.replan;
         params.note("from mission_file: replanning_period_s " + std::to_string(period_s_) + ", horizon_dt_s " +
                     std::to_string(rc.dt_s) + ", horizon_steps " + std::to_string(rc.steps) +
                     ", faults.* limits, controller.brake_accel_mps2, formation, planner");
       }
     } else {
       params.load("replanning_period_s", period_s_, onboard::ranges::kReplanningPeriodS);
-      params.load("horizon_dt_s", rc.dt_s, onboard::ranges::kHorizonDtS);
-      params.load("horizon_steps", rc.steps, onboard::ranges::kHorizonSteps);
-      params.load("max_share_age_s", rc.freshness.max_share_age_s, onboard::ranges::kMaxShareAgeS);
+      params.loadFields(planning::replanConfigFields(), rc);  // horizon_*, *_age_s, brake_accel_mps2, search_*
+      params.load("avoid_all_plans", rc.rule.avoid_all_plans);
       params.load("formation_config", formation_file);
       params.load("planner_config", planner_file);
-      params.load("avoid_all_plans", rc.rule.avoid_all_plans);
-      params.load("max_plan_age_s", rc.rule.max_plan_age_s, onboard::ranges::kMaxPlanAgeS);
-      params.load("max_worker_age_s", rc.freshness.max_worker_age_s, onboard::ranges::kMaxWorkerAgeS);
-      params.load("brake_accel_mps2", rc.brake_accel_mps2, onboard::ranges::kBrakeAccelMps2);
-      params.load("search_timeout_s", rc.search.timeout_s, onboard::ranges::kSearchTimeoutS);
-      params.load("search_height_m", rc.search.height_m, onboard::ranges::kSearchHeightM);
-      params.load("search_vertical_speed_mps", rc.search.vertical_speed_mps, onboard::ranges::kSearchVerticalSpeedMps);
-      params.load("search_period_s", rc.search.period_s, onboard::ranges::kSearchPeriodS);
-      params.load("search_horizontal_speed_mps", rc.search.horizontal_speed_mps, onboard::ranges::kSearchHorizontalSpeedMps);
       formation_loaded = !formation_file.empty() && loadFormation(formation_file, params, fcfg);
       if (!planner_file.empty()) loadPlanner(planner_file, params, pcfg);
     }

@@ -8,6 +8,7 @@
 
 #include <ros/node_handle.h>
 
+#include "gesture_formation/common/config_fields.hpp"
 #include "gesture_formation/common/config_reader.hpp"
 
 namespace gesture_formation::nodelets {
@@ -67,6 +68,24 @@ class ParamLoader {
       return;
     }
     value = static_cast<int>(v);
+  }
+  /// \brief Every number of a core FieldTable, each under the last segment of its key (the table's
+  /// "faults.max_plan_age_s" is the parameter max_plan_age_s) with the table's range.
+  template <class Config>
+  void loadFields(const common::FieldTable<Config>& table, Config& c) {
+    for (const auto& f : table.fields) {
+      const std::string key = f.key;
+      const std::string name = key.substr(key.find_last_of('.') + 1);  // npos + 1 == 0: the whole key
+      if (f.ref_double) {
+        load(name, *f.ref_double(c), f.range);
+      } else if (f.ref_int) {
+        load(name, *f.ref_int(c), f.range);
+      } else {
+        double v = static_cast<double>(*f.ref_float(c));
+        load(name, v, f.range);
+        *f.ref_float(c) = static_cast<float>(v);
+      }
+    }
   }
   void load(const std::string& name, bool& value) {
     if (!nh_.getParam(name, value)) missing(name);

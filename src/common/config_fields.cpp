@@ -32,10 +32,10 @@ void addProblems(ConfigReader& r, const std::string& prefix, const std::vector<C
   for (const auto& p : problems) r.addError(prefix + p.key, p.message);
 }
 
-std::vector<std::string> problemLines(const std::vector<ConfigError>& problems) {
+std::vector<std::string> problemLines(const std::vector<ConfigError>& problems, const std::string& prefix) {
   std::vector<std::string> lines;
   lines.reserve(problems.size());
-  for (const auto& p : problems) lines.push_back(p.key + " " + p.message);
+  for (const auto& p : problems) lines.push_back(prefix + p.key + " " + p.message);
   return lines;
 }
 

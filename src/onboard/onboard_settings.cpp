@@ -14,21 +14,9 @@ using common::Range;
 
 void readOnboardSettings(ConfigReader& r, const std::string& m, OnboardSettings& c) {
   r.readDouble(m + "replanning_period_s", c.replanning_period_s, ranges::kReplanningPeriodS);
-  r.readDouble(m + "horizon_dt_s", c.horizon_dt_s, ranges::kHorizonDtS);
-  r.readInt(m + "horizon_steps", c.horizon_steps, ranges::kHorizonSteps);
-  r.readDouble(m + "controller.brake_accel_mps2", c.brake_accel_mps2, ranges::kBrakeAccelMps2);
-
-  const std::string fk = m + "faults.";
-  r.readDouble(fk + "max_share_age_s", c.freshness.max_share_age_s, ranges::kMaxShareAgeS);
-  r.readDouble(fk + "max_worker_age_s", c.freshness.max_worker_age_s, ranges::kMaxWorkerAgeS);
-  r.readDouble(fk + "search_timeout_s", c.search.timeout_s, ranges::kSearchTimeoutS);
-  r.readDouble(fk + "search_height_m", c.search.height_m, ranges::kSearchHeightM);
-  r.readDouble(fk + "search_vertical_speed_mps", c.search.vertical_speed_mps, ranges::kSearchVerticalSpeedMps);
-  r.readDouble(fk + "search_period_s", c.search.period_s, ranges::kSearchPeriodS);
-  r.readDouble(fk + "search_horizontal_speed_mps", c.search.horizontal_speed_mps, ranges::kSearchHorizontalSpeedMps);
-  r.readDouble(fk + "max_command_age_s", c.max_command_age_s, ranges::kMaxCommandAgeS);
-  r.readDouble(fk + "max_plan_age_s", c.rule.max_plan_age_s, ranges::kMaxPlanAgeS);
-  r.readBool(fk + "avoid_all_plans", c.rule.avoid_all_plans);
+  planning::replanConfigFields().readFields(r, m, c.replan);
+  r.readBool(m + "faults.avoid_all_plans", c.replan.rule.avoid_all_plans);
+  r.readDouble(m + "faults.max_command_age_s", c.max_command_age_s, ranges::kMaxCommandAgeS);
 
   common::withSubReader(r, m + "formation", ConfigReader::MissingKeys::kUseDefaults,
                         [&](ConfigReader& s) { c.formation = formation::readFormationConfig(s); });

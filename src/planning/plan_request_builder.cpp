@@ -98,21 +98,6 @@ Eigen::Vector3d brakingPoint(const Eigen::Vector3d& p_world, const Eigen::Vector
   return p_world + v_world * (v_world.norm() / (2.0 * a));
 }
 
-std::vector<std::string> SearchConfig::validate(const std::string& prefix) const {
-  std::vector<std::string> e;
-  const auto num = [](double v) { return common::formatDouble(v); };
-  if (!(std::isfinite(timeout_s) && timeout_s >= 0.0)) e.push_back(prefix + "search_timeout_s must be >= 0, got " + num(timeout_s));
-  if (!(std::isfinite(height_m) && height_m > 0.0)) e.push_back(prefix + "search_height_m must be > 0, got " + num(height_m));
-  if (!(std::isfinite(vertical_speed_mps) && vertical_speed_mps > 0.0)) {
-    e.push_back(prefix + "search_vertical_speed_mps must be > 0, got " + num(vertical_speed_mps));
-  }
-  if (!(std::isfinite(period_s) && period_s > 0.0)) e.push_back(prefix + "search_period_s must be > 0, got " + num(period_s));
-  if (!(std::isfinite(horizontal_speed_mps) && horizontal_speed_mps >= 0.0)) {
-    e.push_back(prefix + "search_horizontal_speed_mps must be >= 0, got " + num(horizontal_speed_mps));
-  }
-  return e;
-}
-
 bool searching(int uav_index, const std::string& hold_reason, double t_s, double worker_stamp_s,
                const FreshnessLimits& limits, const SearchConfig& config) {
   return uav_index == 0 && config.timeout_s > 0.0 && hold_reason == "worker not seen for more than max_worker_age_s" &&

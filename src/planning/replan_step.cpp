@@ -15,6 +15,30 @@ const char* toString(ReplanMode mode) {
   return "unknown";
 }
 
+const common::FieldTable<ReplanConfig>& replanConfigFields() {
+  using common::Range;
+  using C = ReplanConfig;
+  static const common::FieldTable<C> t{{
+      {"horizon_dt_s", Range::openClosed(0.0, 2.0), [](C& c) { return &c.dt_s; }},
+      {"horizon_steps", Range::closed(2, formation::kMaxHorizonSteps), [](C& c) { return &c.steps; }},
+      {"controller.brake_accel_mps2", Range::openClosed(0.0, 50.0), [](C& c) { return &c.brake_accel_mps2; }},
+      {"faults.max_share_age_s", Range::positive(), [](C& c) { return &c.freshness.max_share_age_s; }},
+      {"faults.max_worker_age_s", Range::positive(), [](C& c) { return &c.freshness.max_worker_age_s; }},
+      {"faults.max_plan_age_s", Range::positive(), [](C& c) { return &c.rule.max_plan_age_s; }},
+      {"faults.search_timeout_s", Range::nonNegative(), [](C& c) { return &c.search.timeout_s; }},
+      {"faults.search_height_m", Range::positive(), [](C& c) { return &c.search.height_m; }},
+      {"faults.search_vertical_speed_mps", Range::positive(), [](C& c) { return &c.search.vertical_speed_mps; }},
+      {"faults.search_period_s", Range::positive(), [](C& c) { return &c.search.period_s; }},
+      {"faults.search_horizontal_speed_mps", Range::nonNegative(),
+       [](C& c) { return &c.search.horizontal_speed_mps; }},
+  }};
+  return t;
+}
+
+std::vector<std::string> ReplanConfig::validate(const std::string& prefix) const {
+  return common::problemLines(replanConfigFields().rangeProblems(*this), prefix);
+}
+
 ReplanStep::ReplanStep(const ReplanConfig& config, std::unique_ptr<Planner> planner)
     : config_(config),
       planner_(std::move(planner)),

@@ -10,25 +10,58 @@
 #include "gesture_formation/common/angles.hpp"
 #include "gesture_formation/common/config_fields.hpp"
 #include "gesture_formation/common/config_reader.hpp"
+#include "gesture_formation/common/format_number.hpp"
 #include "gesture_formation/formation/formation_geometry.hpp"
 #include "gesture_formation/onboard/onboard_settings.hpp"
-#include "validate_util.hpp"
 
 namespace gesture_formation::sim {
 
 using common::ConfigReader;
 using common::Range;
-using detail::check;
+
+const common::FieldTable<LinkConfig>& linkConfigFields() {
+  using C = LinkConfig;
+  static const common::FieldTable<C> t{{
+      {"delay_s", Range::nonNegative(), [](C& c) { return &c.delay_s; }},
+      {"jitter_s", Range::nonNegative(), [](C& c) { return &c.jitter_s; }},
+      {"loss", Range::closed(0.0, 1.0), [](C& c) { return &c.loss; }},
+      {"duplicate", Range::closed(0.0, 1.0), [](C& c) { return &c.duplicate; }},
+      {"reorder", Range::closed(0.0, 1.0), [](C& c) { return &c.reorder; }},
+      {"reorder_extra_delay_s", Range::nonNegative(), [](C& c) { return &c.reorder_extra_delay_s; }},
+  }};
+  return t;
+}
 
 std::vector<std::string> LinkConfig::validate(const std::string& prefix) const {
-  std::vector<std::string> e;
-  check(e, delay_s >= 0, delay_s, prefix, "delay_s", ">= 0");
-  check(e, jitter_s >= 0, jitter_s, prefix, "jitter_s", ">= 0");
-  check(e, loss >= 0 && loss <= 1, loss, prefix, "loss", "in [0, 1]");
-  check(e, duplicate >= 0 && duplicate <= 1, duplicate, prefix, "duplicate", "in [0, 1]");
-  check(e, reorder >= 0 && reorder <= 1, reorder, prefix, "reorder", "in [0, 1]");
-  check(e, reorder_extra_delay_s >= 0, reorder_extra_delay_s, prefix, "reorder_extra_delay_s", ">= 0");
-  return e;
+  return common::problemLines(linkConfigFields().rangeProblems(*this), prefix);
+}
+
+const common::FieldTable<RangeOutlierConfig>& rangeOutlierFields() {
+  using C = RangeOutlierConfig;
+  static const common::FieldTable<C> t{{
+      {"probability", Range::closed(0.0, 1.0), [](C& c) { return &c.probability; }},
+      {"min_error_m", Range::nonNegative(), [](C& c) { return &c.min_error_m; }},
+      {"max_error_m", Range::nonNegative(), [](C& c) { return &c.max_error_m; }},
+  }};
+  return t;
+}
+
+const common::FieldTable<PlannerOutage>& plannerOutageFields() {
+  static const common::FieldTable<PlannerOutage> t{{
+      {"uav", Range::closed(0, 63), [](PlannerOutage& o) { return &o.uav; }},
+      {"from_s", Range::nonNegative(), [](PlannerOutage& o) { return &o.from_s; }},
+      {"to_s", Range::nonNegative(), [](PlannerOutage& o) { return &o.to_s; }},
+  }};
+  return t;
+}
+
+const common::FieldTable<UavDropout>& uavDropoutFields() {
+  static const common::FieldTable<UavDropout> t{{
+      {"uav", Range::closed(1, 63), [](UavDropout& o) { return &o.uav; }},
+      {"from_s", Range::nonNegative(), [](UavDropout& o) { return &o.from_s; }},
+      {"to_s", Range::nonNegative(), [](UavDropout& o) { return &o.to_s; }},
+  }};
+  return t;
 }
 
 std::vector<std::string> FaultConfig::validate(const std::string& prefix) const {
@@ -45,27 +78,23 @@ std::vector<std::string> FaultConfig::validate(const std::string& prefix) const 
   windows(camera_blackouts, "camera_blackouts");
   windows(uwb_dropouts, "uwb_dropouts");
   windows(stereo_dropouts, "stereo_dropouts");
-  for (std::size_t i = 0; i < planner_outages.size(); ++i) {
-    const auto& o = planner_outages[i];
-    if (!(o.from_s < o.to_s)) e.push_back(prefix + "planner_outages[" + std::to_string(i) + "] needs from_s < to_s");
-  }
-  for (std::size_t i = 0; i < follower_dropouts.size(); ++i) {
-    const auto& o = follower_dropouts[i];
-    const std::string k = prefix + "follower_dropouts[" + std::to_string(i) + "]";
-    if (!(o.from_s < o.to_s)) {
-      e.push_back(k + " needs from_s < to_s, got from_s " + common::formatNumber(o.from_s) + ", to_s " + common::formatNumber(o.to_s));
+  const auto entries = [&](const auto& list, const auto& table, const char* name) {
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const auto& o = list[i];
+      auto problems = table.rangeProblems(o);
+      common::checkRule(problems, o.from_s < o.to_s, "from_s", o.from_s, "must be < to_s (" + common::formatNumber(o.to_s) + ")");
+      for (auto& line : common::problemLines(problems, prefix + name + "[" + std::to_string(i) + "].")) e.push_back(line);
     }
-    if (o.uav < 1) e.push_back(k + ".uav must be a follower (>= 1), got " + std::to_string(o.uav));
+  };
+  entries(planner_outages, plannerOutageFields(), "planner_outages");
+  entries(follower_dropouts, uavDropoutFields(), "follower_dropouts");
+  auto outliers = rangeOutlierFields().rangeProblems(range_outliers);
+  common::checkRule(outliers, range_outliers.max_error_m >= range_outliers.min_error_m, "max_error_m",
+                    range_outliers.max_error_m, "must be >= min_error_m");
+  for (auto& line : common::problemLines(outliers, prefix + "range_outliers.")) e.push_back(line);
+  if (!onboard::ranges::kMaxCommandAgeS.contains(max_command_age_s)) {
+    e.push_back(prefix + "max_command_age_s " + common::rangeProblem(onboard::ranges::kMaxCommandAgeS, max_command_age_s));
   }
-  const RangeOutlierConfig& ro = range_outliers;
-  check(e, ro.probability >= 0 && ro.probability <= 1, ro.probability, prefix, "range_outliers.probability", "in [0, 1]");
-  check(e, ro.min_error_m >= 0, ro.min_error_m, prefix, "range_outliers.min_error_m", ">= 0");
-  check(e, ro.max_error_m >= ro.min_error_m, ro.max_error_m, prefix, "range_outliers.max_error_m", ">= min_error_m");
-  check(e, max_share_age_s > 0, max_share_age_s, prefix, "max_share_age_s", "> 0");
-  check(e, max_worker_age_s > 0, max_worker_age_s, prefix, "max_worker_age_s", "> 0");
-  check(e, max_command_age_s > 0, max_command_age_s, prefix, "max_command_age_s", "> 0");
-  check(e, max_plan_age_s > 0, max_plan_age_s, prefix, "max_plan_age_s", "> 0");
-  for (auto& problem : search.validate(prefix)) e.push_back(std::move(problem));
   return e;
 }
 
@@ -86,14 +115,7 @@ bool inWindow(const std::vector<std::pair<double, double>>& windows, double t_s)
 namespace {
 
 /// The keys of one link (mission.links.* and their mission.faults.* overlays) under `k`.
-void readLinkKeys(ConfigReader& r, const std::string& k, LinkConfig& lc) {
-  r.readDouble(k + "delay_s", lc.delay_s, Range::nonNegative());
-  r.readDouble(k + "jitter_s", lc.jitter_s, Range::nonNegative());
-  r.readDouble(k + "loss", lc.loss, Range::closed(0.0, 1.0));
-  r.readDouble(k + "duplicate", lc.duplicate, Range::closed(0.0, 1.0));
-  r.readDouble(k + "reorder", lc.reorder, Range::closed(0.0, 1.0));
-  r.readDouble(k + "reorder_extra_delay_s", lc.reorder_extra_delay_s, Range::nonNegative());
-}
+void readLinkKeys(ConfigReader& r, const std::string& k, LinkConfig& lc) { linkConfigFields().readFields(r, k, lc); }
 
 std::string joinPath(const std::string& base, const std::string& p) {
   if (p.empty() || p[0] == '/' || base.empty()) return p;
@@ -122,25 +144,7 @@ const std::vector<std::pair<std::string, gesture::Motion>>& motionNames() {
 
 void readPlant(ConfigReader& r, const std::string& p, MultirotorParams& m) {
   // Physical limits: every key required (docs/conventions.md, code style 4).
-  const auto req = [&](const std::string& k, double& v, const Range& range) {
-    if (!r.has(p + k)) {
-      r.addError(p + k, "missing (required: physical limits have no defaults)");
-      return;
-    }
-    r.readDouble(p + k, v, range);
-  };
-  req("mass_kg", m.mass_kg, Range::positive());
-  req("max_thrust_to_weight", m.max_thrust_to_weight, Range{1.0, 10.0, false, true});
-  req("min_thrust_to_weight", m.min_thrust_to_weight, Range{0.0, 1.0, true, false});
-  req("max_tilt_deg", m.max_tilt_deg, Range::openClosed(0.0, 80.0));
-  req("attitude_time_constant_s", m.attitude_time_constant_s, Range::positive());
-  req("drag_linear_ns_per_m", m.drag_linear_ns_per_m, Range::nonNegative());
-  req("drag_quadratic_ns2_per_m2", m.drag_quadratic_ns2_per_m2, Range::nonNegative());
-  req("max_yaw_rate_dps", m.max_yaw_rate_dps, Range::positive());
-  req("max_pitch_rate_dps", m.max_pitch_rate_dps, Range::positive());
-  req("min_pitch_deg", m.min_pitch_deg, Range::closed(-90.0, 90.0));
-  req("max_pitch_deg", m.max_pitch_deg, Range::closed(-90.0, 90.0));
-  req("body_radius_m", m.body_radius_m, Range::positive());
+  multirotorParamsFields().readRequiredFields(r, p, m, "physical limits have no defaults");
   for (const auto& e : m.validate()) r.addError(p.substr(0, p.size() - 1), e);
 }
 
@@ -161,7 +165,7 @@ void readRoute(ConfigReader& r, const std::string& p, WorkerConfig& w) {
         ++kinds;
         leg.kind = kind;
         leg.to_feet_world = vec3(r, k + name, Eigen::Vector3d::Zero());
-        r.readDouble(k + "speed_mps", leg.speed_mps, Range::openClosed(0.0, 3.0));
+        routeLegFields().readField(r, k, leg, "speed_mps");
       }
     }
     const std::pair<const char*, RouteLeg::Kind> still[] = {{"work_s", RouteLeg::Kind::kWork},
@@ -170,7 +174,7 @@ void readRoute(ConfigReader& r, const std::string& p, WorkerConfig& w) {
       if (r.has(k + name)) {
         ++kinds;
         leg.kind = kind;
-        r.readDouble(k + name, leg.duration_s, Range::positive());
+        r.readDouble(k + name, leg.duration_s, *routeLegFields().rangeOf("duration_s"));
       }
     }
     if (kinds != 1) {
@@ -178,7 +182,7 @@ void readRoute(ConfigReader& r, const std::string& p, WorkerConfig& w) {
     }
     if (r.has(k + "facing_deg")) {
       double f = 0.0;
-      r.readDouble(k + "facing_deg", f, Range::closed(-360.0, 360.0));
+      r.readDouble(k + "facing_deg", f, kFacingDegRange);
       leg.facing_deg = f;
     }
     w.route.push_back(leg);
@@ -187,11 +191,7 @@ void readRoute(ConfigReader& r, const std::string& p, WorkerConfig& w) {
 
 void readWind(ConfigReader& r, const std::string& k, WindConfig& wd) {
   wd.mean_mps = vec3(r, k + "mean_mps", wd.mean_mps);
-  r.readDouble(k + "turbulence_std_mps", wd.turbulence_std_mps, Range::nonNegative());
-  r.readDouble(k + "turbulence_time_constant_s", wd.turbulence_time_constant_s, Range::positive());
-  r.readDouble(k + "gusts_per_minute", wd.gusts_per_minute, Range::nonNegative());
-  r.readDouble(k + "gust_peak_mps", wd.gust_peak_mps, Range::nonNegative());
-  r.readDouble(k + "gust_duration_s", wd.gust_duration_s, Range::positive());
+  windConfigFields().readFields(r, k, wd);
 }
 
 void readScheduledGestures(ConfigReader& r, const std::string& wk, WorkerConfig& w) {
@@ -201,8 +201,7 @@ void readScheduledGestures(ConfigReader& r, const std::string& wk, WorkerConfig&
       const std::string k = wk + "gestures[" + std::to_string(i) + "].";
       ScheduledGesture g;
       if (!r.has(k + "t_s") || !r.has(k + "gesture")) r.addError(k + "t_s", "each gesture needs t_s and gesture");
-      r.readDouble(k + "t_s", g.t_s, Range::nonNegative());
-      r.readInt(k + "gesture", g.gesture_id, Range::closed(1, 4));
+      scheduledGestureFields().readFields(r, k, g);
       w.gestures.push_back(g);
     }
   } else if (gestures.IsDefined() && !gestures.IsNull()) {
@@ -234,12 +233,9 @@ void readWorkMotions(ConfigReader& r, const std::string& wk, WorkerConfig& w) {
 /// mission.worker: body, start, route, scheduled gestures, work motions, skeleton synthesis.
 void readWorker(ConfigReader& r, const std::string& m, WorkerConfig& w) {
   const std::string wk = m + "worker.";
-  r.readDouble(wk + "height_m", w.height_m, Range::closed(1.0, 2.3));
+  workerConfigFields().readFields(r, wk, w);
   if (!r.has(wk + "start")) r.addError(wk + "start", "missing (required)");
   w.start_feet_world = vec3(r, wk + "start", Eigen::Vector3d::Zero());
-  r.readDouble(wk + "start_facing_deg", w.start_facing_deg, Range::closed(-360.0, 360.0));
-  r.readDouble(wk + "gesture_hold_min_s", w.gesture_hold_min_s, Range::positive());
-  r.readDouble(wk + "gesture_hold_max_s", w.gesture_hold_max_s, Range::positive());
   readRoute(r, wk, w);
   readScheduledGestures(r, wk, w);
   readWorkMotions(r, wk, w);
@@ -269,15 +265,7 @@ void readUavs(ConfigReader& r, const std::string& m, std::vector<UavConfig>& out
 }
 
 void readControllerGains(ConfigReader& r, const std::string& m, ControllerConfig& ct) {
-  const std::string ck = m + "controller.";
-  for (auto [name, v] : std::initializer_list<std::pair<const char*, double*>>{
-           {"kp_xy", &ct.kp_xy}, {"kp_z", &ct.kp_z}, {"kd_xy", &ct.kd_xy}, {"kd_z", &ct.kd_z},
-           {"ki_xy", &ct.ki_xy}, {"ki_z", &ct.ki_z}, {"integral_limit_mps2", &ct.integral_limit_mps2},
-           {"integral_zone_m", &ct.integral_zone_m}, {"integral_zone_mps", &ct.integral_zone_mps},
-           {"max_accel_mps2", &ct.max_accel_mps2}, {"k_heading", &ct.k_heading}, {"k_pitch", &ct.k_pitch},
-           {"hover_speed_mps", &ct.hover_speed_mps}}) {
-    r.readDouble(ck + name, *v, Range::nonNegative());
-  }
+  controllerConfigFields().readFields(r, m + "controller.", ct);  // brake_accel_mps2: readOnboard
 }
 
 /// The product's settings (replanning, safety limits, formation, gestures, planner, estimator):
@@ -286,15 +274,9 @@ void readOnboard(ConfigReader& r, const std::string& m, MissionConfig& c) {
   onboard::OnboardSettings onboard;
   onboard::readOnboardSettings(r, m, onboard);
   c.replanning_period_s = onboard.replanning_period_s;
-  c.horizon_dt_s = onboard.horizon_dt_s;
-  c.horizon_steps = onboard.horizon_steps;
-  c.controller.brake_accel_mps2 = onboard.brake_accel_mps2;
-  c.faults.max_share_age_s = onboard.freshness.max_share_age_s;
-  c.faults.max_worker_age_s = onboard.freshness.max_worker_age_s;
-  c.faults.search = onboard.search;
+  c.replan = onboard.replan;
+  c.controller.brake_accel_mps2 = onboard.replan.brake_accel_mps2;  // the simulated flight controller brakes alike
   c.faults.max_command_age_s = onboard.max_command_age_s;
-  c.faults.max_plan_age_s = onboard.rule.max_plan_age_s;
-  c.faults.avoid_all_plans = onboard.rule.avoid_all_plans;
   c.formation = onboard.formation;
   c.gesture_filter = onboard.gesture_filter;
   c.gesture_mapping = onboard.gesture_mapping;
@@ -305,31 +287,16 @@ void readOnboard(ConfigReader& r, const std::string& m, MissionConfig& c) {
 
 void readOdometry(ConfigReader& r, const std::string& m, OdometryConfig& od) {
   const std::string ok = m + "odometry.";
-  r.readDouble(ok + "position_noise_m", od.position_noise_m, Range::nonNegative());
-  r.readDouble(ok + "velocity_noise_mps", od.velocity_noise_mps, Range::nonNegative());
-  r.readDouble(ok + "heading_noise_deg", od.heading_noise_deg, Range::nonNegative());
-  r.readDouble(ok + "pitch_noise_deg", od.pitch_noise_deg, Range::nonNegative());
-  r.readDouble(ok + "bias_std_m", od.bias_std_m, Range::nonNegative());
-  r.readDouble(ok + "bias_time_constant_s", od.bias_time_constant_s, Range::positive());
+  odometryConfigFields().readFields(r, ok, od);
 }
 
-/// mission.sensors (camera, stereo, UWB) and mission.links.
 void readSensorsAndLinks(ConfigReader& r, const std::string& m, MissionConfig& c) {
   const std::string sk = m + "sensors.";
-  r.readDouble(sk + "camera.rate_hz", c.camera.rate_hz, Range::openClosed(0.0, 60.0));
-  r.readDouble(sk + "camera.pixel_noise_px", c.camera.pixel_noise_px, Range::nonNegative());
-  r.readDouble(sk + "camera.detection_dropout", c.camera.detection_dropout, Range{0.0, 1.0, true, false});
-  r.readDouble(sk + "camera.max_detection_range_m", c.camera.max_detection_range_m, Range::positive());
-  r.readDouble(sk + "camera.min_box_height_px", c.camera.min_box_height_px, Range::atLeast(1.0));
-  r.readDouble(sk + "camera.min_visible_fraction", c.camera.min_visible_fraction, Range::openClosed(0.0, 1.0));
-  r.readDouble(sk + "camera.occlusion_ignore_near_worker_m", c.camera.occlusion_ignore_near_worker_m,
-               Range::nonNegative());
+  cameraSensorFields().readFields(r, sk + "camera.", c.camera);
   for (auto [name, rs] : std::initializer_list<std::pair<const char*, RangeSensorConfig*>>{{"stereo", &c.stereo},
                                                                                          {"uwb", &c.uwb}}) {
     const std::string k = sk + name + ".";
-    r.readDouble(k + "noise_m", rs->noise_m, Range::nonNegative());
-    r.readDouble(k + "max_range_m", rs->max_range_m, Range::positive());
-    r.readDouble(k + "dropout", rs->dropout, Range::closed(0.0, 1.0));
+    rangeSensorFields().readFields(r, k, *rs);
   }
   for (auto [name, lc] : std::initializer_list<std::pair<const char*, LinkConfig*>>{{"links.uav", &c.link},
                                                                                   {"links.operator", &c.operator_link}}) {
@@ -357,9 +324,7 @@ void readPlannerOutages(ConfigReader& r, const std::string& fk, std::vector<Plan
   for (std::size_t i = 0; i < po.size(); ++i) {
     const std::string k = fk + "planner_outages[" + std::to_string(i) + "].";
     PlannerOutage o;
-    r.readInt(k + "uav", o.uav, Range::closed(0, 63));
-    r.readDouble(k + "from_s", o.from_s, Range::nonNegative());
-    r.readDouble(k + "to_s", o.to_s, Range::nonNegative());
+    plannerOutageFields().readFields(r, k, o);
     out.push_back(o);
   }
 }
@@ -370,12 +335,7 @@ void readFollowerDropouts(ConfigReader& r, const std::string& fk, std::vector<Ua
     for (std::size_t i = 0; i < fd.size(); ++i) {
       const std::string k = fk + "follower_dropouts[" + std::to_string(i) + "].";
       UavDropout o;
-      for (const char* key : {"uav", "from_s", "to_s"}) {
-        if (!r.has(k + key)) r.addError(k + key, "missing (required)");
-      }
-      r.readInt(k + "uav", o.uav, Range::closed(1, 63));
-      r.readDouble(k + "from_s", o.from_s, Range::nonNegative());
-      r.readDouble(k + "to_s", o.to_s, Range::nonNegative());
+      uavDropoutFields().readRequiredFields(r, k, o, "a dropout names its follower and window");
       out.push_back(o);
     }
   } else if (fd.IsDefined()) {
@@ -398,9 +358,7 @@ void readFaults(ConfigReader& r, const std::string& m, MissionConfig& c) {
   readPlannerOutages(r, fk, c.faults.planner_outages);
   readFollowerDropouts(r, fk, c.faults.follower_dropouts);
   const std::string k = fk + "range_outliers.";
-  r.readDouble(k + "probability", c.faults.range_outliers.probability, Range::closed(0.0, 1.0));
-  r.readDouble(k + "min_error_m", c.faults.range_outliers.min_error_m, Range::nonNegative());
-  r.readDouble(k + "max_error_m", c.faults.range_outliers.max_error_m, Range::nonNegative());
+  rangeOutlierFields().readFields(r, k, c.faults.range_outliers);
   for (const auto& e : c.faults.validate()) r.addError(m + "faults", e);
 }
 
@@ -504,7 +462,6 @@ common::Result<MissionConfig> parseMissionConfig(const std::string& yaml, const 
   readUavs(r, m, c.uavs);
   readControllerGains(r, m, c.controller);
   readOnboard(r, m, c);
-  for (const auto& e : c.controller.validate()) r.addError(m + "controller", e);
   readOdometry(r, m, c.odometry);
   readWind(r, m + "wind.", c.wind);
   readSensorsAndLinks(r, m, c);

@@ -169,7 +169,6 @@ std::string MissionRun::addUavs() {
   const WorkerState w0 = worker_.stateAt(0.0);
   const double hphi0 = formation::WorkerHeading(cfg_.formation.worker_heading).heading();
   const formation::UavReference lref0 = formation::leaderReference(w0.p_world, hphi0, cfg_.formation.params.leader);
-  const planning::FreshnessLimits freshness{cfg_.faults.max_share_age_s, cfg_.faults.max_worker_age_s};
   for (int i = 0; i < n_; ++i) {
     const formation::UavReference ref =
         i == 0 ? lref0
@@ -188,14 +187,8 @@ std::string MissionRun::addUavs() {
       return os.str();
     }
     auto u = std::make_unique<UavRuntime>(cfg_.uavs[static_cast<std::size_t>(i)], cfg_, s0, seed_, i);
-    planning::ReplanConfig rc;
+    planning::ReplanConfig rc = cfg_.replan;
     rc.uav_index = i;
-    rc.dt_s = cfg_.horizon_dt_s;
-    rc.steps = cfg_.horizon_steps;
-    rc.freshness = freshness;
-    rc.rule = planning::AvoidanceRule{cfg_.faults.avoid_all_plans, cfg_.faults.max_plan_age_s};
-    rc.search = cfg_.faults.search;
-    rc.brake_accel_mps2 = cfg_.controller.brake_accel_mps2;
     rc.worker_heading = cfg_.formation.worker_heading;
     u->step = std::make_unique<planning::ReplanStep>(rc, planners_(i));
     u->next_plan_s = cfg_.replanning_period_s * static_cast<double>(i) / static_cast<double>(n_);

@@ -4,29 +4,33 @@
 #include <cmath>
 
 #include "gesture_formation/common/angles.hpp"
-#include "validate_util.hpp"
 
 namespace gesture_formation::sim {
 
-using detail::check;
+const common::FieldTable<MultirotorParams>& multirotorParamsFields() {
+  using common::Range;
+  using C = MultirotorParams;
+  static const common::FieldTable<C> t{{
+      {"mass_kg", Range::positive(), [](C& c) { return &c.mass_kg; }},
+      {"max_thrust_to_weight", Range{1.0, 10.0, false, true}, [](C& c) { return &c.max_thrust_to_weight; }},
+      {"min_thrust_to_weight", Range{0.0, 1.0, true, false}, [](C& c) { return &c.min_thrust_to_weight; }},
+      {"max_tilt_deg", Range::openClosed(0.0, 80.0), [](C& c) { return &c.max_tilt_deg; }},
+      {"attitude_time_constant_s", Range::positive(), [](C& c) { return &c.attitude_time_constant_s; }},
+      {"drag_linear_ns_per_m", Range::nonNegative(), [](C& c) { return &c.drag_linear_ns_per_m; }},
+      {"drag_quadratic_ns2_per_m2", Range::nonNegative(), [](C& c) { return &c.drag_quadratic_ns2_per_m2; }},
+      {"max_yaw_rate_dps", Range::positive(), [](C& c) { return &c.max_yaw_rate_dps; }},
+      {"max_pitch_rate_dps", Range::positive(), [](C& c) { return &c.max_pitch_rate_dps; }},
+      {"min_pitch_deg", Range::closed(-90.0, 90.0), [](C& c) { return &c.min_pitch_deg; }},
+      {"max_pitch_deg", Range::closed(-90.0, 90.0), [](C& c) { return &c.max_pitch_deg; }},
+      {"body_radius_m", Range::positive(), [](C& c) { return &c.body_radius_m; }},
+  }};
+  return t;
+}
 
 std::vector<std::string> MultirotorParams::validate(const std::string& prefix) const {
-  std::vector<std::string> e;
-  check(e, mass_kg > 0, mass_kg, prefix, "mass_kg", "> 0");
-  check(e, max_thrust_to_weight > 1, max_thrust_to_weight, prefix, "max_thrust_to_weight", "> 1");
-  check(e, min_thrust_to_weight >= 0 && min_thrust_to_weight < 1, min_thrust_to_weight, prefix,
-        "min_thrust_to_weight", "in [0, 1)");
-  check(e, max_tilt_deg > 0 && max_tilt_deg <= 80, max_tilt_deg, prefix, "max_tilt_deg", "in (0, 80]");
-  check(e, attitude_time_constant_s > 0, attitude_time_constant_s, prefix, "attitude_time_constant_s", "> 0");
-  check(e, drag_linear_ns_per_m >= 0, drag_linear_ns_per_m, prefix, "drag_linear_ns_per_m", ">= 0");
-  check(e, drag_quadratic_ns2_per_m2 >= 0, drag_quadratic_ns2_per_m2, prefix, "drag_quadratic_ns2_per_m2", ">= 0");
-  check(e, max_yaw_rate_dps > 0, max_yaw_rate_dps, prefix, "max_yaw_rate_dps", "> 0");
-  check(e, max_pitch_rate_dps > 0, max_pitch_rate_dps, prefix, "max_pitch_rate_dps", "> 0");
-  check(e, min_pitch_deg >= -90 && min_pitch_deg < max_pitch_deg, min_pitch_deg, prefix, "min_pitch_deg",
-        "in [-90, max_pitch_deg)");
-  check(e, max_pitch_deg <= 90, max_pitch_deg, prefix, "max_pitch_deg", "<= 90");
-  check(e, body_radius_m > 0, body_radius_m, prefix, "body_radius_m", "> 0");
-  return e;
+  auto e = multirotorParamsFields().rangeProblems(*this);
+  common::checkRule(e, min_pitch_deg < max_pitch_deg, "min_pitch_deg", min_pitch_deg, "must be < max_pitch_deg");
+  return common::problemLines(e, prefix);
 }
 
 Multirotor::Multirotor(const MultirotorParams& params, const MultirotorState& initial)

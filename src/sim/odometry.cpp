@@ -3,21 +3,25 @@
 #include <cmath>
 
 #include "gesture_formation/common/angles.hpp"
-#include "validate_util.hpp"
 
 namespace gesture_formation::sim {
 
-using detail::check;
+const common::FieldTable<OdometryConfig>& odometryConfigFields() {
+  using common::Range;
+  using C = OdometryConfig;
+  static const common::FieldTable<C> t{{
+      {"position_noise_m", Range::nonNegative(), [](C& c) { return &c.position_noise_m; }},
+      {"velocity_noise_mps", Range::nonNegative(), [](C& c) { return &c.velocity_noise_mps; }},
+      {"heading_noise_deg", Range::nonNegative(), [](C& c) { return &c.heading_noise_deg; }},
+      {"pitch_noise_deg", Range::nonNegative(), [](C& c) { return &c.pitch_noise_deg; }},
+      {"bias_std_m", Range::nonNegative(), [](C& c) { return &c.bias_std_m; }},
+      {"bias_time_constant_s", Range::positive(), [](C& c) { return &c.bias_time_constant_s; }},
+  }};
+  return t;
+}
 
 std::vector<std::string> OdometryConfig::validate(const std::string& prefix) const {
-  std::vector<std::string> e;
-  check(e, position_noise_m >= 0, position_noise_m, prefix, "position_noise_m", ">= 0");
-  check(e, velocity_noise_mps >= 0, velocity_noise_mps, prefix, "velocity_noise_mps", ">= 0");
-  check(e, heading_noise_deg >= 0, heading_noise_deg, prefix, "heading_noise_deg", ">= 0");
-  check(e, pitch_noise_deg >= 0, pitch_noise_deg, prefix, "pitch_noise_deg", ">= 0");
-  check(e, bias_std_m >= 0, bias_std_m, prefix, "bias_std_m", ">= 0");
-  check(e, bias_time_constant_s > 0, bias_time_constant_s, prefix, "bias_time_constant_s", "> 0");
-  return e;
+  return common::problemLines(odometryConfigFields().rangeProblems(*this), prefix);
 }
 
 Odometry::Odometry(const OdometryConfig& config, std::mt19937_64 rng) : config_(config), rng_(std::move(rng)) {

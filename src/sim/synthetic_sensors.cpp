@@ -7,33 +7,44 @@
 #include <Eigen/Geometry>
 
 #include "gesture_formation/planning/occupancy_map.hpp"
-#include "validate_util.hpp"
 
 namespace gesture_formation::sim {
 
-using detail::check;
+const common::FieldTable<CameraSensorConfig>& cameraSensorFields() {
+  using common::Range;
+  using C = CameraSensorConfig;
+  static const common::FieldTable<C> t{{
+      {"rate_hz", Range::openClosed(0.0, 60.0), [](C& c) { return &c.rate_hz; }},
+      {"pixel_noise_px", Range::nonNegative(), [](C& c) { return &c.pixel_noise_px; }},
+      {"detection_dropout", Range{0.0, 1.0, true, false}, [](C& c) { return &c.detection_dropout; }},
+      {"max_detection_range_m", Range::positive(), [](C& c) { return &c.max_detection_range_m; }},
+      {"min_box_height_px", Range::atLeast(1.0), [](C& c) { return &c.min_box_height_px; }},
+      {"min_visible_fraction", Range::openClosed(0.0, 1.0), [](C& c) { return &c.min_visible_fraction; }},
+      {"occlusion_ignore_near_worker_m", Range::nonNegative(), [](C& c) { return &c.occlusion_ignore_near_worker_m; }},
+  }};
+  return t;
+}
+
+const common::FieldTable<RangeSensorConfig>& rangeSensorFields() {
+  using common::Range;
+  using C = RangeSensorConfig;
+  static const common::FieldTable<C> t{{
+      {"noise_m", Range::nonNegative(), [](C& c) { return &c.noise_m; }},
+      {"max_range_m", Range::positive(), [](C& c) { return &c.max_range_m; }},
+      {"dropout", Range::closed(0.0, 1.0), [](C& c) { return &c.dropout; }},
+  }};
+  return t;
+}
 
 std::vector<std::string> CameraSensorConfig::validate(const std::string& prefix) const {
   std::vector<std::string> e;
   for (const auto& c : camera.validate()) e.push_back(prefix + c);
-  check(e, rate_hz > 0 && rate_hz <= 60, rate_hz, prefix, "rate_hz", "in (0, 60]");
-  check(e, pixel_noise_px >= 0, pixel_noise_px, prefix, "pixel_noise_px", ">= 0");
-  check(e, detection_dropout >= 0 && detection_dropout < 1, detection_dropout, prefix, "detection_dropout", "in [0, 1)");
-  check(e, max_detection_range_m > 0, max_detection_range_m, prefix, "max_detection_range_m", "> 0");
-  check(e, min_box_height_px >= 1, min_box_height_px, prefix, "min_box_height_px", ">= 1");
-  check(e, min_visible_fraction > 0 && min_visible_fraction <= 1, min_visible_fraction, prefix, "min_visible_fraction",
-        "in (0, 1]");
-  check(e, occlusion_ignore_near_worker_m >= 0, occlusion_ignore_near_worker_m, prefix,
-        "occlusion_ignore_near_worker_m", ">= 0");
+  for (auto& line : common::problemLines(cameraSensorFields().rangeProblems(*this), prefix)) e.push_back(std::move(line));
   return e;
 }
 
 std::vector<std::string> RangeSensorConfig::validate(const std::string& prefix) const {
-  std::vector<std::string> e;
-  check(e, noise_m >= 0, noise_m, prefix, "noise_m", ">= 0");
-  check(e, max_range_m > 0, max_range_m, prefix, "max_range_m", "> 0");
-  check(e, dropout >= 0 && dropout <= 1, dropout, prefix, "dropout", "in [0, 1]");
-  return e;
+  return common::problemLines(rangeSensorFields().rangeProblems(*this), prefix);
 }
 
 const char* toString(Visibility v) {

@@ -4,29 +4,37 @@
 #include <cmath>
 
 #include "gesture_formation/common/angles.hpp"
-#include "validate_util.hpp"
+#include "gesture_formation/planning/replan_step.hpp"
 
 namespace gesture_formation::sim {
 
-using detail::check;
+const common::FieldTable<ControllerConfig>& controllerConfigFields() {
+  using common::Range;
+  using C = ControllerConfig;
+  static const common::FieldTable<C> t{{
+      {"kp_xy", Range::positive(), [](C& c) { return &c.kp_xy; }},
+      {"kp_z", Range::positive(), [](C& c) { return &c.kp_z; }},
+      {"kd_xy", Range::positive(), [](C& c) { return &c.kd_xy; }},
+      {"kd_z", Range::positive(), [](C& c) { return &c.kd_z; }},
+      {"ki_xy", Range::nonNegative(), [](C& c) { return &c.ki_xy; }},
+      {"ki_z", Range::nonNegative(), [](C& c) { return &c.ki_z; }},
+      {"integral_limit_mps2", Range::nonNegative(), [](C& c) { return &c.integral_limit_mps2; }},
+      {"integral_zone_m", Range::positive(), [](C& c) { return &c.integral_zone_m; }},
+      {"integral_zone_mps", Range::positive(), [](C& c) { return &c.integral_zone_mps; }},
+      {"max_accel_mps2", Range::positive(), [](C& c) { return &c.max_accel_mps2; }},
+      {"k_heading", Range::positive(), [](C& c) { return &c.k_heading; }},
+      {"k_pitch", Range::positive(), [](C& c) { return &c.k_pitch; }},
+      {"hover_speed_mps", Range::positive(), [](C& c) { return &c.hover_speed_mps; }},
+  }};
+  return t;
+}
 
 std::vector<std::string> ControllerConfig::validate(const std::string& prefix) const {
-  std::vector<std::string> e;
-  check(e, kp_xy > 0, kp_xy, prefix, "kp_xy", "> 0");
-  check(e, kp_z > 0, kp_z, prefix, "kp_z", "> 0");
-  check(e, kd_xy > 0, kd_xy, prefix, "kd_xy", "> 0");
-  check(e, kd_z > 0, kd_z, prefix, "kd_z", "> 0");
-  check(e, ki_xy >= 0, ki_xy, prefix, "ki_xy", ">= 0");
-  check(e, ki_z >= 0, ki_z, prefix, "ki_z", ">= 0");
-  check(e, integral_limit_mps2 >= 0, integral_limit_mps2, prefix, "integral_limit_mps2", ">= 0");
-  check(e, integral_zone_m > 0, integral_zone_m, prefix, "integral_zone_m", "> 0");
-  check(e, integral_zone_mps > 0, integral_zone_mps, prefix, "integral_zone_mps", "> 0");
-  check(e, max_accel_mps2 > 0, max_accel_mps2, prefix, "max_accel_mps2", "> 0");
-  check(e, k_heading > 0, k_heading, prefix, "k_heading", "> 0");
-  check(e, k_pitch > 0, k_pitch, prefix, "k_pitch", "> 0");
-  check(e, brake_accel_mps2 > 0, brake_accel_mps2, prefix, "brake_accel_mps2", "> 0");
-  check(e, hover_speed_mps > 0, hover_speed_mps, prefix, "hover_speed_mps", "> 0");
-  return e;
+  auto e = controllerConfigFields().rangeProblems(*this);
+  // The braking deceleration is an onboard setting (the replanning step's stop point): its range.
+  const common::Range& brake = *planning::replanConfigFields().rangeOf("controller.brake_accel_mps2");
+  if (!brake.contains(brake_accel_mps2)) e.push_back({"brake_accel_mps2", common::rangeProblem(brake, brake_accel_mps2)});
+  return common::problemLines(e, prefix);
 }
 
 TrackingController::TrackingController(const ControllerConfig& config, const MultirotorParams& plant)

@@ -4,20 +4,26 @@
 #include <limits>
 
 #include "gesture_formation/common/angles.hpp"
-#include "validate_util.hpp"
 
 namespace gesture_formation::sim {
 
-using detail::check;
+const common::FieldTable<WindConfig>& windConfigFields() {
+  using common::Range;
+  using C = WindConfig;
+  static const common::FieldTable<C> t{{
+      {"turbulence_std_mps", Range::nonNegative(), [](C& c) { return &c.turbulence_std_mps; }},
+      {"turbulence_time_constant_s", Range::positive(), [](C& c) { return &c.turbulence_time_constant_s; }},
+      {"gusts_per_minute", Range::nonNegative(), [](C& c) { return &c.gusts_per_minute; }},
+      {"gust_peak_mps", Range::nonNegative(), [](C& c) { return &c.gust_peak_mps; }},
+      {"gust_duration_s", Range::positive(), [](C& c) { return &c.gust_duration_s; }},
+  }};
+  return t;
+}
 
 std::vector<std::string> WindConfig::validate(const std::string& prefix) const {
   std::vector<std::string> e;
   if (!mean_mps.allFinite()) e.push_back(prefix + "mean_mps must be finite");
-  check(e, turbulence_std_mps >= 0, turbulence_std_mps, prefix, "turbulence_std_mps", ">= 0");
-  check(e, turbulence_time_constant_s > 0, turbulence_time_constant_s, prefix, "turbulence_time_constant_s", "> 0");
-  check(e, gusts_per_minute >= 0, gusts_per_minute, prefix, "gusts_per_minute", ">= 0");
-  check(e, gust_peak_mps >= 0, gust_peak_mps, prefix, "gust_peak_mps", ">= 0");
-  check(e, gust_duration_s > 0, gust_duration_s, prefix, "gust_duration_s", "> 0");
+  for (auto& line : common::problemLines(windConfigFields().rangeProblems(*this), prefix)) e.push_back(std::move(line));
   return e;
 }
 

@@ -9,13 +9,12 @@
 #include "gesture_formation/common/angles.hpp"
 #include "gesture_formation/formation/formation_geometry.hpp"
 #include "gesture_formation/sim/random.hpp"
-#include "validate_util.hpp"
+#include "gesture_formation/common/format_number.hpp"
 
 namespace gesture_formation::sim {
 
 using common::degToRad;
 using common::radToDeg;
-using detail::check;
 using common::formatNumber;
 
 const char* toString(RouteLeg::Kind k) {
@@ -45,26 +44,69 @@ bool moving(RouteLeg::Kind k) {
 }
 }  // namespace
 
+const common::FieldTable<WorkerConfig>& workerConfigFields() {
+  using common::Range;
+  using C = WorkerConfig;
+  static const common::FieldTable<C> t{{
+      {"height_m", Range::closed(1.0, 2.3), [](C& c) { return &c.height_m; }},
+      {"start_facing_deg", kFacingDegRange, [](C& c) { return &c.start_facing_deg; }},
+      {"gesture_hold_min_s", Range::positive(), [](C& c) { return &c.gesture_hold_min_s; }},
+      {"gesture_hold_max_s", Range::openClosed(0.0, 30.0), [](C& c) { return &c.gesture_hold_max_s; }},
+  }};
+  return t;
+}
+
+const common::FieldTable<RouteLeg>& routeLegFields() {
+  using common::Range;
+  static const common::FieldTable<RouteLeg> t{{
+      {"speed_mps", Range::openClosed(0.0, 3.0), [](RouteLeg& l) { return &l.speed_mps; }},
+      {"duration_s", Range::positive(), [](RouteLeg& l) { return &l.duration_s; }},
+  }};
+  return t;
+}
+
+const common::FieldTable<ScheduledGesture>& scheduledGestureFields() {
+  using common::Range;
+  static const common::FieldTable<ScheduledGesture> t{{
+      {"t_s", Range::nonNegative(), [](ScheduledGesture& g) { return &g.t_s; }},
+      {"gesture", Range::closed(1, 4), [](ScheduledGesture& g) { return &g.gesture_id; }},
+  }};
+  return t;
+}
+
+namespace {
+
+/// Appends the range problem of the table field `key` of `c`, if any, as a validate() line.
+template <class Config>
+void checkField(std::vector<std::string>& e, const common::FieldTable<Config>& table, const Config& c,
+                const std::string& prefix, const char* key) {
+  for (const auto& p : table.rangeProblems(c)) {
+    if (p.key == key) e.push_back(prefix + p.key + " " + p.message);
+  }
+}
+
+}  // namespace
+
 std::vector<std::string> WorkerConfig::validate(const std::string& prefix) const {
-  std::vector<std::string> e;
-  check(e, height_m >= 1.0 && height_m <= 2.3, height_m, prefix, "height_m", "in [1.0, 2.3]");
+  auto problems = workerConfigFields().rangeProblems(*this);
+  common::checkRule(problems, gesture_hold_min_s <= gesture_hold_max_s, "gesture_hold_min_s", gesture_hold_min_s,
+                    "must be <= gesture_hold_max_s");
+  std::vector<std::string> e = common::problemLines(problems, prefix);
   if (!start_feet_world.allFinite()) e.push_back(prefix + "start must be finite");
-  check(e, true, start_facing_deg, prefix, "start_facing_deg", "finite");
   if (route.empty()) e.push_back(prefix + "route must have at least one leg");
   for (std::size_t i = 0; i < route.size(); ++i) {
     const RouteLeg& l = route[i];
     const std::string p = prefix + "route[" + std::to_string(i) + "].";
     if (moving(l.kind)) {
       if (!l.to_feet_world.allFinite()) e.push_back(p + "to must be finite");
-      check(e, l.speed_mps > 0 && l.speed_mps <= 3.0, l.speed_mps, p, "speed_mps", "in (0, 3]");
+      checkField(e, routeLegFields(), l, p, "speed_mps");
     } else {
-      check(e, l.duration_s > 0, l.duration_s, p, "duration_s", "> 0");
+      checkField(e, routeLegFields(), l, p, "duration_s");
     }
-    if (l.facing_deg) check(e, true, *l.facing_deg, p, "facing_deg", "finite");
+    if (l.facing_deg && !kFacingDegRange.contains(*l.facing_deg)) {
+      e.push_back(p + "facing_deg " + common::rangeProblem(kFacingDegRange, *l.facing_deg));
+    }
   }
-  check(e, gesture_hold_min_s > 0 && gesture_hold_min_s <= gesture_hold_max_s, gesture_hold_min_s, prefix,
-        "gesture_hold_min_s", "in (0, gesture_hold_max_s]");
-  check(e, gesture_hold_max_s <= 30, gesture_hold_max_s, prefix, "gesture_hold_max_s", "<= 30");
   if (work_motions.empty()) e.push_back(prefix + "work_motions must not be empty");
   for (std::size_t i = 0; i < work_motions.size(); ++i) {
     if (gesture::gestureIdOf(work_motions[i]) != 0) {
@@ -91,7 +133,7 @@ std::vector<std::string> WorkerConfig::validate(const std::string& prefix) const
   for (std::size_t i = 0; i < gestures.size(); ++i) {
     const auto& g = gestures[i];
     const std::string p = prefix + "gestures[" + std::to_string(i) + "].";
-    if (g.gesture_id < 1 || g.gesture_id > 4) e.push_back(p + "gesture must be in [1, 4], got " + std::to_string(g.gesture_id));
+    for (auto& line : common::problemLines(scheduledGestureFields().rangeProblems(g), p)) e.push_back(std::move(line));
     if (i > 0 && !(g.t_s > gestures[i - 1].t_s)) e.push_back(p + "t_s must increase, got " + formatNumber(g.t_s));
     if (i > 0 && g.t_s - gestures[i - 1].t_s < longest) {
       e.push_back(p + "t_s " + formatNumber(g.t_s) + " is within " + formatNumber(longest) + " s of the previous gesture");

@@ -59,8 +59,8 @@ void checkRule(std::vector<ConfigError>& problems, bool ok, const std::string& k
 /// \brief Records each problem in `r` under `prefix` + its key.
 void addProblems(ConfigReader& r, const std::string& prefix, const std::vector<ConfigError>& problems);
 
-/// \brief Each problem as one validate() line: "<key> <message>".
-std::vector<std::string> problemLines(const std::vector<ConfigError>& problems);
+/// \brief Each problem as one validate() line: "<prefix><key> <message>".
+std::vector<std::string> problemLines(const std::vector<ConfigError>& problems, const std::string& prefix = "");
 
 /// \brief The numeric fields of `Config`, in the order they are documented (problems are listed
 /// in this order).
@@ -88,6 +88,18 @@ struct FieldTable {
   /// out-of-range value keeps the value in `c` and is recorded in `r`).
   void readFields(ConfigReader& r, const std::string& prefix, Config& c) const {
     for (const auto& f : fields) read(r, prefix, c, f);
+  }
+
+  /// \brief As readFields, but every field must be present: a missing key is recorded in `r` as
+  /// "missing (required: <why>)" (e.g. physical limits, which have no defaults).
+  void readRequiredFields(ConfigReader& r, const std::string& prefix, Config& c, const std::string& why) const {
+    for (const auto& f : fields) {
+      if (!r.has(prefix + f.key)) {
+        r.addError(prefix + f.key, "missing (required: " + why + ")");
+        continue;
+      }
+      read(r, prefix, c, f);
+    }
   }
 
   /// \brief Reads only the field `key` (one whose presence depends on other keys); a key the

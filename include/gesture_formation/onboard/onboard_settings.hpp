@@ -26,36 +26,24 @@
 #include "gesture_formation/gesture/view_fusion.hpp"
 #include "gesture_formation/planning/plan_request_builder.hpp"
 #include "gesture_formation/planning/planner_config.hpp"
+#include "gesture_formation/planning/replan_step.hpp"
 
 namespace gesture_formation::onboard {
 
-/// \brief The one range of each replanning setting, for the mission keys and the FormationPlanner
-/// nodelet's parameters of the same names alike.
+/// \brief The one range of each setting here that is not a ReplanConfig number (those:
+/// planning::replanConfigFields()), for the mission keys and the nodelets' parameters alike.
 namespace ranges {
 inline const common::Range kReplanningPeriodS = common::Range::openClosed(0.0, 5.0);
-inline const common::Range kHorizonDtS = common::Range::openClosed(0.0, 2.0);
-inline const common::Range kHorizonSteps = common::Range::closed(2, formation::kMaxHorizonSteps);
-inline const common::Range kBrakeAccelMps2 = common::Range::openClosed(0.0, 50.0);
-inline const common::Range kMaxShareAgeS = common::Range::positive();
-inline const common::Range kMaxWorkerAgeS = common::Range::positive();
 inline const common::Range kMaxCommandAgeS = common::Range::positive();
-inline const common::Range kMaxPlanAgeS = common::Range::positive();
-inline const common::Range kSearchTimeoutS = common::Range::nonNegative();
-inline const common::Range kSearchHeightM = common::Range::positive();
-inline const common::Range kSearchVerticalSpeedMps = common::Range::positive();
-inline const common::Range kSearchPeriodS = common::Range::positive();
-inline const common::Range kSearchHorizontalSpeedMps = common::Range::nonNegative();
 }  // namespace ranges
 
 /// \brief The onboard settings of a mission (see the file comment for the keys).
 struct OnboardSettings {
   double replanning_period_s = 0.4;  ///< per UAV, staggered by period·i/n, (0, 5]
-  double horizon_dt_s = 0.2;         ///< (0, 2]
-  int horizon_steps = 40;            ///< [2, formation::kMaxHorizonSteps]
-  double brake_accel_mps2 = 4.0;     ///< controller.brake_accel_mps2, > 0
-  planning::FreshnessLimits freshness;  ///< faults.max_share_age_s, faults.max_worker_age_s
-  planning::AvoidanceRule rule;         ///< faults.avoid_all_plans, faults.max_plan_age_s
-  planning::SearchConfig search;        ///< faults.search_*
+  /// horizon_dt_s, horizon_steps, controller.brake_accel_mps2, faults.max_share_age_s,
+  /// faults.max_worker_age_s, faults.avoid_all_plans, faults.max_plan_age_s, faults.search_*
+  /// (uav_index is the UAV's own; worker_heading is formation.worker_heading).
+  planning::ReplanConfig replan;
   double max_command_age_s = 5.0;       ///< faults.max_command_age_s: never act on an older command, > 0
   formation::FormationConfig formation;
   gesture::GestureFilterConfig gesture_filter;

@@ -120,11 +120,9 @@ struct SearchConfig {
   double period_s = 8.0;             ///< up, back, down, back once [s], > 0
   /// Assumed walking speed for the sideways sweep [m/s], ≥ 0 (0: vertical sweep only): the
   /// camera turns ± atan(this × the estimate's age / horizontal distance to the estimate), left,
-  /// back, right, back once every 2 × period_s. Default 1.5 m/s (since 2026-12-03): a brisk walk.
+  /// back, right, back once every 2 × period_s. Default 1.5 m/s: a brisk walk.
   double horizontal_speed_mps = 1.5;
-  /// Every problem, each naming the key under `prefix` (search_timeout_s, search_height_m,
-  /// search_vertical_speed_mps, search_period_s, search_horizontal_speed_mps); empty when valid.
-  std::vector<std::string> validate(const std::string& prefix) const;
+  // Ranges: planning::replanConfigFields() (faults.search_*).
 };
 
 /// \brief Whether UAV `uav_index` may search at t_s: the leader only, only for the hold reason

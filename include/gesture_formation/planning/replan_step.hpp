@@ -28,6 +28,7 @@
 
 #include <Eigen/Core>
 
+#include "gesture_formation/common/config_fields.hpp"
 #include "gesture_formation/formation/formation_geometry.hpp"
 #include "gesture_formation/formation/formation_params.hpp"
 #include "gesture_formation/formation/worker_heading.hpp"
@@ -85,16 +86,29 @@ enum class ReplanMode {
 const char* toString(ReplanMode mode);
 
 /// \brief The settings of one UAV's replanning (FormationPlanner parameters; mission file).
+/// The ranges of its numbers are written once, in replanConfigFields().
 struct ReplanConfig {
   int uav_index = 0;                ///< 0 = leader, i = follower i (priority order)
-  double dt_s = 0.2;                ///< horizon step [s], > 0
-  int steps = 10;                   ///< horizon steps, ≥ 2
+  double dt_s = 0.2;                ///< horizon step [s]
+  int steps = 40;                   ///< horizon steps
   FreshnessLimits freshness;        ///< hold on data older than these
   AvoidanceRule rule;               ///< which received plans are avoided; listening's time limit
   SearchConfig search;              ///< the leader's camera search
   double brake_accel_mps2 = 4.0;    ///< where a holding UAV stops (brakingPoint)
   formation::WorkerHeadingConfig worker_heading;  ///< the worker-heading filter (^Hφ)
+  /// \brief Every number outside its range, each "<prefix><key> must be ..., got v" (keys as in
+  /// replanConfigFields()); empty when valid.
+  std::vector<std::string> validate(const std::string& prefix = "") const;
 };
+
+/// \brief The one range of each replanning number, keyed as a scenario's `mission` section writes
+/// it: horizon_dt_s, horizon_steps, controller.brake_accel_mps2, faults.max_share_age_s,
+/// faults.max_worker_age_s, faults.max_plan_age_s, faults.search_timeout_s, faults.search_height_m,
+/// faults.search_vertical_speed_mps, faults.search_period_s, faults.search_horizontal_speed_mps.
+/// The FormationPlanner nodelet's parameters of the same settings are the last segment of each
+/// key (brake_accel_mps2, max_share_age_s, search_period_s, ...). (uav_index, the bool
+/// rule.avoid_all_plans and worker_heading are read by their owners.)
+const common::FieldTable<ReplanConfig>& replanConfigFields();
 
 /// \brief The inputs of one replanning.
 struct ReplanInputs {

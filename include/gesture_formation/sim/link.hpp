@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "gesture_formation/comm/fault_channel.hpp"
+#include "gesture_formation/common/config_fields.hpp"
 
 namespace gesture_formation::sim {
 
@@ -30,6 +31,9 @@ struct LinkConfig {
   double reorder_extra_delay_s = 0.2;   ///< hold-back of a reordered message [s], ≥ 0
   std::vector<std::string> validate(const std::string& prefix = "") const;
 };
+
+/// \brief The one range of each number of LinkConfig: mission.links.uav / .operator and mission.faults.link / .operator_link.
+const common::FieldTable<LinkConfig>& linkConfigFields();
 
 struct LinkCounters {
   std::uint64_t sent = 0, lost = 0, duplicated = 0, reordered = 0, delivered = 0;

@@ -26,6 +26,7 @@
 #include "gesture_formation/gesture/view_fusion.hpp"
 #include "gesture_formation/planning/plan_request_builder.hpp"
 #include "gesture_formation/planning/planner_config.hpp"
+#include "gesture_formation/planning/replan_step.hpp"
 #include "gesture_formation/sim/link.hpp"
 #include "gesture_formation/sim/multirotor.hpp"
 #include "gesture_formation/sim/odometry.hpp"
@@ -33,6 +34,7 @@
 #include "gesture_formation/sim/tracking_controller.hpp"
 #include "gesture_formation/sim/wind.hpp"
 #include "gesture_formation/sim/worker_model.hpp"
+#include "gesture_formation/common/config_fields.hpp"
 
 namespace gesture_formation::sim {
 
@@ -80,8 +82,7 @@ struct RangeOutlierConfig {
 /// \brief `mission.faults` (issue 9; docs/safety.md states what the UAVs do for each fault).
 /// Windows are [from, to) in mission seconds. `faults.link`, `faults.operator_link` and
 /// `faults.wind` override `mission.links.uav`, `mission.links.operator` and `mission.wind`
-/// key by key (the loader applies them; they are not kept here). The four ages are the
-/// freshness limits of docs/safety.md §1.
+/// key by key (the loader applies them; they are not kept here).
 struct FaultConfig {
   std::vector<std::pair<double, double>> camera_blackouts;  ///< [from, to] s: the leader sees no worker
   std::vector<PlannerOutage> planner_outages;
@@ -89,21 +90,19 @@ struct FaultConfig {
   std::vector<std::pair<double, double>> uwb_dropouts;     ///< [from, to] s: no UWB range
   std::vector<std::pair<double, double>> stereo_dropouts;  ///< [from, to] s: no stereo range
   RangeOutlierConfig range_outliers;
-  double max_share_age_s = 2.0;    ///< followers do not plan from a leader message older than this, > 0
-  double max_worker_age_s = 3.0;   ///< no fused worker measurement for this long → hold, > 0
   double max_command_age_s = 5.0;  ///< an operator command older than this on arrival is rejected, > 0
-  double max_plan_age_s = 1.0;     ///< a UAV not heard from for this long is avoided by all (right of way), > 0
-  /// Every UAV avoids every other UAV's last plan (not only higher-priority, fallback or silent
-  /// ones): a higher-priority UAV no longer relies on a lower-priority one to dodge it, which a
-  /// late or lost fallback flag makes unsafe (docs/safety.md §2.1).
-  bool avoid_all_plans = true;
-  /// The leader's camera search for a worker it lost (keys search_timeout_s, search_height_m,
-  /// search_vertical_speed_mps, search_period_s, search_horizontal_speed_mps; docs/safety.md §2.2).
-  planning::SearchConfig search;
+  // max_share_age_s, max_worker_age_s, max_plan_age_s, avoid_all_plans and search_* are
+  // MissionConfig::replan's (the onboard replanning settings, read by onboard::readOnboardSettings).
   std::vector<std::string> validate(const std::string& prefix = "") const;
   /// \brief Whether follower `uav`'s computer is down at `t_s` (a follower_dropouts window).
   bool followerOffline(int uav, double t_s) const;
 };
+
+/// \brief The one range of each number of the fault section's entries: range_outliers.*,
+/// planner_outages[i].*, follower_dropouts[i].*.
+const common::FieldTable<RangeOutlierConfig>& rangeOutlierFields();
+const common::FieldTable<PlannerOutage>& plannerOutageFields();
+const common::FieldTable<UavDropout>& uavDropoutFields();
 
 /// \brief True when t_s lies in one of the [from, to) windows.
 bool inWindow(const std::vector<std::pair<double, double>>& windows, double t_s);
@@ -113,8 +112,9 @@ struct MissionConfig {
   double duration_s = 0.0;        ///< > 0; default: the worker's route duration
   double step_s = 0.01;           ///< plant/controller step, (0, 0.05]
   double replanning_period_s = 0.4;  ///< per UAV, staggered by period·i/n, > 0
-  double horizon_dt_s = 0.2;      ///< > 0
-  int horizon_steps = 40;         ///< [2, 128]
+  /// The onboard replanning settings (horizon, freshness limits of docs/safety.md §1, the
+  /// avoidance rule, the search, the braking deceleration), as the nodelets read them.
+  planning::ReplanConfig replan;
   double timeline_rate_hz = 10.0;  ///< > 0
   double gesture_match_window_s = 20.0;  ///< a fired gesture matches a performed one started at most this long before
   std::string gesture_model;      ///< ONNX path (resolved against the scenario's folder); empty: no gesture pipeline

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include "gesture_formation/common/config_fields.hpp"
 
 namespace gesture_formation::sim {
 
@@ -44,6 +45,9 @@ struct MultirotorParams {
   /// \brief Every problem, each naming the field (prefixed by `prefix`) and value.
   std::vector<std::string> validate(const std::string& prefix = "") const;
 };
+
+/// \brief The one range of each number of MultirotorParams: the plant (mission.uavs[i].plant; every key required).
+const common::FieldTable<MultirotorParams>& multirotorParamsFields();
 
 /// \brief True state of one UAV.
 struct MultirotorState {

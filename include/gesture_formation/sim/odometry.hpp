@@ -10,6 +10,7 @@
 
 #include "gesture_formation/sim/multirotor.hpp"
 #include "gesture_formation/sim/tracking_controller.hpp"
+#include "gesture_formation/common/config_fields.hpp"
 
 namespace gesture_formation::sim {
 
@@ -23,6 +24,9 @@ struct OdometryConfig {
 
   std::vector<std::string> validate(const std::string& prefix = "") const;
 };
+
+/// \brief The one range of each number of OdometryConfig: mission.odometry.
+const common::FieldTable<OdometryConfig>& odometryConfigFields();
 
 class Odometry {
  public:

@@ -25,6 +25,7 @@
 
 #include "gesture_formation/estimation/camera_model.hpp"
 #include "gesture_formation/estimation/measurement_model.hpp"
+#include "gesture_formation/common/config_fields.hpp"
 
 namespace gesture_formation::planning {
 class OccupancyMap;
@@ -51,6 +52,11 @@ struct RangeSensorConfig {
   double dropout = 0.05;      ///< probability of no reading, [0, 1]
   std::vector<std::string> validate(const std::string& prefix = "") const;
 };
+
+/// \brief The one range of each number of the simulated sensors (mission.sensors.camera.*,
+/// mission.sensors.stereo.* / uwb.*).
+const common::FieldTable<CameraSensorConfig>& cameraSensorFields();
+const common::FieldTable<RangeSensorConfig>& rangeSensorFields();
 
 /// \brief Why the camera did not deliver a box.
 enum class Visibility { kVisible, kOutOfView, kTooFar, kOccluded, kDropout, kBlackout };

@@ -25,6 +25,7 @@
 
 #include "gesture_formation/planning/uav_planner.hpp"
 #include "gesture_formation/sim/multirotor.hpp"
+#include "gesture_formation/common/config_fields.hpp"
 
 namespace gesture_formation::sim {
 
@@ -45,6 +46,9 @@ struct ControllerConfig {
 
   std::vector<std::string> validate(const std::string& prefix = "") const;
 };
+
+/// \brief The one range of each number of ControllerConfig: the controller gains (mission.controller; brake_accel_mps2: planning::replanConfigFields()).
+const common::FieldTable<ControllerConfig>& controllerConfigFields();
 
 /// \brief The estimated state the controller feeds back on (odometry).
 struct EstimatedState {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include "gesture_formation/common/config_fields.hpp"
 
 namespace gesture_formation::sim {
 
@@ -25,6 +26,9 @@ struct WindConfig {
 
   std::vector<std::string> validate(const std::string& prefix = "") const;
 };
+
+/// \brief The one range of each number of WindConfig: mission.wind and mission.faults.wind (mean_mps: any finite vector).
+const common::FieldTable<WindConfig>& windConfigFields();
 
 class WindModel {
  public:

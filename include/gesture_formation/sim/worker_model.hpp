@@ -21,6 +21,7 @@
 
 #include "gesture_formation/gesture/skeleton_synth.hpp"
 #include "gesture_formation/gesture/view_triangulation.hpp"
+#include "gesture_formation/common/config_fields.hpp"
 
 namespace gesture_formation::sim {
 
@@ -62,6 +63,17 @@ struct WorkerConfig {
   double routeDuration() const;
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
+
+/// \brief The one range of each number of the worker (mission.worker.*; the route's legs and the
+/// scheduled gestures have theirs in routeLegFields() / scheduledGestureFields(); the skeleton
+/// synthesis in gesture::synthConfigFields()).
+const common::FieldTable<WorkerConfig>& workerConfigFields();
+/// \brief speed_mps (walk/climb/descend legs) and duration_s (work/wait legs: keys work_s, wait_s).
+const common::FieldTable<RouteLeg>& routeLegFields();
+/// \brief t_s and gesture (the id, 1..4).
+const common::FieldTable<ScheduledGesture>& scheduledGestureFields();
+/// \brief A route leg's facing_deg (optional, hence not in a table).
+inline const common::Range kFacingDegRange = common::Range::closed(-360.0, 360.0);
 
 /// \brief The worker's true kinematic state at a time.
 struct WorkerState {

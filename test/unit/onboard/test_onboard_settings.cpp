@@ -24,7 +24,7 @@ TEST(OnboardSettingsTest, PowerTowerMissionLoadsWithItsOwnValues) {
   const auto s = go::loadOnboardSettings(std::string(GF_SOURCE_DIR) + "/config/scenarios/power_towers.yaml");
   ASSERT_TRUE(s) << s.reason();
   EXPECT_EQ(s->formation.params.uavCount(), 3);
-  EXPECT_GT(s->horizon_steps, 1);
+  EXPECT_GT(s->replan.steps, 1);
   EXPECT_GT(s->replanning_period_s, 0.0);
   EXPECT_GT(s->view_fusion.min_agreeing_views, 1);  // the formation's cameras vote
 }
@@ -35,13 +35,13 @@ TEST(OnboardSettingsTest, FaultProfileReplacesTheMissionsFaultLimits) {
   const std::string faults = writeTemp("onboard_faults.yaml", "faults:\n  max_share_age_s: 0.7\n  max_plan_age_s: 3.0\n");
   const auto plain = go::loadOnboardSettings(scenario);
   ASSERT_TRUE(plain) << plain.reason();
-  EXPECT_DOUBLE_EQ(plain->freshness.max_share_age_s, 2.0);
-  EXPECT_EQ(plain->horizon_steps, 30);
+  EXPECT_DOUBLE_EQ(plain->replan.freshness.max_share_age_s, 2.0);
+  EXPECT_EQ(plain->replan.steps, 30);
   const auto merged = go::loadOnboardSettings(scenario, faults);
   ASSERT_TRUE(merged) << merged.reason();
-  EXPECT_DOUBLE_EQ(merged->freshness.max_share_age_s, 0.7);
-  EXPECT_DOUBLE_EQ(merged->rule.max_plan_age_s, 3.0);
-  EXPECT_EQ(merged->horizon_steps, 30);
+  EXPECT_DOUBLE_EQ(merged->replan.freshness.max_share_age_s, 0.7);
+  EXPECT_DOUBLE_EQ(merged->replan.rule.max_plan_age_s, 3.0);
+  EXPECT_EQ(merged->replan.steps, 30);
 }
 
 TEST(OnboardSettingsTest, EveryProblemIsListedWithItsKey) {

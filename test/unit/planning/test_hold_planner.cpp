@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "gesture_formation/planning/replan_step.hpp"
 #include "gesture_formation/planning/plan_request_builder.hpp"
 
 namespace gf = gesture_formation;
@@ -50,15 +51,18 @@ TEST(SearchTest, OnlyTheLeaderSearchesForALostWorkerForABoundedTime) {
     EXPECT_NEAR(tg(2, k) - 3.0, want[k], 1e-9) << k;
     EXPECT_EQ(tg.col(k).head<2>(), last.head<2>());
   }
-  EXPECT_EQ(gf::planning::SearchConfig{}.validate("faults.").size(), 0u);
-  gf::planning::SearchConfig bad{-1.0, 0.0, 0.0, std::nan(""), -0.5};
-  const auto problems = bad.validate("faults.");
+  // The search's ranges live in planning::replanConfigFields() (mission keys faults.search_*).
+  EXPECT_EQ(gf::planning::ReplanConfig{}.validate("mission.").size(), 0u);
+  gf::planning::ReplanConfig bad;
+  bad.search = gf::planning::SearchConfig{-1.0, 0.0, 0.0, std::nan(""), -0.5};
+  const auto problems = bad.validate("mission.");
   ASSERT_EQ(problems.size(), 5u);
-  EXPECT_NE(problems[0].find("faults.search_timeout_s"), std::string::npos);
-  EXPECT_NE(problems[1].find("faults.search_height_m"), std::string::npos);
-  EXPECT_NE(problems[2].find("faults.search_vertical_speed_mps"), std::string::npos);
-  EXPECT_NE(problems[3].find("faults.search_period_s"), std::string::npos);
-  EXPECT_NE(problems[4].find("faults.search_horizontal_speed_mps must be >= 0, got -0.5"), std::string::npos) << problems[4];
+  EXPECT_NE(problems[0].find("mission.faults.search_timeout_s"), std::string::npos);
+  EXPECT_NE(problems[1].find("mission.faults.search_height_m"), std::string::npos);
+  EXPECT_NE(problems[2].find("mission.faults.search_vertical_speed_mps"), std::string::npos);
+  EXPECT_NE(problems[3].find("mission.faults.search_period_s"), std::string::npos);
+  EXPECT_NE(problems[4].find("mission.faults.search_horizontal_speed_mps must be >= 0, got -0.5"), std::string::npos)
+      << problems[4];
   // The amplitude stops at height_m.
   const auto late = gf::planning::searchTargets(last, Eigen::Vector3d(11, 2, 8), 70.0, 1.0, 8, 5.0, 8.0, vertical_only);
   EXPECT_LE(late.row(2).maxCoeff(), 3.0 + 15.0 + 1e-9);

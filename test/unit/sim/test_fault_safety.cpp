@@ -160,7 +160,7 @@ TEST(FaultConfigTest, EveryShippedProfileOverlaysThePowerTowerMission) {
   const auto g = gf::sim::loadMissionConfig(scenario, std::string(GF_SOURCE_DIR) + "/config/faults/gusts.yaml");
   ASSERT_TRUE(g);
   EXPECT_DOUBLE_EQ(g->wind.gusts_per_minute, 4.0);
-  EXPECT_TRUE(g->faults.avoid_all_plans);  // the default
+  EXPECT_TRUE(g->replan.rule.avoid_all_plans);  // the default
 }
 
 TEST(FaultConfigTest, FaultFileWithOtherTopLevelKeysIsRefused) {
@@ -197,7 +197,7 @@ TEST(FaultSafetyTest, FollowerHoldsWhenTheLeaderShareIsStaleAndResumes) {
   cfg.faults.planner_outages.push_back({0, 10.0, 20.0});  // the leader sends nothing 10..20 s
   const Flight r = fly(cfg, 30.0);
   ASSERT_TRUE(r.out) << r.out.reason();
-  const double age = cfg.faults.max_share_age_s;
+  const double age = cfg.replan.freshness.max_share_age_s;
   int hold_calls = 0;
   for (const Call& c : *r.calls) {
     if (c.uav == 0) {
@@ -231,7 +231,7 @@ TEST(FaultSafetyTest, WorkerLostFor60sAllHoldThenResume) {
   cfg.faults.camera_blackouts = {{10.0, 70.0}};
   const Flight r = fly(cfg, 90.0);
   ASSERT_TRUE(r.out) << r.out.reason();
-  const double hold_from = 10.0 + cfg.faults.max_worker_age_s + cfg.faults.max_share_age_s;
+  const double hold_from = 10.0 + cfg.replan.freshness.max_worker_age_s + cfg.replan.freshness.max_share_age_s;
   for (const Call& c : *r.calls) {
     if (c.t_s > hold_from && c.t_s < 70.0) {
       EXPECT_TRUE(c.constant_reference) << "UAV " << c.uav << " at " << c.t_s;
@@ -304,7 +304,7 @@ TEST(FaultSafetyTest, RejoiningFollowerListensFirstAndKeepsGammaDis) {
   // While follower 2 is silent (after max_plan_age_s) the leader and follower 1 avoid its last plan.
   int leader_avoids = 0, leader_calls = 0;
   for (const Call& c : *r.calls) {
-    if (c.uav == 0 && c.t_s > 5.0 + cfg.faults.max_plan_age_s + 0.1 && c.t_s < 15.0) {
+    if (c.uav == 0 && c.t_s > 5.0 + cfg.replan.rule.max_plan_age_s + 0.1 && c.t_s < 15.0) {
       ++leader_calls;
       leader_avoids += std::find(c.avoided.begin(), c.avoided.end(), 2) != c.avoided.end() ? 1 : 0;
     }
@@ -410,7 +410,7 @@ TEST(FaultSafetyTest, LeaderPlansOnlyOnAConfirmedTrack) {
 // when that one fell back, holds or went silent for max_plan_age_s.
 TEST(FaultSafetyTest, LeaderAvoidsEveryFollowerPlanByDefault) {
   auto cfg = baseMission();
-  ASSERT_TRUE(cfg.faults.avoid_all_plans);
+  ASSERT_TRUE(cfg.replan.rule.avoid_all_plans);
   const Flight all = fly(cfg, 10.0);
   ASSERT_TRUE(all.out) << all.out.reason();
   int leader_calls = 0;
@@ -422,7 +422,7 @@ TEST(FaultSafetyTest, LeaderAvoidsEveryFollowerPlanByDefault) {
   }
   EXPECT_GT(leader_calls, 10);
 
-  cfg.faults.avoid_all_plans = false;
+  cfg.replan.rule.avoid_all_plans = false;
   const Flight prio = fly(cfg, 10.0);
   ASSERT_TRUE(prio.out);
   // After the start-up listening (a listening follower holds and so has right of way, as every
