@@ -19,23 +19,6 @@ namespace gesture_formation::sim {
 using common::ConfigReader;
 using common::Range;
 
-const common::FieldTable<LinkConfig>& linkConfigFields() {
-  using C = LinkConfig;
-  static const common::FieldTable<C> t{{
-      {"delay_s", Range::nonNegative(), [](C& c) { return &c.delay_s; }},
-      {"jitter_s", Range::nonNegative(), [](C& c) { return &c.jitter_s; }},
-      {"loss", Range::closed(0.0, 1.0), [](C& c) { return &c.loss; }},
-      {"duplicate", Range::closed(0.0, 1.0), [](C& c) { return &c.duplicate; }},
-      {"reorder", Range::closed(0.0, 1.0), [](C& c) { return &c.reorder; }},
-      {"reorder_extra_delay_s", Range::nonNegative(), [](C& c) { return &c.reorder_extra_delay_s; }},
-  }};
-  return t;
-}
-
-std::vector<std::string> LinkConfig::validate(const std::string& prefix) const {
-  return common::problemLines(linkConfigFields().rangeProblems(*this), prefix);
-}
-
 const common::FieldTable<RangeOutlierConfig>& rangeOutlierFields() {
   using C = RangeOutlierConfig;
   static const common::FieldTable<C> t{{
@@ -115,7 +98,7 @@ bool inWindow(const std::vector<std::pair<double, double>>& windows, double t_s)
 namespace {
 
 /// The keys of one link (mission.links.* and their mission.faults.* overlays) under `k`.
-void readLinkKeys(ConfigReader& r, const std::string& k, LinkConfig& lc) { linkConfigFields().readFields(r, k, lc); }
+void readLinkKeys(ConfigReader& r, const std::string& k, LinkConfig& lc) { comm::faultChannelFields().readFields(r, k, lc); }
 
 std::string joinPath(const std::string& base, const std::string& p) {
   if (p.empty() || p[0] == '/' || base.empty()) return p;

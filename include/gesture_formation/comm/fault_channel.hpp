@@ -26,6 +26,8 @@
 #include <utility>
 #include <vector>
 
+#include "gesture_formation/common/config_fields.hpp"
+
 namespace gesture_formation::comm {
 
 /// \brief Fault parameters. Defaults: a perfect link. validate() names the field.
@@ -39,24 +41,15 @@ struct FaultChannelConfig {
   double reorder_extra_delay_s = 0.05;  ///< hold-back of a reordered packet [s], ≥ 0
   std::uint64_t seed = 1;
 
-  std::vector<std::string> validate() const {
-    std::vector<std::string> e;
-    auto prob = [&e](double p, const char* name) {
-      if (!(p >= 0.0 && p <= 1.0)) e.push_back(std::string(name) + " must be in [0, 1], got " + std::to_string(p));
-    };
-    auto nonneg = [&e](double v, const char* name) {
-      if (!(std::isfinite(v) && v >= 0.0)) e.push_back(std::string(name) + " must be finite and >= 0, got " + std::to_string(v));
-    };
-    prob(loss_probability, "loss_probability");
-    prob(duplicate_probability, "duplicate_probability");
-    prob(reorder_probability, "reorder_probability");
-    nonneg(delay_s, "delay_s");
-    nonneg(jitter_s, "jitter_s");
-    nonneg(duplicate_extra_delay_s, "duplicate_extra_delay_s");
-    nonneg(reorder_extra_delay_s, "reorder_extra_delay_s");
-    return e;
-  }
+  /// \brief Every number outside its range (faultChannelFields(), and duplicate_extra_delay_s
+  /// >= 0), each "<key> must be ..., got v".
+  std::vector<std::string> validate() const;
 };
+
+/// \brief The one range of each number of a link's faults, keyed as a mission's link sections
+/// write them: delay_s, jitter_s, loss, duplicate, reorder, reorder_extra_delay_s. (The
+/// simulator sets duplicate_extra_delay_s to delay_s; seed is not a setting.)
+const common::FieldTable<FaultChannelConfig>& faultChannelFields();
 
 /// \brief What happened on a channel so far.
 struct FaultChannelStats {

@@ -128,7 +128,7 @@ struct MissionConfig {
   RangeSensorConfig stereo{0.3, 15.0, 0.05};
   RangeSensorConfig uwb{0.1, 40.0, 0.05};
   LinkConfig link;                ///< between UAVs
-  LinkConfig operator_link{0.1, 0.0, 0.0, 0.0};
+  LinkConfig operator_link = operatorLinkDefaults();
   FaultConfig faults;
   formation::FormationConfig formation;
   gesture::GestureFilterConfig gesture_filter;

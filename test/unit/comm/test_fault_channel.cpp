@@ -171,8 +171,9 @@ TEST(CommFaultChannelTest, ValidateNamesFields) {
   c.jitter_s = -1;
   c.reorder_probability = std::nan("");
   const auto e = c.validate();
+  // Named by the keys a mission's link sections write (comm::faultChannelFields(), in its order).
   ASSERT_EQ(e.size(), 3u);
-  EXPECT_NE(e[0].find("loss_probability"), std::string::npos);
-  EXPECT_NE(e[1].find("reorder_probability"), std::string::npos);
-  EXPECT_NE(e[2].find("jitter_s"), std::string::npos);
+  EXPECT_EQ(e[0], "jitter_s must be >= 0, got -1");
+  EXPECT_EQ(e[1], "loss must be in [0, 1], got 1.5");
+  EXPECT_NE(e[2].find("reorder must be in [0, 1], got"), std::string::npos) << e[2];
 }

@@ -150,7 +150,7 @@ TEST(FaultConfigTest, EveryShippedProfileOverlaysThePowerTowerMission) {
   }
   const auto h = gf::sim::loadMissionConfig(scenario, std::string(GF_SOURCE_DIR) + "/config/faults/harsh.yaml");
   ASSERT_TRUE(h);
-  EXPECT_DOUBLE_EQ(h->link.loss, 0.3);
+  EXPECT_DOUBLE_EQ(h->link.loss_probability, 0.3);
   EXPECT_DOUBLE_EQ(h->link.delay_s, 0.05);
   EXPECT_DOUBLE_EQ(h->operator_link.delay_s, 0.2);
   ASSERT_EQ(h->faults.follower_dropouts.size(), 1u);
@@ -174,9 +174,9 @@ TEST(FaultConfigTest, FaultFileWithOtherTopLevelKeysIsRefused) {
 TEST(LinkTest, ReorderAndDuplicateCounted) {
   gf::sim::LinkConfig c;
   c.delay_s = 0.1;
-  c.reorder = 0.5;
+  c.reorder_probability = 0.5;
   c.reorder_extra_delay_s = 0.5;
-  c.duplicate = 0.2;
+  c.duplicate_probability = 0.2;
   gf::sim::Link<int> link(c, std::mt19937_64(4));
   for (int i = 0; i < 2000; ++i) link.send(i * 0.01, i);
   const auto got = link.receive(1e9);
@@ -320,10 +320,10 @@ TEST(FaultSafetyTest, RejoiningFollowerListensFirstAndKeepsGammaDis) {
 // of hold when shares keep coming), Γ_dis holds, and a run repeats exactly for its seed.
 TEST(FaultSafetyTest, LossyReorderingLinksStaySafeAndDeterministic) {
   auto cfg = baseMission();
-  cfg.link.loss = 0.5;
+  cfg.link.loss_probability = 0.5;
   cfg.link.jitter_s = 0.3;
-  cfg.link.duplicate = 0.3;
-  cfg.link.reorder = 0.3;
+  cfg.link.duplicate_probability = 0.3;
+  cfg.link.reorder_probability = 0.3;
   const Flight a = fly(cfg, 30.0, 11);
   const Flight b = fly(cfg, 30.0, 11);
   ASSERT_TRUE(a.out) << a.out.reason();
@@ -360,7 +360,7 @@ TEST(FaultSafetyTest, StaleCommandsRejectedDuplicatesIgnored) {
   EXPECT_EQ(late.out->timeline.back().uavs[0].d_ref, 10.0);  // unchanged
 
   cfg.operator_link.delay_s = 0.1;
-  cfg.operator_link.duplicate = 1.0;
+  cfg.operator_link.duplicate_probability = 1.0;
   const Flight dup = fly(cfg, 8.0);
   ASSERT_TRUE(dup.out);
   EXPECT_EQ(dup.out->requests[0].status, "applied");

@@ -103,8 +103,9 @@ TEST(MissionConfigRangesTest, EverySimulatorNumberIsReadWithItsModulesRange) {
                                               [](const CameraSensorConfig& c) { return c.validate(); });
   expectEveryFieldRefused<RangeSensorConfig>(rangeSensorFields(), "sensors.uwb.",
                                              [](const RangeSensorConfig& c) { return c.validate(); });
-  expectEveryFieldRefused<LinkConfig>(linkConfigFields(), "links.operator.", [](const LinkConfig& c) { return c.validate(); });
-  expectEveryFieldRefused<LinkConfig>(linkConfigFields(), "faults.link.", nullptr);
+  expectEveryFieldRefused<gf::comm::FaultChannelConfig>(gf::comm::faultChannelFields(), "links.operator.",
+                                                        [](const gf::comm::FaultChannelConfig& c) { return c.validate(); });
+  expectEveryFieldRefused<gf::comm::FaultChannelConfig>(gf::comm::faultChannelFields(), "faults.link.", nullptr);
   expectEveryFieldRefused<RangeOutlierConfig>(rangeOutlierFields(), "faults.range_outliers.", nullptr);
   expectEveryFieldRefused<WorkerConfig>(workerConfigFields(), "worker.", [](const WorkerConfig& c) { return c.validate(); });
 }

@@ -142,7 +142,7 @@ TEST(MissionRunnerTest, FollowerGestureVotesTravelTheLossyLink) {
   const ExtendArmRun ok = runEveryCameraReadingExtendArm(cfg);
   EXPECT_GE(ok.gestures_fired, 1);
   EXPECT_EQ(ok.messages_lost, 0);
-  cfg.link.loss = 1.0;
+  cfg.link.loss_probability = 1.0;
   const ExtendArmRun lost = runEveryCameraReadingExtendArm(cfg);
   EXPECT_EQ(lost.gestures_fired, 0);
   EXPECT_GT(lost.messages_lost, 0);

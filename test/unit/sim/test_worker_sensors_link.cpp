@@ -178,7 +178,7 @@ TEST(LinkTest, DelayLossAndOrder) {
   EXPECT_TRUE(clean.receive(0.05).empty());
   EXPECT_EQ(clean.receive(0.105), std::vector<int>({1}));
   EXPECT_EQ(clean.receive(1.0), std::vector<int>({2}));
-  c.loss = 0.3;
+  c.loss_probability = 0.3;
   c.jitter_s = 0.05;
   gf::sim::Link<int> lossy(c, std::mt19937_64(9));
   for (int i = 0; i < 10000; ++i) lossy.send(i * 0.01, i);
