@@ -260,7 +260,7 @@ def main():
               f"gestures fired {g['fired']}/{g['gestures']} = {g['fired_share']}, mean latency {g['mean_latency_s']} s "
               f"(max {g['max_latency_s']}), wrong {g['wrong_commands']}, repeated {g['repeated_commands']}")
     report = {"date_utc": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M"),
-              "commit": git("rev-parse", "--short", "HEAD"), "worktree_clean": git("status", "--porcelain") == "",
+              "commit": git("rev-parse", "--short", "HEAD"), "worktree_clean": git("status", "--porcelain", "--untracked-files=no") == "",
               "protocol": os.path.relpath(PROTOCOL, ROOT), "protocol_version": protocol["version"],
               "protocol_sha256": sha256(PROTOCOL), "model": os.path.relpath(a.model, ROOT), "model_sha256": sha256(a.model),
               "filter_config": os.path.relpath(GESTURES_YAML, ROOT), "filter_config_sha256": sha256(GESTURES_YAML),
