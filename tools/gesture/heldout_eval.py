@@ -161,7 +161,7 @@ def score(fired, meta, gap_s, fps):
         seq = int(t // gap_s)
         by_seq.setdefault(seq, []).append((t - gap_s * seq, g))
     n_g = succ = wrong = extra = 0
-    latencies, false_list = [], []
+    latencies, false_list, missed = [], [], []
     work_s = 0.0
     for seq, md in sorted(meta.items()):
         gid = int(md["gesture_id"])
@@ -180,12 +180,16 @@ def score(fired, meta, gap_s, fps):
         if ok:
             succ += 1
             latencies.append(ok[0] - t0)
+        else:
+            missed.append({"sequence": seq, "gesture": CLASSES[gid], "hold_s": round(t1 - t0, 2), "commands": [
+                [round(t, 3), CLASSES[g]] for t, g in fs], "distance_m": float(md["distance_m"]),
+                "elevation_deg": float(md["elevation_deg"]), "azimuth_deg": float(md["azimuth_deg"])})
     return {"gestures": n_g, "fired": succ, "fired_share": round(succ / n_g, 4) if n_g else None,
             "mean_latency_s": round(float(np.mean(latencies)), 3) if latencies else None,
             "max_latency_s": round(float(np.max(latencies)), 3) if latencies else None,
             "wrong_commands": wrong, "repeated_commands": extra,
             "work_minutes": round(work_s / 60.0, 2), "false_adaptations": len(false_list),
-            "false_adaptation_list": false_list}
+            "false_adaptation_list": false_list, "missed_list": missed}
 
 
 def filter_config(mode, work):
@@ -341,6 +345,12 @@ def page(r, protocol):
         lines.append(f"- rearm {mode}: " + ("none" if not fl else "; ".join(
             f"{x['gesture']} during {x['motion']} (sequence {x['sequence']}, t {x['t_s']} s, leader {x['distance_m']:.1f} m, "
             f"{x['elevation_deg']:.1f}°, azimuth {x['azimuth_deg']:.0f}°)" for x in fl)))
+    lines += ["", "Gestures that did not fire while performed (three cameras):", ""]
+    for mode, m in r["three_cameras"].items():
+        ml = m["gestures"]["three_cameras"]["missed_list"]
+        lines.append(f"- rearm {mode}: " + ("none" if not ml else "; ".join(
+            f"{x['gesture']} (sequence {x['sequence']}, performed {x['hold_s']} s, commands {x['commands'] or 'none'}, "
+            f"leader {x['distance_m']:.1f} m, {x['elevation_deg']:.1f}°, azimuth {x['azimuth_deg']:.0f}°)" for x in ml)))
     return "\n".join(lines) + "\n"
 
 
