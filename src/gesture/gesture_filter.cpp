@@ -26,6 +26,14 @@ const char* toString(FilterVerdict v) {
   return "?";
 }
 
+const char* toString(RearmMode mode) {
+  switch (mode) {
+    case RearmMode::kRelease: return "release";
+    case RearmMode::kRepeat: return "repeat";
+  }
+  return "?";
+}
+
 namespace {
 
 /// GestureFilterConfig's numbers: key, range — the only place it is written — and place.
@@ -58,9 +66,9 @@ std::vector<std::string> GestureFilterConfig::validate() const { return common::
 
 GestureFilterConfig readGestureFilterConfig(ConfigReader& r) {
   GestureFilterConfig c;
-  std::string rearm = c.rearm_on_release ? "release" : "cooldown";
-  r.readString("rearm", rearm, {"release", "cooldown"});
-  c.rearm_on_release = rearm == "release";
+  std::string rearm = toString(c.rearm);
+  r.readString("rearm", rearm, {toString(RearmMode::kRelease), toString(RearmMode::kRepeat)});  // else: an error naming key and value
+  c.rearm = rearm == toString(RearmMode::kRepeat) ? RearmMode::kRepeat : RearmMode::kRelease;
   fields().readFields(r, "", c);
   if (!r.has("min_measurements")) c.min_measurements = c.window_size;  // default: K
   // The rule between fields, always (a key outside its range kept its default while reading).
@@ -170,13 +178,13 @@ GestureFilterOutput GestureFilter::update(double t_s, double gesture_id) {
     out.verdict = FilterVerdict::kNoneDominant;
   } else if (!std::isnan(last_fired_s_) && !(t_s - last_fired_s_ >= config_.cooldown_s)) {
     out.verdict = FilterVerdict::kCooldown;
-  } else if (config_.rearm_on_release && !armed_) {
+  } else if (config_.rearm == RearmMode::kRelease && !armed_) {
     out.verdict = FilterVerdict::kAwaitingRelease;
   } else {
     out.verdict = FilterVerdict::kFired;
     out.fired = true;
     last_fired_s_ = t_s;
-    armed_ = !config_.rearm_on_release;
+    armed_ = config_.rearm == RearmMode::kRepeat;
     none_since_s_ = std::numeric_limits<double>::quiet_NaN();
   }
   return out;

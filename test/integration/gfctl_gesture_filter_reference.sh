@@ -72,7 +72,7 @@ min_measurements: 5
 max_age_s: 3.0
 ratio_threshold: 0.6
 cooldown_s: 2.0
-rearm: cooldown
+rearm: repeat
 YAML
 cat > "$OUT/distance5.yaml" <<'YAML'
 window_size: 12
@@ -114,7 +114,7 @@ min_measurements: 4
 max_age_s: 1.0
 ratio_threshold: 0.75
 cooldown_s: 2.5
-rearm: cooldown
+rearm: repeat
 YAML
 # The same held gesture with the default re-arming (release): one performance, one command.
 cat > "$OUT/boundary_release.yaml" <<'YAML'
@@ -133,7 +133,7 @@ min_measurements: 5
 max_age_s: 6.0
 ratio_threshold: 0.75
 cooldown_s: 3.0
-rearm: cooldown
+rearm: repeat
 YAML
 
 fails=0
@@ -188,5 +188,5 @@ PYEOF
 [ "$(cat "$OUT/boundary_release.count")" -eq 1 ] \
   || { echo "FAIL: a held gesture fired $(cat "$OUT/boundary_release.count") times with rearm: release (want 1)"; fails=$((fails + 1)); }
 [ "$(cat "$OUT/default_bursty.count")" -lt "$(cat "$OUT/small_bursty.count")" ] \
-  || echo "note: release fired no less than cooldown on the bursty stream"
+  || echo "note: release fired no less than repeat on the bursty stream"
 exit $fails

@@ -12,7 +12,7 @@ nothing; fire when f_d > ratio_threshold, dominant != 0, and (no earlier command
 t - t_last >= cooldown_s), and — with `rearm: release` (the default) — the filter is armed: a
 fired command disarms it; it re-arms when every evaluation since some time s had 0 as its sole
 most frequent id and t - s >= release_s, or when the previous accepted row is older than
-t - max_age_s (nothing seen for t_c). With `rearm: cooldown` it is always armed. Fired rows: `t,gesture_id,parameter,increment,value` with value
+t - max_age_s (nothing seen for t_c). With `rearm: repeat` (the paper) it is always armed; any other `rearm` is an error. Fired rows: `t,gesture_id,parameter,increment,value` with value
 the parameter after the increment, beta wrapped to (-180, 180], gamma / distance clamped
 (docs/formation.md §3-4: every UAV's elevation - leader gamma_L, follower gamma_L + gamma_i -
 within [gamma_min_deg, gamma_max_deg]; distance within [max(distance_min_m,
@@ -117,7 +117,10 @@ def main():
     min_meas = int(cfg.get("min_measurements", K))
     t_c, ratio, t_d, max_id = float(p["max_age_s"]), float(p["ratio_threshold"]), float(p["cooldown_s"]), int(p["max_gesture_id"])
     mapping = {int(k): v for k, v in (cfg["mapping"] if "mapping" in cfg else PAPER_MAPPING).items()}
-    release_mode = cfg.get("rearm", "release") == "release"
+    rearm = cfg.get("rearm", "release")
+    if rearm not in ("release", "repeat"):
+        sys.exit(f"{args.config}: rearm: value '{rearm}' is not one of release|repeat")
+    release_mode = rearm == "release"
     release_s = float(cfg.get("release_s", 1.0))
     formation = Formation(cfg)
 

@@ -22,7 +22,7 @@
 /// evaluation has been 0 (none; no tie) for at least release_s (from the first such evaluation;
 /// any other evaluation restarts it), or every earlier entry of G has expired (nothing seen for
 /// t_c: a new performance). A gesture held, or misread and held, for longer than t_d thus fires
-/// once. With `cooldown` (the paper) the filter is always armed: a held gesture fires again
+/// once. With `repeat` (the paper) the filter is always armed: a held gesture fires again
 /// every t_d. Firing does not clear G. Rejected and unevaluated measurements do not count
 /// toward anything.
 /// Cost per measurement: O(max_gesture_id) with no heap allocation (ring buffer and counts
@@ -41,6 +41,14 @@ namespace gesture_formation::gesture {
 /// \brief Gesture id 0: the worker is not gesturing ("none").
 constexpr int kGestureNone = 0;
 
+/// \brief When the filter may fire again after a command (YAML `rearm`; docs/formation.md §6).
+enum class RearmMode {
+  kRelease,  ///< `release` (default): one performance, one command — again only once released
+  kRepeat,   ///< `repeat`: the paper — a gesture still dominant fires again every cooldown_s
+};
+/// \brief "release", "repeat".
+const char* toString(RearmMode mode);
+
 /// \brief Parameters of the filter (YAML top-level keys of config/gestures.yaml).
 /// Defaults: docs/design.md §2 (K = 20, t_c = 20 s, Π_d = 0.8, t_d = 5 s).
 struct GestureFilterConfig {
@@ -50,17 +58,16 @@ struct GestureFilterConfig {
   double ratio_threshold = 0.8;  ///< Π_d ∈ [0, 1]: fire when f_d > Π_d
   double cooldown_s = 5.0;      ///< t_d [s], ≥ 0: minimum time between two fired commands
   int max_gesture_id = 4;       ///< valid ids are 0..max_gesture_id (0 none, 1..4 the paper's), ≥ 1
-  /// `rearm`: release (true, default: fire again only after the gesture was released) or
-  /// cooldown (false: the paper — fire again every cooldown_s while it is held).
-  bool rearm_on_release = true;
-  double release_s = 1.0;       ///< `release_s` [s], ≥ 0: how long "none" must dominate to re-arm
+  RearmMode rearm = RearmMode::kRelease;  ///< `rearm`: release | repeat (see RearmMode)
+  double release_s = 1.0;       ///< `release_s` [s], ≥ 0: how long "none" must dominate to re-arm (release)
 
   /// \brief Every problem, each naming the key; empty when valid.
   std::vector<std::string> validate() const;
 };
 
 /// \brief Reads the filter keys (`window_size, min_measurements, max_age_s, ratio_threshold,
-/// cooldown_s, max_gesture_id`) from `reader`. When `window_size` is given but
+/// cooldown_s, max_gesture_id, rearm, release_s`) from `reader`; a `rearm` other than release or
+/// repeat is an error naming the key and the value. When `window_size` is given but
 /// `min_measurements` is not, min_measurements = window_size.
 GestureFilterConfig readGestureFilterConfig(common::ConfigReader& reader);
 
@@ -113,7 +120,7 @@ class GestureFilter {
   double lastFiredTime() const { return last_fired_s_; }
   /// \brief Time of the last accepted measurement [s]; NaN before the first.
   double lastTime() const { return last_t_s_; }
-  /// \brief Whether a dominant gesture may fire (always with rearm: cooldown).
+  /// \brief Whether a dominant gesture may fire (always with rearm: repeat).
   bool armed() const { return armed_; }
 
  private:

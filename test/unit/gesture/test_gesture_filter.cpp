@@ -11,11 +11,11 @@ using gesture_formation::common::ConfigReader;
 
 namespace {
 
-/// The paper's filter (rearm: cooldown): the tests below that pin the window, ratio, tie and
+/// The paper's filter (rearm: repeat): the tests below that pin the window, ratio, tie and
 /// cooldown semantics use it; the re-arming on release has its own tests at the end.
 GestureFilterConfig config(int k, int min_meas, double max_age, double ratio, double cooldown) {
   GestureFilterConfig c;
-  c.rearm_on_release = false;
+  c.rearm = RearmMode::kRepeat;
   c.window_size = k;
   c.min_measurements = min_meas;
   c.max_age_s = max_age;
@@ -26,7 +26,7 @@ GestureFilterConfig config(int k, int min_meas, double max_age, double ratio, do
 
 GestureFilterConfig paperDefaults() {
   GestureFilterConfig c;
-  c.rearm_on_release = false;
+  c.rearm = RearmMode::kRepeat;
   return c;
 }
 
@@ -48,7 +48,7 @@ TEST(GestureFilterTest, DefaultsAreThePapers) {
   EXPECT_EQ(c.max_age_s, 20.0);
   EXPECT_EQ(c.ratio_threshold, 0.8);
   EXPECT_EQ(c.cooldown_s, 5.0);
-  EXPECT_TRUE(c.rearm_on_release);  // ours: one performance, one command (the paper: cooldown)
+  EXPECT_EQ(c.rearm, RearmMode::kRelease);  // ours: one performance, one command (the paper: repeat)
   EXPECT_EQ(c.release_s, 1.0);
   EXPECT_TRUE(c.validate().empty());
 }
@@ -306,6 +306,26 @@ TEST(GestureFilterReleaseTest, ReleasedForReleaseSThenTheSameGestureFiresAgain) 
   EXPECT_EQ(run(2, 6.0).size(), 1u);   // a new performance fires once
 }
 
+TEST(GestureFilterReleaseTest, BothModesFireTwiceForTwoPerformancesAndOnlyRepeatRefiresAHold) {
+  for (const RearmMode mode : {RearmMode::kRelease, RearmMode::kRepeat}) {
+    SCOPED_TRACE(toString(mode));
+    GestureFilterConfig c;  // K 20, t_d 5 s, release_s 1 s
+    c.rearm = mode;
+    GestureFilter f(c);
+    double t = 0.0;
+    const auto run = [&](int id, double seconds) {
+      int fired = 0;
+      for (double end = t + seconds; t < end - 1e-9; t += 0.1) fired += f.update(t, id).fired ? 1 : 0;
+      return fired;
+    };
+    // A held gesture (16 s): release fires once, repeat at 1.9, 6.9, 11.9 s (every t_d).
+    EXPECT_EQ(run(1, 16.0), mode == RearmMode::kRelease ? 1 : 3);
+    EXPECT_EQ(run(0, 4.0), 0);  // released (arms down 4 s)
+    // Performed again for 3 s (shorter than t_d after its first command): once, in both modes.
+    EXPECT_EQ(run(1, 3.0), 1);
+  }
+}
+
 TEST(GestureFilterReleaseTest, ATieOrAnotherGestureRestartsTheRelease) {
   GestureFilterConfig c;  // times are multiples of 0.25 s: exact in binary
   c.window_size = 4;
@@ -350,15 +370,27 @@ TEST(GestureFilterReleaseTest, NothingSeenForMaxAgeIsANewPerformance) {
 }
 
 TEST(GestureFilterReleaseTest, ConfigKeysAreReadAndValidated) {
-  ConfigReader r = ConfigReader::fromString("rearm: cooldown\nrelease_s: 2.5\n", "g.yaml", ConfigReader::MissingKeys::kError);
+  ConfigReader r = ConfigReader::fromString("rearm: repeat\nrelease_s: 2.5\n", "g.yaml", ConfigReader::MissingKeys::kError);
   const auto c = readGestureFilterConfig(r);
-  EXPECT_FALSE(c.rearm_on_release);
+  for (const auto& p : r.problems()) EXPECT_NE(p.key, "rearm") << r.errorReport();  // (the other keys are missing)
+  EXPECT_EQ(c.rearm, RearmMode::kRepeat);
+  EXPECT_STREQ(toString(c.rearm), "repeat");
   EXPECT_EQ(c.release_s, 2.5);
+  ConfigReader rel = ConfigReader::fromString("rearm: release\n", "g.yaml", ConfigReader::MissingKeys::kUseDefaults);
+  EXPECT_EQ(readGestureFilterConfig(rel).rearm, RearmMode::kRelease);
+  EXPECT_TRUE(rel.ok()) << rel.errorReport();
   ConfigReader bad = ConfigReader::fromString("rearm: sometimes\nrelease_s: -1\n", "g.yaml", ConfigReader::MissingKeys::kUseDefaults);
-  readGestureFilterConfig(bad);
+  EXPECT_EQ(readGestureFilterConfig(bad).rearm, RearmMode::kRelease);  // the bad value is not taken
   ASSERT_EQ(bad.problems().size(), 2u) << bad.errorReport();
   EXPECT_EQ(bad.problems()[0].key, "rearm");
+  EXPECT_NE(bad.errorReport().find("sometimes"), std::string::npos) << bad.errorReport();
+  EXPECT_NE(bad.errorReport().find("release|repeat"), std::string::npos) << bad.errorReport();
   EXPECT_EQ(bad.problems()[1].key, "release_s");
+  // The mode's former name is not a mode.
+  ConfigReader old = ConfigReader::fromString("rearm: cooldown\n", "g.yaml", ConfigReader::MissingKeys::kUseDefaults);
+  readGestureFilterConfig(old);
+  ASSERT_EQ(old.problems().size(), 1u) << old.errorReport();
+  EXPECT_EQ(old.problems()[0].key, "rearm");
   GestureFilterConfig v;
   v.release_s = std::nan("");
   ASSERT_EQ(v.validate().size(), 1u);

@@ -107,7 +107,7 @@ TEST(GestureMappingTest, GestureToFormationEndToEnd) {
   // 20 × "raise an arm" → one command: leader γ 11° → 16°; the next one only after the cooldown
   // (the paper's re-arming: a held gesture fires every t_d).
   GestureFilterConfig paper;
-  paper.rearm_on_release = false;
+  paper.rearm = RearmMode::kRepeat;
   GestureFilter filter(paper);
   auto state = fm::FormationState::create(fm::FormationParams{}, fm::FormationLimits{}).value();
   const GestureMapping m = GestureMapping::paperDefault();

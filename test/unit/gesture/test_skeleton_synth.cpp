@@ -1,8 +1,10 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include <Eigen/Geometry>
 
@@ -236,5 +238,45 @@ TEST(SkeletonSynthTest, ValidateAndYamlAgreeOnBoundaries) {
     SynthConfig coded;
     coded.dropout_max = std::stod(text);
     EXPECT_EQ(coded.validate().empty(), valid) << text;
+  }
+}
+
+// The formation's three cameras see ONE worker: every view of a multi-view sequence carries the
+// same posed 3-D body in every frame (the held-out protocol's three-camera sets rely on it), and
+// only the camera (azimuth, distance, pixels) differs.
+TEST(SkeletonSynthTest, FurtherViewsShareTheThreeDimensionalMotion) {
+  SynthConfig config;
+  config.gesture_fraction = 0.5;
+  SkeletonSynthesizer synth(config, 9);
+  for (int i = 0; i < 6; ++i) {
+    const std::vector<SynthSequence> views = synth.nextViews({60.0, -60.0});
+    ASSERT_EQ(views.size(), 3u);
+    const SynthSequence& lead = views[0];
+    ASSERT_EQ(lead.bodies.size(), lead.frames.size());
+    ASSERT_GE(lead.bodies.size(), 10u);
+    // The motion moves (else equal bodies would prove nothing): the wrists travel.
+    double travel_m = 0.0;
+    for (const Body3D& b : lead.bodies) travel_m = std::max(travel_m, (b.p[kLeftWrist] - lead.bodies[0].p[kLeftWrist]).norm() +
+                                                                          (b.p[kRightWrist] - lead.bodies[0].p[kRightWrist]).norm());
+    EXPECT_GT(travel_m, 0.02) << toString(lead.motion);
+    for (std::size_t v = 1; v < views.size(); ++v) {
+      const SynthSequence& other = views[v];
+      ASSERT_EQ(other.bodies.size(), lead.bodies.size());
+      EXPECT_EQ(other.motion, lead.motion);
+      EXPECT_EQ(other.left_arm, lead.left_arm);
+      EXPECT_EQ(other.height_m, lead.height_m);
+      EXPECT_EQ(other.elevation_deg, lead.elevation_deg);
+      EXPECT_NEAR(std::remainder(other.azimuth_deg - lead.azimuth_deg - (v == 1 ? 60.0 : -60.0), 360.0), 0.0, 1e-9);
+      for (std::size_t k = 0; k < lead.bodies.size(); ++k) {
+        EXPECT_EQ(other.frames[k].t_s, lead.frames[k].t_s);
+        for (std::size_t j = 0; j < kNumKeypoints; ++j) ASSERT_EQ(other.bodies[k].p[j], lead.bodies[k].p[j]) << "frame " << k << " keypoint " << j;
+        ASSERT_EQ(other.bodies[k].head_top, lead.bodies[k].head_top);
+      }
+      bool pixels_differ = false;
+      for (std::size_t k = 0; k < lead.frames.size(); ++k) {
+        pixels_differ = pixels_differ || other.frames[k].skeleton.x[kNose] != lead.frames[k].skeleton.x[kNose];
+      }
+      EXPECT_TRUE(pixels_differ) << "view " << v << " is not another camera";
+    }
   }
 }

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <string>
 
+#include "gesture_formation/gesture/gesture_filter.hpp"
 #include "gesture_formation/onboard/onboard_settings.hpp"
 
 namespace go = gesture_formation::onboard;
@@ -71,4 +72,21 @@ TEST(OnboardSettingsTest, MissingFilesAndSectionsAreNamed) {
   const auto f = go::loadOnboardSettings(std::string(GF_SOURCE_DIR) + "/config/scenarios/power_towers.yaml", faults);
   ASSERT_FALSE(f);
   EXPECT_NE(f.reason().find("extra: unknown key"), std::string::npos) << f.reason();
+}
+
+// The filter's re-arming mode reaches gfctl simulate and the nodelets' mission_file through this one
+// parse (gesture::readGestureFilterConfig); default release, a bad value names the key and the value.
+TEST(OnboardSettingsTest, GestureRearmModeIsReadFromTheMission) {
+  namespace gg = gesture_formation::gesture;
+  const auto shipped = go::loadOnboardSettings(std::string(GF_SOURCE_DIR) + "/config/scenarios/power_towers.yaml");
+  ASSERT_TRUE(shipped) << shipped.reason();
+  EXPECT_EQ(shipped->gesture_filter.rearm, gg::RearmMode::kRelease);
+  const auto repeat = go::loadOnboardSettings(writeTemp("onboard_repeat.yaml", "mission:\n  gestures:\n    rearm: repeat\n    release_s: 2\n"));
+  ASSERT_TRUE(repeat) << repeat.reason();
+  EXPECT_EQ(repeat->gesture_filter.rearm, gg::RearmMode::kRepeat);
+  EXPECT_DOUBLE_EQ(repeat->gesture_filter.release_s, 2.0);
+  const auto bad = go::loadOnboardSettings(writeTemp("onboard_badrearm.yaml", "mission:\n  gestures:\n    rearm: twice\n"));
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.reason().find("mission.gestures.rearm"), std::string::npos) << bad.reason();
+  EXPECT_NE(bad.reason().find("twice"), std::string::npos) << bad.reason();
 }
