@@ -64,9 +64,12 @@ std::vector<std::string> FaultConfig::validate(const std::string& prefix) const 
   const auto entries = [&](const auto& list, const auto& table, const char* name) {
     for (std::size_t i = 0; i < list.size(); ++i) {
       const auto& o = list[i];
-      auto problems = table.rangeProblems(o);
-      common::checkRule(problems, o.from_s < o.to_s, "from_s", o.from_s, "must be < to_s (" + common::formatNumber(o.to_s) + ")");
-      for (auto& line : common::problemLines(problems, prefix + name + "[" + std::to_string(i) + "].")) e.push_back(line);
+      const std::string k = prefix + name + "[" + std::to_string(i) + "]";
+      for (auto& line : common::problemLines(table.rangeProblems(o), k + ".")) e.push_back(line);
+      if (!(o.from_s < o.to_s)) {
+        e.push_back(k + " needs from_s < to_s, got from_s " + common::formatNumber(o.from_s) + ", to_s " +
+                    common::formatNumber(o.to_s));
+      }
     }
   };
   entries(planner_outages, plannerOutageFields(), "planner_outages");

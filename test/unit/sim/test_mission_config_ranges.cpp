@@ -135,6 +135,6 @@ TEST(MissionConfigRangesTest, RulesBetweenFieldsNameTheirKey) {
   std::string all;
   for (const auto& line : f.validate("faults.")) all += line + "\n";
   EXPECT_NE(all.find("faults.follower_dropouts[0].uav must be in [1, 63], got 0"), std::string::npos) << all;
-  EXPECT_NE(all.find("faults.follower_dropouts[0].from_s must be < to_s (2), got 5"), std::string::npos) << all;
+  EXPECT_NE(all.find("faults.follower_dropouts[0] needs from_s < to_s, got from_s 5, to_s 2"), std::string::npos) << all;
   EXPECT_NE(all.find("faults.range_outliers.max_error_m must be >= min_error_m, got 2"), std::string::npos) << all;
 }
