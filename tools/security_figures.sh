@@ -34,7 +34,6 @@ for n in ${FLOOD_PROCS:-2 4}; do
   flood+="$n flood processes:"$'\n'"$(FLOODERS=$n unshare -n bash "$T/inner.sh")"$'\n\n'
 done
 rmem=$(cat /proc/sys/net/core/rmem_max)
-buf=$(grep -ho "LCM UDP receive buffer size ([0-9]*)\|receive buffer is [0-9]* bytes" "$T"/r_bridge.log | head -1 || true)
 out=docs/results/security.md
 {
   echo "# Link security figures"
@@ -57,7 +56,7 @@ out=docs/results/security.md
   echo "states at 20 Hz for ${FLOOD_SECONDS:-10} s to the follower bridge (sender 2), per-sender Ed25519 keys;"
   echo "flood processes (Python, one socket each) send as fast as they can on the same channel; they share the"
   echo "2 cores with the bridges, so more of them also means less CPU for the receiver. net.core.rmem_max = $rmem"
-  echo "bytes; the bridge asks for a 4 MiB receive buffer (${buf:-LCM printed no buffer warning})."
+  echo "bytes; the bridge reads the group on its own socket (recvmmsg, docs/security.md §7) and asks for a 4 MiB receive buffer."
   echo
   echo '```'
   printf '%s' "$flood"
@@ -65,7 +64,7 @@ out=docs/results/security.md
   echo
   echo "Columns: flood datagrams sent (as counted by the senders; ENOBUFS drops included), and the"
   echo "receiving bridge's counters over the same interval. When the counters add up to the datagrams"
-  echo "sent, the receiver kept up with the flood and nothing was lost in its socket or LCM queue."
+  echo "sent, the receiver kept up with the flood and nothing was lost in its socket."
 } > "$out"
 echo "security_figures.sh: wrote $out"
 cat "$out"

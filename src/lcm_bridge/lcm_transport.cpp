@@ -1,7 +1,18 @@
 #include "gesture_formation/lcm_bridge/lcm_transport.hpp"
 
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <lcm/lcm-cpp.hpp>
 
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <cstring>
 #include <exception>
 
 #include "gf_lcm/envelope_t.hpp"
@@ -74,21 +85,139 @@ bool decodeLcmEnvelope(const void* data, std::size_t size, std::vector<std::uint
   return true;
 }
 
+bool parseLcmDatagram(const std::uint8_t* data, std::size_t size, LcmDatagram& out) {
+  constexpr std::uint8_t kMagic[4] = {'L', 'C', '0', '2'};
+  constexpr std::size_t kHeader = 8;          // magic + sequence number
+  constexpr std::size_t kMaxChannel = 63;     // LCM's limit on a channel name
+  if (data == nullptr || size <= kHeader || std::memcmp(data, kMagic, 4) != 0) return false;
+  const std::size_t room = std::min(size - kHeader, kMaxChannel + 1);
+  const auto* name = data + kHeader;
+  const auto* end = static_cast<const std::uint8_t*>(std::memchr(name, 0, room));
+  if (end == nullptr) return false;
+  out.channel.assign(reinterpret_cast<const char*>(name), static_cast<std::size_t>(end - name));
+  out.data = end + 1;
+  out.size = size - static_cast<std::size_t>(out.data - data);
+  return true;
+}
+
+namespace {
+
+/// group, port and recv_buf_size of a udpm:// URL ("udpm://239.255.76.67:7667?ttl=0&recv_buf_size=N").
+struct UdpmAddress {
+  in_addr group{};
+  std::uint16_t port = 0;
+  int recv_buf_bytes = 0;
+};
+
+std::optional<UdpmAddress> parseUdpm(const std::string& url) {
+  const std::string scheme = "udpm://";
+  if (url.rfind(scheme, 0) != 0) return std::nullopt;
+  std::string rest = url.substr(scheme.size());
+  std::string query;
+  if (const auto q = rest.find('?'); q != std::string::npos) {
+    query = rest.substr(q + 1);
+    rest = rest.substr(0, q);
+  }
+  UdpmAddress a;
+  const auto colon = rest.find(':');
+  const std::string host = colon == std::string::npos ? rest : rest.substr(0, colon);
+  const std::string port = colon == std::string::npos ? "7667" : rest.substr(colon + 1);
+  if (inet_pton(AF_INET, (host.empty() ? "239.255.76.67" : host).c_str(), &a.group) != 1) return std::nullopt;
+  try {
+    const int p = std::stoi(port);
+    if (p <= 0 || p > 65535) return std::nullopt;
+    a.port = static_cast<std::uint16_t>(p);
+    const std::string key = "recv_buf_size=";
+    if (const auto k = query.find(key); k != std::string::npos) a.recv_buf_bytes = std::stoi(query.substr(k + key.size()));
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  return a;
+}
+
+/// A non-blocking UDP socket joined to the group (as LCM's own receive socket would be).
+common::Result<int> openMulticastSocket(const UdpmAddress& a) {
+  using R = common::Result<int>;
+  const int fd = socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+  if (fd < 0) return R::fail(std::string("socket: ") + std::strerror(errno));
+  const int one = 1;
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_addr.s_addr = htonl(INADDR_ANY);
+  addr.sin_port = htons(a.port);
+  ip_mreq mreq{};
+  mreq.imr_multiaddr = a.group;
+  mreq.imr_interface.s_addr = htonl(INADDR_ANY);
+  std::string failed;
+  if (setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one) < 0) failed = "SO_REUSEADDR";
+  else if (bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) < 0) failed = "bind";
+  else if (setsockopt(fd, IPPROTO_IP, IP_ADD_MEMBERSHIP, &mreq, sizeof mreq) < 0) failed = "IP_ADD_MEMBERSHIP";
+  if (!failed.empty()) {
+    const std::string why = failed + ": " + std::strerror(errno);
+    close(fd);
+    return R::fail(why);
+  }
+  // The kernel caps the buffer at net.core.rmem_max (docs/security.md: floods).
+  if (a.recv_buf_bytes > 0) (void)setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &a.recv_buf_bytes, sizeof a.recv_buf_bytes);
+  return R::ok(fd);
+}
+
+constexpr std::size_t kBatch = 32;             ///< datagrams per recvmmsg (32 x 64 KiB of buffer)
+constexpr std::size_t kDatagramBytes = 65536;  ///< the largest UDP datagram
+
+}  // namespace
+
 struct LcmTransport::Impl {
   explicit Impl(const std::string& url) : lcm(url) {}
+  ~Impl() {
+    if (fd >= 0) close(fd);
+  }
   lcm::LCM lcm;
   LcmTransport* owner = nullptr;
+  int fd = -1;  ///< our own multicast socket (udpm://), else -1: LCM receives
+  std::vector<std::uint8_t> buffers;  ///< kBatch datagrams
+  std::array<mmsghdr, kBatch> headers{};
+  std::array<iovec, kBatch> iov{};
 
-  void onMessage(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+  void dispatch(const std::string& channel, const std::uint8_t* data, std::size_t size) {
     owner->counters_.received++;
     const auto type = channelType(channel, owner->prefix_);
     std::vector<std::uint8_t> sealed;
-    if (!type || rbuf == nullptr ||
-        !decodeLcmEnvelope(rbuf->data, static_cast<std::size_t>(rbuf->data_size), sealed)) {
+    if (!type || !decodeLcmEnvelope(data, size, sealed)) {
       owner->counters_.undecodable++;
       return;
     }
     if (owner->handler_) owner->handler_(*type, sealed);
+  }
+
+  void onMessage(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    if (rbuf == nullptr) return dispatch(channel, nullptr, 0);
+    dispatch(channel, static_cast<const std::uint8_t*>(rbuf->data), static_cast<std::size_t>(rbuf->data_size));
+  }
+
+  /// Reads up to `max` datagrams now (non-blocking); returns how many were read.
+  int receive(int max) {
+    if (buffers.empty()) buffers.resize(kBatch * kDatagramBytes);
+    const unsigned int n = static_cast<unsigned int>(std::min<std::size_t>(kBatch, static_cast<std::size_t>(max)));
+    for (unsigned int i = 0; i < n; ++i) {
+      iov[i] = iovec{buffers.data() + i * kDatagramBytes, kDatagramBytes};
+      headers[i] = mmsghdr{};
+      headers[i].msg_hdr.msg_iov = &iov[i];
+      headers[i].msg_hdr.msg_iovlen = 1;
+    }
+    const int got = recvmmsg(fd, headers.data(), n, MSG_DONTWAIT, nullptr);
+    if (got <= 0) return 0;
+    LcmDatagram d;
+    for (int i = 0; i < got; ++i) {
+      const auto* bytes = buffers.data() + static_cast<std::size_t>(i) * kDatagramBytes;
+      if (!parseLcmDatagram(bytes, headers[static_cast<std::size_t>(i)].msg_len, d)) {
+        owner->counters_.received++;
+        owner->counters_.undecodable++;
+        continue;
+      }
+      dispatch(d.channel, d.data, d.size);
+    }
+    return got;
   }
 };
 
@@ -96,10 +225,22 @@ common::Result<std::unique_ptr<LcmTransport>> LcmTransport::create(const std::st
                                                                     const std::string& channel_prefix) {
   using R = common::Result<std::unique_ptr<LcmTransport>>;
   if (channel_prefix.empty()) return R::fail("LCM channel prefix must not be empty");
+  std::optional<UdpmAddress> udpm;
+  if (url.rfind("udpm://", 0) == 0) {
+    udpm = parseUdpm(url);
+    if (!udpm) return R::fail("cannot parse the udpm URL '" + url + "' (udpm://GROUP:PORT?options)");
+  }
   auto impl = std::make_unique<Impl>(url);
   if (!impl->lcm.good()) return R::fail("cannot open LCM with URL '" + url + "'");
   std::unique_ptr<LcmTransport> t(new LcmTransport(std::move(impl), channel_prefix));
   t->impl_->owner = t.get();
+  if (udpm) {
+    // LCM only sends: it opens its receive socket on the first subscription, which never comes.
+    auto fd = openMulticastSocket(*udpm);
+    if (!fd) return R::fail("cannot receive on '" + url + "': " + fd.reason());
+    t->impl_->fd = fd.value();
+    return R::ok(std::move(t));
+  }
   // One regex subscription for our channels (LCM anchors it with ^...$).
   lcm::Subscription* sub = t->impl_->lcm.subscribe(
       channel_prefix + "(HEARTBEAT|WORKER_STATE|PLANNED_TRAJECTORY|FORMATION_PARAMS|FORMATION_COMMAND|GESTURE_OBSERVATION)",
@@ -127,10 +268,24 @@ bool LcmTransport::publish(comm::MessageType type, const std::vector<std::uint8_
 
 void LcmTransport::setHandler(Handler handler) { handler_ = std::move(handler); }
 
-int LcmTransport::handle(int timeout_ms) { return impl_->lcm.handleTimeout(timeout_ms); }
+int LcmTransport::handle(int timeout_ms) {
+  if (impl_->fd < 0) return impl_->lcm.handleTimeout(timeout_ms);
+  pollfd p{impl_->fd, POLLIN, 0};
+  const int ready = poll(&p, 1, timeout_ms);
+  if (ready <= 0) return ready;
+  return impl_->receive(1);
+}
 
 int LcmTransport::drain(int max_messages) {
   int n = 0;
+  if (impl_->fd >= 0) {
+    while (n < max_messages) {
+      const int got = impl_->receive(max_messages - n);
+      if (got == 0) break;
+      n += got;
+    }
+    return n;
+  }
   while (n < max_messages && impl_->lcm.handleTimeout(0) > 0) ++n;
   return n;
 }

@@ -40,7 +40,22 @@ std::vector<std::uint8_t> encodeLcmEnvelope(const std::vector<std::uint8_t>& sea
 /// `sealed` is written only on success.
 bool decodeLcmEnvelope(const void* data, std::size_t size, std::vector<std::uint8_t>& sealed);
 
-/// \brief Publishes and receives envelope bytes on the per-type channels.
+/// \brief One LCM short message (one UDP datagram of an udpm:// URL): "LC02", a 32-bit
+/// sequence number, the channel name ending in a NUL byte, then the message bytes.
+struct LcmDatagram {
+  std::string channel;
+  const std::uint8_t* data = nullptr;  ///< into the datagram
+  std::size_t size = 0;
+};
+/// \brief Parses an LCM short-message datagram; false for anything else (fragments of messages
+/// larger than ~64 kB, which our envelopes never are, foreign or garbage datagrams).
+bool parseLcmDatagram(const std::uint8_t* data, std::size_t size, LcmDatagram& out);
+
+/// \brief Publishes and receives envelope bytes on the per-type channels. With a udpm:// URL
+/// it publishes through LCM but receives on a multicast socket of its own, read in batches
+/// (recvmmsg) with the cheap checks — LCM datagram, our channel, envelope length — before any
+/// copy: under a flood of datagrams the legitimate ones are not lost behind LCM's per-message
+/// receive thread, queue and notification pipe (docs/security.md, floods). memq:// uses LCM.
 class LcmTransport {
  public:
   /// Called for every well-formed gf_lcm::envelope_t on one of our channels.

@@ -130,3 +130,39 @@ TEST(CommLcmTransportTest, ForgedReplayedAndMisroutedEnvelopesAreDroppedAndCount
   EXPECT_EQ(tr->drain(), 1);
   EXPECT_EQ(delivered, 2);
 }
+
+// The udpm:// receive path reads datagrams itself: an LCM short message is "LC02", a 32-bit
+// sequence number, the channel and a NUL, then the message; anything else is refused.
+TEST(CommLcmTransportTest, ParsesLcmShortMessageDatagramsOnly) {
+  const std::string channel = "GF_WORKER_STATE";
+  std::vector<std::uint8_t> d{'L', 'C', '0', '2', 0, 0, 0, 7};
+  d.insert(d.end(), channel.begin(), channel.end());
+  d.push_back(0);
+  const std::vector<std::uint8_t> message{1, 2, 3, 4, 5};
+  d.insert(d.end(), message.begin(), message.end());
+  LcmDatagram out;
+  ASSERT_TRUE(parseLcmDatagram(d.data(), d.size(), out));
+  EXPECT_EQ(out.channel, channel);
+  ASSERT_EQ(out.size, message.size());
+  EXPECT_EQ(std::vector<std::uint8_t>(out.data, out.data + out.size), message);
+
+  auto fragment = d;
+  fragment[3] = '3';  // LC03: a fragment of a large message (ours never are)
+  EXPECT_FALSE(parseLcmDatagram(fragment.data(), fragment.size(), out));
+  std::vector<std::uint8_t> no_nul{'L', 'C', '0', '2', 0, 0, 0, 1};
+  no_nul.insert(no_nul.end(), 80, 'A');  // a channel longer than LCM allows, never terminated
+  EXPECT_FALSE(parseLcmDatagram(no_nul.data(), no_nul.size(), out));
+  EXPECT_FALSE(parseLcmDatagram(d.data(), 8, out));  // header only
+  EXPECT_FALSE(parseLcmDatagram(nullptr, 0, out));
+  // An empty message on a channel is still a datagram (the envelope decoder refuses it later).
+  std::vector<std::uint8_t> empty{'L', 'C', '0', '2', 0, 0, 0, 2, 'G', 0};
+  ASSERT_TRUE(parseLcmDatagram(empty.data(), empty.size(), out));
+  EXPECT_EQ(out.channel, "G");
+  EXPECT_EQ(out.size, 0u);
+}
+
+TEST(CommLcmTransportTest, RefusesAnUnparsableUdpmUrl) {
+  const auto t = LcmTransport::create("udpm://not-an-address:7667");
+  ASSERT_FALSE(t);
+  EXPECT_NE(t.reason().find("udpm://not-an-address:7667"), std::string::npos) << t.reason();
+}
