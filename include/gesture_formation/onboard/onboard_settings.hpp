@@ -10,7 +10,8 @@
 ///     avoid_all_plans, search_timeout_s, search_height_m, search_vertical_speed_mps,
 ///     search_period_s, search_horizontal_speed_mps} (the safety rules' limits, docs/safety.md §1);
 ///   mission.formation.*, mission.gestures.* (filter, mapping, view_fusion), mission.planner.*,
-///   mission.estimator.* (each read by its module's own loader).
+///   mission.estimator.*, mission.abort.* (each read by its module's own loader; abort's rules
+///   against the planner's Γ_dis and speed limit checked here).
 /// A key that is absent keeps the documented default of its struct; every problem is reported
 /// at once, each naming its key.
 
@@ -24,6 +25,7 @@
 #include "gesture_formation/gesture/gesture_filter.hpp"
 #include "gesture_formation/gesture/gesture_mapping.hpp"
 #include "gesture_formation/gesture/view_fusion.hpp"
+#include "gesture_formation/planning/abort_mode.hpp"
 #include "gesture_formation/planning/plan_request_builder.hpp"
 #include "gesture_formation/planning/planner_config.hpp"
 
@@ -63,6 +65,7 @@ struct OnboardSettings {
   gesture::ViewFusionConfig view_fusion;
   planning::PlannerConfig planner;
   estimation::EstimatorConfig estimator;
+  planning::AbortConfig abort;  ///< abort.* (docs/safety.md §2.8)
 };
 
 /// \brief Reads the settings under `prefix` (e.g. "mission.") of `r` into `out`; problems go to
