@@ -301,6 +301,7 @@ void readOnboard(ConfigReader& r, const std::string& m, MissionConfig& c) {
   c.view_fusion = onboard.view_fusion;
   c.planner = onboard.planner;
   c.estimator = onboard.estimator;
+  c.abort = onboard.abort;
 }
 
 void readOdometry(ConfigReader& r, const std::string& m, OdometryConfig& od) {
@@ -397,6 +398,7 @@ void readFaults(ConfigReader& r, const std::string& m, MissionConfig& c) {
   readWindows(r, fk + "stereo_dropouts", c.faults.stereo_dropouts);
   readPlannerOutages(r, fk, c.faults.planner_outages);
   readFollowerDropouts(r, fk, c.faults.follower_dropouts);
+  readAbortEvent(r, fk + "abort", c.faults.abort);
   const std::string k = fk + "range_outliers.";
   r.readDouble(k + "probability", c.faults.range_outliers.probability, Range::closed(0.0, 1.0));
   r.readDouble(k + "min_error_m", c.faults.range_outliers.min_error_m, Range::nonNegative());

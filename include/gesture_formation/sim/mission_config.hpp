@@ -24,7 +24,9 @@
 #include "gesture_formation/gesture/gesture_filter.hpp"
 #include "gesture_formation/gesture/gesture_mapping.hpp"
 #include "gesture_formation/gesture/view_fusion.hpp"
+#include "gesture_formation/planning/abort_mode.hpp"
 #include "gesture_formation/planning/plan_request_builder.hpp"
+#include "gesture_formation/sim/abort_drill.hpp"
 #include "gesture_formation/planning/planner_config.hpp"
 #include "gesture_formation/sim/link.hpp"
 #include "gesture_formation/sim/multirotor.hpp"
@@ -100,6 +102,9 @@ struct FaultConfig {
   /// The leader's camera search for a worker it lost (keys search_timeout_s, search_height_m,
   /// search_vertical_speed_mps, search_period_s, search_horizontal_speed_mps; docs/safety.md §2.2).
   planning::SearchConfig search;
+  /// An abort issued during the mission (`abort: {t_s, source: operator | gesture}`; fault profile
+  /// abort_mid_mission; docs/safety.md §2.8). Absent: none.
+  std::optional<AbortEvent> abort;
   std::vector<std::string> validate(const std::string& prefix = "") const;
   /// \brief Whether follower `uav`'s computer is down at `t_s` (a follower_dropouts window).
   bool followerOffline(int uav, double t_s) const;
@@ -136,6 +141,7 @@ struct MissionConfig {
   gesture::GestureMapping gesture_mapping = gesture::GestureMapping::paperDefault();
   planning::PlannerConfig planner;
   estimation::EstimatorConfig estimator;
+  planning::AbortConfig abort;    ///< mission.abort.* (the onboard settings; docs/safety.md §2.8)
   std::vector<OperatorRequest> requests;  ///< ascending t_s
 };
 

@@ -1,0 +1,59 @@
+#!/usr/bin/env bash
+# gfctl simulate with the fault profile abort_mid_mission (config/faults/abort_mid_mission.yaml:
+# the operator aborts at 100 s while the worker works at height on the west tower) on the
+# power-tower mission shortened to 135 s, seed 1. Asserts docs/safety.md §2.8: every UAV accepts
+# the abort within a second, reaches its retreat goal and hovers there by the end, each goal in the
+# UAV's own layer and >= abort.retreat_distance_m (15 m) from the worker's position then (less the
+# estimate error and the arrival tolerance: 14 m); after the abort no collision, mutual distance
+# >= Gamma_dis 2.5 m, obstacle distance >= the verification clearance 0.5 m, worker distance >= the
+# planner's worker_safety_distance_m 3 m. Then the same with the abort from the worker's gesture.
+# Usage: gfctl_simulate_abort.sh GFCTL SRC
+set -euo pipefail
+GFCTL=$1
+SRC=$2
+TMP=$(mktemp -d)
+trap 'rm -rf "$TMP"' EXIT
+fail=0
+printf 'faults:\n  abort: {t_s: 100, source: gesture}\n' > "$TMP/gesture_abort.yaml"
+for run in operator gesture; do
+  faults=(--fault-profile abort_mid_mission)
+  [ "$run" = gesture ] && faults=(--faults "$TMP/gesture_abort.yaml")
+  "$GFCTL" simulate --scenario "$SRC/config/scenarios/power_towers.yaml" "${faults[@]}" --out "$TMP/$run" \
+    --seed 1 --duration 135 --threads 1 --no-plot > "$TMP/$run.log" 2>&1 \
+    || { echo "FAIL $run: gfctl exited $?"; cat "$TMP/$run.log"; exit 1; }
+  python3 - "$TMP/$run" "$run" <<'PY' || fail=1
+import csv, json, math, sys
+d, run = sys.argv[1], sys.argv[2]
+m = json.load(open(d + "/metrics.json"))
+rows = list(csv.DictReader(open(d + "/timeline.csv")))
+problems = []
+a = m.get("abort")
+if a is None:
+    print(f"FAIL {run}: metrics.json has no abort section"); sys.exit(1)
+if a["source"] != run: problems.append(f"source {a['source']}")
+last = rows[-1]
+worker = [float(last[k]) for k in ("worker_x", "worker_y", "worker_z")]
+zs = []
+for u in a["uavs"]:
+    i, name = u["uav"], ("L" if u["uav"] == 0 else str(u["uav"]))
+    if u["accepted_s"] is None or u["accepted_s"] - a["issued_s"] > 1.0: problems.append(f"uav {i} accepted at {u['accepted_s']}")
+    if u["phase"] != "at_retreat" or u["settled_s"] is None: problems.append(f"uav {i} phase {u['phase']}")
+    if u["min_uav_distance_m"] < 2.5: problems.append(f"uav {i} min mutual {u['min_uav_distance_m']:.2f} < 2.5")
+    if u["min_obstacle_distance_m"] < 0.5: problems.append(f"uav {i} min obstacle {u['min_obstacle_distance_m']:.2f} < 0.5")
+    if u["min_worker_distance_m"] < 3.0: problems.append(f"uav {i} min worker {u['min_worker_distance_m']:.2f} < 3")
+    p = [float(last[f"{name}_{k}"]) for k in "xyz"]
+    horizontal = math.hypot(p[0] - worker[0], p[1] - worker[1])
+    if horizontal < 14.0: problems.append(f"uav {i} ends {horizontal:.1f} m from the worker (< 14)")
+    zs.append(p[2])
+if m["collisions"] != 0: problems.append(f"collisions {m['collisions']}")
+# Each UAV in its own layer (10, 14, 18 m; within the arrival tolerance).
+for i, z in enumerate(zs):
+    if abs(z - (10 + 4 * i)) > 1.0: problems.append(f"uav {i} at height {z:.2f}, layer {10 + 4 * i}")
+print(("FAIL " if problems else "ok   ") + f"abort ({run}): " + (", ".join(problems) if problems else
+      "settled " + ", ".join(f"{u['settled_s'] - a['issued_s']:.1f}" for u in a["uavs"]) + " s after the abort; min mutual "
+      f"{min(u['min_uav_distance_m'] for u in a['uavs']):.2f} m, obstacle {min(u['min_obstacle_distance_m'] for u in a['uavs']):.2f} m, "
+      f"worker {min(u['min_worker_distance_m'] for u in a['uavs']):.2f} m"))
+sys.exit(1 if problems else 0)
+PY
+done
+exit $fail
