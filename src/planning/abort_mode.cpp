@@ -65,7 +65,6 @@ const common::FieldTable<AbortConfig>& abortConfigFields() {
       {"retreat_height_m", Range::positive(), [](C& c) { return &c.retreat_height_m; }},
       {"layer_spacing_m", Range::positive(), [](C& c) { return &c.layer_spacing_m; }},
       {"goal_clearance_m", Range::positive(), [](C& c) { return &c.goal_clearance_m; }},
-      {"distance_step_m", Range::positive(), [](C& c) { return &c.distance_step_m; }},
       {"max_distance_m", Range::positive(), [](C& c) { return &c.max_distance_m; }},
       {"bearing_step_deg", Range::openClosed(0.0, 180.0), [](C& c) { return &c.bearing_step_deg; }},
       {"speed_mps", Range::positive(), [](C& c) { return &c.speed_mps; }},
@@ -149,7 +148,7 @@ bool columnClear(const Eigen::Vector3d& top, const RetreatSpace& space, const Ab
 
 }  // namespace
 
-common::Result<Eigen::Vector3d> chooseRetreatGoal(int uav_index, const Eigen::Vector3d& p_uav_world,
+common::Result<Eigen::Vector3d> chooseRetreatGoal(int uav_index, int uav_count, const Eigen::Vector3d& p_uav_world,
                                                   const Eigen::Vector3d& p_worker_world, const RetreatSpace& space,
                                                   const AbortConfig& c) {
   using R = common::Result<Eigen::Vector3d>;
@@ -170,7 +169,8 @@ common::Result<Eigen::Vector3d> chooseRetreatGoal(int uav_index, const Eigen::Ve
   for (int k = 0; k < bearings; ++k) {
     const double bearing = bearing0 + bearingOffset(k, step);
     const Eigen::Vector2d dir(std::cos(bearing), std::sin(bearing));
-    for (double d = c.retreat_distance_m; d <= c.max_distance_m + 1e-9; d += c.distance_step_m) {
+    const double ring_step = std::max(1, uav_count) * c.layer_spacing_m;
+    for (double d = c.retreat_distance_m + uav_index * c.layer_spacing_m; d <= c.max_distance_m + 1e-9; d += ring_step) {
       const Eigen::Vector2d xy = p_worker_world.head<2>() + d * dir;
       const Eigen::Vector3d g(xy.x(), xy.y(), z);
       const double flight_m = (g - p_uav_world).norm();
@@ -184,9 +184,10 @@ common::Result<Eigen::Vector3d> chooseRetreatGoal(int uav_index, const Eigen::Ve
   }
   if (best) return R::ok(*best);
   std::ostringstream os;
-  os << "no point of UAV " << uav_index << "'s retreat layer (" << common::formatNumber(z) << " m) between "
-     << common::formatNumber(c.retreat_distance_m) << " and " << common::formatNumber(c.max_distance_m)
-     << " m from the worker has goal_clearance_m " << common::formatNumber(c.goal_clearance_m) << " m";
+  os << "no point of UAV " << uav_index << "'s retreat layer (" << common::formatNumber(z) << " m) on its rings from "
+     << common::formatNumber(c.retreat_distance_m + uav_index * c.layer_spacing_m) << " to "
+     << common::formatNumber(c.max_distance_m) << " m from the worker has goal_clearance_m "
+     << common::formatNumber(c.goal_clearance_m) << " m";
   return R::fail(os.str());
 }
 
@@ -231,7 +232,7 @@ AbortAcceptance AbortPlanner::receive(const AbortCommand& command, double t_s) {
 void AbortPlanner::chooseFirstGoal(const Situation& s, Decision& d) {
   started_ = true;
   d.phase_changed = true;
-  const auto goal = chooseRetreatGoal(uav_index_, s.p_world, s.worker_world, space_, config_);
+  const auto goal = chooseRetreatGoal(uav_index_, uav_count_, s.p_world, s.worker_world, space_, config_);
   if (goal) {
     retreat_ = *goal;
     goal_ = *goal;

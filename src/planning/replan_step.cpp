@@ -20,14 +20,14 @@ ReplanStep::ReplanStep(const ReplanConfig& config, std::unique_ptr<Planner> plan
     : config_(config),
       planner_(std::move(planner)),
       hold_(config.freshness, config.search, config.brake_accel_mps2),
-      abort_(config.uav_index, config.abort, space),
+      abort_(config.uav_index, config.uav_count, config.abort, space),
       space_(space),
       heading_(config.worker_heading) {}
 
 void ReplanStep::restart(std::unique_ptr<Planner> planner) {
   planner_ = std::move(planner);
   hold_ = HoldPlanner(config_.freshness, config_.search, config_.brake_accel_mps2);
-  abort_ = AbortPlanner(config_.uav_index, config_.abort, space_);
+  abort_ = AbortPlanner(config_.uav_index, config_.uav_count, config_.abort, space_);
   heading_ = formation::WorkerHeading(config_.worker_heading);
   flown_ = PlannedTrajectory{};
   listen_since_s_ = std::numeric_limits<double>::quiet_NaN();

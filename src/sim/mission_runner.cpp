@@ -198,6 +198,7 @@ std::string MissionRun::addUavs() {
     auto u = std::make_unique<UavRuntime>(cfg_.uavs[static_cast<std::size_t>(i)], cfg_, s0, seed_, i);
     planning::ReplanConfig rc;
     rc.uav_index = i;
+    rc.uav_count = n_;
     rc.dt_s = cfg_.horizon_dt_s;
     rc.steps = cfg_.horizon_steps;
     rc.freshness = freshness;

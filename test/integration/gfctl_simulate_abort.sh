@@ -6,7 +6,9 @@
 # UAV's own layer and >= abort.retreat_distance_m (15 m) from the worker's position then (less the
 # estimate error and the arrival tolerance: 14 m); after the abort no collision, mutual distance
 # >= Gamma_dis 2.5 m, obstacle distance >= the verification clearance 0.5 m, worker distance >= the
-# planner's worker_safety_distance_m 3 m. Then the same with the abort from the worker's gesture.
+# planner's worker_safety_distance_m 3 m. Then the same with the abort from the worker's gesture,
+# and with mission.abort.after: land (to 150 s): every UAV at its landing approach point (2 m above
+# the ground), the spots >= Gamma_dis apart.
 # Usage: gfctl_simulate_abort.sh GFCTL SRC
 set -euo pipefail
 GFCTL=$1
@@ -15,11 +17,17 @@ TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
 fail=0
 printf 'faults:\n  abort: {t_s: 100, source: gesture}\n' > "$TMP/gesture_abort.yaml"
-for run in operator gesture; do
+# The power-tower mission with abort.after: land (the model path made absolute for the copy).
+sed -e "s|gesture_model: \.\./\.\./|gesture_model: $SRC/|" -e 's|^  worker:$|  abort: {after: land}\n  worker:|' \
+  "$SRC/config/scenarios/power_towers.yaml" > "$TMP/power_towers_land.yaml"
+for run in operator gesture land; do
   faults=(--fault-profile abort_mid_mission)
+  scenario="$SRC/config/scenarios/power_towers.yaml"
+  duration=135
   [ "$run" = gesture ] && faults=(--faults "$TMP/gesture_abort.yaml")
-  "$GFCTL" simulate --scenario "$SRC/config/scenarios/power_towers.yaml" "${faults[@]}" --out "$TMP/$run" \
-    --seed 1 --duration 135 --threads 1 --no-plot > "$TMP/$run.log" 2>&1 \
+  [ "$run" = land ] && { faults=(--faults "$SRC/config/faults/abort_mid_mission.yaml"); scenario="$TMP/power_towers_land.yaml"; duration=150; }
+  "$GFCTL" simulate --scenario "$scenario" "${faults[@]}" --out "$TMP/$run" \
+    --seed 1 --duration "$duration" --threads 1 --no-plot > "$TMP/$run.log" 2>&1 \
     || { echo "FAIL $run: gfctl exited $?"; cat "$TMP/$run.log"; exit 1; }
   python3 - "$TMP/$run" "$run" <<'PY' || fail=1
 import csv, json, math, sys
@@ -30,25 +38,30 @@ problems = []
 a = m.get("abort")
 if a is None:
     print(f"FAIL {run}: metrics.json has no abort section"); sys.exit(1)
-if a["source"] != run: problems.append(f"source {a['source']}")
+if a["source"] != ("operator" if run == "land" else run): problems.append(f"source {a['source']}")
+final = "landed" if run == "land" else "at_retreat"
 last = rows[-1]
 worker = [float(last[k]) for k in ("worker_x", "worker_y", "worker_z")]
 zs = []
 for u in a["uavs"]:
     i, name = u["uav"], ("L" if u["uav"] == 0 else str(u["uav"]))
     if u["accepted_s"] is None or u["accepted_s"] - a["issued_s"] > 1.0: problems.append(f"uav {i} accepted at {u['accepted_s']}")
-    if u["phase"] != "at_retreat" or u["settled_s"] is None: problems.append(f"uav {i} phase {u['phase']}")
+    if u["phase"] != final or u["settled_s"] is None: problems.append(f"uav {i} phase {u['phase']}")
     if u["min_uav_distance_m"] < 2.5: problems.append(f"uav {i} min mutual {u['min_uav_distance_m']:.2f} < 2.5")
     if u["min_obstacle_distance_m"] < 0.5: problems.append(f"uav {i} min obstacle {u['min_obstacle_distance_m']:.2f} < 0.5")
     if u["min_worker_distance_m"] < 3.0: problems.append(f"uav {i} min worker {u['min_worker_distance_m']:.2f} < 3")
     p = [float(last[f"{name}_{k}"]) for k in "xyz"]
     horizontal = math.hypot(p[0] - worker[0], p[1] - worker[1])
     if horizontal < 14.0: problems.append(f"uav {i} ends {horizontal:.1f} m from the worker (< 14)")
-    zs.append(p[2])
+    zs.append(p)
 if m["collisions"] != 0: problems.append(f"collisions {m['collisions']}")
-# Each UAV in its own layer (10, 14, 18 m; within the arrival tolerance).
-for i, z in enumerate(zs):
-    if abs(z - (10 + 4 * i)) > 1.0: problems.append(f"uav {i} at height {z:.2f}, layer {10 + 4 * i}")
+# Each UAV in its own layer (10, 14, 18 m) or at its landing approach point (2 m; within the arrival
+# tolerance); landing spots >= Gamma_dis apart.
+for i, p in enumerate(zs):
+    want = 2.0 if run == "land" else 10 + 4 * i
+    if abs(p[2] - want) > 1.0: problems.append(f"uav {i} at height {p[2]:.2f}, want {want}")
+    for q in zs[i + 1:]:
+        if math.hypot(p[0] - q[0], p[1] - q[1]) < 2.5: problems.append(f"uav {i} ends < 2.5 m beside another horizontally")
 print(("FAIL " if problems else "ok   ") + f"abort ({run}): " + (", ".join(problems) if problems else
       "settled " + ", ".join(f"{u['settled_s'] - a['issued_s']:.1f}" for u in a["uavs"]) + " s after the abort; min mutual "
       f"{min(u['min_uav_distance_m'] for u in a['uavs']):.2f} m, obstacle {min(u['min_obstacle_distance_m'] for u in a['uavs']):.2f} m, "

@@ -11,15 +11,18 @@
 /// the command, from what that UAV alone knows — its own position, the worker estimate, its index —
 /// so that no UAV has to hear from another:
 ///   - it lies in the UAV's own *retreat layer*, the height retreat_height_m + i·layer_spacing_m
-///     above the ground (z = 0, docs/conventions.md) for UAV i. Layers are layer_spacing_m apart
+///     above the ground (z = 0, docs/conventions.md) for UAV i of n. Layers are layer_spacing_m apart
 ///     and layer_spacing_m ≥ Γ_dis (checked against the planner's qp.mutual_distance_m), so the
 ///     goals of two UAVs are at least Γ_dis apart whatever each one chose;
-///   - its horizontal distance from the worker estimate is ≥ retreat_distance_m;
+///   - it lies on one of the UAV's own *rings* around the worker estimate: horizontal distance
+///     retreat_distance_m + (i + k·n)·layer_spacing_m, k = 0, 1, … up to max_distance_m. Two UAVs'
+///     goals are then also layer_spacing_m apart horizontally (less the difference between the
+///     worker estimates they chose from), so the spots straight below them — where they land —
+///     keep Γ_dis too;
 ///   - its clearance from the map's obstacles (the planner's distance field) is ≥ goal_clearance_m,
 ///     and it lies inside the map's grid by that much;
 ///   - among the candidates — bearings from the worker out through the UAV's own position, then
-///     ±bearing_step_deg, ±2·bearing_step_deg, … all round; along each, distances
-///     retreat_distance_m, + distance_step_m, … up to max_distance_m — the one nearest to the UAV
+///     ±bearing_step_deg, ±2·bearing_step_deg, … all round; along each, the UAV's rings — the one nearest to the UAV
 ///     wins (the shortest flight; it does not pick a point behind an obstacle when one beside it
 ///     will do); ties go to the earlier candidate of that order.
 /// Thread safety: pure functions; AbortPlanner is not thread-safe (one per UAV).
@@ -58,9 +61,8 @@ const char* toString(AbortAfter after);
 struct AbortConfig {
   double retreat_distance_m = 15.0;   ///< goal ≥ this horizontally from the worker estimate [m], > 0
   double retreat_height_m = 10.0;     ///< UAV 0's retreat layer above the ground [m], > 0
-  double layer_spacing_m = 4.0;       ///< between the layers of UAV i and i+1 [m], ≥ the planner's Γ_dis
+  double layer_spacing_m = 4.0;       ///< between the layers (height) and rings (distance) of UAV i and i+1 [m], ≥ Γ_dis
   double goal_clearance_m = 3.0;      ///< a goal's and a landing column's clearance from obstacles [m], > 0
-  double distance_step_m = 2.0;       ///< goal search: distance step along a bearing [m], > 0
   double max_distance_m = 45.0;       ///< goal search: farthest horizontal distance from the worker [m], ≥ retreat_distance_m
   double bearing_step_deg = 15.0;     ///< goal search: bearing step [deg], (0, 180]
   double speed_mps = 2.0;             ///< reference speed towards a goal [m/s], > 0, < the planner's max speed
@@ -121,9 +123,9 @@ struct RetreatSpace {
   double ground_height_m = 0.0;
 };
 
-/// \brief The retreat goal of UAV `uav_index` (see the file comment); fails naming why (no map,
-/// the layer outside the map, no free point in the search).
-common::Result<Eigen::Vector3d> chooseRetreatGoal(int uav_index, const Eigen::Vector3d& p_uav_world,
+/// \brief The retreat goal of UAV `uav_index` of `uav_count` (see the file comment); fails naming
+/// why (no map, the layer outside the map, no free point in the search).
+common::Result<Eigen::Vector3d> chooseRetreatGoal(int uav_index, int uav_count, const Eigen::Vector3d& p_uav_world,
                                                   const Eigen::Vector3d& p_worker_world, const RetreatSpace& space,
                                                   const AbortConfig& config);
 
@@ -161,8 +163,8 @@ bool settled(AbortPhase phase);
 class AbortPlanner {
  public:
   AbortPlanner() = default;
-  AbortPlanner(int uav_index, const AbortConfig& config, const RetreatSpace& space)
-      : uav_index_(uav_index), config_(config), space_(space) {}
+  AbortPlanner(int uav_index, int uav_count, const AbortConfig& config, const RetreatSpace& space)
+      : uav_index_(uav_index), uav_count_(uav_count), config_(config), space_(space) {}
 
   /// \brief An abort command arriving at t_s (see AbortAcceptance). Repeats and copies change nothing.
   AbortAcceptance receive(const AbortCommand& command, double t_s);
@@ -206,6 +208,7 @@ class AbortPlanner {
   void advance(const Situation& s, Decision& d);
 
   int uav_index_ = 0;
+  int uav_count_ = 1;
   AbortConfig config_;
   RetreatSpace space_;
   std::optional<AbortCommand> command_;

@@ -93,6 +93,7 @@ const char* toString(ReplanMode mode);
 /// \brief The settings of one UAV's replanning (FormationPlanner parameters; mission file).
 struct ReplanConfig {
   int uav_index = 0;                ///< 0 = leader, i = follower i (priority order)
+  int uav_count = 1;                ///< the formation's UAVs (the abort's retreat rings), > uav_index
   double dt_s = 0.2;                ///< horizon step [s], > 0
   int steps = 10;                   ///< horizon steps, ≥ 2
   FreshnessLimits freshness;        ///< hold on data older than these

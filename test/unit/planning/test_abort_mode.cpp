@@ -74,9 +74,13 @@ TEST_P(RetreatGoalAroundTheWorker, IsFarFromTheWorkerClearOfObstaclesAndInTheUav
   const double bearing = GetParam() * M_PI / 8.0;  // UAVs all around the worker, also towards the wall
   for (int uav = 0; uav < 3; ++uav) {
     const Eigen::Vector3d p_uav = kWorker + Eigen::Vector3d(8.0 * std::cos(bearing), 8.0 * std::sin(bearing), 5.0);
-    const auto g = pl::chooseRetreatGoal(uav, p_uav, kWorker, world().space(), c);
+    const auto g = pl::chooseRetreatGoal(uav, 3, p_uav, kWorker, world().space(), c);
     ASSERT_TRUE(g) << g.reason();
-    EXPECT_GE((*g - kWorker).head<2>().norm(), c.retreat_distance_m - 1e-9) << "uav " << uav;
+    // On one of its own rings: retreat_distance_m + (uav + k·3)·layer_spacing_m.
+    const double ring = ((*g - kWorker).head<2>().norm() - c.retreat_distance_m - uav * c.layer_spacing_m) /
+                        (3 * c.layer_spacing_m);
+    EXPECT_GE(ring, -1e-9) << "uav " << uav;
+    EXPECT_NEAR(ring, std::round(ring), 1e-9) << "uav " << uav;
     EXPECT_GE(world().field.clearance(*g), c.goal_clearance_m) << "uav " << uav;
     // Independently of the field: the exact distance to the solids and the ground.
     EXPECT_GE(world().solids.distance(*g), c.goal_clearance_m - world().map.resolution()) << "uav " << uav;
@@ -88,13 +92,13 @@ TEST_P(RetreatGoalAroundTheWorker, IsFarFromTheWorkerClearOfObstaclesAndInTheUav
 
 INSTANTIATE_TEST_SUITE_P(Bearings, RetreatGoalAroundTheWorker, ::testing::Range(0, 16));
 
-TEST(RetreatGoalTest, GoalsOfDifferentUavsKeepGammaDisEvenFromOnePoint) {
+TEST(RetreatGoalTest, GoalsAndLandingSpotsOfDifferentUavsKeepGammaDisEvenFromOnePoint) {
   // Worst case: every UAV chooses from the same position (no negotiation between them).
   const pl::AbortConfig c;
   const Eigen::Vector3d p_uav = kWorker + Eigen::Vector3d(-6.0, 3.0, 4.0);
   std::vector<Eigen::Vector3d> goals;
   for (int uav = 0; uav < 4; ++uav) {
-    const auto g = pl::chooseRetreatGoal(uav, p_uav, kWorker, world().space(), c);
+    const auto g = pl::chooseRetreatGoal(uav, 4, p_uav, kWorker, world().space(), c);
     ASSERT_TRUE(g) << g.reason();
     goals.push_back(*g);
   }
@@ -102,6 +106,8 @@ TEST(RetreatGoalTest, GoalsOfDifferentUavsKeepGammaDisEvenFromOnePoint) {
     for (std::size_t j = i + 1; j < goals.size(); ++j) {
       EXPECT_GE((goals[i] - goals[j]).norm(), c.layer_spacing_m - 1e-9) << i << " " << j;
       EXPECT_GE((goals[i] - goals[j]).norm(), 2.5) << "Gamma_dis";
+      // Horizontally too (the rings): the spots below them, where they would land, keep Γ_dis.
+      EXPECT_GE((goals[i] - goals[j]).head<2>().norm(), c.layer_spacing_m - 1e-9) << i << " " << j;
     }
   }
 }
@@ -109,10 +115,10 @@ TEST(RetreatGoalTest, GoalsOfDifferentUavsKeepGammaDisEvenFromOnePoint) {
 TEST(RetreatGoalTest, IsDeterministic) {
   const pl::AbortConfig c;
   const Eigen::Vector3d p_uav = kWorker + Eigen::Vector3d(7.0, 1.0, 3.0);
-  const auto a = pl::chooseRetreatGoal(1, p_uav, kWorker, world().space(), c);
+  const auto a = pl::chooseRetreatGoal(1, 3, p_uav, kWorker, world().space(), c);
   const WallWorld other;  // another copy of the same map: the same goal
   pl::RetreatSpace s = other.space();
-  const auto b = pl::chooseRetreatGoal(1, p_uav, kWorker, s, c);
+  const auto b = pl::chooseRetreatGoal(1, 3, p_uav, kWorker, s, c);
   ASSERT_TRUE(a && b);
   EXPECT_EQ(*a, *b);
 }
@@ -120,12 +126,12 @@ TEST(RetreatGoalTest, IsDeterministic) {
 TEST(RetreatGoalTest, AUavFacingTheWallTurnsAsideAndAUavInTheOpenGoesStraightOut) {
   const pl::AbortConfig c;
   // East of the worker: straight out (bearing 0) lies in or beside the wall up to max_distance_m.
-  const auto east = pl::chooseRetreatGoal(0, kWorker + Eigen::Vector3d(8.0, 0.0, 5.0), kWorker, world().space(), c);
+  const auto east = pl::chooseRetreatGoal(0, 3, kWorker + Eigen::Vector3d(8.0, 0.0, 5.0), kWorker, world().space(), c);
   ASSERT_TRUE(east) << east.reason();
   EXPECT_GT(std::abs(std::atan2(east->y(), east->x())), 0.1) << east->transpose();
   EXPECT_LT(east->x(), 12.0 - c.goal_clearance_m) << "not in or behind the wall: " << east->transpose();
   // West of the worker in the open: straight out, at the nearest allowed distance.
-  const auto west = pl::chooseRetreatGoal(0, kWorker + Eigen::Vector3d(-8.0, 0.0, 5.0), kWorker, world().space(), c);
+  const auto west = pl::chooseRetreatGoal(0, 3, kWorker + Eigen::Vector3d(-8.0, 0.0, 5.0), kWorker, world().space(), c);
   ASSERT_TRUE(west) << west.reason();
   EXPECT_NEAR(west->x(), -c.retreat_distance_m, 1e-9);
   EXPECT_NEAR(west->y(), 0.0, 1e-9);
@@ -134,16 +140,16 @@ TEST(RetreatGoalTest, AUavFacingTheWallTurnsAsideAndAUavInTheOpenGoesStraightOut
 TEST(RetreatGoalTest, FailsNamingWhyWhenNothingFitsOrTheLayerIsOutsideTheMap) {
   pl::AbortConfig c;
   c.retreat_height_m = 28.0;  // UAV 0 at 28 m: within 3 m of the map's top (30 m)
-  const auto high = pl::chooseRetreatGoal(0, kWorker + Eigen::Vector3d(-8, 0, 5), kWorker, world().space(), c);
+  const auto high = pl::chooseRetreatGoal(0, 3, kWorker + Eigen::Vector3d(-8, 0, 5), kWorker, world().space(), c);
   ASSERT_FALSE(high);
   EXPECT_NE(high.reason().find("outside the map"), std::string::npos) << high.reason();
   c = pl::AbortConfig{};
   c.retreat_distance_m = 40.0;  // every point ≥ 40 m away lies outside the 60 m map
   c.max_distance_m = 45.0;
-  const auto far = pl::chooseRetreatGoal(0, kWorker + Eigen::Vector3d(-8, 0, 5), kWorker, world().space(), c);
+  const auto far = pl::chooseRetreatGoal(0, 3, kWorker + Eigen::Vector3d(-8, 0, 5), kWorker, world().space(), c);
   ASSERT_FALSE(far);
   EXPECT_NE(far.reason().find("no point"), std::string::npos) << far.reason();
-  EXPECT_FALSE(pl::chooseRetreatGoal(0, kWorker, kWorker, pl::RetreatSpace{}, pl::AbortConfig{}));
+  EXPECT_FALSE(pl::chooseRetreatGoal(0, 3, kWorker, kWorker, pl::RetreatSpace{}, pl::AbortConfig{}));
 }
 
 TEST(LandingPointTest, BelowTheGoalWhenItsColumnIsClearElseBelowHomeElseNone) {
@@ -181,7 +187,7 @@ pl::AbortCommand command(double sent_s) { return pl::AbortCommand{{"gcs", 7}, pl
 TEST(AbortPlannerTest, AcceptsOnceRefusesStaleCommandsAndCopiesChangeNothing) {
   pl::AbortConfig c;
   c.max_command_age_s = 10.0;
-  pl::AbortPlanner a(0, c, world().space());
+  pl::AbortPlanner a(0, 3, c, world().space());
   EXPECT_EQ(a.receive(command(0.0), 10.5), pl::AbortAcceptance::kStale);
   EXPECT_FALSE(a.aborting());
   EXPECT_EQ(a.receive(command(5.0), 10.5), pl::AbortAcceptance::kAccepted);
@@ -192,7 +198,7 @@ TEST(AbortPlannerTest, AcceptsOnceRefusesStaleCommandsAndCopiesChangeNothing) {
 }
 
 TEST(AbortPlannerTest, RetreatsThenHovers) {
-  pl::AbortPlanner a(1, pl::AbortConfig{}, world().space());
+  pl::AbortPlanner a(1, 3, pl::AbortConfig{}, world().space());
   a.receive(command(0.0), 0.0);
   const Eigen::Vector3d p0(-8.0, 0.0, 6.0);
   const auto d0 = a.decide(at(0.0, p0));
@@ -220,7 +226,7 @@ TEST(AbortPlannerTest, RetreatsThenHovers) {
 TEST(AbortPlannerTest, RetreatsThenReturnsHome) {
   pl::AbortConfig c;
   c.after = pl::AbortAfter::kReturnHome;
-  pl::AbortPlanner a(0, c, world().space());
+  pl::AbortPlanner a(0, 3, c, world().space());
   a.receive(command(0.0), 0.0);
   a.decide(at(0.0, Eigen::Vector3d(-8.0, 0.0, 6.0)));
   const Eigen::Vector3d goal = *a.retreatGoal();
@@ -233,7 +239,7 @@ TEST(AbortPlannerTest, RetreatsThenReturnsHome) {
 TEST(AbortPlannerTest, RetreatsThenApproachesAVerifiedLandingSpot) {
   pl::AbortConfig c;
   c.after = pl::AbortAfter::kLand;
-  pl::AbortPlanner a(0, c, world().space());
+  pl::AbortPlanner a(0, 3, c, world().space());
   a.receive(command(0.0), 0.0);
   a.decide(at(0.0, Eigen::Vector3d(-8.0, 0.0, 6.0)));
   const Eigen::Vector3d goal = *a.retreatGoal();
@@ -244,7 +250,7 @@ TEST(AbortPlannerTest, RetreatsThenApproachesAVerifiedLandingSpot) {
 }
 
 TEST(AbortPlannerTest, WithoutAGoalItHoldsAtItsBrakingPointAndSaysWhy) {
-  pl::AbortPlanner a(0, pl::AbortConfig{}, pl::RetreatSpace{});  // no map
+  pl::AbortPlanner a(0, 3, pl::AbortConfig{}, pl::RetreatSpace{});  // no map
   a.receive(command(0.0), 0.0);
   const auto d = a.decide(at(0.0, Eigen::Vector3d(0, 0, 5), Eigen::Vector3d(2.0, 0, 0)));
   EXPECT_EQ(d.phase, pl::AbortPhase::kNoGoal);
@@ -334,6 +340,7 @@ struct Follower {
   static pl::ReplanConfig config() {
     pl::ReplanConfig c;
     c.uav_index = 1;
+    c.uav_count = 3;
     c.steps = 10;
     c.freshness = pl::FreshnessLimits{2.0, 3.0};
     c.rule = pl::AvoidanceRule{true, 1.0};
