@@ -7,8 +7,9 @@
 # estimate error and the arrival tolerance: 14 m); after the abort no collision, mutual distance
 # >= Gamma_dis 2.5 m, obstacle distance >= the verification clearance 0.5 m, worker distance >= the
 # planner's worker_safety_distance_m 3 m. Then the same with the abort from the worker's gesture,
-# and with mission.abort.after: land (to 150 s): every UAV at its landing approach point (2 m above
-# the ground), the spots >= Gamma_dis apart.
+# with mission.abort.after: land (to 150 s): every UAV at its landing approach point (2 m above
+# the ground), the spots >= Gamma_dis apart; and from search / hold (the leader's camera blind from
+# 90 s: at 100 s it searches, the followers hold) the same as the first.
 # Usage: gfctl_simulate_abort.sh GFCTL SRC
 set -euo pipefail
 GFCTL=$1
@@ -17,14 +18,16 @@ TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
 fail=0
 printf 'faults:\n  abort: {t_s: 100, source: gesture}\n' > "$TMP/gesture_abort.yaml"
+printf 'faults:\n  camera_blackouts: [[90, 130]]\n  abort: {t_s: 100, source: operator}\n' > "$TMP/search_abort.yaml"
 # The power-tower mission with abort.after: land (the model path made absolute for the copy).
 sed -e "s|gesture_model: \.\./\.\./|gesture_model: $SRC/|" -e 's|^  worker:$|  abort: {after: land}\n  worker:|' \
   "$SRC/config/scenarios/power_towers.yaml" > "$TMP/power_towers_land.yaml"
-for run in operator gesture land; do
+for run in operator gesture land search; do
   faults=(--fault-profile abort_mid_mission)
   scenario="$SRC/config/scenarios/power_towers.yaml"
   duration=135
   [ "$run" = gesture ] && faults=(--faults "$TMP/gesture_abort.yaml")
+  [ "$run" = search ] && faults=(--faults "$TMP/search_abort.yaml")
   [ "$run" = land ] && { faults=(--faults "$SRC/config/faults/abort_mid_mission.yaml"); scenario="$TMP/power_towers_land.yaml"; duration=150; }
   "$GFCTL" simulate --scenario "$scenario" "${faults[@]}" --out "$TMP/$run" \
     --seed 1 --duration "$duration" --threads 1 --no-plot > "$TMP/$run.log" 2>&1 \
@@ -38,7 +41,11 @@ problems = []
 a = m.get("abort")
 if a is None:
     print(f"FAIL {run}: metrics.json has no abort section"); sys.exit(1)
-if a["source"] != ("operator" if run == "land" else run): problems.append(f"source {a['source']}")
+if a["source"] != ("gesture" if run == "gesture" else "operator"): problems.append(f"source {a['source']}")
+modes = list(csv.DictReader(open(d + "/modes.csv")))
+if run == "search":  # the modes just before the abort: the leader searches, the followers hold
+    before = {r["uav"]: r["mode"] for r in modes if float(r["t"]) < a["issued_s"]}
+    if before != {"L": "search", "1": "hold", "2": "hold"}: problems.append(f"modes before the abort {before}")
 final = "landed" if run == "land" else "at_retreat"
 last = rows[-1]
 worker = [float(last[k]) for k in ("worker_x", "worker_y", "worker_z")]
