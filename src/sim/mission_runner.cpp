@@ -537,6 +537,7 @@ void MissionRun::sendPlan(int i, double t, const planning::ReplanOutcome& out, c
     s.params_version = version;
     s.plan = out.result.trajectory;
     s.abort = uav(0).step->abort().command();
+    if (s.abort) s.abort->sent_s = t;  // each relayed copy is stamped when it is sent (its age: the share's)
     for (int j = 1; j < n_; ++j) share_links_[static_cast<std::size_t>(j)]->send(t, s);
     return;
   }
@@ -603,7 +604,11 @@ void MissionRun::deliverAbort(double t) {
 void MissionRun::receiveAbort(int i, const planning::AbortCommand& command, double t) {
   UavRuntime& u = uav(i);
   if (u.step->receiveAbort(command, t) != planning::AbortAcceptance::kAccepted) return;
-  if (abort_record_) abort_record_->accepted(i, t);
+  if (!abort_record_) {  // an abort not injected by faults.abort (a recognised gesture): measured from here
+    abort_record_.emplace(AbortEvent{t, command.source}, n_,
+                          ObstacleDistance{world_.field, world_.solids, world_.ground_height_m});
+  }
+  abort_record_->accepted(i, t);
   setMode(i, t, "abort_accepted", std::string("abort from ") + planning::toString(command.source) + " " + command.id.sender);
 }
 
