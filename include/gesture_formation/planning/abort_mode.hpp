@@ -4,8 +4,9 @@
 /// command it stops serving the formation and flies, along plans that pass the planner's usual
 /// verification (ReplanStep; fallback: the last verified plan or braking, as always), to a retreat
 /// goal of its own, then — by configuration — hovers there, returns to its take-off point, or
-/// approaches a verified landing spot. Shared by `gfctl simulate`'s UAVs and the FormationPlanner
-/// nodelet through planning::ReplanStep.
+/// approaches a verified landing spot. Part of planning::ReplanStep, the step `gfctl simulate`'s UAVs
+/// and the FormationPlanner nodelet share (the nodelets do not receive abort commands yet:
+/// docs/ros.md).
 ///
 /// The retreat goal (chooseRetreatGoal) is chosen once, when the UAV first plans after accepting
 /// the command, from what that UAV alone knows — its own position, the worker estimate, its index —
@@ -56,8 +57,8 @@ enum class AbortAfter {
 /// \brief "hover", "return_home", "land".
 const char* toString(AbortAfter after);
 
-/// \brief The abort settings (mission `abort.*`, config/abort.yaml; FormationPlanner's ~abort_*
-/// parameters). Defaults documented per field; validate() names every bad key.
+/// \brief The abort settings (a mission's `abort.*`, read with the onboard settings:
+/// onboard::OnboardSettings). Defaults documented per field; validate() names every bad key.
 struct AbortConfig {
   double retreat_distance_m = 15.0;   ///< goal ≥ this horizontally from the worker estimate [m], > 0
   double retreat_height_m = 10.0;     ///< UAV 0's retreat layer above the ground [m], > 0
