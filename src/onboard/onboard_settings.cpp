@@ -5,6 +5,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "gesture_formation/common/config_fields.hpp"
 #include "gesture_formation/formation/formation_geometry.hpp"
 
 namespace gesture_formation::onboard {
@@ -35,6 +36,10 @@ void readOnboardSettings(ConfigReader& r, const std::string& m, OnboardSettings&
                         [&](ConfigReader& s) { c.planner = planning::readPlannerConfig(s); });
   common::withSubReader(r, m + "estimator", ConfigReader::MissingKeys::kUseDefaults,
                         [&](ConfigReader& s) { c.estimator = estimation::readEstimatorConfig(s); });
+  common::withSubReader(r, m + "abort", ConfigReader::MissingKeys::kUseDefaults,
+                        [&](ConfigReader& s) { c.replan.abort = planning::readAbortConfig(s); });
+  common::addProblems(r, "", planning::abortPlannerProblems(c.replan.abort, c.planner.mutual_distance_m,
+                                                            c.planner.limits.max_speed_mps, m + "abort."));
 }
 
 namespace {

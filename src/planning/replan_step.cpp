@@ -11,6 +11,7 @@ const char* toString(ReplanMode mode) {
     case ReplanMode::kTrack: return "track";
     case ReplanMode::kHold: return "hold";
     case ReplanMode::kSearch: return "search";
+    case ReplanMode::kAbort: return "abort";
   }
   return "unknown";
 }
@@ -39,15 +40,18 @@ std::vector<std::string> ReplanConfig::validate(const std::string& prefix) const
   return common::problemLines(replanConfigFields().rangeProblems(*this), prefix);
 }
 
-ReplanStep::ReplanStep(const ReplanConfig& config, std::unique_ptr<Planner> planner)
+ReplanStep::ReplanStep(const ReplanConfig& config, std::unique_ptr<Planner> planner, const RetreatSpace& space)
     : config_(config),
       planner_(std::move(planner)),
       hold_(config.freshness, config.search, config.brake_accel_mps2),
+      abort_(config.uav_index, config.uav_count, config.abort, space),
+      space_(space),
       heading_(config.worker_heading) {}
 
 void ReplanStep::restart(std::unique_ptr<Planner> planner) {
   planner_ = std::move(planner);
   hold_ = HoldPlanner(config_.freshness, config_.search, config_.brake_accel_mps2);
+  abort_ = AbortPlanner(config_.uav_index, config_.uav_count, config_.abort, space_);
   heading_ = formation::WorkerHeading(config_.worker_heading);
   flown_ = PlannedTrajectory{};
   listen_since_s_ = std::numeric_limits<double>::quiet_NaN();
@@ -68,17 +72,72 @@ std::string ReplanStep::listeningHold(double t_s, const std::vector<std::optiona
   return listeningReason(config_.uav_index, listen_since_s_, plans, nullptr);
 }
 
+struct ReplanStep::Choice {
+  formation::ReferenceTrajectory reference;  ///< hold / search / abort: the reference
+  formation::HorizonPoints camera_target;    ///< search: the sweep; otherwise 0 columns
+  bool given = false;                        ///< a reference is given (the UAV does not track)
+};
+
+ReplanStep::Choice ReplanStep::choose(const ReplanInputs& in, const std::string& hold, const Eigen::Vector3d& worker_p0,
+                                      ReplanOutcome& out) {
+  Choice c;
+  if (abort_.aborting() && hold.empty()) {
+    AbortPlanner::Situation s;
+    s.t_s = in.t_s;
+    s.dt_s = config_.dt_s;
+    s.steps = config_.steps;
+    s.p_world = in.state.p_world;
+    s.v_world = in.state.v_world;
+    s.heading_rad = in.state.heading_rad;
+    s.worker_world = worker_p0;
+    s.home_world = *home_;
+    s.brake_accel_mps2 = config_.brake_accel_mps2;
+    AbortPlanner::Decision d = abort_.decide(s);
+    out.mode = ReplanMode::kAbort;
+    out.reason = d.reason;
+    out.abort_phase = d.phase;
+    out.abort_phase_changed = d.phase_changed;
+    c.reference = std::move(d.reference);
+    c.given = true;
+    return c;
+  }
+  HoldPlanner::Situation situation;
+  situation.uav_index = config_.uav_index;
+  situation.t_s = in.t_s;
+  situation.dt_s = config_.dt_s;
+  situation.steps = config_.steps;
+  situation.hold_reason = hold;
+  situation.worker_stamp_s = in.worker->fused_s;
+  situation.worker_lost = in.worker->lost;
+  situation.p_world = in.state.p_world;
+  situation.v_world = in.state.v_world;
+  situation.heading_rad = in.state.heading_rad;
+  situation.worker_world = worker_p0;
+  HoldPlanner::Decision decision = hold_.decide(situation);
+  out.mode = decision.mode == HoldMode::kSearch ? ReplanMode::kSearch
+             : decision.holding()               ? ReplanMode::kHold
+                                                : ReplanMode::kTrack;
+  out.reason = hold;
+  c.given = decision.holding();
+  c.reference = std::move(decision.reference);
+  c.camera_target = std::move(decision.camera_target);
+  return c;
+}
+
 ReplanOutcome ReplanStep::step(const ReplanInputs& in) {
   ReplanOutcome out;
   const int i = config_.uav_index;
   const double t = in.t_s;
+  if (!home_) home_ = config_.home_world.allFinite() ? config_.home_world : in.state.p_world;
   if (in.worker == nullptr) {
     out.reason = i == 0 ? "no confirmed worker estimate yet" : "no leader share received yet";
     return out;
   }
   const WorkerKnowledge& w = *in.worker;
-  // Freshness first, then listening (a UAV listens from its first replanning with data).
-  std::string hold = holdReason(i, t, w.stamp_s, w.fused_s, config_.freshness);
+  // Freshness first, then listening (a UAV listens from its first replanning with data). An
+  // aborting UAV does not hold for stale data (it retreats from what it last knew); it listens.
+  const std::string stale = holdReason(i, t, w.stamp_s, w.fused_s, config_.freshness);
+  std::string hold = abort_.aborting() ? std::string() : stale;
   if (hold.empty()) {
     const double since = listen_since_s_;
     const bool was_listening = listening_;
@@ -94,29 +153,12 @@ ReplanOutcome ReplanStep::step(const ReplanInputs& in) {
     }
   }
   // The worker over the horizon: extrapolated from its stamp while fresh, frozen otherwise.
-  const bool still = !hold.empty() || w.lost;
+  const bool still = !hold.empty() || !stale.empty() || w.lost;
   const Eigen::Vector3d v0 = still ? Eigen::Vector3d::Zero() : w.v_world;
   const Eigen::Vector3d p0 = still ? w.p_world : w.positionAt(std::max(t, w.stamp_s));
   const double heading = still ? heading_.heading() : heading_.update(v0);
   out.worker = formation::constantVelocityHorizon(p0, v0, heading, config_.steps, config_.dt_s);
-
-  HoldPlanner::Situation situation;
-  situation.uav_index = i;
-  situation.t_s = t;
-  situation.dt_s = config_.dt_s;
-  situation.steps = config_.steps;
-  situation.hold_reason = hold;
-  situation.worker_stamp_s = w.fused_s;
-  situation.worker_lost = w.lost;
-  situation.p_world = in.state.p_world;
-  situation.v_world = in.state.v_world;
-  situation.heading_rad = in.state.heading_rad;
-  situation.worker_world = p0;
-  const HoldPlanner::Decision decision = hold_.decide(situation);
-  out.mode = decision.mode == HoldMode::kSearch ? ReplanMode::kSearch
-             : decision.holding()               ? ReplanMode::kHold
-                                                : ReplanMode::kTrack;
-  out.reason = hold;
+  const Choice choice = choose(in, hold, p0, out);
 
   PlanRequestInputs req_in;
   req_in.uav_index = i;
@@ -130,13 +172,14 @@ ReplanOutcome ReplanStep::step(const ReplanInputs& in) {
   req_in.leader_plan = in.leader_plan;
   req_in.leader_plan_max_age_s = config_.freshness.max_share_age_s;
   req_in.received = in.received;
-  req_in.hold_reference = decision.holding() ? &decision.reference : nullptr;
-  if (decision.camera_target.cols() > 0) req_in.camera_target = &decision.camera_target;
+  req_in.hold_reference = choice.given ? &choice.reference : nullptr;  // also: avoid every received plan
+  if (choice.camera_target.cols() > 0) req_in.camera_target = &choice.camera_target;
   req_in.rule = config_.rule;
   const PlanRequest request = buildPlanRequest(req_in);
   out.reference = request.reference;
   out.result = planner_->plan(request);
-  out.fallback = out.result.status != PlanStatus::kOptimized || !hold.empty();
+  // Holding and aborting UAVs have right of way: nobody counts on them to dodge.
+  out.fallback = out.result.status != PlanStatus::kOptimized || choice.given;
   flown_ = out.result.trajectory;  // empty: the controller brakes to hover on its own
   return out;
 }

@@ -343,6 +343,7 @@ void readFaults(ConfigReader& r, const std::string& m, MissionConfig& c) {
   readWindows(r, fk + "stereo_dropouts", c.faults.stereo_dropouts);
   readPlannerOutages(r, fk, c.faults.planner_outages);
   readFollowerDropouts(r, fk, c.faults.follower_dropouts);
+  readAbortEvent(r, fk + "abort", c.faults.abort);
   const std::string k = fk + "range_outliers.";
   rangeOutlierFields().readFields(r, k, c.faults.range_outliers);
   for (const auto& e : c.faults.validate()) r.addError(m + "faults", e);

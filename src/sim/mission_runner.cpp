@@ -40,6 +40,9 @@ struct LeaderShare {
   formation::FormationParams params;
   std::uint64_t params_version = 0;
   planning::PlannedTrajectory plan;
+  /// The abort the leader accepted, relayed in every share from then on (the repetition that
+  /// reaches a follower across losses; docs/safety.md §2.8).
+  std::optional<planning::AbortCommand> abort;
 };
 
 /// A follower's plan with its planner status: a UAV that could not plan (braking or on its
@@ -131,6 +134,8 @@ class MissionRun {
   void control(double t, double dt);
   void applyCommand(std::size_t record, const formation::FormationCommand& cmd, double t);
   void setMode(int i, double t, const std::string& mode, const std::string& reason);
+  void deliverAbort(double t);
+  void receiveAbort(int i, const planning::AbortCommand& command, double t);
 
   const MissionConfig& cfg_;
   const MissionWorld& world_;
@@ -154,6 +159,9 @@ class MissionRun {
   std::vector<std::unique_ptr<Link<LeaderShare>>> share_links_;  // [i]: leader → follower i
   std::vector<std::vector<std::unique_ptr<Link<PlanMessage>>>> plan_links_;  // [i][j]: i → j
   std::vector<std::unique_ptr<Link<gesture::ViewObservation>>> vote_links_;  // [i]: follower i → leader
+  std::vector<std::unique_ptr<Link<planning::AbortCommand>>> abort_links_;   // [i]: ground station → UAV i
+  AbortSender abort_sender_{cfg_.faults.abort, cfg_.replan.abort.repeats, cfg_.replan.abort.repeat_period_s};
+  std::optional<AbortRecorder> abort_record_;
   MetricsAccumulator metrics_;
   MissionMetrics& M_;
   std::vector<ModeChange> modes_;
@@ -189,8 +197,19 @@ std::string MissionRun::addUavs() {
     auto u = std::make_unique<UavRuntime>(cfg_.uavs[static_cast<std::size_t>(i)], cfg_, s0, seed_, i);
     planning::ReplanConfig rc = cfg_.replan;
     rc.uav_index = i;
+    rc.uav_count = n_;
     rc.worker_heading = cfg_.formation.worker_heading;
-    u->step = std::make_unique<planning::ReplanStep>(rc, planners_(i));
+    rc.home_world = s0.p_world;  // the mission starts in the air: its take-off point is where it starts
+    planning::RetreatSpace space;
+    space.field = world_.field;
+    if (world_.map != nullptr) {
+      space.bounds = world_.map->gridBounds();
+      space.resolution_m = world_.map->resolution();
+    } else {
+      space.bounds = planning::Aabb{Eigen::Vector3d::Constant(-1e6), Eigen::Vector3d::Constant(1e6)};
+    }
+    space.ground_height_m = world_.ground_height_m;
+    u->step = std::make_unique<planning::ReplanStep>(rc, planners_(i), space);
     u->next_plan_s = cfg_.replanning_period_s * static_cast<double>(i) / static_cast<double>(n_);
     u->received.resize(static_cast<std::size_t>(n_));
     uavs_.push_back(std::move(u));
@@ -217,6 +236,14 @@ void MissionRun::openLinks() {
     vote_links_[i] =
         std::make_unique<Link<gesture::ViewObservation>>(cfg_.link, makeRng(seed_, Stream::kLink, link_index_++));
   }
+  // The ground station's abort → every UAV, over the operator link's model. Created last: the
+  // other links' random streams are unchanged.
+  if (!cfg_.faults.abort) return;
+  for (std::size_t i = 0; i < n; ++i) {
+    abort_links_.push_back(
+        std::make_unique<Link<planning::AbortCommand>>(cfg_.operator_link, makeRng(seed_, Stream::kLink, link_index_++)));
+  }
+  abort_record_.emplace(*cfg_.faults.abort, n_, ObstacleDistance{world_.field, world_.solids, world_.ground_height_m});
 }
 
 MissionOutput MissionRun::run(double duration_s, std::chrono::steady_clock::time_point wall0) {
@@ -228,6 +255,7 @@ MissionOutput MissionRun::run(double duration_s, std::chrono::steady_clock::time
     const double t = static_cast<double>(k) * dt;
     const WorkerState ws = worker_.stateAt(t);
     deliverOperatorMessages(t);
+    deliverAbort(t);
     updateDropouts(t);
     deliverUavMessages(t);
     // Odometry of every UAV at this step (used by sensing, planning and control).
@@ -238,6 +266,7 @@ MissionOutput MissionRun::run(double duration_s, std::chrono::steady_clock::time
     std::vector<Eigen::Vector3d> p_true;
     for (const auto& u : uavs_) p_true.push_back(u->plant.state().p_world);
     metrics_.sampleSafety(t, p_true, ws);
+    if (abort_record_) abort_record_->sample(t, p_true, ws.p_world);
     if (timeline_samples.due(k)) sampleTimeline(t, ws);
     if (k == steps) break;
     control(t, dt);
@@ -254,6 +283,7 @@ MissionOutput MissionRun::run(double duration_s, std::chrono::steady_clock::time
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   MissionOutput out = metrics_.finish(worker_.episodes(), static_cast<double>(steps) * dt, wall_s);
   out.modes = std::move(modes_);
+  if (abort_record_) out.metrics.abort = abort_record_->summary();
   if (const std::vector<PerceptionRecord>* records = camera_.perceptionRecords()) {
     out.perception = *records;
     out.metrics.perception = summarizePerception(*records);
@@ -298,6 +328,7 @@ void MissionRun::deliverUavMessages(double t) {
     UavRuntime& u = uav(i);
     for (auto& s : share_links_[static_cast<std::size_t>(i)]->receive(t)) {
       if (u.offline) continue;
+      if (s.abort) receiveAbort(i, *s.abort, t);  // a relayed abort counts whatever the share's age
       if (!u.share || s.worker.stamp_s > u.share->worker.stamp_s) u.share = std::move(s);
     }
   }
@@ -404,6 +435,8 @@ void MissionRun::actOnFrames(double t, const std::vector<gesture::GestureFrame>&
     const std::size_t record = metrics_.addRequest(firedGestureRecord(t, f.filter.dominant_id, cfg_.gesture_mapping));
     if (f.action != nullptr && f.action->kind != gesture::GestureAction::Kind::kEvent) {
       applyCommand(record, gesture::toCommand(*f.action, ++gesture_seq_), t);
+    } else if (f.action != nullptr && f.action->event == gesture::GestureEvent::kAbort) {
+      receiveAbort(0, planning::AbortCommand{{"gesture", ++gesture_seq_}, planning::AbortSource::kGesture, t}, t);
     }
   }
 }
@@ -471,7 +504,12 @@ void MissionRun::replan(int i, double t) {
     return;
   }
   if (out.holding()) ++M_.plans_hold;
-  setMode(i, t, planning::toString(out.mode), out.holding() ? out.reason : "fresh data");
+  if (out.aborting()) {
+    setMode(i, t, std::string("abort_") + planning::toString(out.abort_phase), out.reason);
+    if (abort_record_) abort_record_->phase(i, t, out.abort_phase);
+  } else {
+    setMode(i, t, planning::toString(out.mode), out.holding() ? out.reason : "fresh data");
+  }
   const planning::PlanResult& res = out.result;
   metrics_.plan(i, t, version, res.status, res.timings.total_ms, res.reason, res.qp_sparse_timeouts);
   if (res.trajectory.empty()) {
@@ -490,6 +528,8 @@ void MissionRun::sendPlan(int i, double t, const planning::ReplanOutcome& out, c
     s.params = params;
     s.params_version = version;
     s.plan = out.result.trajectory;
+    s.abort = uav(0).step->abort().command();
+    if (s.abort) s.abort->sent_s = t;  // each relayed copy is stamped when it is sent (its age: the share's)
     for (int j = 1; j < n_; ++j) share_links_[static_cast<std::size_t>(j)]->send(t, s);
     return;
   }
@@ -533,6 +573,35 @@ void MissionRun::applyCommand(std::size_t record, const formation::FormationComm
   std::vector<int> addressed;
   for (const auto& ch : outcome.changes) addressed.push_back(ch.uav);
   metrics_.requestOutcome(record, formation::toString(outcome.status), t, applied ? ++params_version_ : 0, addressed);
+}
+
+void MissionRun::deliverAbort(double t) {
+  // The injected abort: the ground station's copies over the operator link to every UAV, or the
+  // gesture accepted by the leader's pipeline at its time.
+  const std::optional<AbortEvent>& event = cfg_.faults.abort;
+  if (!event) return;
+  if (event->source == planning::AbortSource::kGesture && t >= event->t_s && !uav(0).step->abort().aborting()) {
+    receiveAbort(0, planning::AbortCommand{{"gesture", ++gesture_seq_}, planning::AbortSource::kGesture, event->t_s}, t);
+  }
+  for (const auto& c : abort_sender_.due(t)) {
+    for (auto& link : abort_links_) link->send(t, c);
+  }
+  for (int i = 0; i < static_cast<int>(abort_links_.size()); ++i) {
+    for (const auto& c : abort_links_[static_cast<std::size_t>(i)]->receive(t)) {
+      if (!uav(i).offline) receiveAbort(i, c, t);  // an offline UAV's radio drops what arrives
+    }
+  }
+}
+
+void MissionRun::receiveAbort(int i, const planning::AbortCommand& command, double t) {
+  UavRuntime& u = uav(i);
+  if (u.step->receiveAbort(command, t) != planning::AbortAcceptance::kAccepted) return;
+  if (!abort_record_) {  // an abort not injected by faults.abort (a recognised gesture): measured from here
+    abort_record_.emplace(AbortEvent{t, command.source}, n_,
+                          ObstacleDistance{world_.field, world_.solids, world_.ground_height_m});
+  }
+  abort_record_->accepted(i, t);
+  setMode(i, t, "abort_accepted", std::string("abort from ") + planning::toString(command.source) + " " + command.id.sender);
 }
 
 void MissionRun::setMode(int i, double t, const std::string& mode, const std::string& reason) {

@@ -10,7 +10,8 @@
 ///     avoid_all_plans, search_timeout_s, search_height_m, search_vertical_speed_mps,
 ///     search_period_s, search_horizontal_speed_mps} (the safety rules' limits, docs/safety.md §1);
 ///   mission.formation.*, mission.gestures.* (filter, mapping, view_fusion), mission.planner.*,
-///   mission.estimator.* (each read by its module's own loader).
+///   mission.estimator.*, mission.abort.* (each read by its module's own loader; abort's rules
+///   against the planner's Γ_dis and speed limit checked here).
 /// A key that is absent keeps the documented default of its struct; every problem is reported
 /// at once, each naming its key.
 
@@ -24,6 +25,7 @@
 #include "gesture_formation/gesture/gesture_filter.hpp"
 #include "gesture_formation/gesture/gesture_mapping.hpp"
 #include "gesture_formation/gesture/view_fusion.hpp"
+#include "gesture_formation/planning/abort_mode.hpp"
 #include "gesture_formation/planning/plan_request_builder.hpp"
 #include "gesture_formation/planning/planner_config.hpp"
 #include "gesture_formation/planning/replan_step.hpp"
@@ -42,7 +44,8 @@ struct OnboardSettings {
   double replanning_period_s = 0.4;  ///< per UAV, staggered by period·i/n, (0, 5]
   /// horizon_dt_s, horizon_steps, controller.brake_accel_mps2, faults.max_share_age_s,
   /// faults.max_worker_age_s, faults.avoid_all_plans, faults.max_plan_age_s, faults.search_*
-  /// (uav_index is the UAV's own; worker_heading is formation.worker_heading).
+  /// abort.* (docs/safety.md §2.8). uav_index, uav_count and home_world are the UAV's own;
+  /// worker_heading is formation.worker_heading.
   planning::ReplanConfig replan;
   double max_command_age_s = 5.0;       ///< faults.max_command_age_s: never act on an older command, > 0
   formation::FormationConfig formation;

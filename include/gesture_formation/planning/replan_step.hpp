@@ -16,6 +16,10 @@
 ///   6. the request (planning::buildPlanRequest: reference + the plans to avoid), with the
 ///      acceleration the UAV's current plan commands now as the start's acceleration (odometry
 ///      carries none), and the planner's verified plan or fallback.
+/// Abort (planning::AbortPlanner, docs/safety.md §2.8): once the UAV accepted an abort command
+/// (receiveAbort), steps 2 and 5 are replaced by the abort's sequence — stale data no longer
+/// holds it, it flies to its retreat goal (then hovers, returns home or lands) around every plan
+/// it has received, its plan flagged like a hold (others avoid it). Listening still comes first.
 ///
 /// Thread safety: not thread-safe; one instance per UAV, called from its planning thread.
 
@@ -32,6 +36,7 @@
 #include "gesture_formation/formation/formation_geometry.hpp"
 #include "gesture_formation/formation/formation_params.hpp"
 #include "gesture_formation/formation/worker_heading.hpp"
+#include "gesture_formation/planning/abort_mode.hpp"
 #include "gesture_formation/planning/plan_request_builder.hpp"
 #include "gesture_formation/planning/planned_trajectory.hpp"
 #include "gesture_formation/planning/uav_planner.hpp"
@@ -82,6 +87,7 @@ enum class ReplanMode {
   kTrack,    ///< fresh data: the formation reference
   kHold,     ///< stale data or listening: the latched braking point, camera on the estimate
   kSearch,   ///< the leader lost the worker: hold point, camera sweeps (HoldPlanner)
+  kAbort,    ///< an accepted abort: the AbortPlanner's phase (ReplanOutcome::abort_phase)
 };
 const char* toString(ReplanMode mode);
 
@@ -89,6 +95,7 @@ const char* toString(ReplanMode mode);
 /// The ranges of its numbers are written once, in replanConfigFields().
 struct ReplanConfig {
   int uav_index = 0;                ///< 0 = leader, i = follower i (priority order)
+  int uav_count = 1;                ///< the formation's UAVs (the abort's retreat rings), > uav_index
   double dt_s = 0.2;                ///< horizon step [s]
   int steps = 40;                   ///< horizon steps
   FreshnessLimits freshness;        ///< hold on data older than these
@@ -96,9 +103,14 @@ struct ReplanConfig {
   SearchConfig search;              ///< the leader's camera search
   double brake_accel_mps2 = 4.0;    ///< where a holding UAV stops (brakingPoint)
   formation::WorkerHeadingConfig worker_heading;  ///< the worker-heading filter (^Hφ)
+  AbortConfig abort;                ///< the abort's settings (mission abort.*)
+  /// The take-off point (abort: return_home, the landing fallback); non-finite: the position of
+  /// the first replanning.
+  Eigen::Vector3d home_world = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
   /// \brief Every number outside its range, each "<prefix><key> must be ..., got v" (keys as in
   /// replanConfigFields()); empty when valid.
   std::vector<std::string> validate(const std::string& prefix = "") const;
+  EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
 
 /// \brief The one range of each replanning number, keyed as a scenario's `mission` section writes
@@ -136,8 +148,11 @@ struct ReplanOutcome {
   bool fallback = false;   ///< others must avoid this plan: the planner fell back, or the UAV holds
   formation::WorkerHorizon worker;          ///< the worker prediction planned around
   formation::ReferenceTrajectory reference; ///< the stage-1 reference (or hold reference)
+  AbortPhase abort_phase = AbortPhase::kRetreat;  ///< kAbort only: the abort's phase
+  bool abort_phase_changed = false;               ///< kAbort only: the phase began at this replanning
   bool planned() const { return mode != ReplanMode::kSkipped; }
   bool holding() const { return mode == ReplanMode::kHold || mode == ReplanMode::kSearch; }
+  bool aborting() const { return mode == ReplanMode::kAbort; }
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
 
@@ -146,14 +161,21 @@ struct ReplanOutcome {
 class ReplanStep {
  public:
   /// \param planner required (non-null).
-  ReplanStep(const ReplanConfig& config, std::unique_ptr<Planner> planner);
+  /// \param space where the abort finds its goals (the planner's map and field; they must outlive
+  /// the step). Empty: an abort holds at the braking point ("no map").
+  ReplanStep(const ReplanConfig& config, std::unique_ptr<Planner> planner, const RetreatSpace& space = {});
 
   /// \brief One replanning at in.t_s (preconditions: in.params non-null with an entry for the UAV).
   ReplanOutcome step(const ReplanInputs& in);
 
   /// \brief A restart (a rebooted computer): a new planner, no memory — hold, heading, the plan
-  /// flown — and it listens again before it moves.
+  /// flown, an accepted abort (the sender repeats it) — and it listens again before it moves.
   void restart(std::unique_ptr<Planner> planner);
+
+  /// \brief An abort command arrived at t_s (AbortPlanner::receive): accepted, a copy, or stale.
+  AbortAcceptance receiveAbort(const AbortCommand& command, double t_s) { return abort_.receive(command, t_s); }
+  /// \brief The abort's state (command, phase, goals).
+  const AbortPlanner& abort() const { return abort_; }
 
   /// \brief The plan the UAV flies now (the last result; empty before the first or when the
   /// planner returned none — the controller then brakes to hover).
@@ -164,12 +186,18 @@ class ReplanStep {
 
  private:
   std::string listeningHold(double t_s, const std::vector<std::optional<ReceivedPlan>>* received);
+  /// The hold / search or abort decision of one replanning (its reference, camera target, mode).
+  struct Choice;
+  Choice choose(const ReplanInputs& in, const std::string& hold, const Eigen::Vector3d& worker_p0, ReplanOutcome& out);
 
   ReplanConfig config_;
   std::unique_ptr<Planner> planner_;
   HoldPlanner hold_;
+  AbortPlanner abort_;
+  RetreatSpace space_;
   formation::WorkerHeading heading_;
   PlannedTrajectory flown_;
+  std::optional<Eigen::Vector3d> home_;  ///< the take-off point (ReplanConfig::home_world or the first position)
   double listen_since_s_ = std::numeric_limits<double>::quiet_NaN();  ///< the first replanning since the (re)start
   bool listening_ = true;
 };

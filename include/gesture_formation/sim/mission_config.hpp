@@ -24,7 +24,9 @@
 #include "gesture_formation/gesture/gesture_filter.hpp"
 #include "gesture_formation/gesture/gesture_mapping.hpp"
 #include "gesture_formation/gesture/view_fusion.hpp"
+#include "gesture_formation/planning/abort_mode.hpp"
 #include "gesture_formation/planning/plan_request_builder.hpp"
+#include "gesture_formation/sim/abort_drill.hpp"
 #include "gesture_formation/planning/planner_config.hpp"
 #include "gesture_formation/planning/replan_step.hpp"
 #include "gesture_formation/sim/link.hpp"
@@ -93,6 +95,9 @@ struct FaultConfig {
   double max_command_age_s = 5.0;  ///< an operator command older than this on arrival is rejected, > 0
   // max_share_age_s, max_worker_age_s, max_plan_age_s, avoid_all_plans and search_* are
   // MissionConfig::replan's (the onboard replanning settings, read by onboard::readOnboardSettings).
+  /// An abort issued during the mission (`abort: {t_s, source: operator | gesture}`; fault profile
+  /// abort_mid_mission; docs/safety.md §2.8). Absent: none.
+  std::optional<AbortEvent> abort;
   std::vector<std::string> validate(const std::string& prefix = "") const;
   /// \brief Whether follower `uav`'s computer is down at `t_s` (a follower_dropouts window).
   bool followerOffline(int uav, double t_s) const;
@@ -113,7 +118,7 @@ struct MissionConfig {
   double step_s = 0.01;           ///< plant/controller step, (0, 0.05]
   double replanning_period_s = 0.4;  ///< per UAV, staggered by period·i/n, > 0
   /// The onboard replanning settings (horizon, freshness limits of docs/safety.md §1, the
-  /// avoidance rule, the search, the braking deceleration), as the nodelets read them.
+  /// avoidance rule, the search, the braking deceleration, the abort), as the nodelets read them.
   planning::ReplanConfig replan;
   double timeline_rate_hz = 10.0;  ///< > 0
   double gesture_match_window_s = 20.0;  ///< a fired gesture matches a performed one started at most this long before

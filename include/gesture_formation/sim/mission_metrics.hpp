@@ -93,6 +93,9 @@ struct MissionMetrics {
   /// The rendered camera's perception against the truth (docs/simulation.md §8); absent for the
   /// synthetic camera (metrics.json then has no `perception` key).
   std::optional<PerceptionSummary> perception;
+  /// The abort of the mission (faults.abort; docs/safety.md §2.8); absent without one
+  /// (metrics.json then has no `abort` key).
+  std::optional<AbortSummary> abort;
 };
 
 /// \brief One UAV's part of a timeline sample (docs/design.md §8.4 timeline.csv).

@@ -143,7 +143,7 @@ TEST(FaultConfigTest, EveryShippedProfileOverlaysThePowerTowerMission) {
   const std::string scenario = std::string(GF_SOURCE_DIR) + "/config/scenarios/power_towers.yaml";
   for (const char* name : {"nominal", "loss10", "loss30", "loss50", "delay_jitter", "dup_reorder", "follower_dropout",
                            "worker_lost_5s", "worker_lost_60s", "sensor_dropouts", "range_outliers", "gusts",
-                           "planner_outage", "harsh"}) {
+                           "planner_outage", "harsh", "abort_mid_mission"}) {
     const auto m = gf::sim::loadMissionConfig(scenario, std::string(GF_SOURCE_DIR) + "/config/faults/" + name + ".yaml");
     ASSERT_TRUE(m) << name << ": " << m.reason();
     EXPECT_EQ(m->requests.size(), 19u) << name;  // the rest of the mission is untouched
