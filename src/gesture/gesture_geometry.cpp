@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <set>
+#include <vector>
 
 #include "gesture_formation/common/angles.hpp"
 
@@ -28,9 +29,8 @@ ArmMeasures measureArm(const Skeleton3D& s, const BodyFrame& f, bool left, const
   if (upper.norm() < 1e-3 || fore.norm() < 1e-3) return a;
   a.valid = true;
   a.elevation_deg = angleDeg(upper, -Eigen::Vector3d::UnitZ());
-  const double outward = upper.normalized().y() * (left ? 1.0 : -1.0);
-  const double lateral_deg = common::radToDeg(std::asin(std::clamp(outward, -1.0, 1.0)));
-  a.abduction_deg = upper.z() > 0.0 ? 180.0 - lateral_deg : lateral_deg;  // unfolded through the horizontal
+  const double outward = upper.y() * (left ? 1.0 : -1.0);
+  a.horizontal_abduction_deg = common::radToDeg(std::atan2(outward, std::abs(upper.x())));
   a.elbow_deg = angleDeg(s.p_world[sh] - s.p_world[el], s.p_world[wr] - s.p_world[el]);
   a.forearm_from_horizontal_deg = std::abs(common::radToDeg(std::asin(std::clamp(fore.normalized().z(), -1.0, 1.0))));
   a.wrist_height_H = height_H(s.p_world[wr]);
@@ -65,19 +65,16 @@ Test crossArms(const PoseMeasures& m, const GestureGeometryNumbers& n) {
 }
 
 Test extendArm(const ArmMeasures& a, const GestureGeometryNumbers& n) {
-  if (!a.valid) return Test::kOut;
-  const double abd = a.abduction_deg;
+  if (!a.valid || a.elevation_deg <= n.hanging_max_elevation_deg) return Test::kOut;
+  const double el = a.elevation_deg, side = a.horizontal_abduction_deg;
   // The band mirrored above the shoulder: 110..125 for 55..70.
   const double mirror_max = 180.0 - n.pointing_max_abduction_deg;
-  if (abd >= n.extend_min_abduction_deg && abd <= n.extend_max_abduction_deg) {
+  if (el >= mirror_max) return Test::kOut;  // an arm up: raise's business
+  if (el <= n.pointing_max_abduction_deg || side <= n.pointing_max_abduction_deg) return Test::kNearMiss;
+  if (el >= n.extend_min_abduction_deg && el <= n.extend_max_abduction_deg && side >= n.extend_min_abduction_deg) {
     return a.elbow_deg >= n.extend_min_elbow_deg ? Test::kInside : Test::kOut;
   }
-  if ((abd > n.pointing_max_abduction_deg && abd < n.extend_min_abduction_deg) ||
-      (abd > n.extend_max_abduction_deg && abd < mirror_max)) {
-    return Test::kBand;
-  }
-  if (abd <= n.pointing_max_abduction_deg && a.elevation_deg > n.hanging_max_elevation_deg) return Test::kNearMiss;
-  return Test::kOut;
+  return Test::kBand;
 }
 
 Test raiseArm(const ArmMeasures& a, const GestureGeometryNumbers& n) {
@@ -164,6 +161,35 @@ PoseVerdict classifyPose(const PoseMeasures& m, const GestureGeometryNumbers& n)
   if (any(extend, Test::kNearMiss)) return PoseVerdict{kNone, PoseRegion::kArmPartwayOrPointing, kExtendArmSide};
   v.region = PoseRegion::kOther;
   return v;
+}
+
+Skeleton3D medianSkeleton(const std::vector<Skeleton3D>& frames, std::size_t first, std::size_t last) {
+  Skeleton3D out;
+  if (frames.empty() || first >= frames.size()) return out;
+  last = std::min(last, frames.size() - 1);
+  if (last < first) return out;
+  const Skeleton3D& mid = frames[first + (last - first) / 2];
+  out.views = mid.views;
+  out.reprojection_px = mid.reprojection_px;
+  std::vector<double> c[3];
+  for (std::size_t k = 0; k < out.p_world.size(); ++k) {
+    for (auto& v : c) v.clear();
+    for (std::size_t i = first; i <= last; ++i) {
+      if (!frames[i].valid[k]) continue;
+      for (int d = 0; d < 3; ++d) c[d].push_back(frames[i].p_world[k][d]);
+    }
+    if (c[0].empty()) continue;
+    for (int d = 0; d < 3; ++d) {
+      auto& v = c[d];
+      const auto half = static_cast<std::ptrdiff_t>(v.size() / 2);
+      std::nth_element(v.begin(), v.begin() + half, v.end());
+      double m = v[static_cast<std::size_t>(half)];
+      if (v.size() % 2 == 0) m = 0.5 * (m + *std::max_element(v.begin(), v.begin() + half));  // even count: mean of the middle two
+      out.p_world[k][d] = m;
+    }
+    out.valid[k] = true;
+  }
+  return out;
 }
 
 PoseVerdict classifyPose3D(const Skeleton3D& s, const GestureGeometryNumbers& numbers) {

@@ -19,21 +19,24 @@
 ///  - cross arms (1): each wrist crossed over the body's midline (the left wrist right of it, the
 ///    right wrist left of it), both at ≥ 0.80 H; near-miss "arms folded low": wrists crossed at
 ///    ≤ 0.70 H; band: crossed at 0.70–0.80 H;
-///  - extend an arm to the side (2): upper-arm abduction 70–110°, elbow ≥ 150°; near-miss "raised
+///  - extend an arm to the side (2): upper arm abducted 70–110°, elbow ≥ 150°; near-miss "raised
 ///    part-way or pointing": abduction ≤ 55°; band 55–70° (and 110–125°, its mirror above the
-///    shoulder). Abduction is the upper arm's angle from hanging towards its own side, measured out
-///    of the sagittal plane (asin of its outward component in the body frame), unfolded through the
-///    horizontal (180° − that when the upper arm points above the shoulder): for an arm in the
-///    frontal plane it is the textbook abduction, and an arm pointing forward (flexion) has
-///    abduction ≈ 0 at any elevation — pointing forward is not "extend to the side";
+///    shoulder). The abduction of a sideways arm is read in two planes, both of which must show it:
+///    in the frontal plane, the upper arm's elevation from hanging down (70–110°; part-way ≤ 55°), and
+///    in the horizontal plane, its horizontal abduction — the angle of its horizontal direction from
+///    straight forward (or back) towards its own side: 90° straight sideways, 0° pointing forward
+///    (≥ 70°; pointing ≤ 55°). So an arm pointing forward, or forward-outward up to 55° from forward,
+///    is the near-miss at any elevation up to 125°, never "extend to the side";
 ///  - raise an arm up (4): upper arm ≥ 150° from hanging (elevation, any plane), elbow ≥ 150°;
 ///    near-miss "reaching": elevation ≤ 130° or elbow < 120°; band: elevation 130–150° or elbow 120–150°.
 /// A one-arm gesture needs exactly one arm in its region; two arms in gesture regions of different
 /// gestures (or a one-arm and a two-arm gesture at once) are ambiguous: none.
 /// Thread safety: free functions without state.
 
+#include <cstddef>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -52,9 +55,9 @@ struct GestureGeometryNumbers {
   double tool_max_height_H = 0.61;                       ///< band: tool_max .. palms_min
   double cross_min_height_H = 0.80;
   double folded_max_height_H = 0.70;                     ///< band: folded_max .. cross_min
-  double extend_min_abduction_deg = 70.0, extend_max_abduction_deg = 110.0;
+  double extend_min_abduction_deg = 70.0, extend_max_abduction_deg = 110.0;  ///< elevation; horizontal: ≥ the min
   double extend_min_elbow_deg = 150.0;
-  double pointing_max_abduction_deg = 55.0;              ///< band: 55..70 (and its mirror 110..125)
+  double pointing_max_abduction_deg = 55.0;              ///< band: 55..70 (and its mirror 110..125), both planes
   double raise_min_elevation_deg = 150.0, raise_min_elbow_deg = 150.0;
   double reach_max_elevation_deg = 130.0, reach_max_elbow_deg = 120.0;  ///< band: 130..150, elbow 120..150
   /// Reporting aid, not in design.md (it changes no gesture decision): an arm whose upper arm is
@@ -66,7 +69,8 @@ struct GestureGeometryNumbers {
 struct ArmMeasures {
   bool valid = false;                 ///< shoulder, elbow and wrist known
   double elevation_deg = 0.0;         ///< upper arm (shoulder → elbow) from hanging down: 0 down, 90 horizontal, 180 up
-  double abduction_deg = 0.0;         ///< upper arm towards its own side (see the file comment); < 0 across the body
+  double horizontal_abduction_deg = 0.0;  ///< upper arm's horizontal direction from forward/back towards its own side:
+                                         ///< 90 sideways, 0 forward or back, < 0 across the body (file comment)
   double elbow_deg = 180.0;           ///< inner elbow angle (180: straight)
   double forearm_from_horizontal_deg = 90.0;  ///< |angle| of elbow → wrist to the body's horizontal plane
   double wrist_height_H = 0.0;        ///< h(wrist)
@@ -116,5 +120,12 @@ struct PoseVerdict {
 PoseVerdict classifyPose(const PoseMeasures& m, const GestureGeometryNumbers& numbers = {});
 /// \brief measurePose() then classifyPose().
 PoseVerdict classifyPose3D(const Skeleton3D& s, const GestureGeometryNumbers& numbers = {});
+
+/// \brief The per-keypoint median (of each world coordinate) of frames[first..last] (inclusive,
+/// clamped to the vector), over the frames in which that keypoint is valid; a keypoint valid in none
+/// of them stays invalid. For a held posture it averages out the triangulation noise of single
+/// frames (ViewFusion's require_3d reads each frame with its neighbours). Views and reprojection
+/// errors: those of the middle frame.
+Skeleton3D medianSkeleton(const std::vector<Skeleton3D>& frames, std::size_t first, std::size_t last);
 
 }  // namespace gesture_formation::gesture

@@ -119,14 +119,16 @@ TEST(GestureGeometryTest, MeasuresTheStandingBody) {
   EXPECT_LT(m.left.elevation_deg, 10.0);
   EXPECT_GT(m.left.elbow_deg, 179.0);
   EXPECT_NEAR(m.left.wrist_height_H, 0.82 - (0.186 + 0.146) * 0.99, 0.01);
-  w.straightArm(true, 90.0, 0.0);  // horizontal to the side: abduction 90
-  EXPECT_NEAR(gf::gesture::measurePose(w.s).left.abduction_deg, 90.0, 1e-6);
-  w.straightArm(true, 100.0, 0.0);
-  EXPECT_NEAR(gf::gesture::measurePose(w.s).left.abduction_deg, 100.0, 1e-6);
-  w.straightArm(true, 90.0, 90.0);  // pointing forward: abduction 0, elevation 90
-  const auto fwd = gf::gesture::measurePose(w.s).left;
-  EXPECT_NEAR(fwd.abduction_deg, 0.0, 1e-6);
+  w.straightArm(true, 100.0, 10.0);  // to the side, 10° above the horizontal and 10° forward
+  const auto side = gf::gesture::measurePose(w.s).left;
+  EXPECT_NEAR(side.elevation_deg, 100.0, 1e-6);
+  EXPECT_NEAR(side.horizontal_abduction_deg, 80.0, 1e-6);
+  w.straightArm(false, 90.0, 90.0);  // pointing forward: horizontal abduction 0, elevation 90
+  const auto fwd = gf::gesture::measurePose(w.s).right;
+  EXPECT_NEAR(fwd.horizontal_abduction_deg, 0.0, 1e-6);
   EXPECT_NEAR(fwd.elevation_deg, 90.0, 1e-6);
+  w.straightArm(false, 90.0, -60.0);  // pointing back and outward: 30° from straight back
+  EXPECT_NEAR(gf::gesture::measurePose(w.s).right.horizontal_abduction_deg, 30.0, 1e-6);
 }
 
 TEST(GestureGeometryTest, RestingArmsAreNoGestureAndNoNearMiss) {
@@ -381,4 +383,28 @@ TEST(GestureGeometryTest, TheGeneratorsCanonicalGesturesLieInsideTheirRegions) {
   // The generator draws extend with ±15° forward and palms with varying forearms: a few of its
   // corners fall in a band (none), never in another gesture's region.
   EXPECT_GE(inside, total * 9 / 10) << inside << " of " << total;
+}
+
+TEST(GestureGeometryTest, TheMedianSkeletonRemovesSingleFrameNoiseAndKeepsMissingKeypointsMissing) {
+  Worker w;
+  w.straightArm(true, 90.0, 0.0);
+  std::vector<Skeleton3D> frames(5, w.s);
+  frames[1].p_world[gf::gesture::kLeftElbow] += Vector3d(0.0, 0.0, 0.30);  // one wild elbow
+  frames[3].valid[gf::gesture::kLeftWrist] = false;                       // one missing wrist
+  for (auto& f : frames) f.valid[gf::gesture::kNose] = false;             // never seen
+  const Skeleton3D m = gf::gesture::medianSkeleton(frames, 0, 4);
+  EXPECT_LT((m.p_world[gf::gesture::kLeftElbow] - w.at(gf::gesture::kLeftElbow)).norm(), 1e-12);
+  EXPECT_TRUE(m.valid[gf::gesture::kLeftWrist]);
+  EXPECT_LT((m.p_world[gf::gesture::kLeftWrist] - w.at(gf::gesture::kLeftWrist)).norm(), 1e-12);
+  EXPECT_FALSE(m.valid[gf::gesture::kNose]);
+  // The wild frame alone reads no gesture (elbow bent), the median reads the extended arm.
+  EXPECT_EQ(classifyPose3D(frames[1]).gesture_id, gf::gesture::kNone);
+  EXPECT_EQ(classifyPose3D(m).gesture_id, gf::gesture::kExtendArmSide);
+  // Clamped ranges; an even count takes the mean of the middle two.
+  EXPECT_TRUE(gf::gesture::medianSkeleton(frames, 3, 99).valid[gf::gesture::kLeftElbow]);
+  EXPECT_FALSE(gf::gesture::medianSkeleton(frames, 7, 9).valid[gf::gesture::kLeftElbow]);
+  std::vector<Skeleton3D> two(2, w.s);
+  two[1].p_world[gf::gesture::kLeftHip] += Vector3d(0.0, 0.0, 0.10);
+  EXPECT_NEAR(gf::gesture::medianSkeleton(two, 0, 1).p_world[gf::gesture::kLeftHip].z(),
+              w.at(gf::gesture::kLeftHip).z() + 0.05, 1e-12);
 }
