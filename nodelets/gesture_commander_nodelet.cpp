@@ -85,7 +85,8 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
                         << vcfg.min_agreeing_views << ", max_age_s " << vcfg.max_age_s << ", envelope "
                         << (vcfg.gate_envelope ? "on" : "off") << " [" << vcfg.distance_min_m << ", "
                         << vcfg.distance_max_m << "] m, [" << vcfg.elevation_min_deg << ", " << vcfg.elevation_max_deg
-                        << "] deg, confirm_3d " << (vcfg.confirm_3d ? "on" : "off") << ", frames closed "
+                        << "] deg, confirm_3d " << (vcfg.confirm_3d ? "on" : "off") << ", require_3d "
+                        << (vcfg.require_3d ? "on" : "off") << ", frames closed "
                         << frames_->closeAfterS() << " s after their stamp\n");
     sequence_ = static_cast<std::uint64_t>(ros::WallTime::now().toNSec() / 1000);
     command_pub_ = nh.advertise<gesture_formation::FormationCommand>("formation_command_out", 10);

@@ -11,7 +11,7 @@
 // Publishes: /clock; worker_truth_out (nav_msgs/Odometry); detection_out (WorkerDetection in
 //   <leader>/camera_optical); uwb_out (sensor_msgs/Range); uav<i>/gesture_out (Gesture: UAV i's
 //   classifier output; followers only while online, i.e. not in a mission follower dropout; with
-//   view_fusion.confirm_3d the skeleton too, in uav<i>/gesture_camera, and tf uav<i>/camera_axis →
+//   view_fusion.confirm_3d or require_3d the skeleton too, in uav<i>/gesture_camera, and tf uav<i>/camera_axis →
 //   uav<i>/gesture_camera);
 //   operator_command_out (FormationCommand, sender/sequence assigned by the OperatorInterface);
 //   done_out (latched, at the end).
@@ -311,7 +311,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
     for (std::size_t i = 0; i < cf.followers.size(); ++i) {
       if (cf.followers[i].classification) {
         publishGesture(static_cast<int>(i) + 1, *cf.followers[i].classification, stamp,
-                       cfg_.view_fusion.confirm_3d && cf.followers[i].visible ? &cf.followers[i].calibrated : nullptr);
+                       cfg_.view_fusion.usesCalibratedViews() && cf.followers[i].visible ? &cf.followers[i].calibrated : nullptr);
       }
     }
     if (!cf.sensors.visible()) return;
@@ -326,7 +326,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
     d.confidence = 0.9f;
     d.stereo_distance_m = cf.sensors.d_stereo_m;
     detection_pub_.publish(d);
-    if (cf.classification) publishGesture(0, *cf.classification, stamp, cfg_.view_fusion.confirm_3d ? &cf.calibrated : nullptr);
+    if (cf.classification) publishGesture(0, *cf.classification, stamp, cfg_.view_fusion.usesCalibratedViews() ? &cf.calibrated : nullptr);
   }
 
   void sample(const sim::WorkerState& ws, bool all_truths) {

@@ -5,6 +5,7 @@
 
 #include "gesture_formation/common/config_fields.hpp"
 #include "gesture_formation/common/csv.hpp"
+#include "gesture_formation/gesture/gesture_geometry.hpp"
 
 namespace gesture_formation::gesture {
 
@@ -28,6 +29,9 @@ const common::FieldTable<ViewFusionConfig>& fields() {
       {"view_fusion.confirm_3d_min_fraction", Range::openClosed(0.0, 1.0), [](C& c) { return &c.confirm_3d_min_fraction; }},
       {"view_fusion.confirm_3d_min_frames", Range::closed(1, 1000), [](C& c) { return &c.confirm_3d_min_frames; }},
       {"view_fusion.confirm_3d_max_dt_s", Range::openClosed(0.0, 1.0), [](C& c) { return &c.confirm_3d_max_dt_s; }},
+      {"view_fusion.require_3d_min_fraction", Range::openClosed(0.0, 1.0), [](C& c) { return &c.require_3d_min_fraction; }},
+      {"view_fusion.require_3d_min_frames", Range::closed(1, 1000), [](C& c) { return &c.require_3d_min_frames; }},
+      {"view_fusion.require_3d_median_frames", Range::closed(1, 31), [](C& c) { return &c.require_3d_median_frames; }},
       {"view_fusion.fusion_lag_s", Range::closed(0.0, 2.0), [](C& c) { return &c.fusion_lag_s; }},
   }};
   return t;
@@ -40,6 +44,8 @@ std::vector<common::ConfigError> problems(const ViewFusionConfig& c) {
                     "must exceed view_fusion.distance_min_m " + common::formatDouble(c.distance_min_m));
   common::checkRule(e, c.elevation_max_deg > c.elevation_min_deg, "view_fusion.elevation_max_deg", c.elevation_max_deg,
                     "must exceed view_fusion.elevation_min_deg " + common::formatDouble(c.elevation_min_deg));
+  common::checkRule(e, c.require_3d_median_frames % 2 == 1, "view_fusion.require_3d_median_frames",
+                    c.require_3d_median_frames, "must be odd (frames centred on the one read)");
   fields().sortByTableOrder(e);
   return e;
 }
@@ -53,6 +59,7 @@ ViewFusionConfig readViewFusionConfig(ConfigReader& r) {
   const std::string k = "view_fusion.";
   r.readBool(k + "gate_envelope", c.gate_envelope);
   r.readBool(k + "confirm_3d", c.confirm_3d);
+  r.readBool(k + "require_3d", c.require_3d);
   fields().readFields(r, "", c);
   // The rules between fields, always (a key outside its range kept its default while reading).
   common::addProblems(r, "", problems(c));
@@ -159,20 +166,35 @@ FusedGesture ViewFusion::fuse(double t_now) const {
     }
   }
   out.agreeing_views = best_votes;
-  if (best_votes >= config_.min_agreeing_views && unique) {
+  const bool one_short = config_.confirm_3d && unique && best_votes + 1 == config_.min_agreeing_views &&
+                         (best == kExtendArmSide || best == kRaiseArmUp);
+  const bool passed = best_votes >= config_.min_agreeing_views && unique;
+  if (!passed && !one_short) return out;
+  // The 3-D frames of the window, triangulated once for both tests.
+  const std::vector<Skeleton3D> frames = framesIn3D(t_now);
+  out.frames_3d = static_cast<int>(frames.size());
+  if (passed) {
     out.gesture_id = best;
-  } else if (config_.confirm_3d && unique && best_votes + 1 == config_.min_agreeing_views &&
-             (best == kExtendArmSide || best == kRaiseArmUp) && confirmedIn3D(best, t_now)) {
+  } else if (confirmedIn3D(best, frames)) {
     out.gesture_id = best;
     out.confirmed_3d = true;
+  }
+  if (out.gesture_id != 0 && config_.require_3d && out.frames_3d > 0) {
+    out.checked_3d = true;
+    if (out.frames_3d < config_.require_3d_min_frames || !holdsIn3D(best, frames)) {
+      out.gesture_id = 0;
+      out.confirmed_3d = false;
+      out.rejected_3d = true;
+    }
   }
   return out;
 }
 
-bool ViewFusion::confirmedIn3D(int g, double t_now) const {
+std::vector<Skeleton3D> ViewFusion::framesIn3D(double t_now) const {
   // One 3-D frame per observation of the most observed view inside the window and the envelope:
   // with it, every other view's observation nearest in time (≤ confirm_3d_max_dt_s) that carries a
   // calibrated skeleton; triangulated when at least two views take part.
+  std::vector<Skeleton3D> out;
   const auto usable = [&](const ViewObservation& o) {
     return o.calibrated && o.t_s > t_now - config_.vote_window_s && o.t_s <= t_now + config_.max_age_s &&
            inEnvelope(o.distance_m, o.elevation_deg);
@@ -185,8 +207,7 @@ bool ViewFusion::confirmedIn3D(int g, double t_now) const {
       ref_count = c;
     }
   }
-  if (ref_count == 0) return false;
-  int frames = 0, hits = 0;
+  if (ref_count == 0) return out;
   std::vector<CalibratedSkeleton> views;
   for (const ViewObservation& o : history_[ref]) {
     if (!usable(o)) continue;
@@ -200,8 +221,24 @@ bool ViewFusion::confirmedIn3D(int g, double t_now) const {
       }
       if (nearest != nullptr) views.push_back(*nearest->calibrated);
     }
-    if (views.size() < 2) continue;
-    const Skeleton3D s = triangulate(views, TriangulationConfig{});
+    if (views.size() >= 2) out.push_back(triangulate(views, TriangulationConfig{}));
+  }
+  return out;
+}
+
+bool ViewFusion::holdsIn3D(int g, const std::vector<Skeleton3D>& frames) const {
+  const auto half = static_cast<std::size_t>(std::max(0, (config_.require_3d_median_frames - 1) / 2));
+  std::size_t holds = 0;
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    const Skeleton3D s = half == 0 ? frames[k] : medianSkeleton(frames, k >= half ? k - half : 0, k + half);
+    if (classifyPose3D(s).gesture_id == g) ++holds;
+  }
+  return static_cast<double>(holds) >= config_.require_3d_min_fraction * static_cast<double>(frames.size());
+}
+
+bool ViewFusion::confirmedIn3D(int g, const std::vector<Skeleton3D>& frames3d) const {
+  int frames = 0, hits = 0;
+  for (const Skeleton3D& s : frames3d) {
     if (!bodyFrameOf(s)) continue;
     ++frames;
     if (oneArmGesture3D(s) == g) ++hits;

@@ -6,10 +6,21 @@
 // is the leader's: one output row per row of it, `t,gesture_id,voting_views,agreeing_views`,
 // fusing at its t the newest row of every view with t' ≤ t. Rows must be in time order per
 // file. Config: `view_fusion.*` and max_gesture_id of config/gestures.yaml (defaults without).
+// Calibrated views (view_fusion.require_3d / confirm_3d, docs/gestures.md §6): a file whose header
+// has the frame's keypoints (x0..x16, y0..y16, c0..c16, image pixels as in skeletons.csv) and its
+// camera (cam_x, cam_y, cam_z: optical centre in a world frame common to all views [m];
+// cam_qw, cam_qx, cam_qy, cam_qz: R_world_camera, unit quaternion; cam_fx, cam_fy, cam_cx, cam_cy,
+// cam_width, cam_height: intrinsics) gives every row's observation its calibrated skeleton; the
+// output then has two more columns, checked_3d and rejected_3d (0/1).
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
 
 #include "commands.hpp"
 #include "gesture_formation/common/config_reader.hpp"
@@ -28,9 +39,60 @@ const Registrar kRegistrar{"fuse-views",
 struct ViewFile {
   std::unique_ptr<common::CsvReader> in;
   bool geometry = false;
+  bool calibrated = false;  ///< rows carry the skeleton and the camera (kCalibratedColumns)
   bool pending = false;  ///< a row read but not yet observed (its t is later than the fusion time)
   gesture::ViewObservation row;
 };
+
+const std::vector<std::string>& calibratedColumns() {
+  static const std::vector<std::string> columns = [] {
+    std::vector<std::string> c;
+    for (const char* p : {"x", "y", "c"}) {
+      for (int k = 0; k < gesture::kNumKeypoints; ++k) c.push_back(p + std::to_string(k));
+    }
+    for (const char* n : {"cam_x", "cam_y", "cam_z", "cam_qw", "cam_qx", "cam_qy", "cam_qz", "cam_fx", "cam_fy", "cam_cx",
+                          "cam_cy", "cam_width", "cam_height"}) {
+      c.emplace_back(n);
+    }
+    return c;
+  }();
+  return columns;
+}
+
+// The current row's calibrated skeleton into f.row.calibrated (an error naming the field otherwise).
+void readCalibrated(ViewFile& f) {
+  common::CsvReader& in = *f.in;
+  gesture::CalibratedSkeleton c;
+  for (int k = 0; k < gesture::kNumKeypoints; ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    c.skeleton.x[i] = in.number("x" + std::to_string(k));
+    c.skeleton.y[i] = in.number("y" + std::to_string(k));
+    c.skeleton.c[i] = in.number("c" + std::to_string(k));
+  }
+  c.p_world_camera = Eigen::Vector3d(in.number("cam_x"), in.number("cam_y"), in.number("cam_z"));
+  const Eigen::Quaterniond q(in.number("cam_qw"), in.number("cam_qx"), in.number("cam_qy"), in.number("cam_qz"));
+  if (in.error().empty() && !(std::abs(q.norm() - 1.0) <= 1e-6)) {
+    in.fail("cam_qw", "the camera quaternion must have norm 1 (within 1e-6), got " + common::formatDouble(q.norm()));
+  }
+  c.R_world_camera = q.normalized().toRotationMatrix();
+  c.intrinsics.fx = in.number("cam_fx");
+  c.intrinsics.fy = in.number("cam_fy");
+  c.intrinsics.cx = in.number("cam_cx");
+  c.intrinsics.cy = in.number("cam_cy");
+  const double w = in.number("cam_width"), h = in.number("cam_height");
+  if (in.error().empty() && !(w >= 1 && w <= 1e5 && w == std::floor(w) && h >= 1 && h <= 1e5 && h == std::floor(h))) {
+    in.fail("cam_width", "image size must be positive integers, got " + common::formatDouble(w) + " x " + common::formatDouble(h));
+  }
+  if (!in.error().empty()) return;
+  c.intrinsics.width_px = static_cast<int>(w);
+  c.intrinsics.height_px = static_cast<int>(h);
+  const std::vector<std::string> problems = gesture::validate(c);
+  if (!problems.empty()) {
+    in.fail("cam_x", "calibrated skeleton: " + problems.front());
+    return;
+  }
+  f.row.calibrated = std::move(c);
+}
 
 // Reads the next row of `f` into f.row; false at the end or on error (in->error() says which).
 bool readRow(ViewFile& f, int view, int max_gesture_id) {
@@ -51,6 +113,8 @@ bool readRow(ViewFile& f, int view, int max_gesture_id) {
     f.row.distance_m = std::nan("");
     f.row.elevation_deg = std::nan("");
   }
+  f.row.calibrated.reset();
+  if (f.calibrated && f.in->error().empty()) readCalibrated(f);
   return f.in->error().empty();
 }
 
@@ -78,12 +142,17 @@ int cmdFuseViews(const Args& args) {
     files[i].in = std::make_unique<common::CsvReader>(paths[i]);
     if (!files[i].in->requireColumns({"t", "gesture_id"})) return badInput(args, files[i].in->error());
     files[i].geometry = files[i].in->column("distance_m") >= 0 && files[i].in->column("elevation_deg") >= 0;
+    if (files[i].in->column("cam_x") >= 0) {
+      if (!files[i].in->requireColumns(calibratedColumns())) return badInput(args, files[i].in->error());
+      files[i].calibrated = true;
+    }
   }
+  const bool any_calibrated = std::any_of(files.begin(), files.end(), [](const ViewFile& f) { return f.calibrated; });
   std::ofstream out(args.get("out"));
   if (!out) return badInput(args, args.get("out") + ": cannot open for writing");
-  out << "t,gesture_id,voting_views,agreeing_views\n";
+  out << "t,gesture_id,voting_views,agreeing_views" << (any_calibrated ? ",checked_3d,rejected_3d" : "") << '\n';
   gesture::ViewFusion fusion(config, static_cast<int>(paths.size()), max_gesture_id);
-  std::size_t rows = 0, fused_gestures = 0;
+  std::size_t rows = 0, fused_gestures = 0, rejected_3d = 0;
   double last_t = -INFINITY;
   ViewFile& lead = files[0];
   while (readRow(lead, 0, max_gesture_id)) {
@@ -107,15 +176,19 @@ int cmdFuseViews(const Args& args) {
       if (!f.in->error().empty()) return badInput(args, f.in->error());
     }
     const gesture::FusedGesture g = fusion.fuse(t);
-    out << common::formatDouble(t) << ',' << g.gesture_id << ',' << g.voting_views << ',' << g.agreeing_views << '\n';
+    out << common::formatDouble(t) << ',' << g.gesture_id << ',' << g.voting_views << ',' << g.agreeing_views;
+    if (any_calibrated) out << ',' << (g.checked_3d ? 1 : 0) << ',' << (g.rejected_3d ? 1 : 0);
+    out << '\n';
     ++rows;
     fused_gestures += g.gesture_id != 0 ? 1 : 0;
+    rejected_3d += g.rejected_3d ? 1 : 0;
   }
   if (!lead.in->error().empty()) return badInput(args, lead.in->error());
   out.flush();
   if (!out) return badInput(args, args.get("out") + ": write failed");
   std::cout << "gfctl fuse-views: " << paths.size() << " views, " << rows << " rows, " << fused_gestures
-            << " fused as a gesture\n";
+            << " fused as a gesture" << (any_calibrated ? ", " + std::to_string(rejected_3d) + " rejected by the 3-D check" : "")
+            << '\n';
   return kExitOk;
 }
 

@@ -4,6 +4,7 @@
 // --views: the same performances also seen by further cameras at these azimuth offsets [deg]
 // from the primary one (the formation's followers, e.g. 60,-60): DIR/skeletons_view1.csv, …
 // and DIR/sequences_view1.csv, … in the same layout; skeletons.csv is unchanged by it.
+// sequences*.csv carry each view's nominal camera pose and intrinsics (cam_* columns, writeSequencesCsv).
 #include <sys/stat.h>
 
 #include <cerrno>
@@ -14,11 +15,14 @@
 #include <system_error>
 #include <iostream>
 
+#include <Eigen/Geometry>
+
 #include "commands.hpp"
 #include "gesture_formation/common/config_fields.hpp"
 #include "gesture_formation/common/config_reader.hpp"
 #include "gesture_formation/common/csv.hpp"
 #include "gesture_formation/gesture/skeleton_synth.hpp"
+#include "gesture_formation/gesture/view_triangulation.hpp"
 
 namespace gesture_formation::gfctl {
 namespace {
@@ -37,6 +41,32 @@ bool readSynthConfig(const std::string& path, gesture::SynthConfig& c, std::stri
   common::addProblems(r, "", gesture::synthConfigProblems(c));
   report = r.errorReport();
   return r.ok();
+}
+
+// What produced each sequence, with the camera's nominal pose in the body frame (x forward, y left,
+// z up, feet at 0): gesture::cameraAround at the view's distance, elevation and azimuth aimed at
+// 0.55 of the height — what the simulator's UAVs know of their cameras (sim::WorkerModel::calibrated);
+// the generator's aim jitter (σ 3 % of the height) is the difference, a pose error of a few tenths of
+// a degree. Columns cam_*: as `gfctl fuse-views` reads them.
+bool writeSequencesCsv(const std::string& path, const std::vector<gesture::SynthSequence>& sequences,
+                       const estimation::CameraIntrinsics& camera) {
+  std::ofstream meta(path);
+  meta << "sequence,motion,gesture_id,left_arm,height_m,distance_m,elevation_deg,azimuth_deg,frames,motion_start_s,"
+          "motion_end_s,cam_x,cam_y,cam_z,cam_qw,cam_qx,cam_qy,cam_qz,cam_fx,cam_fy,cam_cx,cam_cy,cam_width,cam_height\n";
+  const auto f = [](double v) { return common::formatDouble(v); };
+  for (const auto& s : sequences) {
+    const gesture::CalibratedSkeleton c =
+        gesture::cameraAround(s.distance_m, s.elevation_deg, s.azimuth_deg, 0.55 * s.height_m, camera);
+    const Eigen::Quaterniond q(c.R_world_camera);
+    meta << s.id << ',' << gesture::toString(s.motion) << ',' << gesture::gestureIdOf(s.motion) << ',' << (s.left_arm ? 1 : 0)
+         << ',' << f(s.height_m) << ',' << f(s.distance_m) << ',' << f(s.elevation_deg) << ',' << f(s.azimuth_deg) << ','
+         << s.frames.size() << ',' << f(s.motion_start_s) << ',' << f(s.motion_end_s) << ',' << f(c.p_world_camera.x()) << ','
+         << f(c.p_world_camera.y()) << ',' << f(c.p_world_camera.z()) << ',' << f(q.w()) << ',' << f(q.x()) << ',' << f(q.y())
+         << ',' << f(q.z()) << ',' << f(camera.fx) << ',' << f(camera.fy) << ',' << f(camera.cx) << ',' << f(camera.cy) << ','
+         << camera.width_px << ',' << camera.height_px << '\n';
+  }
+  meta.flush();
+  return static_cast<bool>(meta);
 }
 
 int cmdSynthGestures(const Args& args) {
@@ -95,16 +125,7 @@ int cmdSynthGestures(const Args& args) {
     std::string error;
     if (!gesture::writeSkeletonCsv(dir + "/skeletons" + suffix + ".csv", views[v], &error)) return badInput(args, error);
     const std::string meta_path = dir + "/sequences" + suffix + ".csv";
-    std::ofstream meta(meta_path);
-    meta << "sequence,motion,gesture_id,left_arm,height_m,distance_m,elevation_deg,azimuth_deg,frames,motion_start_s,motion_end_s\n";
-    for (const auto& s : views[v]) {
-      meta << s.id << ',' << gesture::toString(s.motion) << ',' << gesture::gestureIdOf(s.motion) << ',' << (s.left_arm ? 1 : 0)
-           << ',' << common::formatDouble(s.height_m) << ',' << common::formatDouble(s.distance_m) << ','
-           << common::formatDouble(s.elevation_deg) << ',' << common::formatDouble(s.azimuth_deg) << ',' << s.frames.size()
-           << ',' << common::formatDouble(s.motion_start_s) << ',' << common::formatDouble(s.motion_end_s) << '\n';
-    }
-    meta.flush();
-    if (!meta) return badInput(args, meta_path + ": write failed");
+    if (!writeSequencesCsv(meta_path, views[v], config.camera)) return badInput(args, meta_path + ": write failed");
   }
   const auto& sequences = views[0];
   std::cout << "gfctl synth-gestures: " << sequences.size() << " sequences, " << frames << " frames → " << dir

@@ -167,7 +167,7 @@ LeaderCameraFrame LeaderCamera::frame(double t, const MultirotorState& leader, c
   }
   const std::vector<gesture::SynthFrame> skeletons = worker.skeletonsAt(t, cameras);
   out.skeleton = skeletons.front();
-  const bool calibrate = cfg_.view_fusion.confirm_3d;  // the poses serve only the 3-D confirmation
+  const bool calibrate = cfg_.view_fusion.usesCalibratedViews();  // the poses serve only the 3-D tests
   if (calibrate) out.calibrated = worker.calibrated(0, out.skeleton.skeleton, ws);
   // A camera's FIFO: a gap breaks its temporal consistency. A full FIFO is classified below,
   // all cameras of the frame together (MissionClassifier::classifyAll).

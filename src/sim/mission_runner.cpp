@@ -387,7 +387,7 @@ gesture::ViewObservation MissionRun::observation(int view, double t, const gestu
     o.distance_m = g.distance_m;
     o.elevation_deg = g.elevation_deg;
   }
-  if (cfg_.view_fusion.confirm_3d) {
+  if (cfg_.view_fusion.usesCalibratedViews()) {
     // The camera pose as the UAV knows it: the rendering pose moved by its odometry's
     // position and heading errors.
     const MultirotorState truth = u.plant.state();

@@ -395,7 +395,7 @@ LeaderCameraFrame RenderedCamera::frame(double t, const MultirotorState& leader,
     for (std::size_t k = 0; k < slots.size() && k < classified.size(); ++k) *slots[k] = std::move(classified[k]);
   }
   // The 3-D confirmation's skeletons: the pipeline's, with the pose of the camera that rendered it.
-  for (std::size_t i = 0; cfg_.view_fusion.confirm_3d && i < results.size(); ++i) {
+  for (std::size_t i = 0; cfg_.view_fusion.usesCalibratedViews() && i < results.size(); ++i) {
     if (!results[i].found) continue;
     gesture::CalibratedSkeleton& cal = i == 0 ? out.calibrated : out.followers[i - 1].calibrated;
     cal.skeleton = results[i].skeleton;

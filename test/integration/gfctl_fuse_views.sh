@@ -72,4 +72,53 @@ expect_error "gesture_id" --in "$T/g0.csv,$T/bad_cols.csv" --out "$T/x.csv"
 printf 'view_fusion: {min_agreeing_views: 0, elevation_max_deg: -10}\n' > "$T/bad.yaml"
 expect_error "view_fusion.min_agreeing_views" --in "$T/g0.csv" --out "$T/x.csv" --config "$T/bad.yaml"
 grep -q "view_fusion.elevation_max_deg" "$T/err" || fail "config report lists only the first problem: $(cat "$T/err")"
-echo "gfctl fuse-views: vote, envelope gate, single camera and bad input OK"
+
+# Calibrated views (view_fusion.require_3d, docs/gestures.md 6): synth-gestures writes each view's camera
+# pose (cam_* of sequences*.csv); joined to every frame's keypoints they give fuse-views the calibrated
+# skeletons it triangulates. Every frame of work motions read as "palms together" (3) by all three
+# views: the vote alone passes it, the 3-D check (design.md 2's geometry) refuses it; real palms
+# together read as 3 pass.
+calibrated_views() {  # calibrated_views DIR ID: DIR/c0.csv.. with every row read as ID (label rows: ID = label)
+  python3 - "$1" "$2" <<'PY'
+import csv, sys
+d, gid = sys.argv[1], sys.argv[2]
+for v, suffix in enumerate(["", "_view1", "_view2"]):
+    seqs = {r["sequence"]: r for r in csv.DictReader(open(f"{d}/sequences{suffix}.csv"))}
+    cam = [c for c in next(iter(seqs.values())) if c.startswith("cam_")]
+    kp = [f"{p}{k}" for p in "xyc" for k in range(17)]
+    with open(f"{d}/c{v}.csv", "w") as out:
+        out.write(",".join(["t", "gesture_id", "distance_m", "elevation_deg"] + kp + cam) + "\n")
+        for r in csv.DictReader(open(f"{d}/skeletons{suffix}.csv")):
+            m = seqs[r["sequence"]]
+            t = 100.0 * int(r["sequence"]) + float(r["t"])
+            g = r["label"] if gid == "label" else gid
+            out.write(",".join([repr(t), g, m["distance_m"], m["elevation_deg"]] + [r[k] for k in kp] + [m[c] for c in cam]) + "\n")
+PY
+}
+printf 'gesture_fraction: 0.0\ndistance_min_m: 6\ndistance_max_m: 12\nelevation_max_deg: 30\n' > "$T/work.yaml"
+"$GFCTL" synth-gestures --seed 3301 --count 6 --out "$T/w" --config "$T/work.yaml" --views 60,-60 > /dev/null
+head -1 "$T/w/sequences_view1.csv" | grep -q "cam_qw" || fail "sequences_view1.csv has no camera pose: $(head -1 "$T/w/sequences_view1.csv")"
+calibrated_views "$T/w" 3
+sed 's/require_3d: true/require_3d: false/' "$SRC/config/gestures.yaml" > "$T/no3d.yaml"
+"$GFCTL" fuse-views --in "$T/w/c0.csv,$T/w/c1.csv,$T/w/c2.csv" --out "$T/w/off.csv" --config "$T/no3d.yaml" > /dev/null
+"$GFCTL" fuse-views --in "$T/w/c0.csv,$T/w/c1.csv,$T/w/c2.csv" --out "$T/w/on.csv" --config "$SRC/config/gestures.yaml" > /dev/null
+head -1 "$T/w/on.csv" | grep -q "checked_3d,rejected_3d" || fail "no 3-D columns: $(head -1 "$T/w/on.csv")"
+rows=$(tail -n +2 "$T/w/on.csv" | wc -l)
+off=$(tail -n +2 "$T/w/off.csv" | awk -F, '$2 == 3' | wc -l)
+on=$(tail -n +2 "$T/w/on.csv" | awk -F, '$2 == 3' | wc -l)
+rejected=$(tail -n +2 "$T/w/on.csv" | awk -F, '$6 == 1' | wc -l)
+[ "$off" -ge $((rows * 9 / 10)) ] || fail "without the 3-D check only $off of $rows work frames fused as 3"
+[ "$on" -le $((rows / 50)) ] || fail "with the 3-D check $on of $rows work frames still fused as palms together"
+[ "$rejected" -ge $((off * 9 / 10)) ] || fail "only $rejected of $off rejected_3d"
+printf 'gesture_fraction: 1.0\ndistance_min_m: 6\ndistance_max_m: 12\nelevation_max_deg: 30\nhold_min_s: 3\nhold_max_s: 4\n' > "$T/g.yaml"
+"$GFCTL" synth-gestures --seed 3302 --count 8 --out "$T/g" --config "$T/g.yaml" --views 60,-60 > /dev/null
+calibrated_views "$T/g" label
+"$GFCTL" fuse-views --in "$T/g/c0.csv,$T/g/c1.csv,$T/g/c2.csv" --out "$T/g/on.csv" --config "$SRC/config/gestures.yaml" > /dev/null
+voted=$(tail -n +2 "$T/g/on.csv" | awk -F, '$4 >= 2' | wc -l)
+kept=$(tail -n +2 "$T/g/on.csv" | awk -F, '$4 >= 2 && $2 != 0' | wc -l)
+[ "$voted" -gt 100 ] && [ "$kept" -ge $((voted * 8 / 10)) ] || fail "gestures: $kept of $voted voted frames passed the 3-D check"
+# A broken camera pose: exit 2 naming the field.
+awk -F, -v OFS=, 'NR == 2 { for (i = 1; i <= NF; ++i) if (h[i] == "cam_qw") $i = 2 } NR == 1 { for (i = 1; i <= NF; ++i) h[i] = $i } 1' \
+  "$T/w/c1.csv" > "$T/w/bad_q.csv"
+expect_error "bad_q.csv:2.*cam_qw" --in "$T/w/c0.csv,$T/w/bad_q.csv" --out "$T/x.csv" --config "$SRC/config/gestures.yaml"
+echo "gfctl fuse-views: vote, envelope gate, single camera, bad input and the 3-D check OK"

@@ -101,9 +101,23 @@ def classify(gfctl, model, laid_out_csv, keys, fps, work):
     return out, res
 
 
+KEYPOINT_COLUMNS = [f"{p}{k}" for p in "xyc" for k in range(17)]
+CAMERA_COLUMNS = ["cam_x", "cam_y", "cam_z", "cam_qw", "cam_qx", "cam_qy", "cam_qz",
+                  "cam_fx", "cam_fy", "cam_cx", "cam_cy", "cam_width", "cam_height"]
+
+
+def frame_skeletons(laid_out_csv):
+    """{round(t, 6): [x0..x16, y0..y16, c0..c16]} of a laid-out skeletons file."""
+    header, rows = read_csv(laid_out_csv)
+    it, ik = header.index("t"), [header.index(c) for c in KEYPOINT_COLUMNS]
+    return {round(float(r[it]), 6): [r[i] for i in ik] for r in rows}
+
+
 def classify_view(gfctl, model, data_dir, suffix, fps, work):
-    """Classifies the view `suffix` ("_view1", …) and adds its camera geometry per row
-    (distance_m, elevation_deg of its sequence) for the envelope gate."""
+    """Classifies the view `suffix` ("_view1", …) and adds per row its camera geometry
+    (distance_m, elevation_deg of its sequence) for the envelope gate and, when the sequences
+    file has the camera's pose (gfctl synth-gestures: cam_* columns), the frame's keypoints and
+    that pose: the calibrated skeleton `gfctl fuse-views` triangulates (view_fusion.require_3d)."""
     vdir = os.path.join(work, "view" + suffix)
     os.makedirs(vdir, exist_ok=True)
     for name in ("skeletons", "sequences"):
@@ -115,12 +129,18 @@ def classify_view(gfctl, model, data_dir, suffix, fps, work):
     laid, keys, meta = laid_out(vdir, fps)
     gcsv, _ = classify(gfctl, model, laid, keys, fps, vdir)
     header, rows = read_csv(gcsv)
+    calibrated = all(c in next(iter(meta.values())) for c in CAMERA_COLUMNS)
+    skeletons = frame_skeletons(laid) if calibrated else {}
     out = os.path.join(vdir, "gestures_geometry.csv")
     with open(out, "w") as f:
-        f.write(",".join(header) + ",distance_m,elevation_deg\n")
+        extra = "," + ",".join(KEYPOINT_COLUMNS + CAMERA_COLUMNS) if calibrated else ""
+        f.write(",".join(header) + ",distance_m,elevation_deg" + extra + "\n")
         for r in rows:
             seq = int(float(r[0]) // SEQ_GAP_S)
-            f.write(",".join(r) + f",{meta[seq]['distance_m']},{meta[seq]['elevation_deg']}\n")
+            line = ",".join(r) + f",{meta[seq]['distance_m']},{meta[seq]['elevation_deg']}"
+            if calibrated:
+                line += "," + ",".join(skeletons[round(float(r[0]), 6)] + [meta[seq][c] for c in CAMERA_COLUMNS])
+            f.write(line + "\n")
     return out
 
 

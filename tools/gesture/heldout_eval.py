@@ -49,6 +49,13 @@ GESTURES_YAML = os.path.join(ROOT, "config/gestures.yaml")
 CLASSES = ev.CLASSES
 
 
+def set_paths(protocol, config):
+    """The protocol and the configuration a run uses (the defaults: the held-out protocol and the shipped
+    config/gestures.yaml; tuning runs pass their own and write elsewhere)."""
+    global PROTOCOL, GESTURES_YAML
+    PROTOCOL, GESTURES_YAML = os.path.abspath(protocol), os.path.abspath(config)
+
+
 def sha256(path):
     h = hashlib.sha256()
     with open(path, "rb") as f:
@@ -138,6 +145,16 @@ def three_views(gfctl, model, name, spec, protocol, work):
     views += [ev.classify_view(gfctl, model, d, f"_view{i + 1}", fps, d) for i in range(len(spec["views_deg"]))]
     fused = ev.fuse(gfctl, views, GESTURES_YAML, os.path.join(d, "fused.csv"))
     return d, meta, views[0], fused
+
+
+def check_3d_counts(fused_csv):
+    """Rows of the fused file checked in 3-D and rejected by it (view_fusion.require_3d; None without
+    calibrated views)."""
+    header, rows = ev.read_csv(fused_csv)
+    if "rejected_3d" not in header:
+        return None
+    ic, ir = header.index("checked_3d"), header.index("rejected_3d")
+    return {"rows": len(rows), "checked_3d": sum(int(r[ic]) for r in rows), "rejected_3d": sum(int(r[ir]) for r in rows)}
 
 
 def run_filter(gfctl, ids_csv, config, out_dir, tag):
@@ -232,7 +249,12 @@ def main():
     ap.add_argument("--work", default=None, help="data directory (default: a new temporary one)")
     ap.add_argument("--rearm", default="shipped", help="comma-separated: shipped and/or mode names (release, repeat)")
     ap.add_argument("--out", default=os.path.join(ROOT, "docs/results/gestures_heldout"), help="page/json path without extension")
+    ap.add_argument("--protocol", default=PROTOCOL,
+                    help="protocol file (default: the held-out one; tuning uses tools/gesture/tuning/protocol_tuning.yaml "
+                         "with its own seeds and --out elsewhere)")
+    ap.add_argument("--config", default=GESTURES_YAML, help="filter and vote configuration (default: the shipped one)")
     a = ap.parse_args()
+    set_paths(a.protocol, a.config)
     with open(PROTOCOL) as f:
         protocol = yaml.safe_load(f)
     work = a.work or tempfile.mkdtemp(prefix="gf_heldout_")
@@ -249,6 +271,7 @@ def main():
           f"(target <= {protocol['targets']['single_camera']['work_windows_read_as_gesture_max']})")
     data = {name: three_views(a.gfctl, a.model, name, sets[name], protocol, work)
             for name in ("three_cameras_work", "three_cameras_gestures")}
+    checks = {name: check_3d_counts(data[name][3]) for name in data}
     three = {}
     for mode in modes:
         cfg = filter_config(mode, work)
@@ -269,7 +292,7 @@ def main():
               "protocol_sha256": sha256(PROTOCOL), "model": os.path.relpath(a.model, ROOT), "model_sha256": sha256(a.model),
               "filter_config": os.path.relpath(GESTURES_YAML, ROOT), "filter_config_sha256": sha256(GESTURES_YAML),
               "machine": dict(machine(), load_average_start=list(load_start)), "targets": protocol["targets"],
-              "single_camera": single, "three_cameras": three}
+              "single_camera": single, "three_cameras": three, "fused_rows_3d_check": checks}
     report["meets_target"] = verdicts(single, three, protocol["targets"])
     with open(a.out + ".json", "w") as f:
         json.dump(report, f, indent=1)
@@ -339,6 +362,9 @@ def page(r, protocol):
                      f"{g['fired']}/{g['gestures']} = {100 * (g['fired_share'] or 0):.1f} % {yes(v['gestures_fired'])} | "
                      f"{g['mean_latency_s']} s ({g['max_latency_s']}) {yes(v['mean_latency'])} | {g['wrong_commands']} | "
                      f"{g['repeated_commands']} | {lw['false_adaptations']}, {lg['fired']}/{lg['gestures']} |")
+    for name, c in r.get("fused_rows_3d_check", {}).items():
+        lines += ["", f"3-D check (view_fusion.require_3d) on {name}: " + ("no calibrated views" if c is None else
+                  f"{c['checked_3d']} of {c['rows']} fused frames checked, {c['rejected_3d']} rejected")]
     lines += ["", "False adaptations (three cameras):", ""]
     for mode, m in r["three_cameras"].items():
         fl = m["work"]["three_cameras"]["false_adaptation_list"]

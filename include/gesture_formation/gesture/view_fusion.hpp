@@ -30,6 +30,16 @@
 ///    the views' skeletons of the vote window, triangulated (gesture/view_triangulation.hpp), show
 ///    the arm in that pose in at least confirm_3d_min_fraction of the 3-D frames: the geometry
 ///    that no 2-D view can tell apart from a pointing arm (docs/gestures.md §6).
+///  - with require_3d (default on), every gesture the vote (or the confirmation) passes is checked in
+///    3-D whenever two or more calibrated views see the worker in the vote window (an instant at
+///    which two or more views' skeletons, at most confirm_3d_max_dt_s apart, triangulate): it goes
+///    to the filter only when there are at least require_3d_min_frames such frames and design.md
+///    §2's geometry of that gesture (gesture/gesture_geometry.hpp: palms together at mid-chest with
+///    forearms near horizontal, wrists crossed at or above the shoulders, an arm abducted to the
+///    side near horizontal, an arm straight up) holds in at least require_3d_min_fraction of them,
+///    each read on the median of require_3d_median_frames frames around it; otherwise none
+///    (FusedGesture::rejected_3d). With fewer calibrated views
+///    (one camera, no camera poses) the vote decides alone, as without require_3d.
 /// min_agreeing_views = 1 with one view is the paper's single-camera pipeline.
 ///
 /// Link delay (fusion_lag_s, docs/gestures.md §4.1): the followers' classifications reach the
@@ -70,7 +80,17 @@ struct ViewFusionConfig {
   bool confirm_3d = false;
   double confirm_3d_min_fraction = 0.5;  ///< (0, 1]
   int confirm_3d_min_frames = 5;         ///< ≥ 1
-  double confirm_3d_max_dt_s = 0.034;    ///< views' frames at most this apart form one 3-D frame [s], > 0
+  double confirm_3d_max_dt_s = 0.034;    ///< views' frames at most this apart form one 3-D frame [s], > 0 (also require_3d's)
+  /// 3-D check of every gesture (docs/gestures.md §6): with two or more calibrated views, a gesture
+  /// passes only when the vote window has at least require_3d_min_frames triangulated frames and its
+  /// design.md §2 geometry holds in at least require_3d_min_fraction of them.
+  bool require_3d = true;
+  double require_3d_min_fraction = 0.3;  ///< (0, 1]; 0.3 chosen on the tuning sets (docs/gestures.md §6)
+  int require_3d_min_frames = 5;         ///< ≥ 1
+  /// Odd, 1..31: each triangulated frame is read on the per-keypoint median of it and its neighbours
+  /// (this many frames centred on it; gesture::medianSkeleton): a held gesture's single frames are
+  /// noisy (the elbow of a triangulated arm moves by centimetres), its median is not. 1: frame by frame.
+  int require_3d_median_frames = 5;
   /// [0, 2] s: callers fuse at t_now − fusion_lag_s (the links' delay budget); observations may
   /// arrive this much out of order and the history is kept this much longer. 0: no lag.
   /// Default 0.4 s (since 2026-12-03): the fault matrix's delay budget (0.1 s + up to 0.3 s).
@@ -78,6 +98,9 @@ struct ViewFusionConfig {
 
   /// \brief Every problem, each naming the key; empty when valid.
   std::vector<std::string> validate() const;
+  /// \brief Whether the views' observations should carry their calibrated skeletons (the 3-D tests
+  /// use them: confirm_3d or require_3d).
+  bool usesCalibratedViews() const { return confirm_3d || require_3d; }
   /// \brief Whether a camera at this distance and elevation from the worker may vote (always with
   /// gate_envelope off; never with an unknown geometry).
   bool inEnvelope(double distance_m, double elevation_deg) const;
@@ -85,7 +108,8 @@ struct ViewFusionConfig {
 
 /// \brief Reads `view_fusion.{min_agreeing_views, max_age_s, gate_envelope, distance_min_m,
 /// distance_max_m, elevation_min_deg, elevation_max_deg, vote_window_s, vote_min_fraction, confirm_3d,
-/// confirm_3d_min_fraction, confirm_3d_min_frames, confirm_3d_max_dt_s, fusion_lag_s}` (missing keys: the defaults above
+/// confirm_3d_min_fraction, confirm_3d_min_frames, confirm_3d_max_dt_s, require_3d, require_3d_min_fraction,
+/// require_3d_min_frames, require_3d_median_frames, fusion_lag_s}` (missing keys: the defaults above
 /// unless the reader requires every key).
 ViewFusionConfig readViewFusionConfig(common::ConfigReader& reader);
 
@@ -96,7 +120,8 @@ struct ViewObservation {
   int gesture_id = 0;           ///< the classifier's argmax, 0..max_gesture_id
   double distance_m = -1.0;     ///< camera → worker [m]; < 0 or NaN: unknown
   double elevation_deg = 0.0;   ///< camera above the worker [deg] (NaN: unknown)
-  /// The frame's skeleton with the camera's pose (for confirm_3d; empty: the view takes no part).
+  /// The frame's skeleton with the camera's pose (for confirm_3d and require_3d; empty: the view takes
+  /// no part in the 3-D tests).
   std::optional<CalibratedSkeleton> calibrated;
 };
 
@@ -106,6 +131,9 @@ struct FusedGesture {
   int voting_views = 0;    ///< fresh views inside the envelope
   int agreeing_views = 0;  ///< votes for gesture_id (for 0: votes of the best gesture, which fell short)
   bool confirmed_3d = false;  ///< gesture_id passed with the 3-D confirmation as its last vote
+  bool checked_3d = false;    ///< require_3d: the vote's gesture was checked in 3-D (two or more calibrated views)
+  bool rejected_3d = false;   ///< require_3d: the vote's gesture failed its 3-D geometry (gesture_id is then 0)
+  int frames_3d = 0;          ///< triangulated frames of the vote window the 3-D tests used
 };
 
 /// \brief Keeps the newest observation per view and fuses them.
@@ -140,8 +168,15 @@ class ViewFusion {
   const ViewObservation* newestAt(std::size_t i, double t_now) const;
   /// The vote of view i at t_now (0: none), `newest` (its newestAt) being fresh and inside the envelope.
   int viewVote(std::size_t i, const ViewObservation& newest, double t_now) const;
-  /// Whether the triangulated frames of the vote window show one-arm gesture g (confirm_3d).
-  bool confirmedIn3D(int g, double t_now) const;
+  /// The vote window's triangulated frames: one per observation of the view with the most usable
+  /// calibrated observations, with every other view's nearest (≤ confirm_3d_max_dt_s); only frames
+  /// two or more views took part in.
+  std::vector<Skeleton3D> framesIn3D(double t_now) const;
+  /// Whether design.md §2's geometry of gesture g holds in require_3d_min_fraction of the frames, each
+  /// read on the median of require_3d_median_frames around it (require_3d).
+  bool holdsIn3D(int g, const std::vector<Skeleton3D>& frames) const;
+  /// Whether the triangulated frames show one-arm gesture g (confirm_3d).
+  bool confirmedIn3D(int g, const std::vector<Skeleton3D>& frames) const;
 };
 
 }  // namespace gesture_formation::gesture

@@ -269,10 +269,9 @@ namespace {
 
 /// 1.2 s of observations at 15 Hz from two cameras (leader at 0°, follower at +60°) of one body;
 /// view 0 reads `id0`, view 1 `id1`. Returns the fused verdict at the end.
-gf::gesture::FusedGesture fuseTwoViews(const gf::gesture::Body3D& body, int id0, int id1, bool confirm_3d,
-                                       bool with_skeletons = true, int frames = 18) {
-  gf::gesture::ViewFusionConfig config;
-  config.confirm_3d = confirm_3d;
+gf::gesture::FusedGesture fuseTwoViews(const gf::gesture::Body3D& body, int id0, int id1,
+                                       const gf::gesture::ViewFusionConfig& config, bool with_skeletons = true,
+                                       int frames = 18) {
   gf::gesture::ViewFusion fusion(config, 3, 4);
   std::vector<CalibratedSkeleton> cams{cameraAt(10.0, 20.0, 0.0, 1.0), cameraAt(9.0, 25.0, 60.0, 1.0)};
   for (auto& c : cams) projectInto(body, c);
@@ -291,6 +290,13 @@ gf::gesture::FusedGesture fuseTwoViews(const gf::gesture::Body3D& body, int id0,
     }
   }
   return fusion.fuse(t);
+}
+
+gf::gesture::FusedGesture fuseTwoViews(const gf::gesture::Body3D& body, int id0, int id1, bool confirm_3d,
+                                       bool with_skeletons = true, int frames = 18) {
+  gf::gesture::ViewFusionConfig config;
+  config.confirm_3d = confirm_3d;
+  return fuseTwoViews(body, id0, id1, config, with_skeletons, frames);
 }
 
 }  // namespace
@@ -356,4 +362,133 @@ TEST(ViewFusion3DTest, ConfirmKeysAreValidatedAndRead) {
   for (const char* key : {"view_fusion.confirm_3d", "view_fusion.confirm_3d_min_frames"}) {
     EXPECT_NE(bad.errorReport().find(key), std::string::npos) << key << " missing in:\n" << bad.errorReport();
   }
+}
+
+// ---------------------------------------------------------------------------------------
+// ViewFusion with require_3d (default on; docs/gestures.md §6): with two or more calibrated views,
+// a gesture both views read passes only when design.md §2's geometry of it holds in 3-D
+// (gesture/gesture_geometry.hpp) in require_3d_min_fraction of the window's triangulated frames.
+namespace {
+
+gf::gesture::ViewFusionConfig require3d(bool on) {
+  gf::gesture::ViewFusionConfig c;
+  c.require_3d = on;
+  return c;
+}
+
+}  // namespace
+
+TEST(ViewFusionRequire3DTest, EveryGestureWhoseGeometryHoldsPasses) {
+  SkeletonSynthesizer synth(SynthConfig{}, 8);
+  const std::pair<Motion, int> gestures[] = {{Motion::kCrossArms, 1}, {Motion::kExtendArmSide, 2},
+                                             {Motion::kPalmsTogether, 3}, {Motion::kRaiseArmUp, 4}};
+  for (const auto& [motion, id] : gestures) {
+    SCOPED_TRACE(gf::gesture::toString(motion));
+    const auto f = fuseTwoViews(synth.pose(motion, 1.0, 0.0, true), id, id, require3d(true));
+    EXPECT_EQ(f.gesture_id, id);
+    EXPECT_TRUE(f.checked_3d);
+    EXPECT_FALSE(f.rejected_3d);
+    EXPECT_EQ(f.frames_3d, 15);  // the 1 s vote window at 15 Hz
+  }
+}
+
+TEST(ViewFusionRequire3DTest, WorkPosturesBothViewsMisreadAreRejected) {
+  SkeletonSynthesizer synth(SynthConfig{}, 9);
+  // What two frontal views may read alike (issue 33): a tool held at the waist as "palms together",
+  // an arm pointing as "extend", a bent arm reaching a bolt as "raise", arms folded low as "cross".
+  const std::pair<Motion, int> misreads[] = {{Motion::kToolAtWaist, 3}, {Motion::kArmPartwayOrPointing, 2},
+                                             {Motion::kReachUpBolt, 4}, {Motion::kArmsFoldedLow, 1}};
+  for (const auto& [motion, id] : misreads) {
+    SCOPED_TRACE(gf::gesture::toString(motion));
+    const auto body = synth.pose(motion, 1.0, 0.0, true);
+    EXPECT_EQ(fuseTwoViews(body, id, id, require3d(false)).gesture_id, id);  // the vote alone passes it
+    const auto f = fuseTwoViews(body, id, id, require3d(true));
+    EXPECT_EQ(f.gesture_id, 0);
+    EXPECT_TRUE(f.checked_3d);
+    EXPECT_TRUE(f.rejected_3d);
+  }
+  // A gesture read as another one: raise read as "extend" by both views.
+  const auto f = fuseTwoViews(synth.pose(Motion::kRaiseArmUp, 1.0, 0.0, false), 2, 2, require3d(true));
+  EXPECT_EQ(f.gesture_id, 0);
+  EXPECT_TRUE(f.rejected_3d);
+}
+
+TEST(ViewFusionRequire3DTest, WithoutTwoCalibratedViewsTheVoteDecidesAloneWithTwoTheGeometry) {
+  SkeletonSynthesizer synth(SynthConfig{}, 10);
+  const auto tool = synth.pose(Motion::kToolAtWaist, 1.0, 0.0, true);
+  // No skeletons (one camera, or no camera poses): today's vote.
+  const auto none = fuseTwoViews(tool, 3, 3, require3d(true), false);
+  EXPECT_EQ(none.gesture_id, 3);
+  EXPECT_FALSE(none.checked_3d);
+  EXPECT_EQ(none.frames_3d, 0);
+  // Two calibrated views but fewer triangulated frames than require_3d_min_frames (5): not enough 3-D
+  // evidence, refused even for a real gesture; with 5, the geometry decides.
+  const auto palms = synth.pose(Motion::kPalmsTogether, 1.0, 0.0, true);
+  const auto few = fuseTwoViews(palms, 3, 3, require3d(true), true, 4);
+  EXPECT_EQ(few.gesture_id, 0);
+  EXPECT_TRUE(few.checked_3d);
+  EXPECT_TRUE(few.rejected_3d);
+  EXPECT_EQ(fuseTwoViews(palms, 3, 3, require3d(true), true, 5).gesture_id, 3);
+  EXPECT_EQ(fuseTwoViews(tool, 3, 3, require3d(true), true, 5).gesture_id, 0);
+}
+
+TEST(ViewFusionRequire3DTest, AConfirmedOneArmGestureMustAlsoHoldItsGeometry) {
+  SkeletonSynthesizer synth(SynthConfig{}, 11);
+  gf::gesture::ViewFusionConfig c = require3d(true);
+  c.confirm_3d = true;
+  // The 3-D confirmation (arm within 27.5° of the outward axis) and the design's region agree on a
+  // clearly extended arm (hand-built: straight out to the side, 5° forward).
+  auto body = synth.pose(Motion::kRaiseArmUp, 0.0, 0.0, true);  // rest pose of this body
+  const Eigen::Vector3d sh = body.p[gf::gesture::kLeftShoulder];
+  const Eigen::Vector3d d = Eigen::Vector3d(std::sin(degToRad(5.0)), std::cos(degToRad(5.0)), 0.0);
+  body.p[gf::gesture::kLeftElbow] = sh + 0.32 * d;
+  body.p[gf::gesture::kLeftWrist] = sh + 0.57 * d;
+  const auto f = fuseTwoViews(body, 2, 0, c);
+  EXPECT_EQ(f.gesture_id, 2);
+  EXPECT_TRUE(f.confirmed_3d);
+  EXPECT_TRUE(f.checked_3d);
+  // 65° of abduction (the design's band, 55–70°): 25° from the outward axis, within the confirmation's 27.5°.
+  const Eigen::Vector3d b = Eigen::Vector3d(0.0, std::sin(degToRad(65.0)), -std::cos(degToRad(65.0)));
+  body.p[gf::gesture::kLeftElbow] = sh + 0.32 * b;
+  body.p[gf::gesture::kLeftWrist] = sh + 0.57 * b;
+  const auto band = fuseTwoViews(body, 2, 0, c);
+  EXPECT_EQ(band.gesture_id, 0);
+  EXPECT_TRUE(band.rejected_3d);
+  EXPECT_FALSE(band.confirmed_3d);
+}
+
+TEST(ViewFusionRequire3DTest, RequireKeysAreValidatedAndRead) {
+  gf::gesture::ViewFusionConfig c;
+  EXPECT_TRUE(c.require_3d);  // default on
+  c.require_3d_min_fraction = 1.5;
+  c.require_3d_min_frames = 0;
+  c.require_3d_median_frames = 4;
+  const auto e = c.validate();
+  ASSERT_EQ(e.size(), 3u);
+  EXPECT_NE(e[0].find("view_fusion.require_3d_min_fraction"), std::string::npos) << e[0];
+  EXPECT_NE(e[1].find("view_fusion.require_3d_min_frames must be in [1, 1000], got 0"), std::string::npos) << e[1];
+  EXPECT_NE(e[2].find("view_fusion.require_3d_median_frames"), std::string::npos) << e[2];
+  EXPECT_NE(e[2].find("odd"), std::string::npos) << e[2];
+  using gf::common::ConfigReader;
+  ConfigReader ok = ConfigReader::fromString("view_fusion: {require_3d: false, require_3d_min_fraction: 0.7, "
+                                             "require_3d_min_frames: 8, require_3d_median_frames: 3}\n",
+                                             "ok.yaml", ConfigReader::MissingKeys::kUseDefaults);
+  const auto read = gf::gesture::readViewFusionConfig(ok);
+  EXPECT_TRUE(ok.ok()) << ok.errorReport();
+  EXPECT_FALSE(read.require_3d);
+  EXPECT_DOUBLE_EQ(read.require_3d_min_fraction, 0.7);
+  EXPECT_EQ(read.require_3d_min_frames, 8);
+  EXPECT_EQ(read.require_3d_median_frames, 3);
+  ConfigReader bad = ConfigReader::fromString("view_fusion: {require_3d: perhaps, require_3d_min_fraction: 0}\n",
+                                              "bad.yaml", ConfigReader::MissingKeys::kUseDefaults);
+  (void)gf::gesture::readViewFusionConfig(bad);
+  EXPECT_FALSE(bad.ok());
+  for (const char* key : {"view_fusion.require_3d", "view_fusion.require_3d_min_fraction"}) {
+    EXPECT_NE(bad.errorReport().find(key), std::string::npos) << key << " missing in:\n" << bad.errorReport();
+  }
+  // The shipped configuration turns it on.
+  ConfigReader shipped = ConfigReader::fromFile(std::string(GF_SOURCE_DIR) + "/config/gestures.yaml",
+                                                ConfigReader::MissingKeys::kUseDefaults);
+  EXPECT_TRUE(gf::gesture::readViewFusionConfig(shipped).require_3d);
+  EXPECT_TRUE(shipped.ok()) << shipped.errorReport();
 }

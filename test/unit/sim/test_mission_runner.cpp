@@ -136,9 +136,13 @@ ExtendArmRun runEveryCameraReadingExtendArm(const gf::sim::MissionConfig& cfg) {
 // The followers' gesture votes reach the leader over the inter-UAV link (as over LCM in the ROS
 // system), so they share its faults: with every message lost, the leader's own view is 1 of the
 // 2 agreeing views the vote needs and nothing fires; with a working link the same readings fire.
+// The test's readings are made up (the simulated worker does not extend an arm), so the vote is
+// tested without the 3-D check of every gesture; with it (the default) they fire nothing.
 TEST(MissionRunnerTest, FollowerGestureVotesTravelTheLossyLink) {
   auto cfg = gf::sim::test::openFieldWithoutRequests();
   ASSERT_EQ(cfg.view_fusion.min_agreeing_views, 2);
+  ASSERT_TRUE(cfg.view_fusion.require_3d);
+  cfg.view_fusion.require_3d = false;
   const ExtendArmRun ok = runEveryCameraReadingExtendArm(cfg);
   EXPECT_GE(ok.gestures_fired, 1);
   EXPECT_EQ(ok.messages_lost, 0);
@@ -146,6 +150,10 @@ TEST(MissionRunnerTest, FollowerGestureVotesTravelTheLossyLink) {
   const ExtendArmRun lost = runEveryCameraReadingExtendArm(cfg);
   EXPECT_EQ(lost.gestures_fired, 0);
   EXPECT_GT(lost.messages_lost, 0);
+  // The 3-D check (docs/gestures.md §6): every view reads "extend", the triangulated arm is not.
+  cfg.link.loss_probability = 0.0;
+  cfg.view_fusion.require_3d = true;
+  EXPECT_EQ(runEveryCameraReadingExtendArm(cfg).gestures_fired, 0);
 }
 
 // A slow link (safety.md §2.1): every follower vote arrives 0.35 s after its frame, older than
@@ -154,6 +162,7 @@ TEST(MissionRunnerTest, FollowerGestureVotesTravelTheLossyLink) {
 TEST(MissionRunnerTest, DelayedFollowerVotesCountWhenTheViewsAreFusedAtALag) {
   auto cfg = gf::sim::test::openFieldWithoutRequests();
   ASSERT_EQ(cfg.view_fusion.min_agreeing_views, 2);
+  cfg.view_fusion.require_3d = false;  // made-up readings (above): the lag is tested, not the 3-D check
   cfg.link.delay_s = 0.35;
   cfg.view_fusion.fusion_lag_s = 0.0;  // fused at the newest frame (the default is 0.4 s)
   EXPECT_EQ(runEveryCameraReadingExtendArm(cfg).gestures_fired, 0);

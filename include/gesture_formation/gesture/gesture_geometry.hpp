@@ -1,0 +1,131 @@
+#pragma once
+/// \file
+/// \brief design.md §2's gestures and near-misses as regions of 3-D body geometry, with the
+/// ambiguity band between each gesture and its nearest near-miss counted as "none"
+/// (docs/gestures.md §6, "Gesture geometry in 3-D"; issue 33 item 2).
+///
+/// Input: a COCO-17 skeleton in 3-D (any right-handed world frame, e.g. triangulated by
+/// gesture/view_triangulation.hpp). The body frame is the one of bodyFrameOf(): y along the right →
+/// left shoulder axis, z from the hips' midpoint towards the shoulders' (orthogonalised), x = y × z
+/// forward, origin the shoulders' midpoint. Every number below is design.md §2's ("In numbers", H =
+/// standing height, shoulder joints ≈ 0.82 H, hip joints ≈ 0.52 H, upper-arm angles from hanging
+/// down); none was tuned on data:
+///  - heights are fractions of H along the body's up axis, placed by the skeleton's own hips
+///    (0.52 H) and shoulders (0.82 H): h(p) = 0.52 + 0.30 · (p − hips)·z / (shoulders − hips)·z,
+///    and lengths are in units of H = torso height / 0.30 — no ankles and no known height needed;
+///  - palms together (3): wrists ≤ 0.06 H apart, both at 0.67–0.80 H, in front of the body, each
+///    forearm within 30° of horizontal; near-miss "tool held in both hands": wrists together (≤ 0.06 H)
+///    at ≤ 0.61 H; band: wrists together at 0.61–0.67 H;
+///  - cross arms (1): each wrist crossed over the body's midline (the left wrist right of it, the
+///    right wrist left of it), both at ≥ 0.80 H; near-miss "arms folded low": wrists crossed at
+///    ≤ 0.70 H; band: crossed at 0.70–0.80 H;
+///  - extend an arm to the side (2): upper arm abducted 70–110°, elbow ≥ 150°; near-miss "raised
+///    part-way or pointing": abduction ≤ 55°; band 55–70° (and 110–125°, its mirror above the
+///    shoulder). The abduction of a sideways arm is read in two planes, both of which must show it:
+///    in the frontal plane, the upper arm's elevation from hanging down (70–110°; part-way ≤ 55°), and
+///    in the horizontal plane, its horizontal abduction — the angle of its horizontal direction from
+///    straight forward (or back) towards its own side: 90° straight sideways, 0° pointing forward
+///    (≥ 70°; pointing ≤ 55°). So an arm pointing forward, or forward-outward up to 55° from forward,
+///    is the near-miss at any elevation up to 125°, never "extend to the side";
+///  - raise an arm up (4): upper arm ≥ 150° from hanging (elevation, any plane), elbow ≥ 150°;
+///    near-miss "reaching": elevation ≤ 130° or elbow < 120°; band: elevation 130–150° or elbow 120–150°.
+/// A one-arm gesture needs exactly one arm in its region; two arms in gesture regions of different
+/// gestures (or a one-arm and a two-arm gesture at once) are ambiguous: none.
+/// Thread safety: free functions without state.
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "gesture_formation/gesture/skeleton.hpp"
+#include "gesture_formation/gesture/view_triangulation.hpp"
+
+namespace gesture_formation::gesture {
+
+/// \brief design.md §2's numbers (fractions of the standing height H, angles in degrees). The
+/// defaults ARE the design; they are not tuning parameters (tests pin them).
+struct GestureGeometryNumbers {
+  double shoulder_height_H = 0.82, hip_height_H = 0.52;  ///< the body's scale: joints' heights
+  double palms_max_separation_H = 0.06;                  ///< wrists "within a hand's width"
+  double palms_min_height_H = 0.67, palms_max_height_H = 0.80;
+  double palms_forearm_max_from_horizontal_deg = 30.0;
+  double tool_max_height_H = 0.61;                       ///< band: tool_max .. palms_min
+  double cross_min_height_H = 0.80;
+  double folded_max_height_H = 0.70;                     ///< band: folded_max .. cross_min
+  double extend_min_abduction_deg = 70.0, extend_max_abduction_deg = 110.0;  ///< elevation; horizontal: ≥ the min
+  double extend_min_elbow_deg = 150.0;
+  double pointing_max_abduction_deg = 55.0;              ///< band: 55..70 (and its mirror 110..125), both planes
+  double raise_min_elevation_deg = 150.0, raise_min_elbow_deg = 150.0;
+  double reach_max_elevation_deg = 130.0, reach_max_elbow_deg = 120.0;  ///< band: 130..150, elbow 120..150
+  /// Reporting aid, not in design.md (it changes no gesture decision): an arm whose upper arm is
+  /// within this of hanging down is "at rest", not the near-miss "part-way or pointing".
+  double hanging_max_elevation_deg = 20.0;
+};
+
+/// \brief One arm measured in the body frame (angles [deg], heights in H, positions [m]).
+struct ArmMeasures {
+  bool valid = false;                 ///< shoulder, elbow and wrist known
+  double elevation_deg = 0.0;         ///< upper arm (shoulder → elbow) from hanging down: 0 down, 90 horizontal, 180 up
+  double horizontal_abduction_deg = 0.0;  ///< upper arm's horizontal direction from forward/back towards its own side:
+                                         ///< 90 sideways, 0 forward or back, < 0 across the body (file comment)
+  double elbow_deg = 180.0;           ///< inner elbow angle (180: straight)
+  double forearm_from_horizontal_deg = 90.0;  ///< |angle| of elbow → wrist to the body's horizontal plane
+  double wrist_height_H = 0.0;        ///< h(wrist)
+  Eigen::Vector3d wrist_body = Eigen::Vector3d::Zero();  ///< wrist in the body frame [m] (x fwd, y left, z up)
+};
+
+/// \brief The measures of design.md §2 on one 3-D skeleton.
+struct PoseMeasures {
+  bool valid = false;         ///< body frame (shoulders and hips) known, torso upright enough to scale
+  BodyFrame frame;
+  double height_m = 0.0;      ///< H implied by the torso: (shoulders − hips)·z / 0.30
+  ArmMeasures left, right;
+  double wrist_separation_H = 0.0;  ///< |left wrist − right wrist| / H (both arms valid)
+  bool wrists_crossed = false;      ///< the left wrist right of the midline (y < 0) and the right wrist left of it
+};
+
+/// \brief Measures a 3-D skeleton (world frame). Invalid (valid = false) without both shoulders and
+/// hips (bodyFrameOf) or with a torso shorter than 0.1 m along its own up axis; an arm is invalid
+/// without its shoulder, elbow or wrist.
+PoseMeasures measurePose(const Skeleton3D& s, const GestureGeometryNumbers& n = {});
+
+/// \brief The region a pose falls in: a gesture, one of design.md §2's near-misses, the ambiguity
+/// band between them, or anything else.
+enum class PoseRegion : int {
+  kOther = 0,           ///< none of the regions below (none)
+  kGesture,             ///< `gesture_id` holds
+  kBand,                ///< between a gesture and its nearest near-miss: none, no command
+  kToolAtWaist,         ///< near-miss of palms together
+  kArmsFoldedLow,       ///< near-miss of cross arms
+  kArmPartwayOrPointing,  ///< near-miss of extend
+  kReachingUp,          ///< near-miss of raise (arm up but bent, or part-way)
+  kAmbiguous,           ///< two different gestures' regions at once: none
+  kUnknown,             ///< not measurable (missing joints): none
+};
+const char* toString(PoseRegion r);
+
+/// \brief The verdict on one pose: gesture_id ≠ 0 only with region kGesture.
+struct PoseVerdict {
+  int gesture_id = kNone;
+  PoseRegion region = PoseRegion::kUnknown;
+  /// For kBand and the near-misses: the gesture whose band / near-miss it is (kNone otherwise).
+  int nearest_gesture = kNone;
+};
+
+/// \brief Classifies measured geometry by design.md §2's regions (file comment). `numbers` must be
+/// consistent (each band's lower edge ≤ its upper edge); the defaults are.
+PoseVerdict classifyPose(const PoseMeasures& m, const GestureGeometryNumbers& numbers = {});
+/// \brief measurePose() then classifyPose().
+PoseVerdict classifyPose3D(const Skeleton3D& s, const GestureGeometryNumbers& numbers = {});
+
+/// \brief The per-keypoint median (of each world coordinate) of frames[first..last] (inclusive,
+/// clamped to the vector), over the frames in which that keypoint is valid; a keypoint valid in none
+/// of them stays invalid. For a held posture it averages out the triangulation noise of single
+/// frames (ViewFusion's require_3d reads each frame with its neighbours). Views and reprojection
+/// errors: those of the middle frame.
+Skeleton3D medianSkeleton(const std::vector<Skeleton3D>& frames, std::size_t first, std::size_t last);
+
+}  // namespace gesture_formation::gesture
