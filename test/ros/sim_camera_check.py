@@ -6,9 +6,11 @@
   (its truth /world/worker_truth, the camera's true pose /uav<i>/ground_truth: camera axis =
   odometry orientation, docs/ros.md) the depth is finite and within WORKER_DEPTH_TOL_M of the
   mid-body's depth along the optical axis, in most of the leader's frames;
-- the leader's Perception nodelet finds the worker (WorkerDetection.detected, box around that
-  projection) with a finite stereo range near the true distance, and only the UAV managers (the
-  Perception nodelets) publish detections and classifications: SimWorld (/world/manager) none.
+- the leader's Perception nodelet finds the worker (WorkerDetection.detected) with a finite stereo
+  range from the rendered depth, and only the UAV managers (the Perception nodelets) publish
+  detections and classifications: SimWorld (/world/manager) none;
+- the leader's WorkerEstimator, fed by that Perception alone (and the UWB range), tracks the
+  worker: its last estimates are not lost and within ESTIMATE_TOL_M of the truth.
 Usage: sim_camera_check.py DURATION_WALL_S CAMERA_RATE_HZ; exit code = number of failures."""
 import math
 import sys
@@ -17,11 +19,12 @@ import time
 import numpy as np
 import rospy
 import rosgraph
-from gesture_formation.msg import WorkerDetection
+from gesture_formation.msg import WorkerDetection, WorkerState
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import CameraInfo, Image
 
 WORKER_DEPTH_TOL_M = 0.6   # the mid-body lies inside the body: the surface is 0.1-0.3 m nearer
+ESTIMATE_TOL_M = 1.5       # tracking, not a precision figure: the estimate is on the worker, not elsewhere
 N_UAVS = 3
 
 fails = 0
@@ -56,7 +59,7 @@ def main():
     depths = {i: [] for i in range(N_UAVS)}
     infos = {i: [] for i in range(N_UAVS)}
     truths = {i: [] for i in range(N_UAVS)}
-    worker, detections = [], []
+    worker, detections, estimates = [], [], []
     subs = []
     for i in range(N_UAVS):
         ns = "/uav%d/" % i
@@ -66,10 +69,11 @@ def main():
         subs.append(rospy.Subscriber(ns + "ground_truth", Odometry, truths[i].append, queue_size=100))
     subs.append(rospy.Subscriber("/world/worker_truth", Odometry, worker.append, queue_size=100))
     subs.append(rospy.Subscriber("/uav0/perception/worker_detection", WorkerDetection, detections.append, queue_size=50))
+    subs.append(rospy.Subscriber("/uav0/worker_state", WorkerState, estimates.append, queue_size=50))
     t0 = time.time()
     while time.time() - t0 < wall_s and not rospy.is_shutdown():
         time.sleep(0.2)
-        for h in list(truths.values()) + [worker]:
+        for h in list(truths.values()) + [worker, estimates]:
             del h[:-400]  # keep the last seconds
     sim_end = rospy.get_time()
     for s in subs:
@@ -103,7 +107,8 @@ def main():
         gaps = np.diff(stamps)
         # on the camera rate's grid in sim time: never more frames than the rate allows (a frame that
         # came late, after a slow one, is followed by the next grid point), most of them delivered
-        on_grid = np.mean(np.abs(gaps * rate_hz - np.round(gaps * rate_hz)) < 0.04) if len(gaps) else 0.0
+        # (SimWorld's frames lie on its 0.01 s clock steps)
+        on_grid = np.mean(np.abs(gaps - np.round(gaps * rate_hz) / rate_hz) < 0.0101) if len(gaps) else 0.0
         check(len(stamps) > 1 and np.all(gaps > 0) and len(stamps) - 1 <= span * rate_hz + 0.5 and
               len(stamps) - 1 >= 0.6 * span * rate_hz and on_grid >= 0.8,
               "uav%d: %d frames over %.1f s sim (%.2f Hz, camera rate %.1f Hz), %.0f %% of the gaps whole periods" %
@@ -147,6 +152,16 @@ def main():
     check(len(ranged) >= 0.7 * max(1, len(found)) and all(2.0 < d.stereo_distance_m < 20.0 for d in ranged),
           "leader Perception: %d stereo ranges from the rendered depth, in (2, 20) m: %s" %
           (len(ranged), ["%.1f" % d.stereo_distance_m for d in ranged[:6]]))
+    errors = []
+    for e in estimates[-40:]:
+        w = nearest(worker, e.header.stamp.to_sec())
+        if w is not None and abs(w.header.stamp.to_sec() - e.header.stamp.to_sec()) < 0.06:
+            a, b = e.position, w.pose.pose.position
+            errors.append(math.sqrt((a.x - b.x) ** 2 + (a.y - b.y) ** 2 + (a.z - b.z) ** 2))
+    tracked = [e for e in estimates[-40:] if not e.lost]
+    check(len(errors) >= 10 and len(tracked) == len(estimates[-40:]) and max(errors) < ESTIMATE_TOL_M,
+          "leader WorkerEstimator on the rendered camera: %d of the last %d estimates tracked, error vs truth max %s m"
+          % (len(tracked), len(estimates[-40:]), "%.2f" % max(errors) if errors else "-"))
     print("sim time reached: %.1f s" % sim_end)
     return fails
 
