@@ -130,7 +130,7 @@ class SimCameraNodelet : public nodelet::Nodelet {
     });
     const std::string e = error.get();
     if (!e.empty()) {
-      params.addError("models_root: " + models_root + ": " + e);
+      params.addError("rendering (models_root " + models_root + "): " + e);
       render_thread_.join();
     }
   }
