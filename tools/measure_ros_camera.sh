@@ -6,8 +6,12 @@
 # against its rate, the frames the leader's Perception processed, how late (sim time) its
 # detections come after the instant they show, and SimCamera's wall time per frame (its log).
 # A setting "synthetic:RTF" runs camera:=synthetic instead (the sim rate reached without rendering).
+# --gestures also flies test/data/sim/rendered_gestures.yaml (58 s: near-misses, then the four
+# gestures; seed 1) to its end at 15 Hz, 0.33x and reports its metrics.json: the gestures that
+# fired through the rendered cameras, the Perception nodelets and the vote, and the safety figures.
 # Appends a dated section to docs/results/ros_camera.md.
-#   tools/measure_ros_camera.sh [--wall S] [--configs "RATE:RTF RATE:RTF ..."] [--no-write]
+#   tools/measure_ros_camera.sh [--wall S] [--configs "RATE:RTF RATE:RTF ..."] [--gestures] [--no-write]
+#   (--configs "" --gestures: the gesture mission only)
 # Build first (tools/build.sh). Exit 2: bad arguments / no build / not root.
 set -o pipefail
 cd "$(dirname "$0")/.."
@@ -16,11 +20,13 @@ BUILD=${GF_BUILD_DIR:-build}
 WALL=40
 CONFIGS="synthetic:1.0 3:0.5 5:1.0 10:1.0 15:0.33"
 WRITE=1
+GESTURES=0
 while [ $# -gt 0 ]; do
   case $1 in
     --wall) WALL=$2; shift 2 ;;
     --configs) CONFIGS=$2; shift 2 ;;
     --no-write) WRITE=0; shift ;;
+    --gestures) GESTURES=1; shift ;;
     -h | --help) sed -n '2,10p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "$0: unknown argument $1" >&2; exit 2 ;;
   esac
@@ -104,6 +110,39 @@ INNER
   rows+=("$row $ms |")
   echo "${rows[-1]}"
 done
+gesture_row=""
+if [ "$GESTURES" -eq 1 ]; then
+  rm -rf "$T/log" "$T/out"; mkdir -p "$T/out"
+  cat > "$T/inner.sh" <<INNER
+export ROS_MASTER_URI=http://127.0.0.1:14311 ROS_IP=127.0.0.1 ROS_HOME=$T/ros ROS_LOG_DIR=$T/log
+source "$BUILD/devel/setup.bash"
+ip link set lo up && ip route add 224.0.0.0/4 dev lo || exit 1
+roslaunch -p 14311 gesture_formation simulation.launch key_dir:=$T/keys output_dir:=$T/out seed:=1 \
+  mission:=$SRC/test/data/sim/rendered_gestures.yaml real_time_factor:=0.33 camera:=rendered camera_rate:=15 > "$T/launch.log" 2>&1 &
+launch=\$!
+for _ in \$(seq 600); do [ -f "$T/out/metrics.json" ] && break; sleep 1; done
+sleep 1
+kill -INT \$launch; wait \$launch
+INNER
+  timeout 700 unshare -n bash "$T/inner.sh"
+  gesture_row=$(python3 - "$T/out" <<'PY'
+import csv, json, sys
+d = sys.argv[1]
+try:
+    m = json.load(open(d + "/metrics.json"))
+    ev = list(csv.DictReader(open(d + "/events.csv")))
+except OSError as e:
+    print("(no metrics: %s)" % e)
+    sys.exit(0)
+fired = sorted({e["gesture_id"] for e in ev if e["source"] == "gesture" and e["status"] == "applied"})
+print("| %d of %d (fired: %s) | %s | %d | %.2f m | %.2f m | %.2f m | %d |" % (
+    m["gestures_successful"], m["gestures_performed"], ", ".join(fired) or "none",
+    "%.2f s" % m["gesture_mean_latency_s"] if m["gesture_mean_latency_s"] is not None else "-", m["false_adaptations"],
+    m["min_mutual_distance_m"], m["min_obstacle_distance_m"], m["min_human_distance_m"], m["collisions"]))
+PY
+)
+  echo "$gesture_row"
+fi
 load1=$(cut -d' ' -f1-3 /proc/loadavg)
 [ "$WRITE" -eq 1 ] || exit 0
 OUT=$SRC/docs/results/ros_camera.md
@@ -125,12 +164,23 @@ HEAD
 fi
 {
   echo
-  echo "## $(date -u +%Y-%m-%d) — ${WALL} s of wall time per setting"
+  echo "## $(date -u +%Y-%m-%d) — $([ ${#rows[@]} -gt 0 ] && echo "${WALL} s of wall time per setting" || echo "the gesture mission")"
   echo
   echo "$(nproc) cores, load average $load0 before, $load1 after ($(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'))."
-  echo
-  echo "| camera rate | RTF asked | sim s / wall s | frames delivered | leader Perception outputs / frames | found | detection lateness [sim s] | estimate error median / max [m] | SimCamera ms / frame |"
-  echo "|---|---|---|---|---|---|---|---|---|"
-  printf '%s\n' "${rows[@]}"
+  if [ ${#rows[@]} -gt 0 ]; then
+    echo
+    echo "| camera rate | RTF asked | sim s / wall s | frames delivered | leader Perception outputs / frames | found | detection lateness [sim s] | estimate error median / max [m] | SimCamera ms / frame |"
+    echo "|---|---|---|---|---|---|---|---|---|"
+    printf '%s\n' "${rows[@]}"
+  fi
+  if [ -n "$gesture_row" ]; then
+    echo
+    echo "test/data/sim/rendered_gestures.yaml to its end (58 s; seed 1; 15 Hz at 0.33x) — the gestures through"
+    echo "the rendered cameras, each UAV's Perception nodelet, its ViewObserver and the leader's GestureCommander:"
+    echo
+    echo "| gestures successful | mean latency | false adaptations | min mutual | min obstacle | min human | collisions |"
+    echo "|---|---|---|---|---|---|---|"
+    echo "$gesture_row"
+  fi
 } >> "$OUT"
 echo "wrote $OUT"
