@@ -1,6 +1,7 @@
 #pragma once
 // All message <-> core conversions of the nodelets (house style: one header, no math).
 #include <cmath>
+#include <cstring>
 #include <string>
 
 #include <Eigen/Geometry>
@@ -528,6 +529,26 @@ inline common::Result<cv::Mat> toDepth(const sensor_msgs::Image& m) {
   const cv::Mat view(static_cast<int>(m.height), static_cast<int>(m.width), type, const_cast<std::uint8_t*>(m.data.data()),
                      m.step);
   return R::ok(view.clone());
+}
+
+/// An owned, continuous or not, cv::Mat (CV_8UC3 as "rgb8"/"bgr8", CV_32FC1 as "32FC1") as an
+/// Image with `encoding`; fails when the Mat's type does not match the encoding.
+inline common::Result<sensor_msgs::Image> toImage(const cv::Mat& mat, const std::string& encoding) {
+  using R = common::Result<sensor_msgs::Image>;
+  const bool colour = encoding == "rgb8" || encoding == "bgr8";
+  if (!(colour && mat.type() == CV_8UC3) && !(encoding == "32FC1" && mat.type() == CV_32FC1)) {
+    return R::fail("Image: a cv::Mat of type " + std::to_string(mat.type()) + " cannot be encoded as '" + encoding + "'");
+  }
+  sensor_msgs::Image m;
+  m.height = static_cast<std::uint32_t>(mat.rows);
+  m.width = static_cast<std::uint32_t>(mat.cols);
+  m.encoding = encoding;
+  m.is_bigendian = 0;
+  const std::size_t row_bytes = static_cast<std::size_t>(mat.cols) * mat.elemSize();
+  m.step = static_cast<std::uint32_t>(row_bytes);
+  m.data.resize(row_bytes * static_cast<std::size_t>(mat.rows));
+  for (int r = 0; r < mat.rows; ++r) std::memcpy(m.data.data() + row_bytes * static_cast<std::size_t>(r), mat.ptr(r), row_bytes);
+  return R::ok(std::move(m));
 }
 
 }  // namespace gesture_formation::nodelets

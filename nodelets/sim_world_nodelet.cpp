@@ -24,7 +24,14 @@
 // the clock.
 // Parameters (required): ~mission_file, ~seed, ~real_time_factor, ~clock_step_s,
 //   ~duration_s, ~output_dir, ~world_frame, ~leader_camera_frame; optional ~faults_file (a fault
-//   profile merged into the mission: camera blackouts, sensor dropouts, range outliers, wind).
+//   profile merged into the mission: camera blackouts, sensor dropouts, range outliers, wind),
+//   ~camera (synthetic | rendered; default synthetic).
+// ~camera rendered (simulation.launch camera:=rendered): every UAV's camera is rendered by its
+//   SimCamera nodelet and goes through its Perception nodelet; SimWorld then publishes no
+//   detection and no classification (no ground truth reaches the estimator or the classifier),
+//   but worker_body_out (WorkerBody: the worker's posed 3-D body at each camera frame, which the
+//   SimCamera nodelets render) and, for its metrics, reads the leader's Perception output on
+//   detection_in (visibility). UWB stays synthetic (a radio sensor), as in gfctl simulate.
 #include <algorithm>
 #include <mutex>
 #include <optional>
@@ -68,6 +75,12 @@ class SimWorldNodelet : public nodelet::Nodelet {
     params.load("output_dir", output_dir_);
     params.load("world_frame", world_frame_);
     params.load("leader_camera_frame", camera_frame_);
+    std::string camera_mode;
+    params.loadOptional("camera", camera_mode, "synthetic");
+    if (camera_mode != "synthetic" && camera_mode != "rendered") {
+      params.addError("camera: must be synthetic or rendered, got '" + camera_mode + "'");
+    }
+    rendered_ = camera_mode == "rendered";
     if (!mission_file.empty() && loadMission(mission_file, params, cfg_)) loadWorldMap(mission_file, params, world_);
     if (params.ok() && !cfg_.gesture_model.empty()) {
       auto c = sim::loadOnnxClassifier(cfg_.gesture_model);
@@ -96,11 +109,18 @@ class SimWorldNodelet : public nodelet::Nodelet {
 
     clock_pub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
     worker_pub_ = nh.advertise<nav_msgs::Odometry>("worker_truth_out", 10);
-    detection_pub_ = nh.advertise<gesture_formation::WorkerDetection>("detection_out", 10);
     uwb_pub_ = nh.advertise<sensor_msgs::Range>("uwb_out", 10);
     follower_views_ = cfg_.view_fusion.min_agreeing_views > 1;  // as sim::runMission
-    for (int i = 0; i < (follower_views_ ? n_ : 1); ++i) {
-      gesture_pubs_.push_back(nh.advertise<gesture_formation::Gesture>("uav" + std::to_string(i) + "/gesture_out", 10));
+    if (rendered_) {
+      // The cameras are rendered (SimCamera) and seen by the Perception nodelets: no detection and
+      // no classification from here, only the body they render.
+      body_pub_ = nh.advertise<gesture_formation::WorkerBody>("worker_body_out", 10);
+      detection_sub_ = nh.subscribe("detection_in", 20, &SimWorldNodelet::onLeaderDetection, this);
+    } else {
+      detection_pub_ = nh.advertise<gesture_formation::WorkerDetection>("detection_out", 10);
+      for (int i = 0; i < (follower_views_ ? n_ : 1); ++i) {
+        gesture_pubs_.push_back(nh.advertise<gesture_formation::Gesture>("uav" + std::to_string(i) + "/gesture_out", 10));
+      }
     }
     command_pub_ = nh.advertise<gesture_formation::FormationCommand>("operator_command_out", 20);
     done_pub_ = nh.advertise<std_msgs::Bool>("done_out", 1, true);
@@ -172,6 +192,10 @@ class SimWorldNodelet : public nodelet::Nodelet {
   /// command_repeat_period_s: 0.4 s later with 5 × 0.1 s); a gesture command keeps the classifier
   /// output's stamp (the fire time).
   static constexpr double kStampToleranceS = 0.6;
+  /// Rendered cameras: the timeline's `visible` holds this long after the leader's Perception last
+  /// found the worker (its frames come at the SimCamera's rate, a few Hz, and late by their
+  /// processing time).
+  static constexpr double kRenderedVisibleS = 1.0;
 
   /// The parameter version a plan was made with: the leader's says it; a follower's parameters
   /// come over LCM without their version, so it is the latest version the leader published
@@ -181,6 +205,17 @@ class SimWorldNodelet : public nodelet::Nodelet {
     const auto used = fromMsg(m.formation);
     if (!used || used->uavCount() != n_) return m.params_version;
     return versions_->versionOf(*used).value_or(m.params_version);
+  }
+
+  /// Rendered cameras: the leader's Perception output, one per frame it processed (metrics:
+  /// visibility and the estimate's error at that frame).
+  void onLeaderDetection(const gesture_formation::WorkerDetection::ConstPtr& m) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (finished_ || !started_) return;
+    const double t = m->header.stamp.toSec();
+    if (m->detected) last_detected_s_ = t;
+    const std::optional<Eigen::Vector3d> est = estimateAt(t);
+    metrics_->cameraFrame(m->detected, est ? &*est : nullptr, worker_->stateAt(t).p_world);
   }
 
   void onGestureStatus(const gesture_formation::GestureStatus::ConstPtr& m) {
@@ -291,11 +326,21 @@ class SimWorldNodelet : public nodelet::Nodelet {
         online.push_back(!cfg_.faults.followerOffline(i, t_));
       }
     }
-    const sim::LeaderCameraFrame cf = camera_->frame(t_, *truth_[0], followers, online, ws, *worker_, classifier_.get());
+    // The worker's performance advances here in both modes (the same motions and gesture
+    // episodes); with rendered cameras only its body leaves (no classifier is run).
+    const sim::LeaderCameraFrame cf =
+        camera_->frame(t_, *truth_[0], followers, online, ws, *worker_, rendered_ ? nullptr : classifier_.get());
     metrics_->counters().range_outliers += cf.range_outliers;
-    const std::optional<Eigen::Vector3d> est = estimateAt(t_);
-    metrics_->cameraFrame(cf.sensors.visible(), est ? &*est : nullptr, ws.p_world);
     const ros::Time stamp(t_);
+    if (rendered_) {
+      auto body = toWorkerBodyMsg(worker_->bodyAt(t_), ws.feet_world, ws.heading_rad);
+      body.header.stamp = stamp;
+      body.header.frame_id = world_frame_;
+      body_pub_.publish(body);
+    } else {
+      const std::optional<Eigen::Vector3d> est = estimateAt(t_);
+      metrics_->cameraFrame(cf.sensors.visible(), est ? &*est : nullptr, ws.p_world);
+    }
     if (std::isfinite(cf.sensors.d_uwb_m)) {
       sensor_msgs::Range r;
       r.header.stamp = stamp;
@@ -306,6 +351,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
       r.range = static_cast<float>(cf.sensors.d_uwb_m);
       uwb_pub_.publish(r);
     }
+    if (rendered_) return;  // the Perception nodelets see the rendered images
     // Each UAV's classifier output, as its Perception nodelet would publish it (the followers'
     // first: the leader's closes the frame at the GestureCommander only when all have reported).
     for (std::size_t i = 0; i < cf.followers.size(); ++i) {
@@ -343,7 +389,8 @@ class SimWorldNodelet : public nodelet::Nodelet {
     in.t_s = t_;
     in.worker = ws;
     if (const auto est = estimateAt(t_)) in.estimate_world = *est;
-    in.visible = camera_->lastVisibleS() > t_ - 0.2 ? 1 : 0;
+    // Rendered cameras: the leader's Perception found the worker within kRenderedVisibleS.
+    in.visible = (rendered_ ? last_detected_s_ > t_ - kRenderedVisibleS : camera_->lastVisibleS() > t_ - 0.2) ? 1 : 0;
     in.gesture_true = worker_->performingAt(t_);
     in.gesture_class = last_class_;
     in.dominant_ratio = last_ratio_;
@@ -395,16 +442,17 @@ class SimWorldNodelet : public nodelet::Nodelet {
   double rtf_ = 1.0, clock_step_s_ = 0.01, duration_s_ = 0.0, t_ = 0.0, last_ratio_ = 0.0;
   long k_ = 0;
   int n_ = 0, last_class_ = -1;
-  bool finished_ = false, started_ = false, follower_views_ = false;
+  bool finished_ = false, started_ = false, follower_views_ = false, rendered_ = false;
+  double last_detected_s_ = -1e9;  ///< rendered cameras: the leader's Perception's last find
   std::optional<sim::OperatorSchedule> schedule_;
   std::vector<std::optional<sim::MultirotorState>> truth_;
   std::optional<gesture_formation::WorkerState> estimate_;
   ros::WallTime wall0_;
-  ros::Publisher clock_pub_, worker_pub_, detection_pub_, uwb_pub_, command_pub_, done_pub_;
+  ros::Publisher clock_pub_, worker_pub_, detection_pub_, uwb_pub_, command_pub_, done_pub_, body_pub_;
   tf2_ros::TransformBroadcaster tf_;  ///< the gesture cameras (3-D confirmation)
   std::vector<ros::Publisher> gesture_pubs_;  ///< per UAV (only the leader's without follower views)
   std::vector<ros::Subscriber> truth_subs_, plan_subs_;
-  ros::Subscriber params_sub_, estimate_sub_, status_sub_;
+  ros::Subscriber params_sub_, estimate_sub_, status_sub_, detection_sub_;
   ros::WallTimer clock_timer_;
 };
 

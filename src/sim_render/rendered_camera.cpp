@@ -197,13 +197,11 @@ gesture::SkeletonWindow windowFromFifo(const std::vector<float>& tensor) {
 
 RenderedCamera::RenderedCamera(const MissionConfig& mission, const planning::OccupancyMap* map, std::uint64_t seed)
     : cfg_(mission),
-      intrinsics_(mission.estimator.camera),
+      intrinsics_(renderedIntrinsics(mission)),
       uwb_(mission.camera, mission.stereo, mission.uwb, map, makeRng(seed, Stream::kCamera), makeRng(seed, Stream::kStereo),
            makeRng(seed, Stream::kUwb)),
       fault_rng_(makeRng(seed, Stream::kFault)),
-      seed_(seed) {
-  intrinsics_.distortion.fill(0.0);  // the rendered image is the rectified one
-}
+      seed_(seed) {}
 
 RenderedCamera::~RenderedCamera() = default;
 
@@ -221,16 +219,11 @@ common::Result<std::unique_ptr<RenderedCamera>> RenderedCamera::create(const Ren
   }
   std::unique_ptr<RenderedCamera> cam(new RenderedCamera(mission, map, seed));
   cam->config_ = config;
-  cam->appearance_ = render::Appearance::fromSeed(seed);
   cam->config_.perception.models_root = config.models_root;
   if (config.stereo_max_from_mission) cam->config_.stereo.max_depth_m = mission.stereo.max_range_m;
-  render::RendererConfig rc;
-  rc.worker_asset_path = config.models_root + "/mannequin/wooden_mannequin.glb";
-  auto renderer = render::Renderer::create(rc);
-  if (!renderer) return R::fail("rendered camera: " + renderer.reason());
-  cam->renderer_ = std::move(*renderer);
-  auto world = cam->renderer_->setWorld(scenario);
-  if (!world) return R::fail("rendered camera: the world: " + world.reason());
+  auto scene = SceneRenderer::create(config.models_root, scenario, seed);
+  if (!scene) return R::fail("rendered camera: " + scene.reason());
+  cam->scene_ = std::move(*scene);
   const std::size_t n = mission.uavs.size();
   for (std::size_t i = 0; i < n; ++i) {
     auto c = std::make_unique<Camera>();
@@ -262,10 +255,7 @@ CameraResult RenderedCamera::renderCamera(std::size_t i, double t, const Eigen::
   if (c.last_frame_s > -1e8 && t - c.last_frame_s > LeaderCamera::kSkeletonGapS + 1e-9) c.pipeline->reset();
   c.last_frame_s = t;
   const auto t0 = Clock::now();
-  render::CameraView view;
-  view.intrinsics = intrinsics_;
-  view.T_world_camera = T_world_camera;
-  auto rendered = renderer_->render(view, i);
+  auto rendered = scene_->render(i, intrinsics_);
   if (!rendered) {
     r.error = "t " + std::to_string(t) + " s, uav " + std::to_string(i) + ": render: " + rendered.reason();
     return r;
@@ -350,25 +340,17 @@ LeaderCameraFrame RenderedCamera::frame(double t, const MultirotorState& leader,
   LeaderCameraFrame out;
   // Every UAV's body and camera pose; the worker's performance advances exactly as with the
   // synthetic camera (the same motions and gesture episodes) — its synthetic skeletons are not used.
-  std::vector<const MultirotorState*> states{&leader};
-  for (const MultirotorState& f : followers) states.push_back(&f);
+  std::vector<MultirotorState> states{leader};
+  states.insert(states.end(), followers.begin(), followers.end());
   std::vector<Eigen::Vector3d> camera_world;
-  CameraPoses bodies, cameras;
-  for (const MultirotorState* s : states) {
-    camera_world.push_back(s->p_world);
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.translation() = s->p_world;
-    T.linear() = Eigen::AngleAxisd(s->heading_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    bodies.push_back(T);
-    cameras.push_back(render::cameraPoseFromHeadingPitch(s->p_world, s->heading_rad, s->pitch_rad));
-  }
+  for (const MultirotorState& s : states) camera_world.push_back(s.p_world);
   out.skeleton.t_s = t;
   out.skeleton.label = worker.skeletonsAt(t, camera_world).front().label;  // the truth label only
   const auto t0 = Clock::now();
-  const auto posed = renderer_->setWorker(render::WorkerJoints::fromBody(worker.bodyAt(t), ws.feet_world, ws.heading_rad),
-                                          cfg_.worker.height_m, appearance_);
-  if (!posed && error_.empty()) error_ = "t " + std::to_string(t) + " s: the worker mesh: " + posed.reason();
-  renderer_->setUavs(bodies);
+  const auto posed = scene_->setScene(worker.bodyAt(t), ws.feet_world, ws.heading_rad, cfg_.worker.height_m, states);
+  if (!posed && error_.empty()) error_ = "t " + std::to_string(t) + " s: " + posed.reason();
+  CameraPoses cameras;
+  for (std::size_t i = 0; i < states.size(); ++i) cameras.push_back(scene_->cameraPose(i));
   const double pose_ms = msSince(t0);  // skinning + upload, charged to the leader's render time
 
   bool blackout = false;
@@ -415,6 +397,6 @@ LeaderCameraFrame RenderedCamera::frame(double t, const MultirotorState& leader,
 
 double RenderedCamera::lastVisibleS() const { return cameras_.empty() ? -1e9 : cameras_.front()->last_visible_s; }
 
-std::string RenderedCamera::glRenderer() const { return renderer_->glRenderer(); }
+std::string RenderedCamera::glRenderer() const { return scene_->glRenderer(); }
 
 }  // namespace gesture_formation::sim

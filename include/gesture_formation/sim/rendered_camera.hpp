@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// \brief The rendered camera (docs/simulation.md §8; issue 32): a CameraSource whose frames are
-/// rendered images of the mission (render::Renderer: the world, the other UAVs, the worker mesh
+/// rendered images of the mission (sim::SceneRenderer over render::Renderer: the world, the other UAVs, the worker mesh
 /// posed every frame from the worker model's own 3-D body, WorkerModel::bodyAt) at each UAV's
 /// **true** camera pose, put through the real perception pipeline of that UAV
 /// (perception::PerceptionPipeline: detector ⇄ tracker, skeleton network, FIFO) and the
@@ -35,6 +35,7 @@
 #include "gesture_formation/render/renderer.hpp"
 #include "gesture_formation/sim/camera_source.hpp"
 #include "gesture_formation/sim/mission_config.hpp"
+#include "gesture_formation/sim/scene_renderer.hpp"
 
 namespace gesture_formation::planning {
 class OccupancyMap;
@@ -96,7 +97,7 @@ class RenderedCamera : public CameraSource {
 
  private:
   RenderedCamera(const MissionConfig& mission, const planning::OccupancyMap* map, std::uint64_t seed);
-  using CameraPoses = std::vector<Eigen::Isometry3d, Eigen::aligned_allocator<Eigen::Isometry3d>>;
+  using CameraPoses = SceneRenderer::Poses;
   /// Renders UAV `i`'s camera at `T_world_camera` (serial: one GL context).
   CameraResult renderCamera(std::size_t i, double t_s, const Eigen::Isometry3d& T_world_camera, double extra_render_ms);
   /// UAV `i`'s pipeline on its rendered image (touches only camera i and `r`: may run concurrently).
@@ -111,13 +112,12 @@ class RenderedCamera : public CameraSource {
   const MissionConfig& cfg_;
   estimation::CameraIntrinsics intrinsics_;  ///< the mission's camera, distortion 0 (rectified)
   RenderedCameraConfig config_;
-  std::unique_ptr<render::Renderer> renderer_;
+  std::unique_ptr<SceneRenderer> scene_;  ///< the world, the worker mesh, the UAVs (shared with the SimCamera nodelet)
   std::vector<std::unique_ptr<Camera>> cameras_;  ///< [0] leader, [i] follower i
   SyntheticSensors uwb_;        ///< the leader's UWB range (its box and stereo outputs are not used)
   std::mt19937_64 fault_rng_;
   std::uint64_t seed_;
   std::vector<PerceptionRecord> records_;
-  render::Appearance appearance_;
   std::string error_;  ///< the first rendering / pipeline failure during the mission
 
  public:
