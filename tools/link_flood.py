@@ -28,6 +28,9 @@ CHANNEL = PREFIX + "WORKER_STATE"
 RATE_HZ = 20.0
 DURATION_S = float(os.environ.get("FLOOD_SECONDS", "10"))
 FLOODERS = int(os.environ.get("FLOODERS", "2"))
+# python: each flood process sends with socket.sendto; c: each runs FLOOD_SENDER (the compiled
+# tools/link_flood_sender.c: sendmmsg batches, several times the Python rate).
+FLOOD_IMPL = os.environ.get("FLOOD_IMPL", "python")
 
 
 def lcm_datagram(seq, body):
@@ -50,6 +53,16 @@ def flood_worker(kind, fingerprint, stop_at, counter):
             header = b"GF" + struct.pack(">BBHBBQdI", 2, 2, sender, 1, 0, 2**60 + i, time.time(), len(payload))
             env = header + payload + bytes(rng.getrandbits(8) for _ in range(64))
         templates.append(fingerprint + struct.pack(">i", len(env)) + env)
+    if FLOOD_IMPL == "c":
+        path = "%s/flood_%d.bin" % (T, os.getpid())
+        with open(path, "wb") as f:
+            for i, t in enumerate(templates):
+                d = lcm_datagram(i, t)
+                f.write(struct.pack(">I", len(d)) + d)
+        out = subprocess.run([os.environ["FLOOD_SENDER"], path, GROUP, str(PORT), repr(stop_at)],
+                             check=True, capture_output=True, text=True).stdout
+        counter.value += int(out.strip())
+        return
     while time.time() < stop_at:
         for i in range(2000):
             try:

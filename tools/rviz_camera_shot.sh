@@ -5,6 +5,7 @@
 # of wall time after the launch (the leader's camera image on the left, the 3-D view beside it).
 #   tools/rviz_camera_shot.sh OUT.png [--wait S] [--rate HZ] [--rtf F] [--seed N]
 # Exit 2: bad arguments, no build, not root; 1: no screenshot.
+case "${1:-}" in -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;; esac
 set -o pipefail
 cd "$(dirname "$0")/.."
 SRC=$PWD

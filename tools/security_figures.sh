@@ -3,7 +3,8 @@
 # the cost per message of HMAC-SHA256 and Ed25519 envelopes (gf_bench_comm) and the legitimate
 # messages delivered while a keyless flood saturates the loopback inside a private network
 # namespace (tools/link_flood.py: two LcmBridges, 20 Hz worker states, flood processes).
-#   tools/security_figures.sh [BUILD_DIR]     (root: unshare -n; FLOOD_SECONDS (10), FLOOD_PROCS ("2 4"): one run per count of flood processes)
+#   tools/security_figures.sh [BUILD_DIR]     (root: unshare -n; FLOOD_SECONDS (10), FLOOD_PROCS ("2 4"): one run per count of flood processes;
+#   FLOOD_IMPLS ("python c"): Python flood processes, then the compiled tools/link_flood_sender.c (sendmmsg))
 case "${1:-}" in -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;; esac
 set -eo pipefail
 cd "$(dirname "$0")/.."
@@ -29,9 +30,12 @@ rc=\$?
 kill %1 2>/dev/null; wait
 exit \$rc
 INNER
+gcc -O2 -Wall -o "$T/flood_sender" tools/link_flood_sender.c
 flood=""
-for n in ${FLOOD_PROCS:-2 4}; do
-  flood+="$n flood processes:"$'\n'"$(FLOODERS=$n unshare -n bash "$T/inner.sh")"$'\n\n'
+for impl in ${FLOOD_IMPLS:-python c}; do
+  for n in ${FLOOD_PROCS:-2 4}; do
+    flood+="$n flood processes ($impl):"$'\n'"$(FLOOD_IMPL=$impl FLOOD_SENDER=$T/flood_sender FLOODERS=$n unshare -n bash "$T/inner.sh")"$'\n\n'
+  done
 done
 rmem=$(cat /proc/sys/net/core/rmem_max)
 out=docs/results/security.md
@@ -54,7 +58,7 @@ out=docs/results/security.md
   echo
   echo "Private network namespace, loopback multicast (ttl 0); leader bridge (sender 0) forwards worker"
   echo "states at 20 Hz for ${FLOOD_SECONDS:-10} s to the follower bridge (sender 2), per-sender Ed25519 keys;"
-  echo "flood processes (Python, one socket each) send as fast as they can on the same channel; they share the"
+  echo "flood processes (Python sendto, or C sendmmsg: tools/link_flood_sender.c; one socket each) send as fast as they can on the same channel; they share the"
   echo "2 cores with the bridges, so more of them also means less CPU for the receiver. net.core.rmem_max = $rmem"
   echo "bytes; the bridge reads the group on its own socket (recvmmsg, docs/security.md §7) and asks for a 4 MiB receive buffer."
   echo
@@ -62,7 +66,7 @@ out=docs/results/security.md
   printf '%s' "$flood"
   echo '```'
   echo
-  echo "Columns: flood datagrams sent (as counted by the senders; ENOBUFS drops included), and the"
+  echo "Columns: flood datagrams sent (as counted by the senders: the Python ones count ENOBUFS drops, the C one only what the kernel took), and the"
   echo "receiving bridge's counters over the same interval. When the counters add up to the datagrams"
   echo "sent, the receiver kept up with the flood and nothing was lost in its socket."
 } > "$out"

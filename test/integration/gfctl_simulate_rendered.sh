@@ -67,17 +67,21 @@ need(m["min_mutual_distance_m"] >= 2.5, f"min_mutual_distance_m {m['min_mutual_d
 need(m["min_obstacle_distance_m"] >= 0.5, f"min_obstacle_distance_m {m['min_obstacle_distance_m']:.3f} < 0.5")
 need(m["min_human_distance_m"] >= 2.5, f"min_human_distance_m {m['min_human_distance_m']:.3f} < 2.5")
 need(m["gestures_performed"] == 4, f"gestures_performed {m['gestures_performed']} != 4")
-# On pixels, through MoveNet and the LSTM, the one-arm gestures fire (extend 2, raise 4; each
-# matched in time), the two-arm ones do not: crossed arms are read by one or two views for well under
-# the filter's 20 fused frames, palms together by one view only — the skeleton network's systematic
-# errors on rendered figures (issue 33). Measured on seed 1: gestures 2 and 4 fired, 1 and 3 missed.
+# On pixels, through MoveNet, the LSTM, the 2-of-3 vote and the 3-D check of every voted gesture
+# (view_fusion.require_3d, the default; issue 33): raise an arm (4) fires, matched in time. Crossed
+# arms and palms together are read by too few views for the filter (the skeleton network's
+# systematic errors on rendered figures); "extend an arm" (2) passes the 2-D vote but its
+# triangulated arm is not abducted to the side in enough frames, so the 3-D check refuses it —
+# the price of the check, which also refuses the near-miss that fired before it (seed 1: "extend"
+# at 18.8 s while follower 1 read an arm partway/pointing as extended). Measured on seed 1 with
+# the check: gesture 4 fired, 1, 2 and 3 missed, no false adaptation (without it: 2 and 4 fired,
+# one false adaptation).
 fired_ok = {e["gesture_id"] for e in events if e["source"] == "gesture" and e["status"] == "applied"
             and e["gesture_start_t"] not in ("", "nan")}
-need({"2", "4"} <= fired_ok, f"gestures fired in time {sorted(fired_ok)}, expected 2 and 4 among them")
-need(m["gestures_successful"] >= 2, f"gestures_successful {m['gestures_successful']} < 2")
-# One near-miss fires a gesture on pixels (seed 1: "extend arm" at 18.8 s, during the work motions,
-# where follower 1 reads the arm partway/pointing as extended): at most that one (issue 33).
-need(m["false_adaptations"] <= 1, f"false_adaptations {m['false_adaptations']} > 1")
+need("4" in fired_ok, f"gestures fired in time {sorted(fired_ok)}, expected 4 among them")
+need(m["gestures_successful"] >= 1, f"gestures_successful {m['gestures_successful']} < 1")
+# No near-miss fires a command on pixels.
+need(m["false_adaptations"] == 0, f"false_adaptations {m['false_adaptations']} > 0")
 p = m.get("perception")
 need(p is not None, "metrics.json has no perception section")
 if p:
