@@ -19,8 +19,10 @@
 /// Depth: metres along the optical axis (the z of the optical frame, as a RealSense aligned
 /// depth image, not the ray length), CV_32FC1; NaN where the pixel sees nothing (sky, and
 /// anything beyond `far_m`) as REP 118 asks of float depth images.
-/// Thread safety: a Renderer must be used by one thread at a time (it makes its context
-/// current on the calling thread at each call); several Renderers may live in one process.
+/// Thread safety: use a Renderer only from the thread that created it. Each call makes its EGL
+/// context current on the calling thread and never releases it, and a context current on one
+/// thread cannot be made current on another (the SimCamera nodelet therefore creates
+/// and uses its renderer on one rendering thread). Several Renderers may live in one process.
 
 #include <array>
 #include <cstdint>
