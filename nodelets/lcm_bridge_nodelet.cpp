@@ -37,9 +37,7 @@
 // Diagnostics: diagnostic_msgs/DiagnosticArray on /diagnostics at 1 Hz, one status for the link
 // (every rejection class in total) and one per known sender (its claimed-name rejections);
 // a throttled warning names the sender and the class of refused envelopes.
-#include <sys/stat.h>
 
-#include <cstdlib>
 #include <deque>
 #include <map>
 #include <mutex>
@@ -52,6 +50,7 @@
 #include <ros/ros.h>
 
 #include "conversions.hpp"
+#include "diagnostics.hpp"
 #include "gesture_formation/comm/command_intake.hpp"
 #include "gesture_formation/comm/link_settings.hpp"
 #include "gesture_formation/comm/rejection_report.hpp"
@@ -67,6 +66,7 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
   ~LcmBridgeNodelet() override {
     std::lock_guard<std::mutex> lock(mutex_);
     drain_timer_.stop();
+    diagnostics_.stop();
     saveMarks();
     link_.reset();
     transport_.reset();
@@ -92,7 +92,7 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     params.load("command_repeats", command_repeats_, 1, 20);
     params.load("command_repeat_period_s", repeat_period_s, 0.01, 1.0);
     ros::NodeHandle& pnh = getPrivateNodeHandle();
-    const std::string state_dir = defaultStateDir();
+    const std::string state_dir = comm::defaultStateDirectory();
     const std::string id_text = std::to_string(sender_id);
     std::string sequence_file, marks_file;
     params.loadOptional("sequence_file", sequence_file, state_dir + "/lcm_bridge_" + id_text + ".boot");
@@ -139,7 +139,7 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     std::uint32_t boot = 0;
     std::map<std::uint16_t, std::uint64_t> marks;
     if (params.ok()) {
-      ensureDirectory(state_dir, sequence_file, marks_file);
+      comm::ensureStateDirectory(state_dir, {sequence_file, marks_file});
       auto b = comm::advanceBootCounter(sequence_file);
       if (b) boot = b.value();
       else params.addError("sequence_file: " + b.reason());
@@ -186,16 +186,15 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     command_sub_ = nh.subscribe("formation_command_in", 100, &LcmBridgeNodelet::onCommand, this);
     observations_pub_ = nh.advertise<gesture_formation::GestureObservation>("gesture_observations_out", 200);
     observation_sub_ = nh.subscribe("gesture_observation_in", 100, &LcmBridgeNodelet::onObservation, this);
-    diagnostics_pub_ = nh.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 10);
     drain_timer_ = nh.createWallTimer(ros::WallDuration(0.005), [this](const ros::WallTimerEvent&) {
       std::lock_guard<std::mutex> lock(mutex_);
       // Bounded: a flood must not keep the mutex from heartbeats and publishing.
       if (transport_) transport_->drain(kMaxDrainPerTick);
     });
-    diagnostics_timer_ = nh.createWallTimer(ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) {
+    diagnostics_.start(nh, 1.0, [this](double) {
       std::lock_guard<std::mutex> lock(mutex_);
-      publishDiagnostics();
       saveMarks();
+      return statuses();
     });
     repeat_timer_ = nh.createTimer(ros::Duration(repeat_period_s), [this](const ros::TimerEvent&) {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -337,21 +336,6 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
                                                          << " refused in all; /diagnostics has the counts)");
   }
 
-  static std::string defaultStateDir() {
-    const char* ros_home = std::getenv("ROS_HOME");
-    const char* home = std::getenv("HOME");
-    const std::string base = ros_home && *ros_home ? ros_home : std::string(home && *home ? home : "/tmp") + "/.ros";
-    return base + "/gesture_formation";
-  }
-
-  /// Creates the default state directory (0700) when a state file lives in it.
-  static void ensureDirectory(const std::string& dir, const std::string& a, const std::string& b) {
-    if (a.rfind(dir + "/", 0) != 0 && b.rfind(dir + "/", 0) != 0) return;
-    const std::string parent = dir.substr(0, dir.rfind('/'));
-    ::mkdir(parent.c_str(), 0700);  // $ROS_HOME may not exist yet; errors show when the files are opened
-    ::mkdir(dir.c_str(), 0700);
-  }
-
   // Mutex held.
   void saveMarks() {
     if (!link_ || marks_file_.empty()) return;
@@ -363,24 +347,23 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
   }
 
   // Mutex held. The counts and what was refused since the last report: comm::RejectionReport.
-  void publishDiagnostics() {
-    if (!link_) return;
+  std::vector<diagnostic_msgs::DiagnosticStatus> statuses() {
+    if (!link_) return {};
     if (!report_) report_.emplace("LcmBridge sender " + std::to_string(link_->signer().senderId()));
     const auto senders = link_->verifier().senderCounters();
     const auto& t = transport_->counters();
-    diagnostic_msgs::DiagnosticArray array;
-    array.header.stamp = ros::Time::now();
-    array.status.push_back(toStatus(report_->link(link_->verifierCounters(), senders,
-                                               {{"channel_mismatch", link_->channelMismatches()},
-                                                {"undecodable_lcm", t.undecodable},
-                                                {"received_lcm", t.received},
-                                                {"published", t.published},
-                                                {"publish_failed", t.publish_failed},
-                                                {"command_copies_dropped", command_intake_.copiesDropped()},
-                                                {"observations_refused", observations_refused_}},
-                                               {"channel_mismatch", "undecodable_lcm"})));
-    for (const auto& [sender, counters] : senders) array.status.push_back(toStatus(report_->sender(sender, counters)));
-    diagnostics_pub_.publish(array);
+    std::vector<diagnostic_msgs::DiagnosticStatus> out{
+        toStatus(report_->link(link_->verifierCounters(), senders,
+                               {{"channel_mismatch", link_->channelMismatches()},
+                                {"undecodable_lcm", t.undecodable},
+                                {"received_lcm", t.received},
+                                {"published", t.published},
+                                {"publish_failed", t.publish_failed},
+                                {"command_copies_dropped", command_intake_.copiesDropped()},
+                                {"observations_refused", observations_refused_}},
+                               {"channel_mismatch", "undecodable_lcm"}))};
+    for (const auto& [sender, counters] : senders) out.push_back(toStatus(report_->sender(sender, counters)));
+    return out;
   }
 
   static diagnostic_msgs::DiagnosticStatus toStatus(const comm::DiagnosticEntry& e) {
@@ -413,9 +396,10 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
   std::string marks_file_;
   std::map<std::uint16_t, std::uint64_t> saved_marks_;
   std::optional<comm::RejectionReport> report_;  ///< /diagnostics: counts and refusals since the last report
-  ros::Publisher worker_pub_, plans_pub_, params_pub_, command_pub_, observations_pub_, diagnostics_pub_;
+  ros::Publisher worker_pub_, plans_pub_, params_pub_, command_pub_, observations_pub_;
   ros::Subscriber worker_sub_, plan_sub_, params_sub_, command_sub_, observation_sub_;
-  ros::WallTimer drain_timer_, diagnostics_timer_;
+  ros::WallTimer drain_timer_;
+  DiagnosticsPublisher diagnostics_;  ///< /diagnostics every wall second (also saves the high-water marks)
   ros::Timer heartbeat_timer_, repeat_timer_;
 };
 

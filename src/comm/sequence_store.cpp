@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdlib>
 #include <cstdio>
 #include <cstring>
 #include <sstream>
@@ -146,6 +147,22 @@ Result<bool> saveHighWaterMarks(const std::string& path, const std::map<std::uin
   std::string text;
   for (const auto& [sender, sequence] : marks) text += std::to_string(sender) + " " + std::to_string(sequence) + "\n";
   return writeStateFile(path, text);
+}
+
+std::string defaultStateDirectory() {
+  const char* ros_home = std::getenv("ROS_HOME");
+  const char* home = std::getenv("HOME");
+  const std::string base = ros_home && *ros_home ? ros_home : std::string(home && *home ? home : "/tmp") + "/.ros";
+  return base + "/gesture_formation";
+}
+
+void ensureStateDirectory(const std::string& dir, const std::vector<std::string>& files) {
+  bool inside = false;
+  for (const auto& f : files) inside = inside || f.rfind(dir + "/", 0) == 0;
+  if (!inside) return;
+  const std::string parent = dir.substr(0, dir.rfind('/'));
+  ::mkdir(parent.c_str(), 0700);  // $ROS_HOME may not exist yet
+  ::mkdir(dir.c_str(), 0700);
 }
 
 }  // namespace gesture_formation::comm

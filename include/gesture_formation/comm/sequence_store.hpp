@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "gesture_formation/common/result.hpp"
 
@@ -28,6 +29,14 @@ constexpr std::uint32_t kMaxBootCounter = (std::uint32_t{1} << 24) - 1;
 constexpr std::uint64_t firstSequenceOfBoot(std::uint32_t boot) {
   return (static_cast<std::uint64_t>(boot) << kBootCounterShift) + 1;
 }
+
+/// \brief Where a bridge keeps its boot counter and high-water marks by default:
+/// $ROS_HOME/gesture_formation, else $HOME/.ros/gesture_formation (else /tmp/.ros/...).
+std::string defaultStateDirectory();
+
+/// \brief Creates `dir` (and its parent) with mode 0700 when one of `files` lives in it; errors
+/// show when the files are opened.
+void ensureStateDirectory(const std::string& dir, const std::vector<std::string>& files);
 
 /// \brief Reads the boot counter at `path` (0 when the file does not exist), adds one, writes
 /// it back durably and returns the new value. Fails (nothing written) on a bad file, a

@@ -310,3 +310,20 @@ TEST(RejectionReportTest, ReportsCountsAndRefusalsSinceThePreviousReport) {
   EXPECT_FALSE(report.sender(2, senders[2]).warn);
   EXPECT_FALSE(report.link(link, senders, {{"channel_mismatch", 1}}, {"channel_mismatch"}).warn);
 }
+
+// The bridge's default state directory: under $ROS_HOME, created (0700) only when a state file
+// lives in it.
+TEST(CommSequenceStoreTest, DefaultStateDirectoryIsCreatedOnlyForFilesInIt) {
+  const std::string home = ::testing::TempDir() + "gf_state_home_" + std::to_string(::getpid());
+  ::setenv("ROS_HOME", home.c_str(), 1);
+  const std::string dir = gesture_formation::comm::defaultStateDirectory();
+  EXPECT_EQ(dir, home + "/gesture_formation");
+  struct stat st {};
+  gesture_formation::comm::ensureStateDirectory(dir, {"/elsewhere/a.boot", "/elsewhere/a.marks"});
+  EXPECT_NE(::stat(dir.c_str(), &st), 0) << "created although no state file lives in it";
+  gesture_formation::comm::ensureStateDirectory(dir, {"/elsewhere/a.boot", dir + "/a.marks"});
+  ASSERT_EQ(::stat(dir.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISDIR(st.st_mode));
+  EXPECT_EQ(st.st_mode & 0777, 0700u);
+  ::unsetenv("ROS_HOME");
+}
