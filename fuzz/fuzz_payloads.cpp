@@ -37,6 +37,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     roundTrip<GestureObservationMessage>(payload, n);
     return 0;
   }
+  if (data[0] == 254) {  // (before the abort payload a formation command, as 254 % 5)
+    roundTrip<AbortMessage>(payload, n);
+    return 0;
+  }
   switch (data[0] % 5) {
     case 0: roundTrip<Heartbeat>(payload, n); break;
     case 1: roundTrip<WorkerStateMessage>(payload, n); break;

@@ -106,4 +106,79 @@ inline bool loadGestures(const std::string& path, int follower_count, ParamLoade
   return true;
 }
 
+/// The scenario map's RetreatSpace (where an abort finds its goals), as gfctl simulate builds it.
+/// `world` must outlive every user.
+inline planning::RetreatSpace retreatSpace(const WorldMap& world) {
+  planning::RetreatSpace space;
+  space.field = world.field.get();
+  if (world.map) {
+    space.bounds = world.map->gridBounds();
+    space.resolution_m = world.map->resolution();
+  }
+  space.ground_height_m = world.ground_height_m;
+  return space;
+}
+
+/// `~abort/*` (config/ros/nodelets.yaml formation_planner.abort): every number of
+/// planning::abortConfigFields() and `after` (hover | return_home | land), all required.
+inline void loadAbortParams(const ros::NodeHandle& pnh, ParamLoader& params, planning::AbortConfig& out) {
+  ParamLoader abort(ros::NodeHandle(pnh, "abort"));
+  abort.loadFields(planning::abortConfigFields(), out);
+  std::string after;
+  abort.load("after", after);
+  if (after == "return_home") out.after = planning::AbortAfter::kReturnHome;
+  else if (after == "land") out.after = planning::AbortAfter::kLand;
+  else if (after == "hover") out.after = planning::AbortAfter::kHover;
+  else if (!after.empty()) abort.addError(pnh.resolveName("abort/after") + ": '" + after + "' is not hover, return_home or land");
+  if (abort.ok()) {  // the rules between fields (ranges: above), on loaded values only
+    for (const auto& e : out.problems()) abort.addError("abort/" + e.key + ": " + e.message);
+  }
+  params.merge(abort);
+}
+
+/// The FormationPlanner's settings, from either source (see the file comment).
+struct PlannerSettings {
+  formation::FormationConfig formation;
+  planning::PlannerConfig planner;
+  planning::ReplanConfig replan;  ///< horizon, freshness, avoidance, search, brake, abort
+  double replanning_period_s = 0.0;
+  bool formation_loaded = false;
+};
+
+/// Simulation (`mission_file` non-empty): the mission's settings — the values gfctl simulate runs
+/// with — win over every parameter. Onboard: ~replanning_period_s, the replanning numbers of
+/// planning::replanConfigFields() (each under its last key segment), ~avoid_all_plans, ~abort/*,
+/// ~formation_config and ~planner_config. Every problem into `params`.
+inline void loadPlannerSettings(const ros::NodeHandle& pnh, ParamLoader& params, const std::string& mission_file,
+                                PlannerSettings& out) {
+  if (!mission_file.empty()) {
+    onboard::OnboardSettings mission;
+    if (!loadOnboard(mission_file, params, mission)) return;
+    out.formation_loaded = true;
+    out.formation = mission.formation;
+    out.planner = mission.planner;
+    out.replanning_period_s = mission.replanning_period_s;
+    out.replan = mission.replan;
+    params.note("from mission_file: replanning_period_s " + std::to_string(out.replanning_period_s) +
+                ", horizon_dt_s " + std::to_string(out.replan.dt_s) + ", horizon_steps " +
+                std::to_string(out.replan.steps) + ", faults.* limits, controller.brake_accel_mps2, abort.*, " +
+                "formation, planner");
+    return;
+  }
+  std::string formation_file, planner_file;
+  params.load("replanning_period_s", out.replanning_period_s, onboard::ranges::kReplanningPeriodS);
+  params.loadFields(planning::replanConfigFields(), out.replan);  // horizon_*, *_age_s, brake_accel_mps2, search_*
+  params.load("avoid_all_plans", out.replan.rule.avoid_all_plans);
+  loadAbortParams(pnh, params, out.replan.abort);
+  params.load("formation_config", formation_file);
+  params.load("planner_config", planner_file);
+  out.formation_loaded = !formation_file.empty() && loadFormation(formation_file, params, out.formation);
+  if (!planner_file.empty() && loadPlanner(planner_file, params, out.planner)) {
+    for (const auto& e : planning::abortPlannerProblems(out.replan.abort, out.planner.mutual_distance_m,
+                                                        out.planner.limits.max_speed_mps, "abort/")) {
+      params.addError(e.key + ": " + e.message);
+    }
+  }
+}
+
 }  // namespace gesture_formation::nodelets

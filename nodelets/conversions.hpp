@@ -13,6 +13,8 @@
 #include <nav_msgs/Odometry.h>
 #include <trajectory_msgs/MultiDOFJointTrajectory.h>
 
+#include "gesture_formation/AbortCommand.h"
+#include "gesture_formation/AbortState.h"
 #include "gesture_formation/FormationCommand.h"
 #include "gesture_formation/FormationParams.h"
 #include "gesture_formation/GestureObservation.h"
@@ -284,6 +286,88 @@ inline common::Result<formation::FormationCommand> fromMsg(const gesture_formati
 }
 
 // ---- worker state over LCM -------------------------------------------------------------
+/// One replanning's outcome as this UAV's PlannedTrajectory: the plan, its fallback flag (a holding,
+/// searching or aborting UAV or a fallback plan has right of way), mode and reason, the reference
+/// and the worker prediction planned around, and the formation parameters it planned with.
+inline gesture_formation::PlannedTrajectory toMsg(const planning::ReplanOutcome& out, int uav_index, double t_s,
+                                                  const formation::FormationParams& params, std::uint64_t version,
+                                                  const std::string& world_frame) {
+  auto msg = toMsg(out.result);
+  msg.fallback = out.fallback;
+  msg.mode = planning::toString(out.mode);
+  msg.mode_reason = out.reason;
+  msg.header.frame_id = world_frame;
+  msg.uav_index = uav_index;
+  msg.params_version = version;
+  msg.planned_at = ros::Time(t_s);
+  msg.formation = toMsg(params, 0).uavs;
+  for (int k = 0; k < out.reference.steps(); ++k) msg.reference.push_back(toPoint(out.reference.p_world.col(k)));
+  for (int k = 0; k < out.worker.steps(); ++k) msg.worker.push_back(toPoint(out.worker.p_world.col(k)));
+  return msg;
+}
+
+/// An abort command from ROS as a UAV's ReplanStep takes it (sent_s = stamp); fails naming the field.
+/// An abort command from ROS as it travels (its send time is the envelope's); fails naming the field.
+inline common::Result<comm::AbortMessage> toWire(const gesture_formation::AbortCommand& m) {
+  using R = common::Result<comm::AbortMessage>;
+  if (m.source > gesture_formation::AbortCommand::SOURCE_GESTURE) {
+    return R::fail("source: " + std::to_string(m.source) + " is not 0 (operator) or 1 (gesture)");
+  }
+  comm::AbortMessage wire{formation::CommandId{m.sender, m.sequence},
+                          m.source == gesture_formation::AbortCommand::SOURCE_GESTURE ? planning::AbortSource::kGesture
+                                                                                      : planning::AbortSource::kOperator};
+  if (auto e = comm::encodePayload(wire); !e) return R::fail(e.reason());  // the name's rules are the wire's
+  return R::ok(wire);
+}
+inline common::Result<planning::AbortCommand> fromMsg(const gesture_formation::AbortCommand& m) {
+  using R = common::Result<planning::AbortCommand>;
+  auto wire = toWire(m);
+  if (!wire) return R::fail(wire.reason());
+  if (m.stamp.isZero()) return R::fail("stamp: zero (when was it sent?)");
+  return R::ok(wire->command(m.stamp.toSec()));
+}
+inline gesture_formation::AbortCommand toMsg(const planning::AbortCommand& c, int link_sender) {
+  gesture_formation::AbortCommand m;
+  m.source = c.source == planning::AbortSource::kGesture ? gesture_formation::AbortCommand::SOURCE_GESTURE
+                                                         : gesture_formation::AbortCommand::SOURCE_OPERATOR;
+  m.sender = c.id.sender;
+  m.sequence = c.id.sequence;
+  m.stamp = ros::Time(c.sent_s);
+  m.link_sender = link_sender;
+  return m;
+}
+inline std::uint8_t toMsgPhase(planning::AbortPhase p) {
+  using S = gesture_formation::AbortState;
+  switch (p) {
+    case planning::AbortPhase::kRetreat: return S::PHASE_RETREAT;
+    case planning::AbortPhase::kAtRetreat: return S::PHASE_AT_RETREAT;
+    case planning::AbortPhase::kReturnHome: return S::PHASE_RETURN_HOME;
+    case planning::AbortPhase::kAtHome: return S::PHASE_AT_HOME;
+    case planning::AbortPhase::kLanding: return S::PHASE_LANDING;
+    case planning::AbortPhase::kLanded: return S::PHASE_LANDED;
+    case planning::AbortPhase::kNoGoal: return S::PHASE_NO_GOAL;
+  }
+  return S::PHASE_NONE;
+}
+/// One UAV's abort state (PHASE_NONE while not aborting); `reason` from its last replanning.
+inline gesture_formation::AbortState toAbortState(const planning::AbortPlanner& a, int uav_index, double t_s,
+                                                  const std::string& reason, int link_sender,
+                                                  const std::string& world_frame) {
+  gesture_formation::AbortState m;
+  m.header.stamp = ros::Time(t_s);
+  m.header.frame_id = world_frame;
+  m.uav_index = uav_index;
+  if (!a.aborting()) return m;
+  m.phase = toMsgPhase(a.phase());
+  m.settled = planning::settled(a.phase());
+  m.goal_valid = a.currentGoal().has_value();
+  if (m.goal_valid) m.goal = toPoint(*a.currentGoal());
+  m.reason = reason;
+  m.command = toMsg(*a.command(), link_sender);
+  m.accepted_at = ros::Time(a.acceptedAt());
+  return m;
+}
+
 inline comm::WorkerStateMessage toWire(const gesture_formation::WorkerState& s) {
   comm::WorkerStateMessage w;
   w.t_s = s.header.stamp.toSec();

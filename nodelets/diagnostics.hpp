@@ -11,6 +11,8 @@
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <ros/ros.h>
 
+#include "gesture_formation/comm/rejection_report.hpp"
+
 namespace gesture_formation::nodelets {
 
 /// \brief One status: OK / WARN / ERROR with a message and named values.
@@ -78,5 +80,21 @@ class DiagnosticsPublisher {
   ros::Publisher pub_;
   ros::WallTimer timer_;
 };
+
+/// A link's diagnostic entry (comm::RejectionReport) as a DiagnosticStatus (hardware "lcm").
+inline diagnostic_msgs::DiagnosticStatus toStatus(const comm::DiagnosticEntry& e) {
+  diagnostic_msgs::DiagnosticStatus s;
+  s.name = e.name;
+  s.hardware_id = "lcm";
+  s.level = e.warn ? diagnostic_msgs::DiagnosticStatus::WARN : diagnostic_msgs::DiagnosticStatus::OK;
+  s.message = e.message;
+  for (const auto& [key, value] : e.values) {
+    diagnostic_msgs::KeyValue kv;
+    kv.key = key;
+    kv.value = std::to_string(value);
+    s.values.push_back(kv);
+  }
+  return s;
+}
 
 }  // namespace gesture_formation::nodelets

@@ -1,43 +1,27 @@
-// FormationPlanner nodelet: one UAV's replanning (planning::UavPlanner, design.md §4) at a fixed
-// period, staggered by UAV index. A thin adapter: stage-1 references from the formation core
-// (formation::leaderHorizon / followerHorizon) on the worker's constant-velocity prediction,
-// the plans received from the other UAVs, and the planner's verified plan (or its fallback:
-// previous plan / brake, flagged `fallback` so that every other UAV plans around it).
-// The leader's instance also owns the formation's parameters (formation::FormationState):
-// commands arrive on formation_command_in (gestures, operator over LCM) and the parameters go
-// out on formation_params_out. The request (reference + the other UAVs' plans to avoid) is
-// planning::buildPlanRequest, the same as gfctl simulate's: with avoid_all_plans every UAV plans
-// around every other UAV's received plan.
+// FormationPlanner nodelet: one UAV's replanning at a fixed period, staggered by UAV index — a thin
+// adapter around planning::ReplanStep, the step gfctl simulate's UAVs run (docs/planning.md "The
+// replanning step"): freshness and hold / search (docs/safety.md §1), listening before moving
+// (§2.4), the stage-1 reference on the worker's prediction, the request around the other UAVs'
+// received plans (planning::buildPlanRequest) and the verified plan or its fallback (flagged
+// `fallback`: every other UAV plans around it). The leader's instance also owns the formation's
+// parameters (onboard::FormationParamsRole): commands arrive on formation_command_in (gestures,
+// operator over LCM), the parameters go out on formation_params_out.
 //
 // Topics: odometry_in (nav_msgs/Odometry, orientation = camera axis, docs/ros.md),
 //   worker_state_in (WorkerState: the leader's estimator, or the leader's share over LCM),
 //   plans_in (PlannedTrajectory of other UAVs), formation_params_in (followers),
 //   formation_command_in (leader), wind_estimate_in (geometry_msgs/TwistWithCovarianceStamped in
-//   world_frame, twist.linear = the wind: mavros `wind_estimation`; optional — without it no
-//   wind allowance, docs/safety.md §4.7) → plan_out (PlannedTrajectory), trajectory_out
-//   (trajectory_msgs/MultiDOFJointTrajectory), formation_params_out (leader, latched).
-// Parameters (all required unless noted): ~uav_index, ~uav_count, ~world_frame,
-//   ~scenario_file (the map), ~mission_file (optional: take formation + planner from a
-//   scenario's mission) or ~formation_config + ~planner_config, ~replanning_period_s,
-//   ~horizon_dt_s, ~horizon_steps, ~max_share_age_s, ~params_rate_hz, ~max_wind_estimate_age_s; without ~mission_file
-//   also ~avoid_all_plans, ~max_plan_age_s, ~max_worker_age_s, ~brake_accel_mps2,
-//   ~search_timeout_s, ~search_height_m, ~search_vertical_speed_mps, ~search_period_s,
-//   ~search_horizontal_speed_mps (with it: the mission's faults.* of the
-//   same names and controller.brake_accel_mps2, as gfctl simulate); optional ~faults_file (a fault
-//   profile merged into the mission, as `gfctl simulate --faults`).
-// Listen before moving (docs/safety.md §2.4, planning::listeningReason — gfctl simulate's rule for a
-// rejoining follower): from its first replanning, the planner holds until it has a plan made since
-// then from every other follower, or for at most max_plan_age_s.
-// Hold (docs/safety.md §1 rules 2–4, planning::holdReason — the decision gfctl simulate makes):
-// the leader holds when its estimate's last fused measurement (WorkerState.last_fused) is older
-// than max_worker_age_s; a follower when the leader's worker state (over LCM) is older than
-// max_share_age_s, or the estimate it carries older than max_worker_age_s. A holding UAV plans
-// to its latched braking point (planning::HoldPlanner: camera on the worker estimate, the
-// estimator's prediction), avoiding every received plan; its plan is flagged `fallback` (others avoid
-// it) with mode `hold` and the reason; the first replanning with fresh data tracks again. The
-// leader, holding because it has not seen the worker, searches (mode `search`, for at most
-// search_timeout_s): once the estimator has lost him (WorkerState.lost) its camera sweeps up and
-// down through the estimate (planning::HoldPlanner, as gfctl simulate).
+//   world_frame, twist.linear = the wind, mavros `wind_estimation`; optional, docs/safety.md §4.7)
+//   abort_in (AbortCommand: every copy, from the LcmBridge and on the leader the GestureCommander)
+//   → plan_out (PlannedTrajectory; mode track | hold | search | abort and its reason), trajectory_out
+//   (trajectory_msgs/MultiDOFJointTrajectory), formation_params_out (leader, latched), abort_state_out
+//   (AbortState, latched: on acceptance and at every replanning while aborting; docs/safety.md §2.8).
+// Parameters (all required unless noted): ~uav_index, ~uav_count, ~world_frame, ~scenario_file
+//   (the map), ~params_rate_hz, ~max_wind_estimate_age_s, and the settings of
+//   loadPlannerSettings (config_sources.hpp): ~mission_file (optional; simulation: the mission's
+//   settings, with the optional ~faults_file merged) or ~replanning_period_s, ~horizon_dt_s,
+//   ~horizon_steps, ~max_share_age_s, ~max_worker_age_s, ~max_plan_age_s, ~avoid_all_plans,
+//   ~brake_accel_mps2, ~search_*, ~abort/*, ~formation_config, ~planner_config.
 #include <cmath>
 #include <map>
 #include <mutex>
@@ -53,6 +37,7 @@
 #include "diagnostics.hpp"
 #include "gesture_formation/formation/formation_geometry.hpp"
 #include "gesture_formation/formation/worker_heading.hpp"
+#include "gesture_formation/onboard/formation_params_role.hpp"
 #include "gesture_formation/planning/replan_health.hpp"
 #include "gesture_formation/planning/replan_step.hpp"
 #include "gesture_formation/planning/trajectory_qp.hpp"
@@ -68,61 +53,37 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     params.load("uav_index", uav_index_, 0, comm::kMaxUavIndex);
     params.load("uav_count", uav_count_, 1, comm::kMaxUavIndex + 1);
     params.load("world_frame", world_frame_);
-    std::string scenario_file, mission_file, formation_file, planner_file;
+    std::string scenario_file, mission_file;
     params.load("scenario_file", scenario_file);
     params.loadOptional("mission_file", mission_file, "");
     params.load("max_wind_estimate_age_s", max_wind_age_s_, 0.1, 60.0);
     double params_rate_hz = 0.0;
     params.load("params_rate_hz", params_rate_hz, 0.1, 50.0);
-    formation::FormationConfig fcfg;
-    planning::PlannerConfig pcfg;
-    planning::ReplanConfig rc;  ///< the replanning step's settings, from either source
-    bool formation_loaded = false;
-    if (!mission_file.empty()) {
-      // Simulation: the mission file's settings — the very values gfctl simulate runs with —
-      // win over every parameter; the replanning parameters below are not read.
-      onboard::OnboardSettings mission;
-      if (loadOnboard(mission_file, params, mission)) {
-        formation_loaded = true;
-        fcfg = mission.formation;
-        pcfg = mission.planner;
-        period_s_ = mission.replanning_period_s;
-        rc = mission.replan;
-        params.note("from mission_file: replanning_period_s " + std::to_string(period_s_) + ", horizon_dt_s " +
-                    std::to_string(rc.dt_s) + ", horizon_steps " + std::to_string(rc.steps) +
-                    ", faults.* limits, controller.brake_accel_mps2, formation, planner");
-      }
-    } else {
-      params.load("replanning_period_s", period_s_, onboard::ranges::kReplanningPeriodS);
-      params.loadFields(planning::replanConfigFields(), rc);  // horizon_*, *_age_s, brake_accel_mps2, search_*
-      params.load("avoid_all_plans", rc.rule.avoid_all_plans);
-      params.load("formation_config", formation_file);
-      params.load("planner_config", planner_file);
-      formation_loaded = !formation_file.empty() && loadFormation(formation_file, params, fcfg);
-      if (!planner_file.empty()) loadPlanner(planner_file, params, pcfg);
-    }
+    PlannerSettings settings;  // from ~mission_file (simulation) or the parameters (config_sources.hpp)
+    loadPlannerSettings(getPrivateNodeHandle(), params, mission_file, settings);
+    const formation::FormationConfig& fcfg = settings.formation;
+    planning::ReplanConfig& rc = settings.replan;
+    period_s_ = settings.replanning_period_s;
     // Every source is checked before refusing (cross-field checks whenever both fields loaded).
-    if (formation_loaded && fcfg.params.uavCount() != uav_count_) {
+    if (settings.formation_loaded && fcfg.params.uavCount() != uav_count_) {
       params.addError("uav_count: " + std::to_string(uav_count_) + " but the formation config has " +
                       std::to_string(fcfg.params.uavCount()) + " UAVs");
     }
     if (uav_index_ >= uav_count_) params.addError("uav_index: must be < uav_count");
-    WorldMap world;
-    loadWorldMap(scenario_file, params, world);
+    loadWorldMap(scenario_file, params, world_);
     if (!params.ok()) {
       NODELET_ERROR_STREAM("FormationPlanner refuses to start; fix these parameters:\n" << params.report());
       return;
     }
     NODELET_INFO_STREAM("FormationPlanner (UAV " << uav_index_ << ") loaded:\n" << params.loaded());
-    params_ = fcfg.params;
-    if (uav_index_ == formation::kLeader) {
-      auto st = formation::FormationState::create(fcfg.params, fcfg.limits, fcfg.duplicates);
-      state_.emplace(std::move(*st));  // the config was validated by its loader
-    }
+    role_.emplace(fcfg, uav_index_);  // the config was validated by its loader
     rc.uav_index = uav_index_;
+    rc.uav_count = uav_count_;
     rc.worker_heading = fcfg.worker_heading;
-    step_ = std::make_unique<planning::ReplanStep>(
-        rc, std::make_unique<planning::UavPlannerAdapter>(std::make_unique<planning::UavPlanner>(pcfg, world.map, world.field)));
+    step_ = std::make_unique<planning::ReplanStep>(rc,
+                                                   std::make_unique<planning::UavPlannerAdapter>(std::make_unique<planning::UavPlanner>(
+                                                       settings.planner, world_.map, world_.field)),
+                                                   retreatSpace(world_));
     received_.resize(static_cast<std::size_t>(uav_count_));
 
     plan_pub_ = nh.advertise<gesture_formation::PlannedTrajectory>("plan_out", 5);
@@ -131,6 +92,9 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     worker_sub_ = nh.subscribe("worker_state_in", 5, &FormationPlannerNodelet::onWorker, this);
     plans_sub_ = nh.subscribe("plans_in", 20, &FormationPlannerNodelet::onPlan, this);
     wind_sub_ = nh.subscribe("wind_estimate_in", 5, &FormationPlannerNodelet::onWind, this);
+    abort_sub_ = nh.subscribe("abort_in", 20, &FormationPlannerNodelet::onAbort, this);
+    abort_pub_ = nh.advertise<gesture_formation::AbortState>("abort_state_out", 5, true);
+    abort_pub_.publish(toAbortState(step_->abort(), uav_index_, ros::Time::now().toSec(), "", -1, world_frame_));
     if (uav_index_ == formation::kLeader) {
       params_pub_ = nh.advertise<gesture_formation::FormationParams>("formation_params_out", 5, true);
       command_sub_ = nh.subscribe("formation_command_in", 20, &FormationPlannerNodelet::onCommand, this);
@@ -183,49 +147,50 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   void onParams(const gesture_formation::FormationParams::ConstPtr& msg) {
     auto p = fromMsg(*msg);
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!p || p->uavCount() != uav_count_) {
-      NODELET_WARN_STREAM_THROTTLE(1.0, "FormationPlanner: formation parameters dropped: "
-                                            << (p ? "wrong UAV count" : p.reason()));
-      return;
-    }
-    params_ = *p;
-    received_version_ = msg->version;
+    const auto r = p ? role_->receive(*p, msg->version) : common::Result<bool>::fail(p.reason());
+    if (!r) NODELET_WARN_STREAM_THROTTLE(1.0, "FormationPlanner: formation parameters dropped: " << r.reason());
   }
   void onCommand(const gesture_formation::FormationCommand::ConstPtr& msg) {
-    auto cmd = fromMsg(*msg);
+    const std::string text = msg->source + " " + msg->sender + "#" + std::to_string(msg->sequence) + ": " +
+                             msg->target + "." + msg->parameter + (msg->kind == "set" ? " = " : " += ") +
+                             std::to_string(msg->amount);
     std::lock_guard<std::mutex> lock(mutex_);
-    last_command_ = msg->source + " " + msg->sender + "#" + std::to_string(msg->sequence) + ": " + msg->target +
-                    "." + msg->parameter + (msg->kind == "set" ? " = " : " += ") + std::to_string(msg->amount);
-    last_source_ = msg->source;
-    last_stamp_ = msg->header.stamp;
-    last_uavs_.clear();
-    if (!cmd) {
-      last_outcome_ = "rejected: " + cmd.reason();
-      last_status_ = formation::toString(formation::CommandStatus::kRejected);
-    } else {
-      const auto out = state_->apply(*cmd);
-      last_outcome_ = out.describe();
-      last_status_ = formation::toString(out.status);
-      if (out.status == formation::CommandStatus::kApplied) {
-        ++version_;
-        params_ = state_->params();
-        for (const auto& c : out.changes) last_uavs_.push_back(c.uav);
-      }
-    }
-    NODELET_INFO_STREAM("FormationPlanner: command " << last_command_ << " → " << last_outcome_);
+    const auto& r = role_->apply(fromMsg(*msg), text, msg->source, msg->header.stamp.toSec());
+    NODELET_INFO_STREAM("FormationPlanner: command " << r.text << " → " << r.outcome);
     publishParams();
   }
   void publishParams() {
-    auto m = toMsg(params_, version_);
+    const onboard::CommandRecord& r = role_->last();
+    auto m = toMsg(role_->params(), role_->version());
     m.header.stamp = ros::Time::now();
     m.header.frame_id = world_frame_;
-    m.last_command = last_command_;
-    m.last_outcome = last_outcome_;
-    m.last_command_source = last_source_;
-    m.last_command_stamp = last_stamp_;
-    m.last_command_status = last_status_;
-    m.last_command_uavs = last_uavs_;
+    m.last_command = r.text;
+    m.last_outcome = r.outcome;
+    m.last_command_source = r.source;
+    m.last_command_stamp = ros::Time(r.stamp_s);
+    m.last_command_status = r.status;
+    m.last_command_uavs = r.uavs;
     params_pub_.publish(m);
+  }
+
+  // Every copy of an abort (operator over LCM, the leader's relay, the gesture commander): the
+  // ReplanStep accepts the first that is fresh enough (planning::AbortPlanner::receive).
+  void onAbort(const gesture_formation::AbortCommand::ConstPtr& msg) {
+    auto c = fromMsg(*msg);
+    std::lock_guard<std::mutex> lock(mutex_);
+    const double t = ros::Time::now().toSec();
+    const auto a = c ? step_->receiveAbort(*c, t) : planning::AbortAcceptance::kStale;
+    if (a == planning::AbortAcceptance::kAlreadyAborting) return;
+    if (a != planning::AbortAcceptance::kAccepted) {
+      NODELET_WARN_STREAM_THROTTLE(1.0, "FormationPlanner UAV " << uav_index_ << ": abort " << msg->sender << "#"
+                                        << msg->sequence << " refused: " << (c ? "older than abort.max_command_age_s" : c.reason()));
+      return;
+    }
+    abort_link_sender_ = msg->link_sender;
+    NODELET_WARN_STREAM("FormationPlanner UAV " << uav_index_ << ": abort accepted: " << msg->sender << "#"
+                                                << msg->sequence << " (" << planning::toString(c->source) << ", via "
+                                                << (msg->link_sender < 0 ? std::string("ROS") : "LCM sender " + std::to_string(msg->link_sender)) << ")");
+    abort_pub_.publish(toAbortState(step_->abort(), uav_index_, t, "accepted", abort_link_sender_, world_frame_));
   }
 
   void onTimer(const ros::TimerEvent&) {
@@ -249,15 +214,18 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     in.state = *odom_;
     if (wind_ && t - wind_stamp_s_ <= max_wind_age_s_) in.wind_estimate_mps = *wind_;
     in.worker = worker ? &*worker : nullptr;
-    in.params = &params_;
+    in.params = &role_->params();
     in.leader_plan = received_[0] ? &received_[0]->plan : nullptr;
     in.received = &received_;
     const planning::ReplanOutcome out = step_->step(in);
     if (!out.planned()) return;
     if (!out.note.empty()) NODELET_WARN_STREAM("FormationPlanner UAV " << uav_index_ << ": " << out.note);
     const std::string mode = planning::toString(out.mode);
+    if (out.aborting()) {
+      abort_pub_.publish(toAbortState(step_->abort(), uav_index_, t, out.reason, abort_link_sender_, world_frame_));
+    }
     if (mode != mode_) {
-      if (out.holding()) {
+      if (out.holding() || out.aborting()) {
         NODELET_WARN_STREAM("FormationPlanner UAV " << uav_index_ << ": " << mode << ": " << out.reason);
       } else {
         NODELET_INFO_STREAM("FormationPlanner UAV " << uav_index_ << ": track: fresh data");
@@ -275,17 +243,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
                                                    << " QP solve(s) stopped (deadline qp.solve_timeout_s, or ProxQP's "
                                                    << "sparse solver broke an invariant: dense backend; docs/safety.md 4.5)");
     }
-    auto msg = toMsg(res);
-    msg.fallback = out.fallback;  // a holding UAV or a fallback plan has right of way (rule 3)
-    msg.mode = mode;
-    msg.mode_reason = out.reason;
-    msg.header.frame_id = world_frame_;
-    msg.uav_index = uav_index_;
-    msg.params_version = uav_index_ == formation::kLeader ? version_ : received_version_;
-    msg.planned_at = ros::Time(t);
-    msg.formation = toMsg(params_, 0).uavs;
-    for (int k = 0; k < out.reference.steps(); ++k) msg.reference.push_back(toPoint(out.reference.p_world.col(k)));
-    for (int k = 0; k < out.worker.steps(); ++k) msg.worker.push_back(toPoint(out.worker.p_world.col(k)));
+    const auto msg = toMsg(out, uav_index_, t, role_->params(), role_->version(), world_frame_);
     plan_pub_.publish(msg);
     traj_pub_.publish(toMultiDof(msg, "uav" + std::to_string(uav_index_)));
   }
@@ -316,20 +274,16 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   double max_wind_age_s_ = 0.0, wind_stamp_s_ = 0.0;
   std::optional<Eigen::Vector3d> wind_;
   std::uint64_t wind_rejected_ = 0;
-  formation::FormationParams params_;
-  std::optional<formation::FormationState> state_;
-  std::uint64_t version_ = 0;           ///< leader: the parameters' version
-  std::uint64_t received_version_ = 0;  ///< followers: the version received (0 over LCM: not carried)
-  std::string mode_ = "track";             ///< track | hold | search (logged on change)
-  std::string last_command_, last_outcome_, last_source_, last_status_;
-  ros::Time last_stamp_;
-  std::vector<int> last_uavs_;
+  std::optional<onboard::FormationParamsRole> role_;  ///< the leader's parameters and commands, or the received ones
+  std::string mode_ = "track";             ///< track | hold | search | abort (logged on change)
+  WorldMap world_;  ///< the map and field the planner and the abort's goal search use
   std::unique_ptr<planning::ReplanStep> step_;  ///< planner, hold / search, listening (shared with gfctl simulate)
   std::optional<planning::UavKinematicState> odom_;
   std::optional<gesture_formation::WorkerState> worker_;
   std::vector<std::optional<planning::ReceivedPlan>> received_;  ///< by sender; [0] the leader's plan
-  ros::Publisher plan_pub_, traj_pub_, params_pub_;
-  ros::Subscriber odom_sub_, worker_sub_, plans_sub_, params_sub_, command_sub_, wind_sub_;
+  int abort_link_sender_ = -1;  ///< who delivered the accepted abort (LCM sender id; -1: ROS)
+  ros::Publisher plan_pub_, traj_pub_, params_pub_, abort_pub_;
+  ros::Subscriber odom_sub_, worker_sub_, plans_sub_, params_sub_, command_sub_, wind_sub_, abort_sub_;
   ros::Timer timer_, params_timer_;
 };
 

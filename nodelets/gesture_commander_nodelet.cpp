@@ -13,7 +13,8 @@
 //
 // Topics: observation_in (GestureObservation: the leader's own ViewObserver), peer_observations_in
 //   (GestureObservation: the followers', from the LcmBridge) → formation_command_out
-//   (FormationCommand), gesture_status_out (GestureStatus, one per fused frame).
+//   (FormationCommand), abort_out (AbortCommand, source gesture: a fired {event: abort}; to the
+//   leader's FormationPlanner), gesture_status_out (GestureStatus, one per fused frame).
 // Parameters (required): ~gesture_config (config/gestures.yaml: filter, mapping, view_fusion.*)
 //   or ~mission_file (a scenario's mission.gestures), ~uav_count, ~sender_name, ~frame_wait_s.
 //   Command sequence numbers start at the wall clock in microseconds, so a restarted commander
@@ -91,6 +92,7 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
     sequence_ = static_cast<std::uint64_t>(ros::WallTime::now().toNSec() / 1000);
     command_pub_ = nh.advertise<gesture_formation::FormationCommand>("formation_command_out", 10);
     status_pub_ = nh.advertise<gesture_formation::GestureStatus>("gesture_status_out", 10);
+    abort_pub_ = nh.advertise<gesture_formation::AbortCommand>("abort_out", 10);
     own_sub_ = nh.subscribe("observation_in", 50, &GestureCommanderNodelet::onObservation, this);
     peer_sub_ = nh.subscribe("peer_observations_in", 100, &GestureCommanderNodelet::onObservation, this);
     timer_ = nh.createTimer(ros::Duration(0.01), [this](const ros::TimerEvent&) {
@@ -165,6 +167,17 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
         last_fired_ = "gesture " + std::to_string(id) + ": unmapped";
       } else if (f.action->kind == gesture::GestureAction::Kind::kEvent) {
         last_fired_ = "gesture " + std::to_string(id) + ": event " + gesture::toString(f.action->event);
+        if (f.action->event == gesture::GestureEvent::kAbort) {
+          // The leader's own ReplanStep takes it (abort_out → its FormationPlanner's abort_in); once
+          // accepted it travels in the leader's share (LcmBridge relay), as in gfctl simulate.
+          gesture_formation::AbortCommand abort;
+          abort.source = gesture_formation::AbortCommand::SOURCE_GESTURE;
+          abort.sender = sender_;
+          abort.sequence = ++sequence_;
+          abort.stamp = st.header.stamp;  // when the filter fired: the frame's time
+          abort.link_sender = -1;
+          abort_pub_.publish(abort);
+        }
       } else {
         auto cmd = toMsg(gesture::toCommand(*f.action, ++sequence_));
         cmd.sender = sender_;
@@ -190,7 +203,7 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
   std::optional<gesture::GestureFrames> frames_;  ///< vote, filter, mapping (shared with gfctl simulate)
   std::uint64_t sequence_ = 0;
   std::string last_fired_;
-  ros::Publisher command_pub_, status_pub_;
+  ros::Publisher command_pub_, status_pub_, abort_pub_;
   ros::Subscriber own_sub_, peer_sub_;
   ros::Timer timer_;
 };

@@ -5,14 +5,21 @@
 // ~sender_name, sequence from the wall clock in µs, so a restart never reuses numbers) and
 // published on formation_command_out (to the LcmBridge → the leader's FormationPlanner, which
 // applies and clamps it).
-// Parameters (required): ~sender_name, ~uav_count.
+// Abort (docs/safety.md §2.8): the service send_abort (gesture_formation/SendAbort; tools/gf_command.py
+// abort) publishes one AbortCommand (source operator, the next sequence number) on abort_out — to
+// the ground station's LcmBridge, which sends every copy to every UAV — ~abort_repeats times,
+// ~abort_repeat_period_s apart, each copy stamped when sent (as gfctl simulate's AbortSender).
+// Parameters (required): ~sender_name, ~uav_count, ~abort_repeats, ~abort_repeat_period_s; with
+// ~mission_file (simulation; optional ~faults_file) the mission's abort.repeats / repeat_period_s win.
 #include <mutex>
 
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
 #include <ros/ros.h>
 
+#include "config_sources.hpp"
 #include "conversions.hpp"
+#include "gesture_formation/SendAbort.h"
 #include "gesture_formation/SendCommand.h"
 #include "param_loader.hpp"
 
@@ -26,6 +33,18 @@ class OperatorInterfaceNodelet : public nodelet::Nodelet {
     params.load("sender_name", sender_);
     params.load("uav_count", uav_count_, 1, comm::kMaxUavIndex + 1);
     if (sender_.empty() || sender_.find(' ') != std::string::npos) params.addError("sender_name: must be non-empty without spaces");
+    std::string mission_file;
+    params.loadOptional("mission_file", mission_file, "");
+    onboard::OnboardSettings mission;
+    if (!mission_file.empty() && loadOnboard(mission_file, params, mission)) {
+      abort_repeats_ = mission.replan.abort.repeats;
+      abort_period_s_ = mission.replan.abort.repeat_period_s;
+      params.note("from mission_file: abort.repeats " + std::to_string(abort_repeats_) + ", abort.repeat_period_s " +
+                  std::to_string(abort_period_s_));
+    } else if (mission_file.empty()) {
+      params.load("abort_repeats", abort_repeats_, 1, 100);
+      params.load("abort_repeat_period_s", abort_period_s_, 0.01, 10.0);
+    }
     if (!params.ok()) {
       NODELET_ERROR_STREAM("OperatorInterface refuses to start; fix these parameters:\n" << params.report());
       return;
@@ -35,6 +54,37 @@ class OperatorInterfaceNodelet : public nodelet::Nodelet {
     command_pub_ = nh.advertise<gesture_formation::FormationCommand>("formation_command_out", 20);
     command_sub_ = nh.subscribe("command_in", 20, &OperatorInterfaceNodelet::onCommand, this);
     service_ = nh.advertiseService("send_command", &OperatorInterfaceNodelet::onService, this);
+    abort_pub_ = nh.advertise<gesture_formation::AbortCommand>("abort_out", 20);
+    abort_service_ = nh.advertiseService("send_abort", &OperatorInterfaceNodelet::onAbort, this);
+    abort_timer_ = nh.createTimer(ros::Duration(abort_period_s_), &OperatorInterfaceNodelet::repeatAbort, this);
+  }
+
+  bool onAbort(gesture_formation::SendAbort::Request&, gesture_formation::SendAbort::Response& res) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    abort_.source = gesture_formation::AbortCommand::SOURCE_OPERATOR;
+    abort_.sender = sender_;
+    abort_.sequence = ++sequence_;
+    abort_.link_sender = -1;
+    abort_copies_left_ = abort_repeats_;
+    sendAbortCopy();
+    res.accepted = true;
+    res.sequence = abort_.sequence;
+    res.copies = abort_repeats_;
+    res.message = "sent";
+    NODELET_WARN_STREAM("OperatorInterface: abort #" << abort_.sequence << " sent (" << abort_repeats_ << " copies, "
+                                                     << abort_period_s_ << " s apart)");
+    return true;
+  }
+  // Mutex held. One copy, stamped now (its age at each UAV is this copy's).
+  void sendAbortCopy() {
+    if (abort_copies_left_ <= 0) return;
+    abort_.stamp = ros::Time::now();
+    abort_pub_.publish(abort_);
+    --abort_copies_left_;
+  }
+  void repeatAbort(const ros::TimerEvent&) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    sendAbortCopy();
   }
 
   // Checks, numbers and publishes; returns an empty string or why it was refused.
@@ -92,9 +142,14 @@ class OperatorInterfaceNodelet : public nodelet::Nodelet {
   std::string sender_;
   int uav_count_ = 0;
   std::uint64_t sequence_ = 0;
-  ros::Publisher command_pub_;
+  int abort_repeats_ = 1;
+  double abort_period_s_ = 0.2;
+  int abort_copies_left_ = 0;  ///< copies of abort_ still to send
+  gesture_formation::AbortCommand abort_;
+  ros::Publisher command_pub_, abort_pub_;
   ros::Subscriber command_sub_;
-  ros::ServiceServer service_;
+  ros::ServiceServer service_, abort_service_;
+  ros::Timer abort_timer_;
 };
 
 }  // namespace gesture_formation::nodelets

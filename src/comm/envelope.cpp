@@ -15,6 +15,7 @@ const char* toString(MessageType type) {
     case MessageType::kFormationParams: return "formation_params";
     case MessageType::kFormationCommand: return "formation_command";
     case MessageType::kGestureObservation: return "gesture_observation";
+    case MessageType::kAbortCommand: return "abort_command";
   }
   return "unknown";
 }

@@ -37,7 +37,8 @@ VerifierConfig verifierConfigOf(const LinkSettings& s, std::vector<common::Confi
   }
   senderList("known_senders", s.known_senders, s.sender_id, c.known_senders, problems);
   for (const auto& [key, list, type] : {std::make_tuple(std::string("command_senders"), &s.command_senders, MessageType::kFormationCommand),
-                                        std::make_tuple(std::string("params_senders"), &s.params_senders, MessageType::kFormationParams)}) {
+                                        std::make_tuple(std::string("params_senders"), &s.params_senders, MessageType::kFormationParams),
+                                        std::make_tuple(std::string("abort_senders"), &s.abort_senders, MessageType::kAbortCommand)}) {
     if (!list->has_value()) continue;
     if ((*list)->empty()) problems.push_back({key, "must list at least one sender id (omit it to allow every known sender)"});
     senderList(key, **list, s.sender_id, c.senders_by_type[type], problems);  // own id only → empty: no one else
@@ -47,6 +48,7 @@ VerifierConfig verifierConfigOf(const LinkSettings& s, std::vector<common::Confi
   c.max_age_s_by_type[MessageType::kHeartbeat] = std::max(c.max_age_s, 2.0);
   c.max_age_s_by_type[MessageType::kFormationCommand] =
       age.contains(s.command_max_age_s) ? s.command_max_age_s : defaults.command_max_age_s;
+  c.max_age_s_by_type[MessageType::kAbortCommand] = c.max_age_s_by_type[MessageType::kFormationCommand];
   c.max_rate_hz = s.max_rate_hz;
   c.burst = s.burst;
   for (const auto& e : c.validate()) problems.push_back({"verifier", e});
@@ -62,6 +64,16 @@ std::optional<common::ConfigError> keyRingOwnerProblem(const KeyRing& keys, int 
 std::string withReceiveBuffer(const std::string& url, int bytes) {
   if (url.rfind("udpm://", 0) != 0 || url.find("recv_buf_size") != std::string::npos || bytes < 65536) return url;
   return url + (url.find('?') == std::string::npos ? "?" : "&") + "recv_buf_size=" + std::to_string(bytes);
+}
+
+std::string describeOptional(const LinkSettings& s) {
+  const auto ids = [](const std::optional<std::vector<int>>& list) {
+    return list ? std::to_string(list->size()) + " id(s)" : std::string("any known sender");
+  };
+  return "command_max_age_s: " + std::to_string(s.command_max_age_s) + ", recv_buf_bytes: " +
+         std::to_string(s.recv_buf_bytes) + ", max_rate_hz: " + std::to_string(s.max_rate_hz) +
+         ", burst: " + std::to_string(s.burst) + ", command_senders: " + ids(s.command_senders) +
+         ", params_senders: " + ids(s.params_senders) + ", abort_senders: " + ids(s.abort_senders);
 }
 
 }  // namespace gesture_formation::comm

@@ -556,4 +556,40 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, GestureOb
   return d.report(reason);
 }
 
+// ---- abort command: u8 sender length, sender bytes, u64 sequence, u8 source (0 operator, 1 gesture) --
+
+EncodeResult encodePayload(const AbortMessage& m) {
+  if (!validSenderName(m.id.sender)) {
+    return EncodeResult::fail("abort_command.id.sender must be 1.." + std::to_string(kMaxSenderNameBytes) +
+                              " printable ASCII characters without spaces");
+  }
+  ByteWriter w;
+  w.u8(static_cast<std::uint8_t>(m.id.sender.size()));
+  w.bytes(reinterpret_cast<const std::uint8_t*>(m.id.sender.data()), m.id.sender.size());
+  w.u64(m.id.sequence);
+  w.u8(m.source == planning::AbortSource::kGesture ? 1 : 0);
+  return EncodeResult::ok(w.release());
+}
+
+PayloadError decodePayload(const std::uint8_t* data, std::size_t size, AbortMessage& out, std::string* reason) {
+  Decoder d(data, size);
+  AbortMessage m;
+  std::uint8_t name_len = 0, source = 0;
+  if (d.u8(name_len, "abort_command.id.sender_length") && (name_len == 0 || name_len > kMaxSenderNameBytes)) {
+    d.fail(name_len == 0 ? PayloadError::kOutOfRange : PayloadError::kOversizeArray, "abort_command.id.sender_length");
+  }
+  const std::uint8_t* name = nullptr;
+  if (d.bytes(name_len, name, "abort_command.id.sender")) {
+    m.id.sender.assign(reinterpret_cast<const char*>(name), name_len);
+    if (!validSenderName(m.id.sender)) d.fail(PayloadError::kOutOfRange, "abort_command.id.sender");
+  }
+  d.u64(m.id.sequence, "abort_command.id.sequence");
+  if (d.u8(source, "abort_command.source") && source > 1) d.fail(PayloadError::kOutOfRange, "abort_command.source");
+  if (d.finish()) {
+    m.source = source == 1 ? planning::AbortSource::kGesture : planning::AbortSource::kOperator;
+    out = std::move(m);
+  }
+  return d.report(reason);
+}
+
 }  // namespace gesture_formation::comm

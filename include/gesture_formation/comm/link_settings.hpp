@@ -24,17 +24,20 @@ struct LinkSettings {
   int recv_buf_bytes = 4194304;         ///< UDP receive buffer to ask for, ≥ 65536
   double max_rate_hz = 400.0;           ///< per-sender verification budget
   double burst = 200.0;
-  /// Who may send formation commands / parameters (absent: any known sender).
-  std::optional<std::vector<int>> command_senders, params_senders;
+  /// Who may send formation commands / parameters / abort commands (absent: any known sender).
+  std::optional<std::vector<int>> command_senders, params_senders, abort_senders;
 };
 
-/// \brief The VerifierConfig of `s` (heartbeats: at least 2 s of age; commands:
+/// \brief The VerifierConfig of `s` (heartbeats: at least 2 s of age; formation and abort commands:
 /// command_max_age_s), and in `problems` everything wrong with it, keyed by parameter name.
 VerifierConfig verifierConfigOf(const LinkSettings& s, std::vector<common::ConfigError>& problems);
 
 /// \brief A problem when a per-sender key ring's signing key is not `sender_id`'s (empty: fine).
 std::optional<common::ConfigError> keyRingOwnerProblem(const KeyRing& keys, int sender_id);
 
+/// \brief The optional settings as one line (a node's "loaded" report): ages, buffer, budget and
+/// how many ids each sender list holds.
+std::string describeOptional(const LinkSettings& s);
 /// \brief `url` with recv_buf_size=bytes added for udpm:// URLs that do not set it.
 std::string withReceiveBuffer(const std::string& url, int bytes);
 

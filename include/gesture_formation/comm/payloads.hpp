@@ -25,6 +25,7 @@
 #include "gesture_formation/formation/formation_commands.hpp"
 #include "gesture_formation/formation/formation_params.hpp"
 #include "gesture_formation/gesture/view_triangulation.hpp"
+#include "gesture_formation/planning/abort_mode.hpp"
 #include "gesture_formation/planning/planned_trajectory.hpp"
 
 namespace gesture_formation::comm {
@@ -91,6 +92,18 @@ struct GestureObservationMessage {
   std::optional<ObservedSkeleton> skeleton;
 };
 
+/// \brief An abort command as it travels (docs/safety.md §2.8): the command's id and who issued it.
+/// When it was sent is the envelope's stamp (each copy — the sender's repeats, the leader's relay in
+/// its share — is a new envelope, stamped when sent: planning::AbortCommand::sent_s); replays are
+/// the envelope's to refuse (sequence, age).
+struct AbortMessage {
+  formation::CommandId id;  ///< sender name (1..kMaxSenderNameBytes printable ASCII, no spaces), sequence
+  planning::AbortSource source = planning::AbortSource::kOperator;
+
+  /// \brief The command as a UAV's ReplanStep takes it, sent at `sent_s` (the envelope's stamp).
+  planning::AbortCommand command(double sent_s) const { return planning::AbortCommand{id, source, sent_s}; }
+};
+
 /// Largest gesture id and number of class probabilities on the wire.
 constexpr int kMaxGestureId = 15;
 constexpr std::size_t kMaxGestureClasses = 16;
@@ -117,6 +130,7 @@ common::Result<std::vector<std::uint8_t>> encodePayload(const planning::PlannedT
 common::Result<std::vector<std::uint8_t>> encodePayload(const formation::FormationParams& m);
 common::Result<std::vector<std::uint8_t>> encodePayload(const formation::FormationCommand& m);
 common::Result<std::vector<std::uint8_t>> encodePayload(const GestureObservationMessage& m);
+common::Result<std::vector<std::uint8_t>> encodePayload(const AbortMessage& m);
 
 /// \brief The envelope type of each payload.
 inline MessageType messageTypeOf(const Heartbeat&) { return MessageType::kHeartbeat; }
@@ -125,6 +139,7 @@ inline MessageType messageTypeOf(const planning::PlannedTrajectory&) { return Me
 inline MessageType messageTypeOf(const formation::FormationParams&) { return MessageType::kFormationParams; }
 inline MessageType messageTypeOf(const formation::FormationCommand&) { return MessageType::kFormationCommand; }
 inline MessageType messageTypeOf(const GestureObservationMessage&) { return MessageType::kGestureObservation; }
+inline MessageType messageTypeOf(const AbortMessage&) { return MessageType::kAbortCommand; }
 
 // ---- decoders: `out` written only on kNone; `reason` (optional) names the field ---------
 PayloadError decodePayload(const std::uint8_t* data, std::size_t size, Heartbeat& out, std::string* reason = nullptr);
@@ -138,6 +153,7 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, formation
                            std::string* reason = nullptr);
 PayloadError decodePayload(const std::uint8_t* data, std::size_t size, GestureObservationMessage& out,
                            std::string* reason = nullptr);
+PayloadError decodePayload(const std::uint8_t* data, std::size_t size, AbortMessage& out, std::string* reason = nullptr);
 
 /// \brief One counter per PayloadError (kNone counts successful decodes).
 struct PayloadCounters {

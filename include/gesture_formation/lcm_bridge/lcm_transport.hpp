@@ -27,7 +27,7 @@
 namespace gesture_formation::lcm_bridge {
 
 /// \brief The channel of a message type: prefix + HEARTBEAT | WORKER_STATE |
-/// PLANNED_TRAJECTORY | FORMATION_PARAMS | FORMATION_COMMAND.
+/// PLANNED_TRAJECTORY | FORMATION_PARAMS | FORMATION_COMMAND | GESTURE_OBSERVATION | ABORT_COMMAND.
 std::string channelName(comm::MessageType type, const std::string& prefix);
 /// \brief The message type a channel carries, or nothing for foreign channels.
 std::optional<comm::MessageType> channelType(const std::string& channel, const std::string& prefix);

@@ -37,6 +37,27 @@ TEST(LinkSettingsTest, AGoodSettingGivesTheBridgesVerifier) {
   EXPECT_EQ(c.senders_by_type.at(MessageType::kFormationParams), (std::vector<std::uint16_t>{0}));
   EXPECT_DOUBLE_EQ(c.max_age_s_by_type.at(MessageType::kHeartbeat), 2.0);
   EXPECT_DOUBLE_EQ(c.max_age_s_by_type.at(MessageType::kFormationCommand), 5.0);
+  EXPECT_DOUBLE_EQ(c.max_age_s_by_type.at(MessageType::kAbortCommand), 5.0);
+  EXPECT_EQ(c.senders_by_type.count(MessageType::kAbortCommand), 0u);  // absent: any known sender
+}
+
+// Aborts come from the ground station and the leader's relay: their own sender list.
+TEST(LinkSettingsTest, AbortSendersAreTheirOwnList) {
+  LinkSettings s;
+  s.sender_id = 1;
+  s.known_senders = {0, 1, 2, 100};
+  s.command_max_age_s = 3.0;
+  s.abort_senders = std::vector<int>{0, 100};
+  std::vector<ConfigError> problems;
+  const VerifierConfig c = verifierConfigOf(s, problems);
+  EXPECT_TRUE(problems.empty());
+  EXPECT_EQ(c.senders_by_type.at(MessageType::kAbortCommand), (std::vector<std::uint16_t>{0, 100}));
+  EXPECT_DOUBLE_EQ(c.max_age_s_by_type.at(MessageType::kAbortCommand), 3.0);
+  s.abort_senders = std::vector<int>{};
+  problems.clear();
+  verifierConfigOf(s, problems);
+  EXPECT_TRUE(names(problems, "abort_senders"));
+  EXPECT_NE(describeOptional(s).find("abort_senders: 0 id(s)"), std::string::npos) << describeOptional(s);
 }
 
 // Every field is checked, and the verifier's own rules run too (no known sender), in one pass.

@@ -260,6 +260,57 @@ TEST(CommPayloadsTest, FormationCommandRoundTrip) {
   }
 }
 
+TEST(CommPayloadsTest, AbortCommandRoundTripAndByteLayout) {
+  AbortMessage m;
+  m.id = {"operator", 0x0102030405060708ull};
+  m.source = planning::AbortSource::kGesture;
+  const auto b = encoded(m);
+  // u8 length, "operator", u64 sequence big-endian, u8 source (docs/security.md §3.2).
+  const std::vector<std::uint8_t> expected{8, 'o', 'p', 'e', 'r', 'a', 't', 'o', 'r', 1, 2, 3, 4, 5, 6, 7, 8, 1};
+  EXPECT_EQ(b, expected);
+  AbortMessage d;
+  ASSERT_EQ(decode(b, d), PayloadError::kNone);
+  EXPECT_EQ(d.id.sender, "operator");
+  EXPECT_EQ(d.id.sequence, m.id.sequence);
+  EXPECT_EQ(d.source, planning::AbortSource::kGesture);
+  const planning::AbortCommand c = d.command(12.5);
+  EXPECT_EQ(c.sent_s, 12.5);
+  EXPECT_EQ(c.id.sender, "operator");
+  EXPECT_EQ(c.source, planning::AbortSource::kGesture);
+}
+
+TEST(CommPayloadsTest, AbortCommandRefusals) {
+  AbortMessage m;
+  m.id = {"has space", 1};
+  EXPECT_FALSE(encodePayload(m));
+  m.id.sender = std::string(kMaxSenderNameBytes + 1, 'a');
+  EXPECT_FALSE(encodePayload(m));
+  m.id.sender = "gcs";
+  const auto b = encoded(m);
+  AbortMessage d;
+  d.id.sender = "untouched";
+  auto bad = b;
+  bad[0] = 0;
+  EXPECT_EQ(decode(bad, d), PayloadError::kOutOfRange);
+  bad[0] = 200;
+  EXPECT_EQ(decode(bad, d), PayloadError::kOversizeArray);
+  bad = b;
+  bad[1] = ' ';
+  EXPECT_EQ(decode(bad, d), PayloadError::kOutOfRange);
+  bad = b;
+  bad.back() = 2;  // source
+  std::string reason;
+  EXPECT_EQ(decodePayload(bad.data(), bad.size(), d, &reason), PayloadError::kOutOfRange);
+  EXPECT_NE(reason.find("abort_command.source"), std::string::npos) << reason;
+  bad = b;
+  bad.push_back(0);
+  EXPECT_EQ(decode(bad, d), PayloadError::kTrailingBytes);
+  bad = b;
+  bad.pop_back();
+  EXPECT_EQ(decode(bad, d), PayloadError::kTruncated);
+  EXPECT_EQ(d.id.sender, "untouched");  // written only on success
+}
+
 TEST(CommPayloadsTest, FormationCommandRefusals) {
   auto c = command();
   c.amount = kNaN;

@@ -1,0 +1,60 @@
+#pragma once
+/// \file
+/// \brief What a receiving node does with each authenticated envelope before it hands the content
+/// on (the LcmBridge's receive side, docs/security.md §2–3), ROS-free: the payload decoded
+/// (comm::PayloadDecoder: strict, every refusal counted), heartbeats kept per peer (a plan whose
+/// sequence a degraded heartbeat named just before is a fallback plan), formation commands through
+/// comm::CommandIntake (first copy of each id, name bound to the envelope sender), gesture
+/// observations refused when the observing UAV is not the envelope's sender or the frame time is
+/// not a valid time, abort commands handed on at every copy with sent_s = the envelope's stamp (the
+/// UAV's ReplanStep acts on the first it accepts; docs/safety.md §2.8).
+/// Thread safety: none (the caller's lock).
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <variant>
+
+#include "gesture_formation/comm/command_intake.hpp"
+#include "gesture_formation/comm/envelope.hpp"
+#include "gesture_formation/comm/payloads.hpp"
+
+namespace gesture_formation::comm {
+
+/// \brief A received plan with the fallback flag of its sender's last heartbeat.
+struct ReceivedPlanMessage {
+  planning::PlannedTrajectory plan;
+  bool fallback = false;  ///< the sender's heartbeat just before it was degraded and named this plan
+};
+
+/// \brief What one envelope yields to hand on (monostate: nothing — a heartbeat, a command's copy,
+/// a refusal).
+using InboxItem = std::variant<std::monostate, WorkerStateMessage, ReceivedPlanMessage, formation::FormationParams,
+                               formation::FormationCommand, GestureObservationMessage, planning::AbortCommand>;
+
+class LinkInbox {
+ public:
+  /// \brief The content of an authenticated envelope to hand on (see the file comment).
+  InboxItem take(const Envelope& envelope);
+
+  /// \brief Why the last envelope yielded nothing (empty: it did or it was a heartbeat / copy).
+  const std::string& lastRefusal() const { return last_refusal_; }
+  /// \brief The last refusal was a payload that did not decode (the verifier counts those).
+  bool lastWasDecodeFailure() const { return last_decode_failure_; }
+
+  std::uint64_t commandCopiesDropped() const { return intake_.copiesDropped(); }
+  std::uint64_t observationsRefused() const { return observations_refused_; }
+  const PayloadCounters& payloadCounters() const { return decoder_.counters(); }
+
+ private:
+  InboxItem decodeOne(const Envelope& e);
+
+  PayloadDecoder decoder_;
+  CommandIntake intake_;
+  std::map<std::uint16_t, Heartbeat> peers_;  ///< each sender's last heartbeat
+  std::uint64_t observations_refused_ = 0;
+  std::string last_refusal_;
+  bool last_decode_failure_ = false;
+};
+
+}  // namespace gesture_formation::comm

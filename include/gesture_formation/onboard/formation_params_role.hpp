@@ -1,0 +1,56 @@
+#pragma once
+/// \file
+/// \brief A UAV's part in the formation's parameters (docs/formation.md §6–7, the FormationPlanner's
+/// state), ROS-free: the leader owns them (formation::FormationState applies and clamps every
+/// command, each applied command bumps the version, the last command and its outcome are kept for
+/// the operator); a follower holds the parameters it last received from the leader, refusing a set
+/// for another number of UAVs.
+/// Thread safety: none (the caller's lock).
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "gesture_formation/common/result.hpp"
+#include "gesture_formation/formation/formation_commands.hpp"
+#include "gesture_formation/formation/formation_config.hpp"
+
+namespace gesture_formation::onboard {
+
+/// \brief The last command the leader handled (FormationParams.last_* in ROS).
+struct CommandRecord {
+  std::string text;     ///< what was asked, as the caller described it (source, sender#sequence, change)
+  std::string outcome;  ///< formation::CommandOutcome::describe(), or "rejected: <why>" for a bad command
+  std::string source;   ///< "gesture" | "operator"
+  double stamp_s = 0.0; ///< when it was sent
+  std::string status;   ///< formation::toString(CommandStatus)
+  std::vector<int> uavs;  ///< the UAVs whose parameters changed
+};
+
+class FormationParamsRole {
+ public:
+  /// \brief The leader (uav_index 0) owns `config`'s parameters; a follower starts with them and
+  /// takes the leader's. `config` must be valid (its loader checked it).
+  FormationParamsRole(const formation::FormationConfig& config, int uav_index);
+
+  bool leader() const { return state_.has_value(); }
+  /// \brief The leader: applies `command` (or records why it could not be parsed) and returns the record.
+  const CommandRecord& apply(const common::Result<formation::FormationCommand>& command, std::string text,
+                             std::string source, double stamp_s);
+  /// \brief A follower: the leader's parameters; refused (nothing changes) naming the UAV count.
+  common::Result<bool> receive(const formation::FormationParams& params, std::uint64_t version);
+
+  const formation::FormationParams& params() const { return params_; }
+  /// \brief The leader: the version of its parameters (applied commands); a follower: the version received.
+  std::uint64_t version() const { return version_; }
+  const CommandRecord& last() const { return last_; }
+
+ private:
+  formation::FormationParams params_;
+  std::optional<formation::FormationState> state_;
+  std::uint64_t version_ = 0;
+  CommandRecord last_;
+};
+
+}  // namespace gesture_formation::onboard

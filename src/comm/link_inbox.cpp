@@ -1,0 +1,74 @@
+#include "gesture_formation/comm/link_inbox.hpp"
+
+#include <sstream>
+#include <utility>
+
+namespace gesture_formation::comm {
+
+InboxItem LinkInbox::take(const Envelope& e) {
+  last_refusal_.clear();
+  last_decode_failure_ = false;
+  InboxItem item = decodeOne(e);
+  if (!decoder_.lastReason().empty()) {
+    last_decode_failure_ = true;
+    last_refusal_ = "payload refused (decode_failure): " + decoder_.lastReason();
+  }
+  return item;
+}
+
+InboxItem LinkInbox::decodeOne(const Envelope& e) {
+  switch (e.type) {
+    case MessageType::kHeartbeat: {
+      Heartbeat h;
+      if (decoder_.decode(e, h)) peers_[e.sender_id] = h;
+      return {};
+    }
+    case MessageType::kWorkerState: {
+      WorkerStateMessage w;
+      if (decoder_.decode(e, w)) return w;
+      return {};
+    }
+    case MessageType::kPlannedTrajectory: {
+      ReceivedPlanMessage m;
+      if (!decoder_.decode(e, m.plan)) return {};
+      const auto peer = peers_.find(e.sender_id);
+      m.fallback = peer != peers_.end() && peer->second.status != Heartbeat::Status::kOk &&
+                   peer->second.last_plan_sequence == m.plan.sequence;
+      return m;
+    }
+    case MessageType::kFormationParams: {
+      formation::FormationParams p;
+      if (decoder_.decode(e, p)) return p;
+      return {};
+    }
+    case MessageType::kFormationCommand: {
+      formation::FormationCommand c;
+      if (!decoder_.decode(e, c)) return {};
+      auto forwarded = intake_.accept(e.sender_id, std::move(c));
+      if (forwarded) return std::move(*forwarded);
+      return {};
+    }
+    case MessageType::kGestureObservation: {
+      GestureObservationMessage o;
+      if (!decoder_.decode(e, o)) return {};
+      // A UAV votes for its own camera only; the frame time must be a ROS time.
+      if (o.uav_index != e.sender_id || !(o.t_s >= 0.0 && o.t_s < 4.0e9)) {
+        ++observations_refused_;
+        std::ostringstream os;
+        os << "gesture observation refused (" << observations_refused_ << " so far): sender " << e.sender_id
+           << ", uav_index " << o.uav_index << ", t " << o.t_s << " s";
+        last_refusal_ = os.str();
+        return {};
+      }
+      return o;
+    }
+    case MessageType::kAbortCommand: {
+      AbortMessage a;
+      if (decoder_.decode(e, a)) return a.command(e.stamp_s);
+      return {};
+    }
+  }
+  return {};
+}
+
+}  // namespace gesture_formation::comm

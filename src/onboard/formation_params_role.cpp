@@ -1,0 +1,46 @@
+#include "gesture_formation/onboard/formation_params_role.hpp"
+
+#include <utility>
+
+namespace gesture_formation::onboard {
+
+FormationParamsRole::FormationParamsRole(const formation::FormationConfig& config, int uav_index)
+    : params_(config.params) {
+  if (uav_index != formation::kLeader) return;
+  auto st = formation::FormationState::create(config.params, config.limits, config.duplicates);
+  if (st) state_.emplace(std::move(*st));
+}
+
+const CommandRecord& FormationParamsRole::apply(const common::Result<formation::FormationCommand>& command,
+                                                std::string text, std::string source, double stamp_s) {
+  last_ = CommandRecord{std::move(text), "", std::move(source), stamp_s, "", {}};
+  if (!state_) {
+    last_.outcome = "rejected: not the leader";
+    last_.status = formation::toString(formation::CommandStatus::kRejected);
+  } else if (!command) {
+    last_.outcome = "rejected: " + command.reason();
+    last_.status = formation::toString(formation::CommandStatus::kRejected);
+  } else {
+    const auto out = state_->apply(*command);
+    last_.outcome = out.describe();
+    last_.status = formation::toString(out.status);
+    if (out.status == formation::CommandStatus::kApplied) {
+      ++version_;
+      params_ = state_->params();
+      for (const auto& c : out.changes) last_.uavs.push_back(c.uav);
+    }
+  }
+  return last_;
+}
+
+common::Result<bool> FormationParamsRole::receive(const formation::FormationParams& params, std::uint64_t version) {
+  if (params.uavCount() != params_.uavCount()) {
+    return common::Result<bool>::fail("formation parameters for " + std::to_string(params.uavCount()) +
+                                      " UAVs, the formation has " + std::to_string(params_.uavCount()));
+  }
+  params_ = params;
+  version_ = version;
+  return common::Result<bool>::ok(true);
+}
+
+}  // namespace gesture_formation::onboard

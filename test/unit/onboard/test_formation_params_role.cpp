@@ -1,0 +1,71 @@
+// onboard::FormationParamsRole: the leader applies commands (version, record), a follower takes
+// the leader's parameters for the same number of UAVs only.
+#include <gtest/gtest.h>
+
+#include "gesture_formation/onboard/formation_params_role.hpp"
+
+using namespace gesture_formation;
+using onboard::FormationParamsRole;
+
+namespace {
+
+formation::FormationCommand distancePlusOne(std::uint64_t sequence) {
+  formation::FormationCommand c;
+  c.id = {"operator@100", sequence};
+  c.target.group = formation::TargetGroup::kFollowers;
+  c.parameter = formation::Parameter::kDistance;
+  c.amount = 1.0;
+  return c;
+}
+
+}  // namespace
+
+TEST(FormationParamsRoleTest, TheLeaderAppliesACommandOnceAndBumpsTheVersion) {
+  formation::FormationConfig config;
+  FormationParamsRole role(config, 0);
+  ASSERT_TRUE(role.leader());
+  const double d1 = role.params().uav(1).distance_m;
+  const auto& r = role.apply(common::Result<formation::FormationCommand>::ok(distancePlusOne(3)), "op #3", "operator", 7.5);
+  EXPECT_EQ(r.status, "applied");
+  EXPECT_EQ(r.text, "op #3");
+  EXPECT_EQ(r.source, "operator");
+  EXPECT_DOUBLE_EQ(r.stamp_s, 7.5);
+  EXPECT_EQ(r.uavs, (std::vector<int>{1, 2}));
+  EXPECT_EQ(role.version(), 1u);
+  EXPECT_DOUBLE_EQ(role.params().uav(1).distance_m, d1 + 1.0);
+  // The same id again (a repeat): a duplicate, nothing changes.
+  role.apply(common::Result<formation::FormationCommand>::ok(distancePlusOne(3)), "op #3", "operator", 7.6);
+  EXPECT_EQ(role.last().status, "duplicate");
+  EXPECT_EQ(role.version(), 1u);
+  EXPECT_TRUE(role.last().uavs.empty());
+  EXPECT_DOUBLE_EQ(role.params().uav(1).distance_m, d1 + 1.0);
+}
+
+TEST(FormationParamsRoleTest, AnUnparsableCommandIsRecordedAsRejectedWithItsReason) {
+  FormationParamsRole role(formation::FormationConfig{}, 0);
+  role.apply(common::Result<formation::FormationCommand>::fail("parameter: 'speed' unknown"), "op #1", "operator", 1.0);
+  EXPECT_EQ(role.last().status, "rejected");
+  EXPECT_EQ(role.last().outcome, "rejected: parameter: 'speed' unknown");
+  EXPECT_EQ(role.version(), 0u);
+}
+
+TEST(FormationParamsRoleTest, AFollowerTakesTheLeadersParametersForItsUavCountOnly) {
+  formation::FormationConfig config;
+  FormationParamsRole role(config, 2);
+  EXPECT_FALSE(role.leader());
+  formation::FormationParams p = config.params;
+  p.followers[1].distance_m += 2.0;
+  ASSERT_TRUE(role.receive(p, 4));
+  EXPECT_EQ(role.version(), 4u);
+  EXPECT_DOUBLE_EQ(role.params().uav(2).distance_m, p.followers[1].distance_m);
+  formation::FormationParams wrong = p;
+  wrong.followers.pop_back();
+  const auto r = role.receive(wrong, 5);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.reason().find("for 2 UAVs, the formation has 3"), std::string::npos) << r.reason();
+  EXPECT_EQ(role.version(), 4u);
+  // A follower applies no command.
+  role.apply(common::Result<formation::FormationCommand>::ok(distancePlusOne(1)), "op #1", "operator", 1.0);
+  EXPECT_EQ(role.last().status, "rejected");
+  EXPECT_EQ(role.params().uav(2).distance_m, p.followers[1].distance_m);
+}
