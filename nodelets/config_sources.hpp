@@ -4,7 +4,9 @@
 // in simulation, the `mission` section of a scenario file, so that the ROS simulation runs
 // with exactly the parameters of `gfctl simulate` (parameter `mission_file`; the mission file's
 // values win over every other parameter source, and the nodelet's "loaded" report says so).
+#include <iomanip>
 #include <memory>
+#include <sstream>
 #include <string>
 
 #include "gesture_formation/formation/formation_config.hpp"
@@ -119,21 +121,34 @@ inline planning::RetreatSpace retreatSpace(const WorldMap& world) {
   return space;
 }
 
-/// `~abort/*` (config/ros/nodelets.yaml formation_planner.abort): every number of
-/// planning::abortConfigFields() and `after` (hover | return_home | land), all required.
+/// `~abort` (config/ros/nodelets.yaml formation_planner.abort: every planning::AbortConfig key,
+/// all required), read with one parameter look-up and the core's own reader (planning::readAbortConfig,
+/// as a mission's `abort:`); every problem into `params`, named `abort/<key>`.
 inline void loadAbortParams(const ros::NodeHandle& pnh, ParamLoader& params, planning::AbortConfig& out) {
-  ParamLoader abort(ros::NodeHandle(pnh, "abort"));
-  abort.loadFields(planning::abortConfigFields(), out);
-  std::string after;
-  abort.load("after", after);
-  if (after == "return_home") out.after = planning::AbortAfter::kReturnHome;
-  else if (after == "land") out.after = planning::AbortAfter::kLand;
-  else if (after == "hover") out.after = planning::AbortAfter::kHover;
-  else if (!after.empty()) abort.addError(pnh.resolveName("abort/after") + ": '" + after + "' is not hover, return_home or land");
-  if (abort.ok()) {  // the rules between fields (ranges: above), on loaded values only
-    for (const auto& e : out.problems()) abort.addError("abort/" + e.key + ": " + e.message);
+  XmlRpc::XmlRpcValue v;
+  std::string yaml;
+  const bool found = pnh.getParam("abort", v);
+  if (found && v.getType() == XmlRpc::XmlRpcValue::TypeStruct) {
+    for (auto& [key, value] : v) {
+      std::ostringstream text;
+      switch (value.getType()) {
+        case XmlRpc::XmlRpcValue::TypeDouble: text << std::setprecision(17) << static_cast<double>(value); break;
+        case XmlRpc::XmlRpcValue::TypeInt: text << static_cast<int>(value); break;
+        case XmlRpc::XmlRpcValue::TypeString: text << '"' << static_cast<std::string>(value) << '"'; break;
+        default: params.addError(pnh.resolveName("abort/" + key) + ": not a number or a string"); continue;
+      }
+      yaml += key + ": " + text.str() + "\n";
+    }
+  } else {
+    params.addError(pnh.resolveName("abort") + (found ? ": not a map of the abort settings" : ": missing (required; a map of the abort settings)"));
+    return;
   }
-  params.merge(abort);
+  auto reader = common::ConfigReader::fromString(yaml.empty() ? "{}" : yaml, pnh.resolveName("abort"),
+                                                 common::ConfigReader::MissingKeys::kError);
+  out = planning::readAbortConfig(reader);
+  for (const auto& e : reader.errors()) params.addError(e);
+  params.note("abort: retreat_distance_m " + std::to_string(out.retreat_distance_m) + ", after " +
+              planning::toString(out.after) + ", repeats " + std::to_string(out.repeats));
 }
 
 /// The FormationPlanner's settings, from either source (see the file comment).
@@ -147,7 +162,7 @@ struct PlannerSettings {
 
 /// Simulation (`mission_file` non-empty): the mission's settings — the values gfctl simulate runs
 /// with — win over every parameter. Onboard: ~replanning_period_s, the replanning numbers of
-/// planning::replanConfigFields() (each under its last key segment), ~avoid_all_plans, ~abort/*,
+/// planning::replanConfigFields() (each under its last key segment), ~avoid_all_plans, ~abort,
 /// ~formation_config and ~planner_config. Every problem into `params`.
 inline void loadPlannerSettings(const ros::NodeHandle& pnh, ParamLoader& params, const std::string& mission_file,
                                 PlannerSettings& out) {

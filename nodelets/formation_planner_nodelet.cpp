@@ -21,7 +21,7 @@
 //   loadPlannerSettings (config_sources.hpp): ~mission_file (optional; simulation: the mission's
 //   settings, with the optional ~faults_file merged) or ~replanning_period_s, ~horizon_dt_s,
 //   ~horizon_steps, ~max_share_age_s, ~max_worker_age_s, ~max_plan_age_s, ~avoid_all_plans,
-//   ~brake_accel_mps2, ~search_*, ~abort/*, ~formation_config, ~planner_config.
+//   ~brake_accel_mps2, ~search_*, ~abort (a map), ~formation_config, ~planner_config.
 #include <cmath>
 #include <map>
 #include <mutex>

@@ -110,11 +110,6 @@ class ParamLoader {
   void addError(const std::string& error) { errors_.push_back(error); }
   void addErrors(const std::vector<std::string>& errors) { errors_.insert(errors_.end(), errors.begin(), errors.end()); }
 
-  /// \brief Takes over another loader's problems and report (e.g. one for a sub-namespace).
-  void merge(const ParamLoader& other) {
-    errors_.insert(errors_.end(), other.errors_.begin(), other.errors_.end());
-    loaded_ << other.loaded();
-  }
   bool ok() const { return errors_.empty(); }
   std::string report() const {
     std::string s;
