@@ -5,8 +5,8 @@
 /// verification (ReplanStep; fallback: the last verified plan or braking, as always), to a retreat
 /// goal of its own, then — by configuration — hovers there, returns to its take-off point, or
 /// approaches a verified landing spot. Part of planning::ReplanStep, the step `gfctl simulate`'s UAVs
-/// and the FormationPlanner nodelet share (the nodelets do not receive abort commands yet:
-/// docs/ros.md).
+/// and the FormationPlanner nodelet share (in ROS the command arrives on the planner's abort_in:
+/// docs/ros.md "Abort").
 ///
 /// The retreat goal (chooseRetreatGoal) is chosen once, when the UAV first plans after accepting
 /// the command, from what that UAV alone knows — its own position, the worker estimate, its index —
