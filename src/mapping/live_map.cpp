@@ -1,0 +1,140 @@
+#include "gesture_formation/mapping/live_map.hpp"
+
+#include <chrono>
+#include <mutex>
+
+#include <octomap/OcTree.h>
+
+namespace gesture_formation::mapping {
+
+namespace {
+
+double msSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+octomap::point3d toOcto(const Eigen::Vector3d& p) {
+  return octomap::point3d(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
+}
+
+std::string joinLines(const std::vector<std::string>& lines) {
+  std::string out;
+  for (const auto& line : lines) out += (out.empty() ? "" : "; ") + line;
+  return out;
+}
+
+}  // namespace
+
+common::Result<std::unique_ptr<LiveMap>> LiveMap::create(const MappingConfig& config, const planning::MapConfig& grid,
+                                                         std::shared_ptr<const planning::OccupancyMap> prior) {
+  using R = common::Result<std::unique_ptr<LiveMap>>;
+  std::vector<std::string> problems = config.validate();
+  for (const auto& p : grid.validate()) problems.push_back("map." + p);
+  if (!problems.empty()) return R::fail(joinLines(problems));
+  auto map = std::make_shared<planning::OccupancyMap>(
+      planning::OccupancyMap::fromPrimitives(grid, planning::PrimitiveSet{}, planning::GroundSpec{}));
+  if (prior) {
+    if (prior->resolution() != map->resolution() || prior->gridOrigin() != map->gridOrigin() ||
+        prior->gridSize() != map->gridSize()) {
+      return R::fail("prior map: its grid (resolution " + std::to_string(prior->resolution()) +
+                     " m) differs from the mapping grid (map.resolution_m " + std::to_string(grid.resolution_m) +
+                     " and map.bounds)");
+    }
+    *map = *prior;  // a deep copy: the prior itself is never changed
+  }
+  auto field = planning::DistanceField::truncated(*map, config.field_range_m);
+  if (!field) return R::fail("field.range_m: " + field.reason());
+  auto shared_field = std::make_shared<planning::DistanceField>(std::move(*field));
+  return R::ok(std::unique_ptr<LiveMap>(new LiveMap(config, std::move(map), std::move(shared_field), std::move(prior))));
+}
+
+LiveMap::LiveMap(const MappingConfig& config, std::shared_ptr<planning::OccupancyMap> map,
+                 std::shared_ptr<planning::DistanceField> field, std::shared_ptr<const planning::OccupancyMap> prior)
+    : config_(config),
+      map_(std::move(map)),
+      field_(std::move(field)),
+      prior_(std::move(prior)),
+      tree_(std::make_unique<octomap::OcTree>(map_->resolution())) {
+  tree_->setProbHit(config_.prob_hit);
+  tree_->setProbMiss(config_.prob_miss);
+  tree_->setClampingThresMin(config_.clamping_min);
+  tree_->setClampingThresMax(config_.clamping_max);
+  tree_->enableChangeDetection(true);
+}
+
+LiveMap::~LiveMap() = default;
+
+int LiveMap::castRays(const DepthPoints& points) {
+  // Returns that end in one voxel give the same occupied voxel and nearly the same free ray:
+  // one ray per end voxel (the first return's, its exact point, so the range test is unchanged).
+  octomap::Pointcloud cloud;
+  octomap::KeySet ends;
+  auto add = [&](const std::vector<Eigen::Vector3d>& pts) {
+    for (const auto& p : pts) {
+      const octomap::point3d q = toOcto(p);
+      octomap::OcTreeKey key;
+      if (tree_->coordToKeyChecked(q, key) && ends.insert(key).second) cloud.push_back(q);
+    }
+  };
+  add(points.hits_world);
+  add(points.free_rays_world);
+  tree_->insertPointCloud(cloud, toOcto(points.origin_world), config_.max_range_m, /*lazy_eval=*/false,
+                          /*discretize=*/false);
+  return static_cast<int>(cloud.size());
+}
+
+std::vector<planning::VoxelChange> LiveMap::fusedChanges(int& observed_changes) {
+  std::vector<planning::VoxelChange> changes;
+  observed_changes = 0;
+  for (auto it = tree_->changedKeysBegin(), end = tree_->changedKeysEnd(); it != end; ++it) {
+    ++observed_changes;
+    const planning::VoxelIndex voxel = map_->voxelOf(
+        Eigen::Vector3d(tree_->keyToCoord(it->first[0]), tree_->keyToCoord(it->first[1]), tree_->keyToCoord(it->first[2])));
+    const octomap::OcTreeNode* node = tree_->search(it->first);
+    const bool seen_occupied = node != nullptr && tree_->isNodeOccupied(node);
+    const bool occupied = seen_occupied || (prior_ && prior_->isOccupied(voxel));
+    if (occupied != map_->isOccupied(voxel)) changes.push_back({voxel, occupied});
+  }
+  tree_->resetChangeDetection();
+  return changes;
+}
+
+common::Result<FrameUpdate> LiveMap::integrate(const DepthFrame& frame) {
+  using R = common::Result<FrameUpdate>;
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto points = depthToPoints(frame, config_, 2.0 * map_->resolution());
+  if (!points) return R::fail(points.reason());
+  FrameUpdate out;
+  out.pixels = points->pixels;
+  out.hits = static_cast<int>(points->hits_world.size());
+  out.free_rays = static_cast<int>(points->free_rays_world.size());
+  out.skipped = points->skipped_invalid + points->skipped_near;
+  out.points_ms = msSince(t0);
+
+  const auto t1 = std::chrono::steady_clock::now();
+  out.rays_cast = castRays(*points);
+  out.raycast_ms = msSince(t1);
+
+  const auto t2 = std::chrono::steady_clock::now();
+  const std::vector<planning::VoxelChange> changes = fusedChanges(out.observed_changes);
+  std::unique_lock<std::shared_mutex> lock(mutex_);
+  const std::vector<planning::VoxelIndex> changed = map_->setOccupancy(changes);
+  out.map_changes = static_cast<int>(changed.size());
+  out.map_ms = msSince(t2);
+
+  const auto t3 = std::chrono::steady_clock::now();
+  const auto field_stats = field_->update(*map_, changed);
+  if (!field_stats) return R::fail(field_stats.reason());  // cannot happen: same grid by construction
+  out.field = *field_stats;
+  out.field_ms = msSince(t3);
+  out.total_ms = msSince(t0);
+  return R::ok(out);
+}
+
+Observed LiveMap::observed(const Eigen::Vector3d& p_world) const {
+  const octomap::OcTreeNode* node = tree_->search(toOcto(p_world));
+  if (node == nullptr) return Observed::kUnknown;
+  return tree_->isNodeOccupied(node) ? Observed::kOccupied : Observed::kFree;
+}
+
+}  // namespace gesture_formation::mapping
