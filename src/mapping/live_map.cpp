@@ -60,27 +60,102 @@ LiveMap::LiveMap(const MappingConfig& config, std::shared_ptr<planning::Occupanc
   tree_->setClampingThresMin(config_.clamping_min);
   tree_->setClampingThresMax(config_.clamping_max);
   tree_->enableChangeDetection(true);
+  const std::size_t voxels = static_cast<std::size_t>(map_->gridSize().prod());
+  mark_.assign(voxels, 0);
+  key_origin_ = map_->gridOrigin() + planning::VoxelIndex::Constant(kKeyOrigin);
+  grid_size_ = map_->gridSize();
+  saturated_.assign(voxels, 0);
 }
 
 LiveMap::~LiveMap() = default;
 
-int LiveMap::castRays(const DepthPoints& points) {
-  // Returns that end in one voxel give the same occupied voxel and nearly the same free ray:
-  // one ray per end voxel (the first return's, its exact point, so the range test is unchanged).
-  octomap::Pointcloud cloud;
-  octomap::KeySet ends;
+std::vector<octomap::point3d> LiveMap::rayEnds(const DepthPoints& points, std::size_t& hits) {
+  std::vector<octomap::point3d> ends;
+  ends.reserve(points.hits_world.size() + points.free_rays_world.size());
+  octomap::KeySet seen_outside;
+  std::vector<std::size_t> touched;
   auto add = [&](const std::vector<Eigen::Vector3d>& pts) {
     for (const auto& p : pts) {
       const octomap::point3d q = toOcto(p);
       octomap::OcTreeKey key;
-      if (tree_->coordToKeyChecked(q, key) && ends.insert(key).second) cloud.push_back(q);
+      if (!tree_->coordToKeyChecked(q, key)) continue;
+      const std::ptrdiff_t index = gridIndex(key);
+      if (index < 0) {
+        if (seen_outside.insert(key).second) ends.push_back(q);
+      } else if (mark_[static_cast<std::size_t>(index)] == 0) {
+        mark_[static_cast<std::size_t>(index)] = 1;
+        touched.push_back(static_cast<std::size_t>(index));
+        ends.push_back(q);
+      }
     }
   };
   add(points.hits_world);
+  hits = ends.size();
   add(points.free_rays_world);
-  tree_->insertPointCloud(cloud, toOcto(points.origin_world), config_.max_range_m, /*lazy_eval=*/false,
-                          /*discretize=*/false);
-  return static_cast<int>(cloud.size());
+  for (const std::size_t index : touched) mark_[index] = 0;
+  return ends;
+}
+
+void LiveMap::updateVoxel(const octomap::OcTreeKey& key, std::ptrdiff_t index, bool hit) {
+  // OctoMap's updateNode aborts when the voxel is already clamped in the update's direction;
+  // saturated_ remembers that per grid voxel, so those voxels are not even searched.
+  const std::uint8_t skip = hit ? kSaturatedOccupied : kSaturatedFree;
+  if (index >= 0 && saturated_[static_cast<std::size_t>(index)] == skip) return;
+  const octomap::OcTreeNode* node = tree_->updateNode(key, hit, /*lazy_eval=*/false);
+  if (index < 0 || node == nullptr) return;
+  const float l = node->getLogOdds();
+  saturated_[static_cast<std::size_t>(index)] = l <= tree_->getClampingThresMinLog()   ? kSaturatedFree
+                                                : l >= tree_->getClampingThresMaxLog() ? kSaturatedOccupied
+                                                                                       : 0;
+}
+
+int LiveMap::castRays(const DepthPoints& points) {
+  // OctoMap's insertPointCloud (computeUpdate, then free cells, then occupied cells), with the set
+  // of this frame's cells kept in a dense mark over the planner's grid instead of a hash set
+  // (cells outside the grid: hash sets, as OctoMap does).
+  std::size_t hits = 0;
+  const std::vector<octomap::point3d> ends = rayEnds(points, hits);
+  const octomap::point3d origin = toOcto(points.origin_world);
+  std::vector<std::pair<octomap::OcTreeKey, std::ptrdiff_t>>& free_cells = free_cells_;
+  std::vector<std::pair<octomap::OcTreeKey, std::ptrdiff_t>>& occupied_cells = occupied_cells_;
+  std::vector<std::size_t>& touched = touched_;
+  free_cells.clear();
+  occupied_cells.clear();
+  touched.clear();
+  octomap::KeySet free_outside, occupied_outside;
+  for (std::size_t i = 0; i < hits; ++i) {  // occupied ends first: a cell both free and occupied is occupied
+    octomap::OcTreeKey key;
+    if (!tree_->coordToKeyChecked(ends[i], key)) continue;
+    const std::ptrdiff_t index = gridIndex(key);
+    if (index < 0) {
+      occupied_outside.insert(key);
+    } else if (mark_[static_cast<std::size_t>(index)] == 0) {
+      mark_[static_cast<std::size_t>(index)] = 2;
+      touched.push_back(static_cast<std::size_t>(index));
+      occupied_cells.push_back({key, index});
+    }
+  }
+  const float max_range = static_cast<float>(config_.max_range_m);
+  for (std::size_t i = 0; i < ends.size(); ++i) {
+    const octomap::point3d end = i < hits ? ends[i] : origin + (ends[i] - origin).normalized() * max_range;
+    if (!tree_->computeRayKeys(origin, end, keyray_)) continue;
+    for (const octomap::OcTreeKey& key : keyray_) {
+      const std::ptrdiff_t index = gridIndex(key);
+      if (index < 0) {
+        if (!occupied_outside.count(key)) free_outside.insert(key);
+      } else if (mark_[static_cast<std::size_t>(index)] == 0) {
+        mark_[static_cast<std::size_t>(index)] = 1;
+        touched.push_back(static_cast<std::size_t>(index));
+        free_cells.push_back({key, index});
+      }
+    }
+  }
+  for (const auto& [key, index] : free_cells) updateVoxel(key, index, false);
+  for (const auto& key : free_outside) updateVoxel(key, -1, false);
+  for (const auto& [key, index] : occupied_cells) updateVoxel(key, index, true);
+  for (const auto& key : occupied_outside) updateVoxel(key, -1, true);
+  for (const std::size_t index : touched) mark_[index] = 0;
+  return static_cast<int>(ends.size());
 }
 
 std::vector<planning::VoxelChange> LiveMap::fusedChanges(int& observed_changes) {

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
 
 #include <fcl/geometry/octree/octree.h>
 #include <fcl/geometry/shape/sphere.h>
@@ -53,16 +56,40 @@ DistanceField::DistanceField(const OccupancyMap& map)
 DistanceField::DistanceField(const OccupancyMap& map, double max_distance_m)
     : resolution_m_(map.resolution()), max_distance_m_(max_distance_m), origin_(map.gridOrigin()), size_(map.gridSize()) {
   range_voxels_ = std::isfinite(max_distance_m_) ? static_cast<int>(std::ceil(max_distance_m_ / resolution_m_)) : 0;
-  dist_m_.assign(static_cast<std::size_t>(size_.x()) * static_cast<std::size_t>(size_.y()) * static_cast<std::size_t>(size_.z()),
-                 0.0f);
-  recomputeBox(map.denseGrid(), LocalBox{VoxelIndex::Zero(), size_ - VoxelIndex::Ones()});
-  scratch_ = std::vector<double>();  // a whole-grid scratch is not kept
+  const std::size_t voxels =
+      static_cast<std::size_t>(size_.x()) * static_cast<std::size_t>(size_.y()) * static_cast<std::size_t>(size_.z());
+  dist_m_.assign(voxels, 0.0f);
+  if (range_voxels_ == 0) {
+    recomputeBox(map.denseGrid(), LocalBox{VoxelIndex::Zero(), size_ - VoxelIndex::Ones()});
+    scratch_ = std::vector<double>();  // a whole-grid scratch is not kept
+    return;
+  }
+  const std::size_t nmax = static_cast<std::size_t>(size_.maxCoeff());
+  line_f_.resize(nmax);
+  line_d_.resize(nmax);
+  line_z_.resize(nmax + 1);
+  line_v_.resize(nmax);
+  pass1_.assign(voxels, kFarSquared);
+  pass2_.assign(voxels, kFarSquared);
+  for (int k = 0; k < size_.z(); ++k) {
+    for (int j = 0; j < size_.y(); ++j) rowX(map.denseGrid(), j, k);
+  }
+  for (int k = 0; k < size_.z(); ++k) {
+    for (int i = 0; i < size_.x(); ++i) columnY(i, k);
+  }
+  for (int j = 0; j < size_.y(); ++j) {
+    for (int i = 0; i < size_.x(); ++i) columnZ(i, j, 0, size_.z() - 1);
+  }
 }
 
 common::Result<DistanceField> DistanceField::truncated(const OccupancyMap& map, double max_distance_m) {
   using R = common::Result<DistanceField>;
   if (!(std::isfinite(max_distance_m) && max_distance_m > 0.0)) {
     return R::fail("distance field max_distance_m must be finite and > 0, got " + std::to_string(max_distance_m));
+  }
+  if (max_distance_m / map.resolution() > 255.0) {
+    return R::fail("distance field max_distance_m must be at most 255 voxels (" + std::to_string(255.0 * map.resolution()) +
+                   " m), got " + std::to_string(max_distance_m));
   }
   return R::ok(DistanceField(map, max_distance_m));
 }
@@ -126,12 +153,113 @@ std::size_t DistanceField::recomputeBox(const std::vector<std::uint8_t>& occupan
 
 namespace {
 
-double boxCost(const Eigen::Vector3i& lo, const Eigen::Vector3i& hi, int grow) {
-  const Eigen::Vector3d n = (hi - lo).cast<double>().array() + 1.0 + 2.0 * grow;
-  return n.prod();
+std::uint16_t capSquared(double d, int range_voxels, std::uint16_t far) {
+  return d <= static_cast<double>(range_voxels) * range_voxels ? static_cast<std::uint16_t>(d) : far;
 }
 
 }  // namespace
+
+void DistanceField::rowX(const std::vector<std::uint8_t>& occupancy, int j, int k) {
+  const int n = size_.x();
+  const std::size_t row = linear(0, j, k);
+  bool any = false;
+  for (int i = 0; i < n; ++i) {
+    const bool occupied = occupancy[row + static_cast<std::size_t>(i)] != 0;
+    line_f_[static_cast<std::size_t>(i)] = occupied ? 0.0 : kFar;
+    any = any || occupied;
+  }
+  if (!any) {  // an empty line stays empty: every transform of it is far
+    std::fill_n(pass1_.begin() + static_cast<std::ptrdiff_t>(row), n, kFarSquared);
+    return;
+  }
+  transform1d(line_f_.data(), n, line_d_.data(), line_v_.data(), line_z_.data());
+  for (int i = 0; i < n; ++i) pass1_[row + static_cast<std::size_t>(i)] = capSquared(line_d_[static_cast<std::size_t>(i)], range_voxels_, kFarSquared);
+}
+
+void DistanceField::columnY(int i, int k) {
+  const int n = size_.y();
+  bool any = false;
+  for (int j = 0; j < n; ++j) {
+    const std::uint16_t s = pass1_[linear(i, j, k)];
+    line_f_[static_cast<std::size_t>(j)] = s == kFarSquared ? kFar : static_cast<double>(s);
+    any = any || s != kFarSquared;
+  }
+  if (any) transform1d(line_f_.data(), n, line_d_.data(), line_v_.data(), line_z_.data());
+  for (int j = 0; j < n; ++j) {
+    pass2_[linear(i, j, k)] = any ? capSquared(line_d_[static_cast<std::size_t>(j)], range_voxels_, kFarSquared) : kFarSquared;
+  }
+}
+
+void DistanceField::columnZ(int i, int j, int k_lo, int k_hi) {
+  const int n = size_.z();
+  bool any = false;
+  for (int k = 0; k < n; ++k) {
+    const std::uint16_t s = pass2_[linear(i, j, k)];
+    line_f_[static_cast<std::size_t>(k)] = s == kFarSquared ? kFar : static_cast<double>(s);
+    any = any || s != kFarSquared;
+  }
+  if (!any) {
+    for (int k = k_lo; k <= k_hi; ++k) dist_m_[linear(i, j, k)] = static_cast<float>(max_distance_m_);
+    return;
+  }
+  transform1d(line_f_.data(), n, line_d_.data(), line_v_.data(), line_z_.data());
+  for (int k = k_lo; k <= k_hi; ++k) dist_m_[linear(i, j, k)] = toMetres(std::min(line_d_[static_cast<std::size_t>(k)], kFar));
+}
+
+FieldUpdateStats DistanceField::updateTruncated(const std::vector<std::uint8_t>& occupancy,
+                                                const std::vector<VoxelIndex>& changed) {
+  const int nx = size_.x(), ny = size_.y(), nz = size_.z(), r = range_voxels_;
+  constexpr int kNone = std::numeric_limits<int>::max();
+  // x rows holding a changed voxel, with the x range of the changes
+  std::vector<int> rows, row_lo(static_cast<std::size_t>(ny) * static_cast<std::size_t>(nz), kNone),
+      row_hi(row_lo.size(), -1);
+  for (const VoxelIndex& voxel : changed) {
+    const VoxelIndex c = voxel - origin_;
+    if ((c.array() < 0).any() || (c.array() >= size_.array()).any()) continue;
+    const std::size_t row = static_cast<std::size_t>(c.y()) + static_cast<std::size_t>(ny) * static_cast<std::size_t>(c.z());
+    if (row_lo[row] == kNone) rows.push_back(static_cast<int>(row));
+    row_lo[row] = std::min(row_lo[row], c.x());
+    row_hi[row] = std::max(row_hi[row], c.x());
+  }
+  // y columns (i, k) whose pass-1 input changed within the range, with the y range of the rows
+  std::vector<int> columns, col_lo(static_cast<std::size_t>(nx) * static_cast<std::size_t>(nz), kNone),
+      col_hi(col_lo.size(), -1);
+  for (const int row : rows) {
+    const int j = row % ny, k = row / ny;
+    rowX(occupancy, j, k);
+    for (int i = std::max(0, row_lo[static_cast<std::size_t>(row)] - r);
+         i <= std::min(nx - 1, row_hi[static_cast<std::size_t>(row)] + r); ++i) {
+      const std::size_t col = static_cast<std::size_t>(i) + static_cast<std::size_t>(nx) * static_cast<std::size_t>(k);
+      if (col_lo[col] == kNone) columns.push_back(static_cast<int>(col));
+      col_lo[col] = std::min(col_lo[col], j);
+      col_hi[col] = std::max(col_hi[col], j);
+    }
+  }
+  // z columns (i, j) whose pass-2 input changed, with the z range of the change (values change
+  // only within the range of it)
+  std::vector<int> verticals, vert_lo(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny), kNone),
+      vert_hi(vert_lo.size(), -1);
+  for (const int col : columns) {
+    const int i = col % nx, k = col / nx;
+    columnY(i, k);
+    for (int j = std::max(0, col_lo[static_cast<std::size_t>(col)] - r);
+         j <= std::min(ny - 1, col_hi[static_cast<std::size_t>(col)] + r); ++j) {
+      const std::size_t xy = static_cast<std::size_t>(i) + static_cast<std::size_t>(nx) * static_cast<std::size_t>(j);
+      if (vert_lo[xy] == kNone) verticals.push_back(static_cast<int>(xy));
+      vert_lo[xy] = std::min(vert_lo[xy], k);
+      vert_hi[xy] = std::max(vert_hi[xy], k);
+    }
+  }
+  FieldUpdateStats stats;
+  for (const int xy : verticals) {
+    const int k_lo = std::max(0, vert_lo[static_cast<std::size_t>(xy)] - r);
+    const int k_hi = std::min(nz - 1, vert_hi[static_cast<std::size_t>(xy)] + r);
+    columnZ(xy % nx, xy / nx, k_lo, k_hi);
+    stats.voxels_written += static_cast<std::size_t>(k_hi - k_lo + 1);
+  }
+  stats.lines = static_cast<int>(rows.size() + columns.size() + verticals.size());
+  return stats;
+}
 
 common::Result<FieldUpdateStats> DistanceField::update(const OccupancyMap& map, const std::vector<VoxelIndex>& changed_voxels) {
   using R = common::Result<FieldUpdateStats>;
@@ -139,54 +267,17 @@ common::Result<FieldUpdateStats> DistanceField::update(const OccupancyMap& map, 
     return R::fail("distance field update: the map's grid differs from the field's");
   }
   FieldUpdateStats stats;
+  if (!changed_voxels.empty()) {
+    if (range_voxels_ > 0) {
+      stats = updateTruncated(map.denseGrid(), changed_voxels);
+    } else {
+      recomputeBox(map.denseGrid(), LocalBox{VoxelIndex::Zero(), size_ - VoxelIndex::Ones()});
+      scratch_ = std::vector<double>();
+      stats.lines = size_.y() * size_.z() + size_.x() * size_.z() + size_.x() * size_.y();
+      stats.voxels_written = dist_m_.size();
+    }
+  }
   stats.changed_voxels = static_cast<int>(changed_voxels.size());
-  if (changed_voxels.empty()) return R::ok(stats);
-  std::vector<LocalBox> boxes;
-  if (range_voxels_ == 0) {
-    boxes.push_back(LocalBox{VoxelIndex::Zero(), size_ - VoxelIndex::Ones()});
-  } else {
-    // One box per kGroup³ group of changed voxels (their bounding box), grown by the range.
-    constexpr int kGroup = 8;
-    std::vector<std::pair<VoxelIndex, LocalBox>> groups;
-    for (const VoxelIndex& voxel : changed_voxels) {
-      const VoxelIndex local = voxel - origin_;
-      if ((local.array() < 0).any() || (local.array() >= size_.array()).any()) continue;
-      const VoxelIndex g = local / kGroup;
-      auto it = std::find_if(groups.begin(), groups.end(), [&](const auto& e) { return e.first == g; });
-      if (it == groups.end()) {
-        groups.push_back({g, LocalBox{local, local}});
-      } else {
-        it->second.lo = it->second.lo.cwiseMin(local);
-        it->second.hi = it->second.hi.cwiseMax(local);
-      }
-    }
-    const VoxelIndex grow = VoxelIndex::Constant(range_voxels_);
-    for (const auto& e : groups) {
-      boxes.push_back(LocalBox{(e.second.lo - grow).cwiseMax(VoxelIndex::Zero()),
-                               (e.second.hi + grow).cwiseMin(size_ - VoxelIndex::Ones())});
-    }
-    // Merge two boxes while one transform over their bounding box reads less than two.
-    for (bool merged = true; merged;) {
-      merged = false;
-      for (std::size_t a = 0; a < boxes.size() && !merged; ++a) {
-        for (std::size_t b = a + 1; b < boxes.size() && !merged; ++b) {
-          const VoxelIndex lo = boxes[a].lo.cwiseMin(boxes[b].lo), hi = boxes[a].hi.cwiseMax(boxes[b].hi);
-          if (boxCost(lo, hi, range_voxels_) <
-              boxCost(boxes[a].lo, boxes[a].hi, range_voxels_) + boxCost(boxes[b].lo, boxes[b].hi, range_voxels_)) {
-            boxes[a] = LocalBox{lo, hi};
-            boxes.erase(boxes.begin() + static_cast<std::ptrdiff_t>(b));
-            merged = true;
-          }
-        }
-      }
-    }
-  }
-  for (const LocalBox& box : boxes) {
-    stats.voxels_read += recomputeBox(map.denseGrid(), box);
-    stats.voxels_written += static_cast<std::size_t>((box.hi - box.lo + VoxelIndex::Ones()).prod());
-  }
-  stats.boxes = static_cast<int>(boxes.size());
-  if (range_voxels_ == 0) scratch_ = std::vector<double>();
   return R::ok(stats);
 }
 

@@ -22,11 +22,16 @@
 /// so that it never sees a half-applied update; on the same thread no lock is needed. map() and
 /// field() point to the same objects for the live map's lifetime.
 
+#include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <shared_mutex>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <Eigen/Core>
+#include <octomap/OcTree.h>
 
 #include "gesture_formation/common/result.hpp"
 #include "gesture_formation/mapping/depth_points.hpp"
@@ -35,9 +40,6 @@
 #include "gesture_formation/planning/occupancy_map.hpp"
 #include "gesture_formation/planning/scenario.hpp"
 
-namespace octomap {
-class OcTree;
-}
 
 namespace gesture_formation::mapping {
 
@@ -92,8 +94,18 @@ class LiveMap {
  private:
   LiveMap(const MappingConfig& config, std::shared_ptr<planning::OccupancyMap> map,
           std::shared_ptr<planning::DistanceField> field, std::shared_ptr<const planning::OccupancyMap> prior);
-  /// Ray-casts the points (returns ending in one voxel merged) into tree_; returns rays cast.
+  /// The rays' ends: the first return per end voxel, hits (the first `hits`) before free rays.
+  std::vector<octomap::point3d> rayEnds(const DepthPoints& points, std::size_t& hits);
+  /// Ray-casts the points into tree_ as OctoMap's insertPointCloud does; returns rays cast.
   int castRays(const DepthPoints& points);
+  /// Linear index of the key's voxel in the planner's grid, −1 outside it.
+  std::ptrdiff_t gridIndex(const octomap::OcTreeKey& key) const {
+    const int i = key[0] - key_origin_.x(), j = key[1] - key_origin_.y(), k = key[2] - key_origin_.z();
+    if (i < 0 || j < 0 || k < 0 || i >= grid_size_.x() || j >= grid_size_.y() || k >= grid_size_.z()) return -1;
+    return i + static_cast<std::ptrdiff_t>(grid_size_.x()) * (j + static_cast<std::ptrdiff_t>(grid_size_.y()) * k);
+  }
+  /// One hit or miss of a voxel (index −1: outside the grid), skipped when OctoMap would abort it.
+  void updateVoxel(const octomap::OcTreeKey& key, std::ptrdiff_t index, bool hit);
   /// The changed OctoMap voxels as planner-map changes (fused with the prior); clears the record.
   std::vector<planning::VoxelChange> fusedChanges(int& observed_changes);
 
@@ -102,7 +114,17 @@ class LiveMap {
   std::shared_ptr<planning::DistanceField> field_;
   std::shared_ptr<const planning::OccupancyMap> prior_;
   std::unique_ptr<octomap::OcTree> tree_;
+  octomap::KeyRay keyray_;  ///< castRays' scratch
+  std::vector<std::pair<octomap::OcTreeKey, std::ptrdiff_t>> free_cells_, occupied_cells_;  ///< castRays' scratch
+  std::vector<std::size_t> touched_;                                                          ///< castRays' scratch
+  planning::VoxelIndex key_origin_ = planning::VoxelIndex::Zero();  ///< OctoMap key of the grid's first voxel
+  planning::VoxelIndex grid_size_ = planning::VoxelIndex::Zero();
+  std::vector<std::uint8_t> mark_;       ///< per grid voxel, this frame: 1 free cell, 2 occupied cell
+  std::vector<std::uint8_t> saturated_;  ///< per grid voxel: kSaturatedFree / kSaturatedOccupied / 0
   mutable std::shared_mutex mutex_;
+  static constexpr int kKeyOrigin = 32768;  ///< OctoMap's key of voxel index 0 (tree depth 16)
+  static constexpr std::uint8_t kSaturatedFree = 1;
+  static constexpr std::uint8_t kSaturatedOccupied = 2;
 };
 
 }  // namespace gesture_formation::mapping
