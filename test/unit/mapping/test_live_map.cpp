@@ -9,6 +9,10 @@
 #include <limits>
 #include <set>
 #include <tuple>
+#include <utility>
+#include <vector>
+
+#include <octomap/OcTree.h>
 
 #include "gesture_formation/mapping/depth_points.hpp"
 #include "gesture_formation/mapping/live_map.hpp"
@@ -207,6 +211,60 @@ TEST(LiveMapTest, PriorVoxelsStayOccupiedWhenRaysPassThem) {
   EXPECT_EQ(live->map()->occupiedCount(), prior_count + 70);
   EXPECT_EQ(prior->occupiedCount(), prior_count);  // the prior itself is untouched
   expectFieldIsFullRebuild(*live);
+}
+
+TEST(LiveMapTest, RayCastingEqualsOctomapInsertPointCloud) {
+  // LiveMap casts its rays itself (a dense mark instead of OctoMap's hash sets, clamped voxels
+  // skipped): the observed tree must equal OctoMap's insertPointCloud of the same rays, also
+  // outside the grid (the rays here leave it above, below and to the sides).
+  auto live = makeLiveMap();
+  ASSERT_TRUE(live);
+  const MappingConfig& c = live->config();
+  octomap::OcTree reference(kRes);
+  reference.setProbHit(c.prob_hit);
+  reference.setProbMiss(c.prob_miss);
+  reference.setClampingThresMin(c.clamping_min);
+  reference.setClampingThresMax(c.clamping_max);
+  const std::vector<std::pair<Eigen::Vector3d, bool>> shots = {
+      {kCamera, false}, {kCamera, false}, {Eigen::Vector3d(0.5, -1.0, 2.0), true},
+      {Eigen::Vector3d(1.0, 0.7, 1.2), false}, {kCamera, true}, {kCamera, true}, {kCamera, true}};
+  for (const auto& [p, moved] : shots) {
+    DepthFrame f = cameraAt(p);
+    renderBox(f, moved ? kBoxBLo : kBoxALo, moved ? kBoxBHi : kBoxAHi);
+    ASSERT_TRUE(live->integrate(f));
+    const auto points = mapping::depthToPoints(f, c, 2.0 * kRes);
+    ASSERT_TRUE(points);
+    // the same rays: the first return per end voxel, returns within range before the others
+    octomap::Pointcloud cloud;
+    octomap::KeySet ends;
+    for (const auto* list : {&points->hits_world, &points->free_rays_world}) {
+      for (const auto& q : *list) {
+        const octomap::point3d e(static_cast<float>(q.x()), static_cast<float>(q.y()), static_cast<float>(q.z()));
+        if (ends.insert(reference.coordToKey(e)).second) cloud.push_back(e);
+      }
+    }
+    reference.insertPointCloud(cloud, octomap::point3d(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())),
+                               c.max_range_m);
+  }
+  const octomap::OcTree& tree = live->observedTree();
+  int compared = 0, known = 0;
+  for (int k = -40; k < 40; ++k) {
+    for (int j = -45; j < 45; ++j) {
+      for (int i = -10; i < 75; ++i) {
+        const octomap::point3d q(static_cast<float>((i + 0.5) * kRes), static_cast<float>((j + 0.5) * kRes),
+                                 static_cast<float>((k + 0.5) * kRes));
+        const octomap::OcTreeNode* a = tree.search(q);
+        const octomap::OcTreeNode* b = reference.search(q);
+        ++compared;
+        ASSERT_EQ(a == nullptr, b == nullptr) << "voxel " << i << " " << j << " " << k;
+        if (a != nullptr) {
+          ++known;
+          ASSERT_EQ(a->getLogOdds(), b->getLogOdds()) << "voxel " << i << " " << j << " " << k;
+        }
+      }
+    }
+  }
+  EXPECT_GT(known, 20000) << "of " << compared;
 }
 
 TEST(LiveMapTest, PriorOnAnotherGridIsRefused) {
