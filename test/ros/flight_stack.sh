@@ -7,7 +7,6 @@
 # plan's last point after its end and refuses plans in another frame or of another UAV.
 set -o pipefail
 command -v roscore > /dev/null || { echo "SKIP: no ROS (roscore not found)"; exit 77; }
-[ -f "$2/devel/setup.bash" ] || { echo "SKIP: no devel space in $2"; exit 77; }
 source "$(dirname "$0")/common.bash"
 start_master
 roslaunch -p "$PORT" gesture_formation flight_stack.launch flight_stack:=mavros setpoints:=both rate_hz:=50 \
