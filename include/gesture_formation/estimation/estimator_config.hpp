@@ -29,7 +29,7 @@ struct EstimatorConfig {
 
 /// \brief Reads an EstimatorConfig from `reader`, starting from the defaults above.
 /// Keys: `camera.{fx,fy,cx,cy,distortion,width,height}`, `human_height_m`,
-/// `process_noise.{sigma_p_m,sigma_v_mps}`,
+/// `process_noise.{sigma_p_m,sigma_v_mps,reference_period_s}`,
 /// `measurement_noise.{sigma_xy_m,sigma_z_uwb_m,sigma_z_stereo_m,sigma_z_apparent_m}`,
 /// `initial_velocity_std_mps`, `gate_chi2`, `max_consecutive_rejections`, `lost_timeout_s`,
 /// `confirm_measurements`,

@@ -43,6 +43,11 @@ using Matrix6d = Eigen::Matrix<double, 6, 6>;
 struct HumanKalmanConfig {
   double sigma_p_m = 0.1;                 ///< process noise on position per step [m], > 0
   double sigma_v_mps = 0.1;               ///< process noise on velocity per step [m/s], > 0
+  /// Q's time base [s], ≥ 0. 0: Q is added once per prediction step, whatever its length (the
+  /// paper's filter, tuned for a 15 Hz camera). > 0: Q is scaled by dt / reference_period_s, so the
+  /// noise per second is the same at any measurement rate (a camera at 5 Hz, sensors arriving
+  /// together or apart); set it to the period the sigmas were tuned at (1/15 s for the paper's).
+  double reference_period_s = 0.0;
   double initial_velocity_std_mps = 1.0;  ///< σ_v0 of the velocity at (re-)initialisation [m/s], > 0
   double gate_chi2 = 16.27;               ///< Mahalanobis gate, χ²₃ at 0.999, > 0
   int max_consecutive_rejections = 10;    ///< at most this many gated-out measurements in a row, ≥ 1
@@ -135,7 +140,8 @@ class HumanKalman {
     consecutive_rejections_ = 0;
   }
 
-  /// \brief Predicts the state to `t_s` (≥ time()), adding Q once. Returns false and changes
+  /// \brief Predicts the state to `t_s` (≥ time()), adding Q once (scaled by
+  /// dt / reference_period_s when that is > 0, dt = t_s − time()). Returns false and changes
   /// nothing when not initialised, `t_s` is not finite, or `t_s` < time().
   ///
   /// The constant-velocity model holds for at most lost_timeout_s after the last fused
@@ -167,8 +173,9 @@ class HumanKalman {
       P.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity() * (s0 * s0);
       P.topLeftCorner<3, 3>().diagonal().array() += s0 * s0 * dt_held * 1.0 /* s */;
     }
-    const double qp = config_.sigma_p_m * config_.sigma_p_m;
-    const double qv = config_.sigma_v_mps * config_.sigma_v_mps;
+    const double q_scale = config_.reference_period_s > 0.0 ? (t_s - t_) / config_.reference_period_s : 1.0;
+    const double qp = q_scale * config_.sigma_p_m * config_.sigma_p_m;
+    const double qv = q_scale * config_.sigma_v_mps * config_.sigma_v_mps;
     P.diagonal() += (Vector6d() << qp, qp, qp, qv, qv, qv).finished();
     if (!x.allFinite() || !P.allFinite()) return false;
     x_ = x;

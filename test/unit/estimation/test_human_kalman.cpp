@@ -57,6 +57,46 @@ TEST(HumanKalmanTest, PredictInflatesCovarianceByFPFtPlusQ) {
   EXPECT_LT((kf.covariance() - expected).norm(), 1e-14) << "a refused prediction changes nothing";
 }
 
+TEST(HumanKalmanTest, ReferencePeriodScalesQWithTheStepLength) {
+  HumanKalmanConfig c;
+  c.reference_period_s = 0.1;
+  HumanKalman kf(c);
+  kf.step(0.0, meas(Eigen::Vector3d(0, 0, 0)));
+  const Matrix6d P0 = kf.covariance();
+  ASSERT_TRUE(kf.predict(0.5));  // five reference periods: 5 Q
+  Matrix6d F = Matrix6d::Identity();
+  F.topRightCorner<3, 3>() = 0.5 * Eigen::Matrix3d::Identity();
+  const Matrix6d expected = F * P0 * F.transpose() + 5.0 * 0.01 * Matrix6d::Identity();
+  EXPECT_LT((kf.covariance() - expected).norm(), 1e-13);
+
+  // The velocity's variance after one second is the same whether it is predicted in 15 steps
+  // or 5 (no measurement in between): the noise is per second, not per step.
+  HumanKalman fast(c), slow(c);
+  fast.step(0.0, meas(Eigen::Vector3d(0, 0, 0)));
+  slow.step(0.0, meas(Eigen::Vector3d(0, 0, 0)));
+  for (int k = 1; k <= 15; ++k) ASSERT_TRUE(fast.predict(k / 15.0));
+  for (int k = 1; k <= 5; ++k) ASSERT_TRUE(slow.predict(k / 5.0));
+  EXPECT_NEAR(fast.covariance()(3, 3), slow.covariance()(3, 3), 1e-12);
+  EXPECT_NEAR(fast.covariance()(3, 3), 1.0 + 10.0 * 0.01, 1e-12);  // σ_v0² + (1 s / 0.1 s)·σ_v²
+
+  // Without a reference period (the paper's filter) Q is added once per step: 15 steps add 3× what 5 do.
+  HumanKalman fast0, slow0;
+  fast0.step(0.0, meas(Eigen::Vector3d(0, 0, 0)));
+  slow0.step(0.0, meas(Eigen::Vector3d(0, 0, 0)));
+  for (int k = 1; k <= 15; ++k) ASSERT_TRUE(fast0.predict(k / 15.0));
+  for (int k = 1; k <= 5; ++k) ASSERT_TRUE(slow0.predict(k / 5.0));
+  EXPECT_NEAR(fast0.covariance()(3, 3) - 1.0, 3.0 * (slow0.covariance()(3, 3) - 1.0), 1e-12);
+}
+
+TEST(HumanKalmanTest, ReferencePeriodOutOfRangeIsNamed) {
+  HumanKalmanConfig c;
+  c.reference_period_s = -0.1;
+  const auto problems = c.validate();
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_NE(problems[0].find("process_noise.reference_period_s"), std::string::npos) << problems[0];
+  EXPECT_NE(problems[0].find("-0.1"), std::string::npos) << problems[0];
+}
+
 TEST(HumanKalmanTest, UpdateMatchesTextbookFormulaOnDynamicMatrices) {
   HumanKalman kf;
   kf.step(0.0, meas(Eigen::Vector3d(0, 0, 0), 0.5));
