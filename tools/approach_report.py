@@ -36,12 +36,14 @@ def quantiles(values):
 
 
 def backoffs(path):
-    """Per UAV: the first back-off row (t, mode) of modes.csv, or None."""
+    """Per UAV: the first back-off row of modes.csv as (t, "backoff" | "none": no goal found)."""
     first = {}
     with open(path) as f:
         for row in csv.DictReader(f):
-            if row["mode"] in ("backoff", "backoff_none") and int(row["uav"]) not in first:
-                first[int(row["uav"])] = (float(row["t"]), row["mode"])
+            uav = 0 if row["uav"] == "L" else int(row["uav"])
+            for prefix, kind in (("backing off from the worker's reach", "backoff"), ("no back-off goal", "none")):
+                if row["reason"].startswith(prefix) and uav not in first:
+                    first[uav] = (float(row["t"]), kind)
     return first
 
 
@@ -53,6 +55,7 @@ def main():
     ap.add_argument("--profile", required=True)
     ap.add_argument("--load", required=True, help="the machine load, as measured by the caller")
     ap.add_argument("--out", required=True)
+    ap.add_argument("--commit", help="the commit gfctl was built from (default: HEAD, as git reports it)")
     a = ap.parse_args()
     missions, modes = [], []
     for seed in range(1, a.seeds + 1):
@@ -65,10 +68,11 @@ def main():
         sys.exit("approach_report.py: a mission has no worker_approach section (profile without faults.worker_approach?)")
     ap0 = missions[0]["worker_approach"]
     n_uav = len(ap0["uavs"])
-    commit = subprocess.run(["git", "rev-parse", "--short=10", "HEAD"], capture_output=True, text=True).stdout.strip()
+    commit = a.commit or subprocess.run(["git", "rev-parse", "--short=10", "HEAD"], capture_output=True,
+                                        text=True).stdout.strip()
     dirty = subprocess.run(["git", "status", "--porcelain", "--", "src", "include", "config"], capture_output=True,
                            text=True).stdout.strip()
-    if dirty:
+    if dirty and not a.commit:
         commit += " + uncommitted changes to src/include/config"
     now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     violations = sum(m["worker_approach"]["gamma_dis_violations"] for m in missions)

@@ -11,7 +11,8 @@
 #
 # Environment: GF_SEEDS (default 10), GF_DURATION (240), GF_PROFILE (worker_approaches_holding_uav),
 # GFCTL (default build/devel/lib/gesture_formation/gfctl), GF_OUT (the missions' folder, default
-# a temporary one), GF_REPORT (default docs/results/worker_approach.md). Runs nice -n 10, one mission
+# a temporary one), GF_REPORT (default docs/results/worker_approach.md), GF_COMMIT (the commit GFCTL was
+# built from, for the report; default HEAD). Runs nice -n 10, one mission
 # at a time.
 case "${1:-}" in -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;; esac  # the comment above
 set -euo pipefail
@@ -38,4 +39,4 @@ wall_s=$(( $(date +%s) - wall0 ))
 load_after=$(cut -d' ' -f1-3 /proc/loadavg)
 python3 tools/approach_report.py --missions "$OUT" --seeds "$SEEDS" --duration "$DURATION" --profile "$PROFILE" \
   --load "before $load_before, after $load_after (1/5/15-min averages; $(nproc) cores), $wall_s s wall for the seeds run by this call" \
-  --out "${GF_REPORT:-docs/results/worker_approach.md}"
+  --out "${GF_REPORT:-docs/results/worker_approach.md}" ${GF_COMMIT:+--commit "$GF_COMMIT"}

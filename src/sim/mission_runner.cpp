@@ -517,8 +517,8 @@ void MissionRun::replan(int i, double t) {
   } else {
     setMode(i, t, planning::toString(out.mode), out.holding() ? out.reason : "fresh data");
   }
-  // A back-off from the worker's reach begins (or finds no goal): one row of its own.
-  if (out.backoff_started) modes_.push_back(ModeChange{t, i, out.backing_off ? "backoff" : "backoff_none", out.backoff});
+  // A back-off from the worker's reach begins (or finds no goal): a row of the same mode with its reason.
+  if (out.backoff_started) modes_.push_back(ModeChange{t, i, u.mode, out.backoff});
   const planning::PlanResult& res = out.result;
   metrics_.plan(i, t, version, res.status, res.timings.total_ms, res.reason, res.qp_sparse_timeouts);
   if (res.trajectory.empty()) {

@@ -3,7 +3,7 @@
 # fault profile worker_approaches_holding_uav (the leader's camera blind from 205 s, the UAVs holding
 # from ~208 s; at 210 s the worker turns back and walks at 1.2 m/s to the point below follower 2,
 # which holds 2 m above his mid-body). Run to 228 s (he arrives at ~219 s and stands there). Every
-# UAV near the growing reach backs off (modes.csv `backoff`, follower 2 among them); while he is
+# UAV near the growing reach backs off (a modes.csv row "backing off from the worker's reach ...", follower 2 among them); while he is
 # unseen no UAV comes within Gamma_dis of him (metrics.json worker_approach); Gamma_dis between the
 # UAVs, no collision. (Without the reach he walks to 1.7 m of follower 2: docs/safety.md §3.)
 # Usage: gfctl_simulate_worker_approach.sh GFCTL SRC
@@ -25,7 +25,8 @@ if a is None:
 if not (abs(a["unseen_from_s"] - 210.0) < 0.02 and a["unseen_to_s"] > 227.9): problems.append(f"unseen phase {a['unseen_from_s']}-{a['unseen_to_s']}")
 if a["gamma_dis_violations"] != 0: problems.append(f"Gamma_dis violations {a['gamma_dis_violations']}")
 if not a["min_distance_m"] >= a["gamma_dis_m"]: problems.append(f"min distance {a['min_distance_m']:.2f} < {a['gamma_dis_m']}")
-backoffs = {r["uav"] for r in csv.DictReader(open(f"{d}/modes.csv")) if r["mode"] == "backoff" and float(r["t"]) >= 205}
+backoffs = {r["uav"] for r in csv.DictReader(open(f"{d}/modes.csv"))
+            if r["reason"].startswith("backing off from the worker's reach") and float(r["t"]) >= 205}
 if "2" not in backoffs: problems.append(f"follower 2 did not back off: {sorted(backoffs)}")
 if m["min_mutual_distance_m"] < 2.5: problems.append(f"min mutual {m['min_mutual_distance_m']:.2f} < 2.5")
 if m["collisions"] != 0: problems.append(f"collisions {m['collisions']}")
