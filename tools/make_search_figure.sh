@@ -2,11 +2,12 @@
 # Regenerates docs/images/search_climbing_worker.png (docs/safety.md §2.2): the power-tower mission,
 # seed 1, the leader's camera blind 8–25 s while the worker climbs the west tower, once with the
 # camera search and once without (search_timeout_s: 0), drawn by tools/plot_search.py.
-# Usage: tools/make_search_figure.sh [GFCTL]   (default: build/devel/lib/gesture_formation/gfctl)
+# Usage: tools/make_search_figure.sh [GFCTL]   (default: gfctl of the build tools/lib/devel_dir.bash finds)
 case "${1:-}" in -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;; esac  # the comment above
 set -euo pipefail
 cd "$(dirname "$0")/.."
-GFCTL=${1:-build/devel/lib/gesture_formation/gfctl}
+source tools/lib/devel_dir.bash
+GFCTL=${1:-$(gf_devel_dir . || echo /nonexistent)/lib/gesture_formation/gfctl}
 PY=/opt/gesture_formation/venv/bin/python
 [ -x "$GFCTL" ] || { echo "make_search_figure.sh: $GFCTL not built (tools/build.sh)" >&2; exit 2; }
 TMP=$(mktemp -d)

@@ -16,7 +16,7 @@
 set -o pipefail
 cd "$(dirname "$0")/.."
 SRC=$PWD
-BUILD=${GF_BUILD_DIR:-build}
+source tools/lib/devel_dir.bash
 WALL=40
 CONFIGS="synthetic:1.0 3:0.5 5:1.0 10:1.0 15:0.33"
 WRITE=1
@@ -32,7 +32,8 @@ while [ $# -gt 0 ]; do
   esac
 done
 [[ $WALL =~ ^[0-9]+$ ]] && [ "$WALL" -ge 10 ] || { echo "$0: --wall: expected whole seconds >= 10, got '$WALL'" >&2; exit 2; }
-[ -f "$BUILD/devel/lib/libgesture_formation_sim_nodelets.so" ] || { echo "$0: build first (tools/build.sh)" >&2; exit 2; }
+DEVEL=$(gf_devel_dir .) || exit 2
+[ -f "$DEVEL/lib/libgesture_formation_sim_nodelets.so" ] || { echo "$0: $DEVEL lacks the simulation nodelets: build first (tools/build.sh)" >&2; exit 2; }
 [ "$(id -u)" -eq 0 ] || { echo "$0: needs root (unshare -n keeps LCM on this machine)" >&2; exit 2; }
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
@@ -94,7 +95,7 @@ for c in $CONFIGS; do
   rm -rf "$T/log" "$T/out"
   cat > "$T/inner.sh" <<INNER
 export ROS_MASTER_URI=http://127.0.0.1:14311 ROS_IP=127.0.0.1 ROS_HOME=$T/ros ROS_LOG_DIR=$T/log
-source "$BUILD/devel/setup.bash"
+source "$DEVEL/setup.bash"
 ip link set lo up && ip route add 224.0.0.0/4 dev lo || exit 1
 roslaunch -p 14311 gesture_formation simulation.launch key_dir:=$T/keys output_dir:=$T/out duration:=-1 \
   real_time_factor:=$rtf camera:=$camera camera_rate:=\$([ $rate = 0 ] && echo 5 || echo $rate) > "$T/launch.log" 2>&1 &
@@ -115,7 +116,7 @@ if [ "$GESTURES" -eq 1 ]; then
   rm -rf "$T/log" "$T/out"; mkdir -p "$T/out"
   cat > "$T/inner.sh" <<INNER
 export ROS_MASTER_URI=http://127.0.0.1:14311 ROS_IP=127.0.0.1 ROS_HOME=$T/ros ROS_LOG_DIR=$T/log
-source "$BUILD/devel/setup.bash"
+source "$DEVEL/setup.bash"
 ip link set lo up && ip route add 224.0.0.0/4 dev lo || exit 1
 roslaunch -p 14311 gesture_formation simulation.launch key_dir:=$T/keys output_dir:=$T/out seed:=1 \
   mission:=$SRC/test/data/sim/rendered_gestures.yaml real_time_factor:=0.33 camera:=rendered camera_rate:=15 > "$T/launch.log" 2>&1 &

@@ -9,12 +9,13 @@
 #   GF_SEEDS=100 tools/run_abort_profile.sh
 #
 # Environment: GF_SEEDS (default 10), GF_DURATION (160), GF_PROFILE (abort_mid_mission),
-# GFCTL (default build/devel/lib/gesture_formation/gfctl), GF_OUT (the missions' folder, default
+# GFCTL (default: gfctl of the build tools/lib/devel_dir.bash finds), GF_OUT (the missions' folder, default
 # a temporary one), GF_REPORT (default docs/results/abort.md). Runs nice -n 10, one mission at a time.
 case "${1:-}" in -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;; esac  # the comment above
 set -euo pipefail
 cd "$(dirname "$0")/.."
-GFCTL=${GFCTL:-build/devel/lib/gesture_formation/gfctl}
+source tools/lib/devel_dir.bash
+GFCTL=${GFCTL:-$(gf_devel_dir . || echo /nonexistent)/lib/gesture_formation/gfctl}
 SEEDS=${GF_SEEDS:-10}
 DURATION=${GF_DURATION:-160}
 PROFILE=${GF_PROFILE:-abort_mid_mission}

@@ -18,7 +18,7 @@ case "${1:-}" in -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/,
 set -eo pipefail  # not -u: devel/setup.bash reads unset variables
 cd "$(dirname "$0")/.."
 SRC=$PWD
-BUILD=${GF_BUILD_DIR:-build}
+source tools/lib/devel_dir.bash
 OUT=results/multihost
 DURATION=120
 RTF=1.5
@@ -46,7 +46,8 @@ while [ $# -gt 0 ]; do
   shift 2
 done
 [ "$(id -u)" -eq 0 ] || { echo "$0: needs root for the network namespaces (sudo $0 ...)" >&2; exit 2; }
-[ -f "$BUILD/devel/lib/libgesture_formation_nodelets.so" ] && [ -f "$BUILD/devel/lib/libgesture_formation_sim_nodelets.so" ] || { echo "$0: build first (tools/build.sh; GF_BUILD_DIR=$BUILD)" >&2; exit 2; }
+DEVEL=$(gf_devel_dir .) || exit 2
+[ -f "$DEVEL/lib/libgesture_formation_nodelets.so" ] && [ -f "$DEVEL/lib/libgesture_formation_sim_nodelets.so" ] || { echo "$0: $DEVEL lacks the nodelet libraries: build first (tools/build.sh)" >&2; exit 2; }
 # The relay validates its own arguments (and names the bad one) before anything is set up.
 python3 tools/radio_relay.py --links 10.0.0.1,10.0.1.1 --loss "$LOSS" --delay-ms "$DELAY" --jitter-ms "$JITTER" \
   --duplicate "$DUP" --check-only || exit 2
@@ -105,7 +106,7 @@ export PATH=/usr/bin:/bin:$PATH
 in_host() {  # in_host K command...: run in host K's namespace with its ROS environment
   local k=$1; shift
   ip netns exec "${P}_${HOSTS[$k]}" env ROS_MASTER_URI=$MASTER ROS_IP=10.77.$k.2 ROS_HOME="$T/ros_${HOSTS[$k]}" \
-    ROS_LOG_DIR="$OUT/logs/ros_${HOSTS[$k]}" bash -c "source '$(realpath "$BUILD")/devel/setup.bash' && $*"
+    ROS_LOG_DIR="$OUT/logs/ros_${HOSTS[$k]}" bash -c "source '$DEVEL/setup.bash' && $*"
 }
 in_host $WORLD "exec roscore -p 11311" > "$OUT/logs/roscore.log" 2>&1 &
 pids+=($!)
@@ -128,7 +129,7 @@ sleep 1
 kill -INT $relay 2>/dev/null || true
 wait $relay 2>/dev/null || true
 [ -f "$OUT/metrics.json" ] || { echo "$0: the mission did not finish; see $OUT/logs/world.log" >&2; tail -20 "$OUT/logs/world.log" >&2; exit 1; }
-tools/plot_mission.sh "$OUT" "$MISSION" "$BUILD"
+tools/plot_mission.sh "$OUT" "$MISSION" "$DEVEL"
 python3 - "$OUT" "$(( $(date +%s) - start ))" <<'PY'
 import json, sys
 out = sys.argv[1]

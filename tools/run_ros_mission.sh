@@ -17,7 +17,7 @@ case "${1:-}" in -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/,
 set -eo pipefail  # not -u: devel/setup.bash reads unset variables
 cd "$(dirname "$0")/.."
 SRC=$PWD
-BUILD=${GF_BUILD_DIR:-build}
+source tools/lib/devel_dir.bash
 OUT=results/demo
 DURATION=-1
 RTF=2.0
@@ -37,7 +37,8 @@ while [ $# -gt 0 ]; do
     *) echo "usage: $0 [--out DIR] [--duration S] [--rtf X] [--seed N] [--mission FILE] [--faults FILE] [--rviz]" >&2; exit 2 ;;
   esac
 done
-[ -f "$BUILD/devel/lib/libgesture_formation_nodelets.so" ] && [ -f "$BUILD/devel/lib/libgesture_formation_sim_nodelets.so" ] || { echo "$0: build first (tools/build.sh; GF_BUILD_DIR=$BUILD)" >&2; exit 2; }
+DEVEL=$(gf_devel_dir "$SRC") || exit 2
+[ -f "$DEVEL/lib/libgesture_formation_nodelets.so" ] && [ -f "$DEVEL/lib/libgesture_formation_sim_nodelets.so" ] || { echo "$0: $DEVEL lacks the nodelet libraries: build first (tools/build.sh)" >&2; exit 2; }
 NETNS=(unshare -n)
 if [ "$(id -u)" -ne 0 ]; then
   command -v sudo > /dev/null || { echo "$0: not root and no sudo: the private network namespace (unshare -n) that keeps LCM on this machine needs root" >&2; exit 2; }
@@ -48,13 +49,12 @@ OUT=$(realpath "$OUT")
 rm -f "$OUT/metrics.json" "$OUT/mission.bag" "$OUT/mission.bag.active"
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
-BUILD_ABS=$(realpath "$BUILD")
 # Fresh per-sender Ed25519 keys for this run: one owner-only file per bridge (UAVs 0-2, the
 # ground station 100), each with its signing key and the others' verifying keys (docs/security.md §5).
 tools/make_fleet_keys.sh "$T/keys" 0 1 2 100 > /dev/null
 export PATH=/usr/bin:/bin:$PATH
 # shellcheck disable=SC1091
-source "$BUILD/devel/setup.bash"
+source "$DEVEL/setup.bash"
 # In the namespace: the loopback with the multicast route (root), then the launch as the caller.
 if [ "$(id -u)" -eq 0 ]; then as_caller=""; else as_caller="setpriv --reuid=$(id -u) --regid=$(id -g) --init-groups"; fi
 cat > "$T/netns.sh" <<NETNS
@@ -68,7 +68,7 @@ cat > "$T/inner.sh" <<INNER
 export PATH=/usr/bin:/bin:\$PATH
 export ROS_MASTER_URI=http://127.0.0.1:11311 ROS_IP=127.0.0.1 ROS_HOME=$T/ros ROS_LOG_DIR=$T/log
 export DISPLAY=${DISPLAY:-} XAUTHORITY=${XAUTHORITY:-${HOME:-/root}/.Xauthority}
-source "$BUILD_ABS/devel/setup.bash"
+source "$DEVEL/setup.bash"
 roslaunch --screen -p 11311 gesture_formation simulation.launch mission:=$MISSION seed:=$SEED \
   real_time_factor:=$RTF duration:=$DURATION output_dir:=$OUT key_dir:=$T/keys record:=true \
   bag:=$OUT/mission.bag rviz:=$RVIZ faults:=$FAULTS > "$T/launch.log" 2>&1 &
@@ -86,7 +86,7 @@ echo "running the mission through simulation.launch (real-time factor $RTF; log:
 "${NETNS[@]}" bash "$T/netns.sh"
 cp "$T/launch.log" "$OUT/launch.log"
 [ -f "$OUT/metrics.json" ] || { echo "$0: the mission did not finish; see $OUT/launch.log" >&2; tail -30 "$OUT/launch.log" >&2; exit 1; }
-tools/plot_mission.sh "$OUT" "$MISSION" "$BUILD"
+tools/plot_mission.sh "$OUT" "$MISSION" "$DEVEL"
 # The summary, in the words of gfctl simulate's (same metric definitions: docs/simulation.md §4).
 python3 - "$OUT/metrics.json" "$(( $(date +%s) - start ))" "$SEED" <<'PY'
 import json, sys

@@ -9,7 +9,7 @@ case "${1:-}" in -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/,
 set -o pipefail
 cd "$(dirname "$0")/.."
 SRC=$PWD
-BUILD=${GF_BUILD_DIR:-build}
+source tools/lib/devel_dir.bash
 OUT=${1:-}
 [ -n "$OUT" ] && [ "${OUT#-}" = "$OUT" ] || { echo "usage: $0 OUT.png [--wait S] [--rate HZ] [--rtf F] [--seed N]" >&2; exit 2; }
 shift
@@ -24,7 +24,8 @@ while [ $# -gt 0 ]; do
   esac
 done
 [[ $WAIT =~ ^[0-9]+$ ]] || { echo "$0: --wait: expected whole seconds, got '$WAIT'" >&2; exit 2; }
-[ -f "$BUILD/devel/lib/libgesture_formation_sim_nodelets.so" ] || { echo "$0: build first (tools/build.sh)" >&2; exit 2; }
+DEVEL=$(gf_devel_dir .) || exit 2
+[ -f "$DEVEL/lib/libgesture_formation_sim_nodelets.so" ] || { echo "$0: $DEVEL lacks the simulation nodelets: build first (tools/build.sh)" >&2; exit 2; }
 [ "$(id -u)" -eq 0 ] || { echo "$0: needs root (unshare -n keeps LCM on this machine)" >&2; exit 2; }
 OUT=$(realpath -m "$OUT")
 T=$(mktemp -d)
@@ -33,7 +34,7 @@ export PATH=/usr/bin:/bin:$PATH
 "$SRC/tools/make_fleet_keys.sh" "$T/keys" 0 1 2 100 > /dev/null
 cat > "$T/inner.sh" <<INNER
 export ROS_MASTER_URI=http://127.0.0.1:14411 ROS_IP=127.0.0.1 ROS_HOME=$T/ros ROS_LOG_DIR=$T/log
-source "$BUILD/devel/setup.bash"
+source "$DEVEL/setup.bash"
 ip link set lo up && ip route add 224.0.0.0/4 dev lo || exit 1
 xvfb-run -a -s "-screen 0 1200x800x24" bash -c "
   roslaunch -p 14411 gesture_formation simulation.launch key_dir:=$T/keys output_dir:=$T/out duration:=-1 seed:=$SEED \

@@ -3,13 +3,14 @@
 # the cost per message of HMAC-SHA256 and Ed25519 envelopes (gf_bench_comm) and the legitimate
 # messages delivered while a keyless flood saturates the loopback inside a private network
 # namespace (tools/link_flood.py: two LcmBridges, 20 Hz worker states, flood processes).
-#   tools/security_figures.sh [BUILD_DIR]     (root: unshare -n; FLOOD_SECONDS (10), FLOOD_PROCS ("2 4"): one run per count of flood processes;
+#   tools/security_figures.sh [BUILD_DIR or DEVEL_DIR]     (default: the build tools/lib/devel_dir.bash finds; root: unshare -n; FLOOD_SECONDS (10), FLOOD_PROCS ("2 4"): one run per count of flood processes;
 #   FLOOD_IMPLS ("python c"): Python flood processes, then the compiled tools/link_flood_sender.c (sendmmsg))
 case "${1:-}" in -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;; esac
 set -eo pipefail
 cd "$(dirname "$0")/.."
 SRC=$PWD
-BUILD=$(realpath "${1:-build}")
+source tools/lib/devel_dir.bash
+DEVEL=$(gf_devel_dir "$SRC" "${1:-}") || exit 2
 [ "$(id -u)" -eq 0 ] || { echo "security_figures.sh: needs root (unshare -n keeps the flood on this machine)" >&2; exit 1; }
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
@@ -17,9 +18,9 @@ export PATH=/usr/bin:/bin:$PATH ROS_IP=127.0.0.1 ROS_HOME=$T/ros ROS_LOG_DIR=$T/
 PORT=$((14000 + RANDOM % 1000))
 export ROS_MASTER_URI=http://127.0.0.1:$PORT
 # shellcheck disable=SC1091
-source "$BUILD/devel/setup.bash"
+source "$DEVEL/setup.bash"
 tools/make_fleet_keys.sh "$T/keys" 0 1 2 > /dev/null
-bench=$("$BUILD/devel/lib/gesture_formation/gf_bench_comm" --benchmark_repetitions=3 --benchmark_report_aggregates_only=true 2>/dev/null | grep -E "_median|^Benchmark|^-" || true)
+bench=$("$DEVEL/lib/gesture_formation/gf_bench_comm" --benchmark_repetitions=3 --benchmark_report_aggregates_only=true 2>/dev/null | grep -E "_median|^Benchmark|^-" || true)
 load_before=$(cut -d' ' -f1-3 /proc/loadavg)
 cat > "$T/inner.sh" <<INNER
 ip link set lo up && ip route add 224.0.0.0/4 dev lo || exit 1

@@ -1,13 +1,17 @@
 # Shared setup of the ROS tests (sourced): private master on a random port, private ROS_HOME,
-# the build's devel space, cleanup of every process started. Args of the test: SOURCE_DIR BUILD_DIR.
+# the build's devel space, cleanup of every process started. Args of the test: SOURCE_DIR BUILD_DIR
+# [DEVEL_DIR] (CMake passes CATKIN_DEVEL_PREFIX: BUILD_DIR/devel with tools/build.sh, the
+# package's devel space in a catkin workspace); nothing needs sourcing beforehand.
 SRC=$1
 BUILD=$2
+DEVEL=${3:-$BUILD/devel}
+[ -f "$DEVEL/setup.bash" ] || { echo "FAIL: no devel space at $DEVEL (build first)"; exit 1; }
 T=$(mktemp -d)
 PORT=$((12000 + RANDOM % 2000))
 export ROS_MASTER_URI=http://127.0.0.1:$PORT ROS_IP=127.0.0.1 ROS_HOME=$T/ros ROS_LOG_DIR=$T/log
 export PATH=/usr/bin:/bin:$PATH
 # shellcheck disable=SC1091
-source "$BUILD/devel/setup.bash"
+source "$DEVEL/setup.bash"
 pids=()
 fails=0
 cleanup() {

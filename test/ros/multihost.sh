@@ -8,10 +8,11 @@
 set -o pipefail
 SRC=$1
 BUILD=$2
+DEVEL=${3:-$BUILD/devel}
 [ "$(id -u)" -eq 0 ] || { echo "SKIP: needs root (network namespaces)"; exit 77; }
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
-GF_BUILD_DIR=$BUILD timeout 130 "$SRC/tools/run_multihost.sh" --out "$T/out" --duration 40 --rtf 1.5 \
+GF_DEVEL_DIR=$DEVEL timeout 130 "$SRC/tools/run_multihost.sh" --out "$T/out" --duration 40 --rtf 1.5 \
   --loss 0.2 --delay-ms 30 --jitter-ms 20 --duplicate 0.01 --seed 3
 rc=$?
 [ -f "$T/out/metrics.json" ] || { echo "FAIL: no metrics.json (run_multihost.sh rc $rc)"; tail -20 "$T/out/logs/world.log" 2>/dev/null; exit 1; }

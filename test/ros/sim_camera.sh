@@ -8,7 +8,7 @@
 set -o pipefail
 source "$(dirname "$0")/common.bash"
 [ "$(id -u)" -eq 0 ] || { echo "SKIP: needs root (unshare -n keeps LCM on this machine)"; exit 77; }
-GFCTL=$BUILD/devel/lib/gesture_formation/gfctl
+GFCTL=$DEVEL/lib/gesture_formation/gfctl
 "$GFCTL" render --scenario "$SRC/config/scenarios/power_towers.yaml" --t 1 --uav 0 --out "$T/probe.png" > "$T/probe.log" 2>&1
 rc=$?
 if [ $rc -eq 1 ] && grep -q "EGL\|OpenGL" "$T/probe.log"; then echo "SKIP: no EGL device here: $(cat "$T/probe.log")"; exit 77; fi
