@@ -10,14 +10,15 @@
 #   GF_SEEDS=100 tools/run_approach_profile.sh
 #
 # Environment: GF_SEEDS (default 10), GF_DURATION (240), GF_PROFILE (worker_approaches_holding_uav),
-# GFCTL (default build/devel/lib/gesture_formation/gfctl), GF_OUT (the missions' folder, default
+# GFCTL (default: gfctl of the build tools/lib/devel_dir.bash finds), GF_OUT (the missions' folder, default
 # a temporary one), GF_REPORT (default docs/results/worker_approach.md), GF_COMMIT (the commit GFCTL was
 # built from, for the report; default HEAD). Runs nice -n 10, one mission
 # at a time.
 case "${1:-}" in -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;; esac  # the comment above
 set -euo pipefail
 cd "$(dirname "$0")/.."
-GFCTL=${GFCTL:-build/devel/lib/gesture_formation/gfctl}
+source tools/lib/devel_dir.bash
+GFCTL=${GFCTL:-$(gf_devel_dir . || echo /nonexistent)/lib/gesture_formation/gfctl}
 SEEDS=${GF_SEEDS:-10}
 DURATION=${GF_DURATION:-240}
 PROFILE=${GF_PROFILE:-worker_approaches_holding_uav}
