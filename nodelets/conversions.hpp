@@ -7,8 +7,10 @@
 #include <Eigen/Geometry>
 #include <geometry_msgs/TransformStamped.h>
 #include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
 #include <nav_msgs/Odometry.h>
 #include <trajectory_msgs/MultiDOFJointTrajectory.h>
@@ -504,6 +506,22 @@ inline common::Result<cv::Mat> toBgr(const sensor_msgs::Image& m) {
   if (m.encoding == "bgr8") bgr = view.clone();
   else if (m.encoding == "rgb8") cv::cvtColor(view, bgr, cv::COLOR_RGB2BGR);
   else cv::cvtColor(view, bgr, cv::COLOR_GRAY2BGR);
+  return R::ok(std::move(bgr));
+}
+/// A compressed colour image (sensor_msgs/CompressedImage as image_transport's `compressed`
+/// publishes it: JPEG or PNG, format e.g. "jpeg", "bgr8; jpeg compressed bgr8") as an owned BGR cv::Mat.
+inline common::Result<cv::Mat> toBgr(const sensor_msgs::CompressedImage& m) {
+  using R = common::Result<cv::Mat>;
+  if (m.format.find("compressedDepth") != std::string::npos) {
+    return R::fail("CompressedImage.format '" + m.format + "': a depth image (compressedDepth), expected a colour image");
+  }
+  if (m.data.empty()) return R::fail("CompressedImage.data: empty (format '" + m.format + "')");
+  const cv::Mat bytes(1, static_cast<int>(m.data.size()), CV_8UC1, const_cast<std::uint8_t*>(m.data.data()));
+  cv::Mat bgr = cv::imdecode(bytes, cv::IMREAD_COLOR);
+  if (bgr.empty()) {
+    return R::fail("CompressedImage: " + std::to_string(m.data.size()) + " bytes of format '" + m.format +
+                   "' do not decode as JPEG or PNG");
+  }
   return R::ok(std::move(bgr));
 }
 /// An aligned depth image (16UC1 / mono16: units of depth_scale_m; 32FC1: metres) as an owned cv::Mat.

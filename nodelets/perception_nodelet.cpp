@@ -19,6 +19,13 @@
 //   topics are not delivered in order, and a colour image processed late must still find its depth).
 // Optional: ~dnn_device (cpu): where the networks run — cpu, opencl, opencl_fp16, cuda, cuda_fp16
 //   (refused at start, naming what this OpenCV can use, when it cannot run there).
+//   ~image_transport (raw): how image_in arrives, through image_transport (image_in/<transport>);
+//   `compressed` (sensor_msgs/CompressedImage, JPEG / PNG) is decoded here with OpenCV when the
+//   compressed_image_transport plugin is not installed (Debian ships the raw transport only).
+//   ~depth_transport (raw): the same for depth_in, through image_transport only (a transport whose
+//   plugin is not installed is refused at start, naming the ones that are).
+// /diagnostics: `Perception`: images per second, found, gestures, images refused, the last image's age.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -26,11 +33,14 @@
 #include <mutex>
 #include <optional>
 
+#include <image_transport/image_transport.h>
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
 #include <ros/ros.h>
+#include <sensor_msgs/CompressedImage.h>
 
 #include "conversions.hpp"
+#include "diagnostics.hpp"
 #include "gesture_formation/Gesture.h"
 #include "gesture_formation/common/config_fields.hpp"
 #include "gesture_formation/estimation/stereo_distance.hpp"
@@ -76,6 +86,7 @@ class PerceptionNodelet : public nodelet::Nodelet {
     }
     for (const auto& p : estimation::stereoDistanceProblems(stereo_)) params.addError(p.key + ": " + p.message);
     for (const auto& e : cfg.validate()) params.addError(e);
+    loadTransports(params);
     if (params.ok()) {
       auto p = perception::PerceptionPipeline::create(cfg);
       if (p) pipeline_ = std::move(*p);
@@ -104,29 +115,98 @@ class PerceptionNodelet : public nodelet::Nodelet {
     // On the multi-threaded handle with its own lock: a depth image is stored at once, also while a
     // colour image is being processed (on the single-threaded handle it would queue behind it and
     // the depth stream would fall behind the colour stream on a busy computer).
-    depth_sub_ = getMTNodeHandle().subscribe<sensor_msgs::Image>("depth_in", 2, [this](const sensor_msgs::Image::ConstPtr& m) {
-      std::lock_guard<std::mutex> lock(depth_mutex_);
-      depths_.push_back(m);
-      while (depths_.size() > kDepthBuffer) depths_.pop_front();
-      depth_arrived_.notify_all();
-    });
-    image_sub_ = nh.subscribe("image_in", 2, &PerceptionNodelet::onImage, this);
+    depth_sub_ = depth_it_->subscribe("depth_in", 2, &PerceptionNodelet::onDepth, this,
+                                      image_transport::TransportHints(depth_transport_, ros::TransportHints(),
+                                                                      getPrivateNodeHandle(), "depth_transport"));
+    if (decode_compressed_) {
+      compressed_sub_ = nh.subscribe(nh.resolveName("image_in") + "/compressed", 2, &PerceptionNodelet::onCompressed, this);
+    } else {
+      image_sub_ = image_it_->subscribe("image_in", 2, &PerceptionNodelet::onImage, this,
+                                        image_transport::TransportHints(image_transport_, ros::TransportHints(),
+                                                                        getPrivateNodeHandle(), "image_transport"));
+    }
+    diagnostics_.start(nh, 1.0, [this](double since_s) { return health(since_s); });
+  }
+
+  /// image_in's and depth_in's transports: each through image_transport when its plugin is
+  /// installed; image_in's `compressed` without the plugin decoded here (decode_compressed_).
+  void loadTransports(ParamLoader& params) {
+    params.loadOptional("image_transport", image_transport_, "raw");
+    params.loadOptional("depth_transport", depth_transport_, "raw");
+    image_it_.emplace(getNodeHandle());
+    depth_it_.emplace(getMTNodeHandle());
+    const std::vector<std::string> loadable = image_it_->getLoadableTransports();
+    const auto installed = [&](const std::string& t) {
+      return std::find(loadable.begin(), loadable.end(), "image_transport/" + t) != loadable.end();
+    };
+    std::string names;
+    for (const auto& l : loadable) names += (names.empty() ? "" : ", ") + l.substr(l.find('/') + 1);
+    decode_compressed_ = image_transport_ == "compressed" && !installed("compressed");
+    if (!installed(image_transport_) && !decode_compressed_) {
+      params.addError("image_transport '" + image_transport_ + "': no such image_transport plugin installed (installed: " +
+                      names + "; compressed is decoded here without one)");
+    }
+    if (!installed(depth_transport_)) {
+      params.addError("depth_transport '" + depth_transport_ + "': no such image_transport plugin installed (installed: " + names + ")");
+    }
+  }
+
+  void onDepth(const sensor_msgs::Image::ConstPtr& m) {
+    std::lock_guard<std::mutex> lock(depth_mutex_);
+    depths_.push_back(m);
+    while (depths_.size() > kDepthBuffer) depths_.pop_front();
+    depth_arrived_.notify_all();
+  }
+
+  void onCompressed(const sensor_msgs::CompressedImage::ConstPtr& msg) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto bgr = toBgr(*msg);
+    if (!bgr) {
+      ++refused_since_report_;
+      NODELET_WARN_STREAM_THROTTLE(5.0, "Perception: compressed image refused: " << bgr.reason());
+      return;
+    }
+    process(msg->header, *bgr);
   }
 
   void onImage(const sensor_msgs::Image::ConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
     auto bgr = toBgr(*msg);
     if (!bgr) {
+      ++refused_since_report_;
       NODELET_WARN_STREAM_THROTTLE(5.0, "Perception: image refused: " << bgr.reason());
       return;
     }
-    auto frame = pipeline_->step(*bgr);
+    process(msg->header, *bgr);
+  }
+
+  /// Perception on /diagnostics: WARN when no image arrived or images were refused since the last report.
+  std::vector<diagnostic_msgs::DiagnosticStatus> health(double since_s) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    Health h("Perception", image_transport_);
+    h.warn(images_since_report_ == 0 && refused_since_report_ == 0, "no image on image_in")
+        .warn(refused_since_report_ > 0, std::to_string(refused_since_report_) + " image(s) refused")
+        .value("images_per_s", images_since_report_ / since_s)
+        .value("found_per_s", found_since_report_ / since_s)
+        .value("gestures_per_s", gestures_since_report_ / since_s)
+        .value("refused", refused_since_report_)
+        .value("last_image_age_s", last_image_.isZero() ? -1.0 : (ros::Time::now() - last_image_).toSec())
+        .value("image_transport", image_transport_ + (decode_compressed_ ? " (decoded here)" : ""));
+    images_since_report_ = found_since_report_ = gestures_since_report_ = refused_since_report_ = 0;
+    return {h.status()};
+  }
+
+  /// One colour image (caller holds mutex_): the pipeline, the stereo range, the classifier.
+  void process(const std_msgs::Header& header, const cv::Mat& bgr) {
+    ++images_since_report_;
+    last_image_ = header.stamp;
+    auto frame = pipeline_->step(bgr);
     if (!frame) {
       NODELET_WARN_STREAM_THROTTLE(5.0, "Perception: " << frame.reason());
       return;
     }
     gesture_formation::WorkerDetection d;
-    d.header = msg->header;
+    d.header = header;
     d.detected = frame->track.found;
     d.stereo_distance_m = std::nan("");
     if (frame->track.found) {
@@ -140,7 +220,7 @@ class PerceptionNodelet : public nodelet::Nodelet {
       if (t.identity_changed) last_score_ = 0.0f;
       if (t.worker_detection >= 0) last_score_ = t.detections[static_cast<std::size_t>(t.worker_detection)].score;
       d.confidence = last_score_;
-      const sensor_msgs::Image::ConstPtr depth_msg = nearestDepth(msg->header.stamp);
+      const sensor_msgs::Image::ConstPtr depth_msg = nearestDepth(header.stamp);
       if (depth_msg && camera_) {
         auto depth = toDepth(*depth_msg);
         const estimation::Box box{d.u, d.v, d.w, d.h};
@@ -150,6 +230,7 @@ class PerceptionNodelet : public nodelet::Nodelet {
         else NODELET_DEBUG_STREAM_THROTTLE(5.0, "Perception: no stereo range: " << range.reason());
       }
     }
+    if (d.detected) ++found_since_report_;
     detection_pub_.publish(d);
     if (!frame->fifo_full) return;
     const std::vector<float> window = pipeline_->classifierInput();
@@ -159,7 +240,7 @@ class PerceptionNodelet : public nodelet::Nodelet {
       return;
     }
     gesture_formation::Gesture g;
-    g.header = msg->header;
+    g.header = header;
     g.gesture_id = c->gesture_id;
     g.probabilities.assign(c->probabilities.begin(), c->probabilities.end());
     if (frame->has_skeleton && camera_info_) {  // the window's newest skeleton, in this image's pixels
@@ -168,6 +249,7 @@ class PerceptionNodelet : public nodelet::Nodelet {
       g.camera = *camera_info_;
     }
     gesture_pub_.publish(g);
+    ++gestures_since_report_;
   }
 
   std::mutex mutex_;
@@ -206,8 +288,15 @@ class PerceptionNodelet : public nodelet::Nodelet {
   std::mutex depth_mutex_;                         ///< guards depths_ only
   std::condition_variable depth_arrived_;
   std::deque<sensor_msgs::Image::ConstPtr> depths_;  ///< the last kDepthBuffer depth images
+  std::string image_transport_, depth_transport_;
+  bool decode_compressed_ = false;  ///< image_transport compressed without its plugin: decoded here
+  int images_since_report_ = 0, found_since_report_ = 0, gestures_since_report_ = 0, refused_since_report_ = 0;
+  ros::Time last_image_;
+  DiagnosticsPublisher diagnostics_;
+  std::optional<image_transport::ImageTransport> image_it_, depth_it_;
   ros::Publisher detection_pub_, gesture_pub_;
-  ros::Subscriber info_sub_, depth_sub_, image_sub_;
+  ros::Subscriber info_sub_, compressed_sub_;
+  image_transport::Subscriber depth_sub_, image_sub_;
 };
 
 }  // namespace gesture_formation::nodelets

@@ -18,6 +18,11 @@
 // Parameters (required): ~uav_index, ~max_state_age_s (odometry and worker state older than this
 //   at the frame's time, or a lost worker: geometry unknown, the view does not vote),
 //   ~world_frame, ~tf_timeout_s (how long to wait for the camera's pose at the frame's time).
+// odometry_in must be in the planner's convention (docs/ros.md): header.frame_id and
+// child_frame_id = ~world_frame; other odometry is refused (onboard::checkOdometryFrames), the
+// error naming the field, expected and received value, at most every 2 s, and counted.
+// /diagnostics: `ViewObserver uav<i>`: observations per second, how many had their geometry and
+// their skeleton, refused odometry, the ages of the odometry and worker state.
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -31,8 +36,10 @@
 #include <tf2_ros/transform_listener.h>
 
 #include "conversions.hpp"
+#include "diagnostics.hpp"
 #include "gesture_formation/Gesture.h"
 #include "gesture_formation/common/angles.hpp"
+#include "gesture_formation/onboard/frame_check.hpp"
 #include "param_loader.hpp"
 
 namespace gesture_formation::nodelets {
@@ -55,7 +62,15 @@ class ViewObserverNodelet : public nodelet::Nodelet {
     tf_listener_ = std::make_unique<tf2_ros::TransformListener>(tf_buffer_);
     observation_pub_ = nh.advertise<gesture_formation::GestureObservation>("observation_out", 20);
     odometry_sub_ = nh.subscribe<nav_msgs::Odometry>("odometry_in", 5, [this](const nav_msgs::Odometry::ConstPtr& m) {
+      const auto refusal = onboard::checkOdometryFrames("odometry_in", onboard::plannerOdometryFrames(world_frame_),
+                                                        m->header.frame_id, m->child_frame_id);
       std::lock_guard<std::mutex> lock(mutex_);
+      if (refusal) {
+        ++odometry_refused_;
+        last_refusal_ = *refusal;
+        NODELET_ERROR_STREAM_THROTTLE(2.0, "ViewObserver: odometry refused (nothing from it is used): " << *refusal);
+        return;
+      }
       odometry_ = *m;
     });
     worker_sub_ = nh.subscribe<gesture_formation::WorkerState>(
@@ -64,6 +79,29 @@ class ViewObserverNodelet : public nodelet::Nodelet {
           worker_ = *m;
         });
     gesture_sub_ = nh.subscribe("gesture_in", 20, &ViewObserverNodelet::onGesture, this);
+    diagnostics_.start(nh, 1.0, [this](double since_s) { return health(since_s); });
+  }
+
+  /// This UAV's vote on /diagnostics: WARN when classifications went out without geometry (they
+  /// do not vote) or odometry was refused since the last report.
+  std::vector<diagnostic_msgs::DiagnosticStatus> health(double since_s) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const double t = ros::Time::now().toSec();
+    const auto age = [t](const ros::Time& s) { return s.isZero() ? -1.0 : t - s.toSec(); };
+    const std::uint64_t new_refusals = odometry_refused_ - refused_reported_;
+    Health h("ViewObserver uav" + std::to_string(uav_index_), "uav" + std::to_string(uav_index_));
+    h.warn(new_refusals > 0, std::to_string(new_refusals) + " odometry message(s) refused: " + last_refusal_)
+        .warn(observations_ > with_geometry_,
+              std::to_string(observations_ - with_geometry_) + " observation(s) without geometry (no vote)")
+        .value("observations_per_s", observations_ / since_s)
+        .value("with_geometry", with_geometry_)
+        .value("with_skeleton", with_skeleton_)
+        .value("odometry_refused", odometry_refused_)
+        .value("odometry_age_s", odometry_ ? age(odometry_->header.stamp) : -1.0)
+        .value("worker_state_age_s", worker_ ? age(worker_->header.stamp) : -1.0);
+    refused_reported_ = odometry_refused_;
+    observations_ = with_geometry_ = with_skeleton_ = 0;
+    return {h.status()};
   }
 
   void onGesture(const gesture_formation::Gesture::ConstPtr& g) {
@@ -87,6 +125,9 @@ class ViewObserverNodelet : public nodelet::Nodelet {
           o.elevation_deg = g.elevation_deg;
         }
       }
+      ++observations_;
+      if (o.geometry_known) ++with_geometry_;
+      if (!o.keypoints.empty()) ++with_skeleton_;
     }
     observation_pub_.publish(o);
   }
@@ -112,6 +153,10 @@ class ViewObserverNodelet : public nodelet::Nodelet {
   }
 
   std::mutex mutex_;
+  DiagnosticsPublisher diagnostics_;
+  int observations_ = 0, with_geometry_ = 0, with_skeleton_ = 0;  ///< since the last report
+  std::uint64_t odometry_refused_ = 0, refused_reported_ = 0;
+  std::string last_refusal_;
   int uav_index_ = 0;
   double max_state_age_s_ = 0.0, tf_timeout_s_ = 0.0;
   std::string world_frame_;

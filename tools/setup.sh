@@ -45,7 +45,8 @@ PACKAGES=(
   libeigen3-dev libopencv-dev libopencv-contrib-dev libompl-dev liboctomap-dev libfcl-dev libceres-dev
   libegl-dev libgl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri libassimp-dev   # render/: headless OpenGL (EGL, Mesa llvmpipe), Assimp
   liblcm-dev liblcm-bin libyaml-cpp-dev libssl-dev
-  libdiagnostic-msgs-dev ros-diagnostic-msgs python3-diagnostic-msgs   # LcmBridge link diagnostics (docs/security.md §6)
+  libdiagnostic-msgs-dev ros-diagnostic-msgs python3-diagnostic-msgs   # /diagnostics of every nodelet (docs/ros.md)
+  libimage-transport-dev                        # Perception subscribes through image_transport (Debian ships the raw transport only)
   python3-cryptography faketime                 # the attacker test (test/ros/link_attack.sh): its own Ed25519/HMAC envelope builder; a sender restarted with its clock set back
   libcereal-dev libsimde-dev
   python3-venv python3-pip python3-yaml python3-numpy

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
 
 #include <fcl/geometry/octree/octree.h>
 #include <fcl/geometry/shape/sphere.h>
@@ -48,31 +51,234 @@ void transform1d(const double* f, int n, double* d, int* v, double* z) {
 }  // namespace
 
 DistanceField::DistanceField(const OccupancyMap& map)
-    : resolution_m_(map.resolution()), origin_(map.gridOrigin()), size_(map.gridSize()) {
-  const std::size_t nx = static_cast<std::size_t>(size_.x()), ny = static_cast<std::size_t>(size_.y()),
-                    nz = static_cast<std::size_t>(size_.z());
-  const std::vector<std::uint8_t>& occ = map.denseGrid();
-  std::vector<double> sq(occ.size());
-  for (std::size_t i = 0; i < occ.size(); ++i) sq[i] = occ[i] != 0 ? 0.0 : kFar;
-  const std::size_t nmax = std::max({nx, ny, nz});
-  std::vector<double> f(nmax), d(nmax), z(nmax + 1);
-  std::vector<int> v(nmax);
-  auto pass = [&](std::size_t n, std::size_t stride, std::size_t count_outer, auto&& base_of) {
-    for (std::size_t o = 0; o < count_outer; ++o) {
-      const std::size_t base = base_of(o);
-      for (std::size_t q = 0; q < n; ++q) f[q] = sq[base + q * stride];
-      transform1d(f.data(), static_cast<int>(n), d.data(), v.data(), z.data());
-      for (std::size_t q = 0; q < n; ++q) sq[base + q * stride] = std::min(d[q], kFar);
-    }
-  };
-  pass(nx, 1, ny * nz, [&](std::size_t o) { return o * nx; });
-  pass(ny, nx, nx * nz, [&](std::size_t o) { return (o % nx) + (o / nx) * nx * ny; });
-  pass(nz, nx * ny, nx * ny, [&](std::size_t o) { return o; });
-  dist_m_.resize(sq.size());
-  for (std::size_t i = 0; i < sq.size(); ++i) {
-    dist_m_[i] = sq[i] >= 0.5 * kFar ? std::numeric_limits<float>::infinity()
-                                     : static_cast<float>(std::sqrt(sq[i]) * resolution_m_);
+    : DistanceField(map, std::numeric_limits<double>::infinity()) {}
+
+DistanceField::DistanceField(const OccupancyMap& map, double max_distance_m)
+    : resolution_m_(map.resolution()), max_distance_m_(max_distance_m), origin_(map.gridOrigin()), size_(map.gridSize()) {
+  range_voxels_ = std::isfinite(max_distance_m_) ? static_cast<int>(std::ceil(max_distance_m_ / resolution_m_)) : 0;
+  const std::size_t voxels =
+      static_cast<std::size_t>(size_.x()) * static_cast<std::size_t>(size_.y()) * static_cast<std::size_t>(size_.z());
+  dist_m_.assign(voxels, 0.0f);
+  if (range_voxels_ == 0) {
+    recomputeBox(map.denseGrid(), LocalBox{VoxelIndex::Zero(), size_ - VoxelIndex::Ones()});
+    scratch_ = std::vector<double>();  // a whole-grid scratch is not kept
+    return;
   }
+  const std::size_t nmax = static_cast<std::size_t>(size_.maxCoeff());
+  line_f_.resize(nmax);
+  line_d_.resize(nmax);
+  line_z_.resize(nmax + 1);
+  line_v_.resize(nmax);
+  pass1_.assign(voxels, kFarSquared);
+  pass2_.assign(voxels, kFarSquared);
+  for (int k = 0; k < size_.z(); ++k) {
+    for (int j = 0; j < size_.y(); ++j) rowX(map.denseGrid(), j, k);
+  }
+  for (int k = 0; k < size_.z(); ++k) {
+    for (int i = 0; i < size_.x(); ++i) columnY(i, k);
+  }
+  for (int j = 0; j < size_.y(); ++j) {
+    for (int i = 0; i < size_.x(); ++i) columnZ(i, j, 0, size_.z() - 1);
+  }
+}
+
+common::Result<DistanceField> DistanceField::truncated(const OccupancyMap& map, double max_distance_m) {
+  using R = common::Result<DistanceField>;
+  if (!(std::isfinite(max_distance_m) && max_distance_m > 0.0)) {
+    return R::fail("distance field max_distance_m must be finite and > 0, got " + std::to_string(max_distance_m));
+  }
+  if (max_distance_m / map.resolution() > 255.0) {
+    return R::fail("distance field max_distance_m must be at most 255 voxels (" + std::to_string(255.0 * map.resolution()) +
+                   " m), got " + std::to_string(max_distance_m));
+  }
+  return R::ok(DistanceField(map, max_distance_m));
+}
+
+float DistanceField::toMetres(double squared_voxels) const {
+  if (squared_voxels >= 0.5 * kFar) return static_cast<float>(max_distance_m_);
+  return static_cast<float>(std::min(std::sqrt(squared_voxels) * resolution_m_, max_distance_m_));
+}
+
+std::size_t DistanceField::recomputeBox(const std::vector<std::uint8_t>& occupancy, const LocalBox& target) {
+  // The box whose occupancy decides the target's values: every voxel within the range of one.
+  const VoxelIndex grow = range_voxels_ > 0 ? VoxelIndex::Constant(range_voxels_) : size_;
+  const VoxelIndex lo = (target.lo - grow).cwiseMax(VoxelIndex::Zero());
+  const VoxelIndex hi = (target.hi + grow).cwiseMin(size_ - VoxelIndex::Ones());
+  const VoxelIndex n = hi - lo + VoxelIndex::Ones();
+  const VoxelIndex t0 = target.lo - lo, t1 = target.hi - lo;  // the target, relative to lo
+  const std::size_t nx = static_cast<std::size_t>(n.x()), ny = static_cast<std::size_t>(n.y());
+  scratch_.resize(nx * ny * static_cast<std::size_t>(n.z()));
+  auto at = [&](int i, int j, int k) -> double& {
+    return scratch_[static_cast<std::size_t>(i) + nx * (static_cast<std::size_t>(j) + ny * static_cast<std::size_t>(k))];
+  };
+  for (int k = 0; k < n.z(); ++k) {
+    for (int j = 0; j < n.y(); ++j) {
+      const std::size_t row = linear(lo.x(), lo.y() + j, lo.z() + k);
+      for (int i = 0; i < n.x(); ++i) at(i, j, k) = occupancy[row + static_cast<std::size_t>(i)] != 0 ? 0.0 : kFar;
+    }
+  }
+  const int nmax = n.maxCoeff();
+  std::vector<double> f(static_cast<std::size_t>(nmax)), d(static_cast<std::size_t>(nmax)),
+      z(static_cast<std::size_t>(nmax) + 1);
+  std::vector<int> v(static_cast<std::size_t>(nmax));
+  // One 1-D transform along axis `axis` through (i, j, k) (its own coordinate ignored).
+  auto line = [&](int axis, int i, int j, int k) {
+    VoxelIndex q(i, j, k);
+    for (q(axis) = 0; q(axis) < n(axis); ++q(axis)) f[static_cast<std::size_t>(q(axis))] = at(q.x(), q.y(), q.z());
+    transform1d(f.data(), n(axis), d.data(), v.data(), z.data());
+  };
+  // x over the whole grown box; y only where the target's x lies; z only in the target's x-y.
+  for (int k = 0; k < n.z(); ++k) {
+    for (int j = 0; j < n.y(); ++j) {
+      line(0, 0, j, k);
+      for (int i = 0; i < n.x(); ++i) at(i, j, k) = std::min(d[static_cast<std::size_t>(i)], kFar);
+    }
+  }
+  for (int k = 0; k < n.z(); ++k) {
+    for (int i = t0.x(); i <= t1.x(); ++i) {
+      line(1, i, 0, k);
+      for (int j = 0; j < n.y(); ++j) at(i, j, k) = std::min(d[static_cast<std::size_t>(j)], kFar);
+    }
+  }
+  for (int j = t0.y(); j <= t1.y(); ++j) {
+    for (int i = t0.x(); i <= t1.x(); ++i) {
+      line(2, i, j, 0);
+      for (int k = t0.z(); k <= t1.z(); ++k) {
+        dist_m_[linear(lo.x() + i, lo.y() + j, lo.z() + k)] = toMetres(std::min(d[static_cast<std::size_t>(k)], kFar));
+      }
+    }
+  }
+  return scratch_.size();
+}
+
+namespace {
+
+std::uint16_t capSquared(double d, int range_voxels, std::uint16_t far) {
+  return d <= static_cast<double>(range_voxels) * range_voxels ? static_cast<std::uint16_t>(d) : far;
+}
+
+}  // namespace
+
+void DistanceField::rowX(const std::vector<std::uint8_t>& occupancy, int j, int k) {
+  const int n = size_.x();
+  const std::size_t row = linear(0, j, k);
+  bool any = false;
+  for (int i = 0; i < n; ++i) {
+    const bool occupied = occupancy[row + static_cast<std::size_t>(i)] != 0;
+    line_f_[static_cast<std::size_t>(i)] = occupied ? 0.0 : kFar;
+    any = any || occupied;
+  }
+  if (!any) {  // an empty line stays empty: every transform of it is far
+    std::fill_n(pass1_.begin() + static_cast<std::ptrdiff_t>(row), n, kFarSquared);
+    return;
+  }
+  transform1d(line_f_.data(), n, line_d_.data(), line_v_.data(), line_z_.data());
+  for (int i = 0; i < n; ++i) pass1_[row + static_cast<std::size_t>(i)] = capSquared(line_d_[static_cast<std::size_t>(i)], range_voxels_, kFarSquared);
+}
+
+void DistanceField::columnY(int i, int k) {
+  const int n = size_.y();
+  bool any = false;
+  for (int j = 0; j < n; ++j) {
+    const std::uint16_t s = pass1_[linear(i, j, k)];
+    line_f_[static_cast<std::size_t>(j)] = s == kFarSquared ? kFar : static_cast<double>(s);
+    any = any || s != kFarSquared;
+  }
+  if (any) transform1d(line_f_.data(), n, line_d_.data(), line_v_.data(), line_z_.data());
+  for (int j = 0; j < n; ++j) {
+    pass2_[linear(i, j, k)] = any ? capSquared(line_d_[static_cast<std::size_t>(j)], range_voxels_, kFarSquared) : kFarSquared;
+  }
+}
+
+void DistanceField::columnZ(int i, int j, int k_lo, int k_hi) {
+  const int n = size_.z();
+  bool any = false;
+  for (int k = 0; k < n; ++k) {
+    const std::uint16_t s = pass2_[linear(i, j, k)];
+    line_f_[static_cast<std::size_t>(k)] = s == kFarSquared ? kFar : static_cast<double>(s);
+    any = any || s != kFarSquared;
+  }
+  if (!any) {
+    for (int k = k_lo; k <= k_hi; ++k) dist_m_[linear(i, j, k)] = static_cast<float>(max_distance_m_);
+    return;
+  }
+  transform1d(line_f_.data(), n, line_d_.data(), line_v_.data(), line_z_.data());
+  for (int k = k_lo; k <= k_hi; ++k) dist_m_[linear(i, j, k)] = toMetres(std::min(line_d_[static_cast<std::size_t>(k)], kFar));
+}
+
+FieldUpdateStats DistanceField::updateTruncated(const std::vector<std::uint8_t>& occupancy,
+                                                const std::vector<VoxelIndex>& changed) {
+  const int nx = size_.x(), ny = size_.y(), nz = size_.z(), r = range_voxels_;
+  constexpr int kNone = std::numeric_limits<int>::max();
+  // x rows holding a changed voxel, with the x range of the changes
+  std::vector<int> rows, row_lo(static_cast<std::size_t>(ny) * static_cast<std::size_t>(nz), kNone),
+      row_hi(row_lo.size(), -1);
+  for (const VoxelIndex& voxel : changed) {
+    const VoxelIndex c = voxel - origin_;
+    if ((c.array() < 0).any() || (c.array() >= size_.array()).any()) continue;
+    const std::size_t row = static_cast<std::size_t>(c.y()) + static_cast<std::size_t>(ny) * static_cast<std::size_t>(c.z());
+    if (row_lo[row] == kNone) rows.push_back(static_cast<int>(row));
+    row_lo[row] = std::min(row_lo[row], c.x());
+    row_hi[row] = std::max(row_hi[row], c.x());
+  }
+  // y columns (i, k) whose pass-1 input changed within the range, with the y range of the rows
+  std::vector<int> columns, col_lo(static_cast<std::size_t>(nx) * static_cast<std::size_t>(nz), kNone),
+      col_hi(col_lo.size(), -1);
+  for (const int row : rows) {
+    const int j = row % ny, k = row / ny;
+    rowX(occupancy, j, k);
+    for (int i = std::max(0, row_lo[static_cast<std::size_t>(row)] - r);
+         i <= std::min(nx - 1, row_hi[static_cast<std::size_t>(row)] + r); ++i) {
+      const std::size_t col = static_cast<std::size_t>(i) + static_cast<std::size_t>(nx) * static_cast<std::size_t>(k);
+      if (col_lo[col] == kNone) columns.push_back(static_cast<int>(col));
+      col_lo[col] = std::min(col_lo[col], j);
+      col_hi[col] = std::max(col_hi[col], j);
+    }
+  }
+  // z columns (i, j) whose pass-2 input changed, with the z range of the change (values change
+  // only within the range of it)
+  std::vector<int> verticals, vert_lo(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny), kNone),
+      vert_hi(vert_lo.size(), -1);
+  for (const int col : columns) {
+    const int i = col % nx, k = col / nx;
+    columnY(i, k);
+    for (int j = std::max(0, col_lo[static_cast<std::size_t>(col)] - r);
+         j <= std::min(ny - 1, col_hi[static_cast<std::size_t>(col)] + r); ++j) {
+      const std::size_t xy = static_cast<std::size_t>(i) + static_cast<std::size_t>(nx) * static_cast<std::size_t>(j);
+      if (vert_lo[xy] == kNone) verticals.push_back(static_cast<int>(xy));
+      vert_lo[xy] = std::min(vert_lo[xy], k);
+      vert_hi[xy] = std::max(vert_hi[xy], k);
+    }
+  }
+  FieldUpdateStats stats;
+  for (const int xy : verticals) {
+    const int k_lo = std::max(0, vert_lo[static_cast<std::size_t>(xy)] - r);
+    const int k_hi = std::min(nz - 1, vert_hi[static_cast<std::size_t>(xy)] + r);
+    columnZ(xy % nx, xy / nx, k_lo, k_hi);
+    stats.voxels_written += static_cast<std::size_t>(k_hi - k_lo + 1);
+  }
+  stats.lines = static_cast<int>(rows.size() + columns.size() + verticals.size());
+  return stats;
+}
+
+common::Result<FieldUpdateStats> DistanceField::update(const OccupancyMap& map, const std::vector<VoxelIndex>& changed_voxels) {
+  using R = common::Result<FieldUpdateStats>;
+  if (map.gridOrigin() != origin_ || map.gridSize() != size_ || map.resolution() != resolution_m_) {
+    return R::fail("distance field update: the map's grid differs from the field's");
+  }
+  FieldUpdateStats stats;
+  if (!changed_voxels.empty()) {
+    if (range_voxels_ > 0) {
+      stats = updateTruncated(map.denseGrid(), changed_voxels);
+    } else {
+      recomputeBox(map.denseGrid(), LocalBox{VoxelIndex::Zero(), size_ - VoxelIndex::Ones()});
+      scratch_ = std::vector<double>();
+      stats.lines = size_.y() * size_.z() + size_.x() * size_.z() + size_.x() * size_.y();
+      stats.voxels_written = dist_m_.size();
+    }
+  }
+  stats.changed_voxels = static_cast<int>(changed_voxels.size());
+  return R::ok(stats);
 }
 
 double DistanceField::clearance(const Eigen::Vector3d& p_world) const {
@@ -90,7 +296,8 @@ struct FclClearance::Impl {
   std::shared_ptr<fcl::OcTree<double>> tree;
   std::unique_ptr<fcl::CollisionObject<double>> tree_object;
   std::shared_ptr<fcl::Sphere<double>> probe;
-  bool empty = true;
+  const OccupancyMap* map = nullptr;  ///< asked per query: a live map may start empty and fill
+  bool empty() const { return map->occupiedCount() == 0; }
 };
 
 namespace {
@@ -98,7 +305,7 @@ constexpr double kProbeRadiusM = 1e-3;
 }
 
 FclClearance::FclClearance(const OccupancyMap& map) : impl_(std::make_unique<Impl>()) {
-  impl_->empty = map.occupiedCount() == 0;
+  impl_->map = &map;
   impl_->tree = std::make_shared<fcl::OcTree<double>>(map.octree());
   impl_->tree_object = std::make_unique<fcl::CollisionObject<double>>(impl_->tree);
   impl_->probe = std::make_shared<fcl::Sphere<double>>(kProbeRadiusM);
@@ -107,7 +314,7 @@ FclClearance::FclClearance(const OccupancyMap& map) : impl_(std::make_unique<Imp
 FclClearance::~FclClearance() = default;
 
 double FclClearance::clearance(const Eigen::Vector3d& p_world) const {
-  if (impl_->empty) return std::numeric_limits<double>::infinity();
+  if (impl_->empty()) return std::numeric_limits<double>::infinity();
   fcl::Transform3<double> tf = fcl::Transform3<double>::Identity();
   tf.translation() = p_world;
   fcl::CollisionObject<double> probe(impl_->probe, tf);
@@ -118,7 +325,7 @@ double FclClearance::clearance(const Eigen::Vector3d& p_world) const {
 }
 
 bool FclClearance::collides(const Eigen::Vector3d& p_world, double radius_m) const {
-  if (impl_->empty) return false;
+  if (impl_->empty()) return false;
   fcl::Transform3<double> tf = fcl::Transform3<double>::Identity();
   tf.translation() = p_world;
   fcl::CollisionObject<double> ball(std::make_shared<fcl::Sphere<double>>(std::max(radius_m, kProbeRadiusM)), tf);

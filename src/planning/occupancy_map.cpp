@@ -98,36 +98,18 @@ void OccupancyMap::markFromOctree(const octomap::OcTree& tree) {
 }
 
 void OccupancyMap::finalise() {
-  const std::size_t nblocks = static_cast<std::size_t>(blocks_.prod());
-  std::vector<std::uint32_t> count(nblocks + 1, 0);
-  auto blockOf = [&](int i, int j, int k) {
-    return static_cast<std::size_t>(i / kBlock) +
-           static_cast<std::size_t>(blocks_.x()) * (static_cast<std::size_t>(j / kBlock) +
-                                                    static_cast<std::size_t>(blocks_.y()) * static_cast<std::size_t>(k / kBlock));
-  };
-  std::size_t total = 0;
-  for (int k = 0; k < size_.z(); ++k) {
-    for (int j = 0; j < size_.y(); ++j) {
-      for (int i = 0; i < size_.x(); ++i) {
-        if (grid_[linear(VoxelIndex(i, j, k))] != 0) {
-          ++count[blockOf(i, j, k) + 1];
-          ++total;
-        }
-      }
-    }
-  }
-  for (std::size_t b = 0; b < nblocks; ++b) count[b + 1] += count[b];
-  block_start_ = count;
-  centers_.assign(total, Eigen::Vector3d::Zero());
-  std::vector<std::uint32_t> fill(count.begin(), count.end() - 1);
+  block_centers_.assign(static_cast<std::size_t>(blocks_.prod()), {});
+  occupied_count_ = 0;
   auto tree = std::make_shared<octomap::OcTree>(resolution_m_);
   const float occupied_log = tree->getClampingThresMaxLog();
   for (int k = 0; k < size_.z(); ++k) {
     for (int j = 0; j < size_.y(); ++j) {
       for (int i = 0; i < size_.x(); ++i) {
-        if (grid_[linear(VoxelIndex(i, j, k))] == 0) continue;
-        const Eigen::Vector3d c = centerOf(VoxelIndex(i, j, k) + origin_);
-        centers_[fill[blockOf(i, j, k)]++] = c;
+        const VoxelIndex local(i, j, k);
+        if (grid_[linear(local)] == 0) continue;
+        const Eigen::Vector3d c = centerOf(local + origin_);
+        block_centers_[blockOfLocal(local)].push_back(c);
+        ++occupied_count_;
         octomap::OcTreeKey key;
         if (tree->coordToKeyChecked(octomap::point3d(static_cast<float>(c.x()), static_cast<float>(c.y()),
                                                      static_cast<float>(c.z())),
@@ -140,6 +122,62 @@ void OccupancyMap::finalise() {
   tree->updateInnerOccupancy();
   tree->prune();
   octree_ = tree;
+}
+
+OccupancyMap::OccupancyMap(const OccupancyMap& other)
+    : resolution_m_(other.resolution_m_),
+      grid_bounds_(other.grid_bounds_),
+      origin_(other.origin_),
+      size_(other.size_),
+      blocks_(other.blocks_),
+      grid_(other.grid_),
+      block_centers_(other.block_centers_),
+      occupied_count_(other.occupied_count_),
+      dropped_(other.dropped_),
+      octree_(other.octree_ ? std::make_shared<octomap::OcTree>(*other.octree_) : nullptr) {}
+
+OccupancyMap& OccupancyMap::operator=(const OccupancyMap& other) {
+  if (this != &other) *this = OccupancyMap(other);
+  return *this;
+}
+
+std::vector<Eigen::Vector3d> OccupancyMap::occupiedCenters() const {
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(occupied_count_);
+  for (const auto& block : block_centers_) out.insert(out.end(), block.begin(), block.end());
+  return out;
+}
+
+std::vector<VoxelIndex> OccupancyMap::setOccupancy(const std::vector<VoxelChange>& changes) {
+  std::vector<VoxelIndex> changed;
+  const float occupied_log = octree_->getClampingThresMaxLog();
+  for (const VoxelChange& change : changes) {
+    const VoxelIndex local = change.voxel - origin_;
+    if ((local.array() < 0).any() || (local.array() >= size_.array()).any()) continue;
+    std::uint8_t& cell = grid_[linear(local)];
+    if ((cell != 0) == change.occupied) continue;
+    cell = change.occupied ? 1 : 0;
+    const Eigen::Vector3d c = centerOf(change.voxel);
+    std::vector<Eigen::Vector3d>& block = block_centers_[blockOfLocal(local)];
+    const octomap::point3d c_octo(static_cast<float>(c.x()), static_cast<float>(c.y()), static_cast<float>(c.z()));
+    if (change.occupied) {
+      block.push_back(c);
+      ++occupied_count_;
+      octree_->setNodeValue(c_octo, occupied_log, false);
+    } else {
+      const auto it = std::find(block.begin(), block.end(), c);
+      if (it != block.end()) {
+        *it = block.back();
+        block.pop_back();
+      }
+      --occupied_count_;
+      // Marked free rather than deleted (OctoMap 1.9.7's deleteNode leaves childless inner nodes
+      // that assert when the tree is destroyed); FCL treats free nodes as empty.
+      octree_->setNodeValue(c_octo, octree_->getClampingThresMinLog(), false);
+    }
+    changed.push_back(change.voxel);
+  }
+  return changed;
 }
 
 void OccupancyMap::pointsInBox(const Aabb& box, std::vector<Eigen::Vector3d>& out) const {
@@ -156,8 +194,8 @@ void OccupancyMap::pointsInBox(const Aabb& box, std::vector<Eigen::Vector3d>& ou
         const std::size_t blk = static_cast<std::size_t>(i) +
                                 static_cast<std::size_t>(blocks_.x()) *
                                     (static_cast<std::size_t>(j) + static_cast<std::size_t>(blocks_.y()) * static_cast<std::size_t>(k));
-        for (std::uint32_t p = block_start_[blk]; p < block_start_[blk + 1]; ++p) {
-          if (box.contains(centers_[p])) out.push_back(centers_[p]);
+        for (const Eigen::Vector3d& c : block_centers_[blk]) {
+          if (box.contains(c)) out.push_back(c);
         }
       }
     }

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """/diagnostics of a running simulation.launch (test/ros/simulation_launch.sh): every UAV's
-FormationPlanner, the leader's WorkerEstimator and GestureCommander and every LcmBridge report about once a second
+FormationPlanner and ViewObserver, the leader's WorkerEstimator and GestureCommander and every LcmBridge report about once a second
 (wall clock) with their values; the planners and the estimator are not in ERROR."""
 import sys
 import time
@@ -11,11 +11,14 @@ from diagnostic_msgs.msg import DiagnosticArray
 
 WALL_S = 5.0
 WANT = ["FormationPlanner uav0", "FormationPlanner uav1", "FormationPlanner uav2", "WorkerEstimator", "GestureCommander",
+        "ViewObserver uav0", "ViewObserver uav1", "ViewObserver uav2",
         "LcmBridge sender 0: link", "LcmBridge sender 1: link", "LcmBridge sender 2: link",
         "LcmBridge sender 100: link"]
 KEYS = {"FormationPlanner": {"mode", "plans_per_s", "fallbacks", "last_planning_ms", "last_plan_age_s"},
         "WorkerEstimator": {"confirmed", "lost", "fused_per_s", "last_fused_age_s", "published_per_s"},
-        "GestureCommander": {"frames", "observations", "rejected", "fired", "last_fired"}}
+        "GestureCommander": {"frames", "observations", "rejected", "fired", "last_fired"},
+        "ViewObserver": {"observations_per_s", "with_geometry", "with_skeleton", "odometry_refused", "odometry_age_s",
+                         "worker_state_age_s"}}
 
 
 def main():

@@ -5,7 +5,9 @@
 out: a WorkerDetection with the worker found, its box inside the image and a stereo range along
 the box-centre ray (>= DEPTH_M, within the ray's stretch), then a Gesture once the skeleton FIFO
 is full (the still astronaut: none, as GestureEndToEndTest.CommittedStillImageSkeletonClassifiesAsNone).
-Usage: perception_check.py IMAGE.png; exit code = number of failures."""
+With --compressed the colour image goes out as the PNG file's bytes in a sensor_msgs/CompressedImage
+(format "png") on /cam/image/compressed, image_transport's `compressed` topic, and no raw image.
+Usage: perception_check.py IMAGE.png [--compressed]; exit code = number of failures."""
 import math
 import struct
 import sys
@@ -14,8 +16,9 @@ import zlib
 
 import numpy as np
 import rospy
+from diagnostic_msgs.msg import DiagnosticArray
 from gesture_formation.msg import Gesture, WorkerDetection
-from sensor_msgs.msg import CameraInfo, Image
+from sensor_msgs.msg import CameraInfo, CompressedImage, Image
 
 DEPTH_M = 4.0
 F_PX = 500.0
@@ -68,14 +71,19 @@ def read_png(path):
 
 def main():
     bgr = read_png(sys.argv[1])
+    compressed = "--compressed" in sys.argv[2:]
+    png_bytes = open(sys.argv[1], "rb").read()
     h, w = bgr.shape[:2]
     rospy.init_node("perception_check")
-    img_pub = rospy.Publisher("/cam/image", Image, queue_size=2)
+    img_pub = rospy.Publisher("/cam/image/compressed", CompressedImage, queue_size=2) if compressed \
+        else rospy.Publisher("/cam/image", Image, queue_size=2)
     depth_pub = rospy.Publisher("/cam/depth", Image, queue_size=2)
     info_pub = rospy.Publisher("/cam/camera_info", CameraInfo, queue_size=2, latch=True)
     detections, gestures = [], []
     rospy.Subscriber("/perception/worker_detection", WorkerDetection, detections.append)
     rospy.Subscriber("/perception/gesture", Gesture, gestures.append)
+    health = []
+    rospy.Subscriber("/diagnostics", DiagnosticArray, lambda a: health.extend(x for x in a.status if x.name == "Perception"))
     info = CameraInfo(width=w, height=h, distortion_model="plumb_bob", D=[0.0] * 5,
                       K=[F_PX, 0, w / 2.0, 0, F_PX, h / 2.0, 0, 0, 1])
     info.header.frame_id = "cam_optical"
@@ -84,7 +92,8 @@ def main():
     wall0 = time.time()
     while time.time() - wall0 < 50 and not rospy.is_shutdown():
         stamp = rospy.Time.now()
-        m = Image(height=h, width=w, encoding="bgr8", step=3 * w, data=bgr.tobytes())
+        m = CompressedImage(format="png", data=png_bytes) if compressed \
+            else Image(height=h, width=w, encoding="bgr8", step=3 * w, data=bgr.tobytes())
         m.header.stamp, m.header.frame_id = stamp, "cam_optical"
         d = Image(height=h, width=w, encoding="32FC1", step=4 * w, data=depth.tobytes())
         d.header.stamp, d.header.frame_id = stamp, "cam_optical"
@@ -97,8 +106,8 @@ def main():
     fails = 0
     found = [x for x in detections if x.detected]
     ok = len(detections) >= 10 and len(found) >= 9
-    print("%s: %d WorkerDetection messages, %d with the worker found (expected >= 10, >= 9)" % (
-        "PASS" if ok else "FAIL", len(detections), len(found)))
+    print("%s: %d WorkerDetection messages from %s images, %d with the worker found (expected >= 10, >= 9)" % (
+        "PASS" if ok else "FAIL", len(detections), "compressed (png)" if compressed else "raw bgr8", len(found)))
     fails += 0 if ok else 1
     if found:
         x = found[-1]
@@ -129,6 +138,14 @@ def main():
     print("%s: Gesture after a full skeleton window: %s (expected id 0, none: a still worker)" % (
         "PASS" if ok else "FAIL", "id %d, p(none) %.3f" % (gestures[0].gesture_id, gestures[0].probabilities[0])
         if gestures else "none published"))
+    fails += 0 if ok else 1
+    time.sleep(1.2)  # one more /diagnostics report (1 s of wall time)
+    values = [{kv.key: kv.value for kv in x.values} for x in health]
+    busy = [v for v in values if float(v.get("images_per_s", 0)) > 0 and float(v.get("found_per_s", 0)) > 0]
+    want = "compressed (decoded here)" if compressed else "raw"
+    ok = bool(busy) and all(v.get("image_transport") == want for v in values)
+    print("%s: /diagnostics Perception: %d reports, %d with images and finds per second, transport %s (%s expected)" % (
+        "PASS" if ok else "FAIL", len(values), len(busy), sorted({v.get("image_transport") for v in values}), want))
     fails += 0 if ok else 1
     return fails
 

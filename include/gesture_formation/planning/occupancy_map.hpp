@@ -9,7 +9,9 @@
 /// solid is then occupied (the voxels cover every obstacle, so conductors of 3 cm still
 /// occupy a voxel chain), and every occupied voxel lies within √3·resolution of a solid.
 /// Voxels follow OctoMap's grid: voxel i spans [i·res, (i+1)·res), its centre is (i+½)·res.
-/// Thread safety: const methods may be called concurrently once built.
+/// Thread safety: const methods may be called concurrently once built. setOccupancy() (the live
+/// map's update, mapping::LiveMap) changes the map in place: it must not run concurrently with
+/// any other method (the caller serialises; LiveMap does it with a reader/writer lock).
 
 #include <cstdint>
 #include <memory>
@@ -32,8 +34,21 @@ namespace gesture_formation::planning {
 /// \brief Integer voxel index (OctoMap grid, not offset by OctoMap's key origin).
 using VoxelIndex = Eigen::Vector3i;
 
+/// \brief A voxel's new state for OccupancyMap::setOccupancy (world voxel index).
+struct VoxelChange {
+  VoxelIndex voxel = VoxelIndex::Zero();
+  bool occupied = false;
+};
+
 class OccupancyMap : public ObstaclePoints {
  public:
+  /// Copies are deep (the copy owns its own OctoMap); moves keep it.
+  OccupancyMap(const OccupancyMap& other);
+  OccupancyMap& operator=(const OccupancyMap& other);
+  OccupancyMap(OccupancyMap&&) noexcept = default;
+  OccupancyMap& operator=(OccupancyMap&&) noexcept = default;
+  ~OccupancyMap() override = default;
+
   /// \brief Rasterises the scenario's solids (and merges its `map.octomap_file`, if any).
   /// Fails when the `.bt` file cannot be read or its resolution differs.
   static common::Result<OccupancyMap> fromScenario(const Scenario& scenario);
@@ -51,9 +66,9 @@ class OccupancyMap : public ObstaclePoints {
   const Aabb& gridBounds() const { return grid_bounds_; }
   const VoxelIndex& gridOrigin() const { return origin_; }
   const VoxelIndex& gridSize() const { return size_; }
-  /// \brief Centres of all occupied voxels, world frame (m), ordered by block.
-  const std::vector<Eigen::Vector3d>& occupiedCenters() const { return centers_; }
-  std::size_t occupiedCount() const { return centers_.size(); }
+  /// \brief Centres of all occupied voxels, world frame (m), ordered by block (a copy).
+  std::vector<Eigen::Vector3d> occupiedCenters() const;
+  std::size_t occupiedCount() const { return occupied_count_; }
   std::size_t droppedVoxels() const { return dropped_; }
 
   /// \brief Index of the voxel containing p (world, m).
@@ -70,6 +85,13 @@ class OccupancyMap : public ObstaclePoints {
 
   /// \brief The OctoMap (max-depth voxels, pruned; occupancy = clamping max). Shared with FCL.
   std::shared_ptr<const octomap::OcTree> octree() const { return octree_; }
+  /// \brief Sets voxels occupied or free in place — the dense grid, the block index and the
+  /// OctoMap (a freed voxel's node is set free), so that everything holding this map (the
+  /// distance field's update, FclClearance, the corridor builder) sees the new state. Voxels
+  /// outside the grid are ignored. Returns the voxels whose state changed (the input for
+  /// DistanceField::update). Cost: O(changes · (block occupancy + tree depth)).
+  std::vector<VoxelIndex> setOccupancy(const std::vector<VoxelChange>& changes);
+
   /// \brief Writes the OctoMap as `.bt`. Returns an empty string or the reason of failure.
   std::string writeBinary(const std::string& path) const;
 
@@ -77,8 +99,14 @@ class OccupancyMap : public ObstaclePoints {
   explicit OccupancyMap(const MapConfig& map);
   void rasterise(const PrimitiveSet& solids, const GroundSpec& ground);
   void markFromOctree(const octomap::OcTree& tree);
-  /// Builds centres_, the block index and the OctoMap from grid_.
+  /// Builds the block index and the OctoMap from grid_.
   void finalise();
+  std::size_t blockOfLocal(const VoxelIndex& local) const {
+    return static_cast<std::size_t>(local.x() / kBlock) +
+           static_cast<std::size_t>(blocks_.x()) * (static_cast<std::size_t>(local.y() / kBlock) +
+                                                    static_cast<std::size_t>(blocks_.y()) *
+                                                        static_cast<std::size_t>(local.z() / kBlock));
+  }
   std::size_t linear(const VoxelIndex& local) const {
     return static_cast<std::size_t>(local.x()) +
            static_cast<std::size_t>(size_.x()) *
@@ -93,10 +121,11 @@ class OccupancyMap : public ObstaclePoints {
   VoxelIndex size_ = VoxelIndex::Zero();
   VoxelIndex blocks_ = VoxelIndex::Zero();
   std::vector<std::uint8_t> grid_;
-  std::vector<Eigen::Vector3d> centers_;
-  std::vector<std::uint32_t> block_start_;  ///< CSR offsets into centres_, one per block + 1
+  /// Occupied voxel centres per kBlock³ block (x fastest), each in grid scan order when built.
+  std::vector<std::vector<Eigen::Vector3d>> block_centers_;
+  std::size_t occupied_count_ = 0;
   std::size_t dropped_ = 0;
-  std::shared_ptr<const octomap::OcTree> octree_;
+  std::shared_ptr<octomap::OcTree> octree_;
 };
 
 }  // namespace gesture_formation::planning

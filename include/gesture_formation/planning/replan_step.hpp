@@ -23,7 +23,10 @@
 /// holds it, it flies to its retreat goal (then hovers, returns home or lands) around every plan
 /// it has received, its plan flagged like a hold (others avoid it). Listening still comes first.
 ///
-/// Thread safety: not thread-safe; one instance per UAV, called from its planning thread.
+/// Thread safety: not thread-safe; one instance per UAV, called from its planning thread. With a
+/// live map (mapping::LiveMap: the planner's map and field, and RetreatSpace::field, updated in
+/// place per depth frame), a step must not overlap LiveMap::integrate(): when frames are
+/// integrated on another thread, call step() under LiveMap::readLock() (docs/mapping.md §3).
 
 #include <cmath>
 #include <limits>

@@ -129,6 +129,11 @@ struct TrajectoryQpProblem;
 /// Stateful (last verified plan, QP warm start, plan sequence); deterministic for the same
 /// sequence of requests when `time_budget_ms` is 0 (otherwise only the budget fallback
 /// depends on the machine's speed). Not thread-safe; one instance per UAV.
+/// Live map: the map and field may instead be a mapping::LiveMap's (map(), field()), which its
+/// integrate() updates in place — nothing is copied per replanning; every stage, the fallback's
+/// re-verification of the previous plan included, reads the map as it is at plan(). plan() must
+/// not overlap an update: on another thread than integrate(), hold LiveMap::readLock() during
+/// plan() (docs/mapping.md §3).
 class UavPlanner {
  public:
   /// \brief `config` must be valid; otherwise `configError()` names every bad field and

@@ -1,0 +1,396 @@
+// Online mapping against an analytic scene: depth images of an axis-aligned box rendered in the
+// test (ray–box intersection per pixel), integrated by LiveMap. The box's front-face voxels become
+// occupied and nothing else; after the box moves the old voxels are cleared and the new ones
+// occupied; the field stays equal to a full rebuild; prior voxels stay; bad settings and frames are
+// named.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <set>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include <octomap/OcTree.h>
+
+#include "gesture_formation/mapping/depth_points.hpp"
+#include "gesture_formation/mapping/live_map.hpp"
+#include "gesture_formation/mapping/mapping_config.hpp"
+
+using namespace gesture_formation;
+using mapping::DepthFrame;
+using mapping::LiveMap;
+using mapping::MappingConfig;
+using planning::VoxelIndex;
+
+namespace {
+
+constexpr double kRes = 0.2;
+
+planning::MapConfig grid() {
+  planning::MapConfig m;
+  m.resolution_m = kRes;
+  m.bounds = planning::Aabb{Eigen::Vector3d(-1.0, -6.0, -1.0), Eigen::Vector3d(14.0, 6.0, 5.0)};
+  return m;
+}
+
+/// A camera at p looking along world +x (optical z = +x, x = −y, y = −z), 640×480, f = 400 px.
+DepthFrame cameraAt(const Eigen::Vector3d& p_world) {
+  DepthFrame f;
+  f.intrinsics = mapping::PinholeIntrinsics{400.0, 400.0, 319.5, 239.5};
+  Eigen::Matrix3d R;
+  R.col(0) = Eigen::Vector3d(0, -1, 0);
+  R.col(1) = Eigen::Vector3d(0, 0, -1);
+  R.col(2) = Eigen::Vector3d(1, 0, 0);
+  f.T_world_camera.linear() = R;
+  f.T_world_camera.translation() = p_world;
+  f.depth_m = cv::Mat(480, 640, CV_32FC1);
+  return f;
+}
+
+/// Renders the depth of an axis-aligned box [lo, hi] (slab method per pixel ray): the optical z of
+/// the first intersection, +Inf where the ray misses it (nothing within the sensor's range).
+void renderBox(DepthFrame& f, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  const Eigen::Matrix3d R = f.T_world_camera.linear();
+  const Eigen::Vector3d o = f.T_world_camera.translation();
+  for (int v = 0; v < f.depth_m.rows; ++v) {
+    for (int u = 0; u < f.depth_m.cols; ++u) {
+      // direction with optical z = 1, so the ray parameter is the depth
+      const Eigen::Vector3d d = R * Eigen::Vector3d((u - f.intrinsics.cx) / f.intrinsics.fx,
+                                                    (v - f.intrinsics.cy) / f.intrinsics.fy, 1.0);
+      double t0 = 0.0, t1 = std::numeric_limits<double>::infinity();
+      for (int i = 0; i < 3; ++i) {
+        if (std::abs(d(i)) < 1e-12) {
+          if (o(i) < lo(i) || o(i) > hi(i)) t0 = std::numeric_limits<double>::infinity();
+          continue;
+        }
+        double a = (lo(i) - o(i)) / d(i), b = (hi(i) - o(i)) / d(i);
+        if (a > b) std::swap(a, b);
+        t0 = std::max(t0, a);
+        t1 = std::min(t1, b);
+      }
+      f.depth_m.at<float>(v, u) = t0 <= t1 ? static_cast<float>(t0) : std::numeric_limits<float>::infinity();
+    }
+  }
+}
+
+using Key = std::tuple<int, int, int>;
+
+/// Voxels of the face x = x_face, y ∈ [y0, y1], z ∈ [z0, z1] (edges mid-voxel, so unambiguous).
+std::set<Key> faceVoxels(double x_face, double y0, double y1, double z0, double z1) {
+  std::set<Key> out;
+  const int i = static_cast<int>(std::floor(x_face / kRes));
+  for (int j = static_cast<int>(std::floor(y0 / kRes)); j <= static_cast<int>(std::floor(y1 / kRes)); ++j) {
+    for (int k = static_cast<int>(std::floor(z0 / kRes)); k <= static_cast<int>(std::floor(z1 / kRes)); ++k) {
+      out.insert({i, j, k});
+    }
+  }
+  return out;
+}
+
+std::set<Key> occupiedVoxels(const planning::OccupancyMap& map) {
+  std::set<Key> out;
+  for (const auto& c : map.occupiedCenters()) {
+    const VoxelIndex v = map.voxelOf(c);
+    out.insert({v.x(), v.y(), v.z()});
+  }
+  return out;
+}
+
+Eigen::Vector3d centre(const Key& k) {
+  return (Eigen::Vector3d(std::get<0>(k), std::get<1>(k), std::get<2>(k)).array() + 0.5).matrix() * kRes;
+}
+
+/// The live field equals a full rebuild over the live map.
+void expectFieldIsFullRebuild(const LiveMap& live) {
+  const auto rebuilt = planning::DistanceField::truncated(*live.map(), live.config().field_range_m);
+  ASSERT_TRUE(rebuilt);
+  const VoxelIndex n = live.map()->gridSize();
+  int mismatches = 0;
+  for (int k = 0; k < n.z(); ++k) {
+    for (int j = 0; j < n.y(); ++j) {
+      for (int i = 0; i < n.x(); ++i) mismatches += live.field()->atLocal(i, j, k) != rebuilt->atLocal(i, j, k);
+    }
+  }
+  EXPECT_EQ(mismatches, 0);
+}
+
+std::unique_ptr<LiveMap> makeLiveMap(std::shared_ptr<const planning::OccupancyMap> prior = nullptr) {
+  auto live = LiveMap::create(MappingConfig{}, grid(), std::move(prior));
+  EXPECT_TRUE(live) << live.reason();
+  return live ? std::move(*live) : nullptr;
+}
+
+const Eigen::Vector3d kCamera(0.0, 0.0, 1.5);
+// Box A: front face x = 4.7, y ∈ [−0.9, 0.9], z ∈ [0.9, 2.1] (every edge in the middle of a voxel).
+const Eigen::Vector3d kBoxALo(4.7, -0.9, 0.9), kBoxAHi(5.5, 0.9, 2.1);
+// Box B: the same box moved 2.6 m to the left (+y): y ∈ [1.7, 3.5].
+const Eigen::Vector3d kBoxBLo(4.7, 1.7, 0.9), kBoxBHi(5.5, 3.5, 2.1);
+
+}  // namespace
+
+TEST(LiveMapTest, DepthImageOfABoxOccupiesExactlyItsFrontFaceVoxels) {
+  auto live = makeLiveMap();
+  ASSERT_TRUE(live);
+  DepthFrame frame = cameraAt(kCamera);
+  renderBox(frame, kBoxALo, kBoxAHi);
+  const auto update = live->integrate(frame);
+  ASSERT_TRUE(update) << update.reason();
+  const std::set<Key> face = faceVoxels(4.7, -0.9, 0.9, 0.9, 2.1);
+  ASSERT_EQ(face.size(), 70u);  // 10 × 7 voxels
+  EXPECT_EQ(occupiedVoxels(*live->map()), face);  // the camera sees neither the sides nor the top
+  EXPECT_EQ(update->map_changes, 70);
+  EXPECT_EQ(update->pixels, 160 * 120);  // stride 4
+  EXPECT_GT(update->free_rays, 0);       // the +Inf pixels around the box
+  for (const auto& k : face) EXPECT_EQ(live->observed(centre(k)), mapping::Observed::kOccupied);
+  // in front of the face: observed free; behind it: never seen
+  EXPECT_EQ(live->observed(Eigen::Vector3d(2.5, 0.1, 1.5)), mapping::Observed::kFree);
+  EXPECT_EQ(live->observed(Eigen::Vector3d(6.1, 0.1, 1.5)), mapping::Observed::kUnknown);
+  // the field: distance to the nearest face voxel centre, capped at the range
+  for (const Eigen::Vector3d& p : {Eigen::Vector3d(3.7, 0.1, 1.5), Eigen::Vector3d(4.1, 1.9, 2.7), Eigen::Vector3d(0.5, 0.1, 1.5)}) {
+    double d = live->config().field_range_m;
+    for (const auto& k : face) d = std::min(d, (centre(k) - live->map()->centerOf(live->map()->voxelOf(p))).norm());
+    EXPECT_NEAR(live->field()->clearance(live->map()->centerOf(live->map()->voxelOf(p))), d, 1e-5) << p.transpose();
+  }
+  expectFieldIsFullRebuild(*live);
+}
+
+TEST(LiveMapTest, MovedBoxIsClearedWhereItWasAndOccupiedWhereItIs) {
+  auto live = makeLiveMap();
+  ASSERT_TRUE(live);
+  DepthFrame a = cameraAt(kCamera);
+  renderBox(a, kBoxALo, kBoxAHi);
+  for (int i = 0; i < 10; ++i) ASSERT_TRUE(live->integrate(a));  // saturated log-odds
+  const std::set<Key> old_face = faceVoxels(4.7, -0.9, 0.9, 0.9, 2.1);
+  ASSERT_EQ(occupiedVoxels(*live->map()), old_face);
+
+  DepthFrame b = cameraAt(kCamera);
+  renderBox(b, kBoxBLo, kBoxBHi);
+  int changes = 0;
+  for (int i = 0; i < 10; ++i) {
+    const auto update = live->integrate(b);
+    ASSERT_TRUE(update) << update.reason();
+    changes += update->map_changes;
+    expectFieldIsFullRebuild(*live);
+  }
+  const std::set<Key> occupied = occupiedVoxels(*live->map());
+  for (const auto& k : old_face) {
+    EXPECT_EQ(occupied.count(k), 0u) << "old voxel " << centre(k).transpose() << " still occupied";
+    EXPECT_EQ(live->observed(centre(k)), mapping::Observed::kFree);
+  }
+  const std::set<Key> new_face = faceVoxels(4.7, 1.7, 3.5, 0.9, 2.1);
+  for (const auto& k : new_face) EXPECT_EQ(occupied.count(k), 1u) << "new voxel " << centre(k).transpose() << " free";
+  // Besides the new front face only the side face y = 1.7 (which the camera at y = 0 sees) is occupied.
+  for (const auto& k : occupied) {
+    const Eigen::Vector3d c = centre(k);
+    const bool front = new_face.count(k) > 0;
+    const bool side = std::abs(c.y() - 1.7) < kRes && c.x() > 4.6 && c.x() < 5.6 && c.z() > 0.8 && c.z() < 2.2;
+    EXPECT_TRUE(front || side) << "unexpected occupied voxel " << c.transpose();
+  }
+  EXPECT_EQ(changes, 70 + static_cast<int>(occupied.size()));  // every old voxel freed once, every new one set once
+}
+
+TEST(LiveMapTest, PriorVoxelsStayOccupiedWhenRaysPassThem) {
+  planning::PrimitiveSet solids;
+  planning::OrientedBox post;  // a thin post between the camera and the box, on the rays to it
+  post.center_world = Eigen::Vector3d(3.1, 0.1, 1.5);
+  post.size_m = Eigen::Vector3d(0.05, 0.05, 0.05);
+  solids.boxes.push_back(post);
+  auto prior = std::make_shared<planning::OccupancyMap>(
+      planning::OccupancyMap::fromPrimitives(grid(), solids, planning::GroundSpec{}));
+  const std::size_t prior_count = prior->occupiedCount();
+  ASSERT_GT(prior_count, 0u);
+  auto live = makeLiveMap(prior);
+  ASSERT_TRUE(live);
+  DepthFrame a = cameraAt(kCamera);
+  renderBox(a, kBoxALo, kBoxAHi);  // the rendered world has no post: its rays pass through it
+  for (int i = 0; i < 10; ++i) ASSERT_TRUE(live->integrate(a));
+  EXPECT_EQ(live->observed(post.center_world), mapping::Observed::kFree);
+  EXPECT_TRUE(live->map()->isOccupied(post.center_world));
+  EXPECT_EQ(live->map()->occupiedCount(), prior_count + 70);
+  EXPECT_EQ(prior->occupiedCount(), prior_count);  // the prior itself is untouched
+  expectFieldIsFullRebuild(*live);
+}
+
+TEST(LiveMapTest, RayCastingEqualsOctomapInsertPointCloud) {
+  // LiveMap casts its rays itself (a dense mark instead of OctoMap's hash sets, clamped voxels
+  // skipped): the observed tree must equal OctoMap's insertPointCloud of the same rays, also
+  // outside the grid (the rays here leave it above, below and to the sides).
+  auto live = makeLiveMap();
+  ASSERT_TRUE(live);
+  const MappingConfig& c = live->config();
+  octomap::OcTree reference(kRes);
+  reference.setProbHit(c.prob_hit);
+  reference.setProbMiss(c.prob_miss);
+  reference.setClampingThresMin(c.clamping_min);
+  reference.setClampingThresMax(c.clamping_max);
+  const std::vector<std::pair<Eigen::Vector3d, bool>> shots = {
+      {kCamera, false}, {kCamera, false}, {Eigen::Vector3d(0.5, -1.0, 2.0), true},
+      {Eigen::Vector3d(1.0, 0.7, 1.2), false}, {kCamera, true}, {kCamera, true}, {kCamera, true}};
+  for (const auto& [p, moved] : shots) {
+    DepthFrame f = cameraAt(p);
+    renderBox(f, moved ? kBoxBLo : kBoxALo, moved ? kBoxBHi : kBoxAHi);
+    ASSERT_TRUE(live->integrate(f));
+    const auto points = mapping::depthToPoints(f, c, 2.0 * kRes);
+    ASSERT_TRUE(points);
+    // the same rays: the first return per end voxel, returns within range before the others
+    octomap::Pointcloud cloud;
+    octomap::KeySet ends;
+    for (const auto* list : {&points->hits_world, &points->free_rays_world}) {
+      for (const auto& q : *list) {
+        const octomap::point3d e(static_cast<float>(q.x()), static_cast<float>(q.y()), static_cast<float>(q.z()));
+        if (ends.insert(reference.coordToKey(e)).second) cloud.push_back(e);
+      }
+    }
+    reference.insertPointCloud(cloud, octomap::point3d(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())),
+                               c.max_range_m);
+  }
+  const octomap::OcTree& tree = live->observedTree();
+  int compared = 0, known = 0;
+  for (int k = -40; k < 40; ++k) {
+    for (int j = -45; j < 45; ++j) {
+      for (int i = -10; i < 75; ++i) {
+        const octomap::point3d q(static_cast<float>((i + 0.5) * kRes), static_cast<float>((j + 0.5) * kRes),
+                                 static_cast<float>((k + 0.5) * kRes));
+        const octomap::OcTreeNode* a = tree.search(q);
+        const octomap::OcTreeNode* b = reference.search(q);
+        ++compared;
+        ASSERT_EQ(a == nullptr, b == nullptr) << "voxel " << i << " " << j << " " << k;
+        if (a != nullptr) {
+          ++known;
+          ASSERT_EQ(a->getLogOdds(), b->getLogOdds()) << "voxel " << i << " " << j << " " << k;
+        }
+      }
+    }
+  }
+  EXPECT_GT(known, 20000) << "of " << compared;
+}
+
+TEST(LiveMapTest, PriorOnAnotherGridIsRefused) {
+  planning::MapConfig other = grid();
+  other.resolution_m = 0.25;
+  auto prior = std::make_shared<planning::OccupancyMap>(
+      planning::OccupancyMap::fromPrimitives(other, planning::PrimitiveSet{}, planning::GroundSpec{}));
+  const auto live = LiveMap::create(MappingConfig{}, grid(), prior);
+  ASSERT_FALSE(live);
+  EXPECT_NE(live.reason().find("prior map"), std::string::npos) << live.reason();
+}
+
+TEST(DepthPointsTest, DecimationRangesAndRep118ValuesAreSortedOut) {
+  DepthFrame f = cameraAt(Eigen::Vector3d::Zero());
+  f.depth_m = cv::Mat(4, 8, CV_32FC1, cv::Scalar(5.0f));
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  // row 0 (used with stride 2: columns 0, 2, 4, 6): NaN, +Inf, −Inf, 0
+  f.depth_m.at<float>(0, 0) = nan;
+  f.depth_m.at<float>(0, 2) = inf;
+  f.depth_m.at<float>(0, 4) = -inf;
+  f.depth_m.at<float>(0, 6) = 0.0f;
+  // row 2: near, in range, beyond max range, in range
+  f.depth_m.at<float>(2, 0) = 0.1f;
+  f.depth_m.at<float>(2, 4) = 25.0f;
+  f.depth_m.at<float>(1, 1) = nan;  // not on the decimated grid: never looked at
+  MappingConfig c;
+  c.pixel_stride = 2;
+  c.min_range_m = 0.3;
+  c.max_range_m = 10.0;
+  const auto pts = mapping::depthToPoints(f, c, 0.4);
+  ASSERT_TRUE(pts) << pts.reason();
+  EXPECT_EQ(pts->pixels, 8);
+  EXPECT_EQ(pts->skipped_invalid, 3);
+  EXPECT_EQ(pts->skipped_near, 1);
+  EXPECT_EQ(pts->free_rays_world.size(), 2u);
+  EXPECT_EQ(pts->hits_world.size(), 2u);
+  for (const auto& p : pts->free_rays_world) EXPECT_NEAR(p.norm(), 10.4, 1e-9);
+  // pixel (2, 2) at depth 5: optical ((2 − 319.5)/400·5, (2 − 239.5)/400·5, 5) → world (5, 3.97, 2.97)
+  EXPECT_NEAR(pts->hits_world[0].x(), 5.0, 1e-9);
+  EXPECT_NEAR(pts->hits_world[0].y(), (319.5 - 2.0) / 400.0 * 5.0, 1e-9);
+  EXPECT_NEAR(pts->hits_world[0].z(), (239.5 - 2.0) / 400.0 * 5.0, 1e-9);
+}
+
+TEST(DepthPointsTest, BadFramesAreNamed) {
+  MappingConfig c;
+  DepthFrame f = cameraAt(Eigen::Vector3d::Zero());
+  f.depth_m = cv::Mat(4, 4, CV_16UC1, cv::Scalar(1000));
+  auto r = mapping::depthToPoints(f, c, 0.4);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.reason().find("depth_m must be CV_32FC1"), std::string::npos) << r.reason();
+  f = cameraAt(Eigen::Vector3d::Zero());
+  f.intrinsics.fx = 0.0;
+  r = mapping::depthToPoints(f, c, 0.4);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.reason().find("intrinsics.fx must be finite and > 0, got 0"), std::string::npos) << r.reason();
+  f = cameraAt(Eigen::Vector3d::Zero());
+  f.intrinsics.cy = std::nan("");
+  r = mapping::depthToPoints(f, c, 0.4);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.reason().find("intrinsics.cy"), std::string::npos) << r.reason();
+  f = cameraAt(Eigen::Vector3d::Zero());
+  f.T_world_camera.linear() *= 2.0;
+  r = mapping::depthToPoints(f, c, 0.4);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.reason().find("T_world_camera"), std::string::npos) << r.reason();
+  f = cameraAt(Eigen::Vector3d::Zero());
+  f.depth_m = cv::Mat();
+  r = mapping::depthToPoints(f, c, 0.4);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.reason().find("depth_m is empty"), std::string::npos);
+  // a bad frame changes nothing in the live map
+  auto live = makeLiveMap();
+  ASSERT_TRUE(live);
+  const auto refused = live->integrate(f);
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(live->map()->occupiedCount(), 0u);
+}
+
+TEST(MappingConfigTest, DefaultsAreValid) { EXPECT_TRUE(MappingConfig{}.validate().empty()); }
+
+TEST(MappingConfigTest, EveryBadFieldIsNamedWithItsValue) {
+  MappingConfig c;
+  c.pixel_stride = 0;
+  c.min_range_m = -0.5;
+  c.prob_hit = 0.4;
+  c.prob_miss = 0.6;
+  c.clamping_min = 0.0;
+  c.clamping_max = 1.5;
+  c.field_range_m = std::nan("");
+  const auto problems = c.validate("mapping.");
+  const auto has = [&](const std::string& text) {
+    for (const auto& p : problems) {
+      if (p.find(text) != std::string::npos) return true;
+    }
+    return false;
+  };
+  EXPECT_TRUE(has("mapping.depth.pixel_stride must be in [1, 64], got 0")) << ::testing::PrintToString(problems);
+  EXPECT_TRUE(has("mapping.depth.min_range_m must be > 0, got -0.5")) << ::testing::PrintToString(problems);
+  EXPECT_TRUE(has("mapping.octomap.prob_hit")) << ::testing::PrintToString(problems);
+  EXPECT_TRUE(has("got 0.4")) << ::testing::PrintToString(problems);
+  EXPECT_TRUE(has("mapping.octomap.prob_miss")) << ::testing::PrintToString(problems);
+  EXPECT_TRUE(has("mapping.octomap.clamping_min")) << ::testing::PrintToString(problems);
+  EXPECT_TRUE(has("mapping.octomap.clamping_max")) << ::testing::PrintToString(problems);
+  EXPECT_TRUE(has("mapping.field.range_m")) << ::testing::PrintToString(problems);
+  EXPECT_EQ(problems.size(), 7u) << ::testing::PrintToString(problems);
+
+  MappingConfig ranges;
+  ranges.min_range_m = 5.0;
+  ranges.max_range_m = 4.0;
+  const auto rule = ranges.validate();
+  ASSERT_EQ(rule.size(), 1u);
+  EXPECT_NE(rule[0].find("depth.max_range_m must be > depth.min_range_m, got 4"), std::string::npos) << rule[0];
+
+  const auto live = LiveMap::create(c, grid());
+  ASSERT_FALSE(live);
+  EXPECT_NE(live.reason().find("depth.pixel_stride"), std::string::npos) << live.reason();
+}
+
+TEST(MappingConfigTest, YamlReaderUsesTheSameRanges) {
+  auto reader = common::ConfigReader::fromString(
+      "mapping: {depth: {pixel_stride: 8, max_range_m: 6.0}, field: {range_m: -1}}", "test.yaml",
+      common::ConfigReader::MissingKeys::kUseDefaults);
+  const MappingConfig c = mapping::readMappingConfig(reader, "mapping.");
+  EXPECT_EQ(c.pixel_stride, 8);
+  EXPECT_EQ(c.max_range_m, 6.0);
+  ASSERT_FALSE(reader.ok());
+  ASSERT_EQ(reader.problems().size(), 1u);
+  EXPECT_EQ(reader.problems()[0].key, "mapping.field.range_m");
+}
