@@ -21,6 +21,7 @@ void readOnboardSettings(ConfigReader& r, const std::string& m, OnboardSettings&
 
   common::withSubReader(r, m + "formation", ConfigReader::MissingKeys::kUseDefaults,
                         [&](ConfigReader& s) { c.formation = formation::readFormationConfig(s); });
+  c.replan.reach.worker_min_distance_m = c.formation.limits.safety_distance_m;  // Γ_dis: the reach keeps it
   common::withSubReader(r, m + "gestures", ConfigReader::MissingKeys::kUseDefaults, [&](ConfigReader& s) {
     c.gesture_filter = gesture::readGestureFilterConfig(s);
     gesture::readGestureMapping(s, c.gesture_filter.max_gesture_id,

@@ -32,6 +32,10 @@ const common::FieldTable<ReplanConfig>& replanConfigFields() {
       {"faults.search_period_s", Range::positive(), [](C& c) { return &c.search.period_s; }},
       {"faults.search_horizontal_speed_mps", Range::nonNegative(),
        [](C& c) { return &c.search.horizontal_speed_mps; }},
+      {"faults.reach_walking_speed_mps", Range::closed(0.0, 10.0), [](C& c) { return &c.reach.walking_speed_mps; }},
+      {"faults.reach_base_m", Range::closed(0.0, 20.0), [](C& c) { return &c.reach.base_m; }},
+      {"faults.reach_max_m", Range::openClosed(0.0, 100.0), [](C& c) { return &c.reach.max_radius_m; }},
+      {"faults.reach_margin_m", Range::closed(0.0, 20.0), [](C& c) { return &c.reach.margin_m; }},
   }};
   return t;
 }
@@ -45,6 +49,7 @@ ReplanStep::ReplanStep(const ReplanConfig& config, std::unique_ptr<Planner> plan
       planner_(std::move(planner)),
       hold_(config.freshness, config.search, config.brake_accel_mps2),
       abort_(config.uav_index, config.uav_count, config.abort, space),
+      reach_(config.uav_index, config.uav_count, config.reach, config.abort, space),
       space_(space),
       heading_(config.worker_heading) {}
 
@@ -52,6 +57,7 @@ void ReplanStep::restart(std::unique_ptr<Planner> planner) {
   planner_ = std::move(planner);
   hold_ = HoldPlanner(config_.freshness, config_.search, config_.brake_accel_mps2);
   abort_ = AbortPlanner(config_.uav_index, config_.uav_count, config_.abort, space_);
+  reach_ = ReachKeeper(config_.uav_index, config_.uav_count, config_.reach, config_.abort, space_);
   heading_ = formation::WorkerHeading(config_.worker_heading);
   flown_ = PlannedTrajectory{};
   listen_since_s_ = std::numeric_limits<double>::quiet_NaN();
@@ -99,6 +105,7 @@ ReplanStep::Choice ReplanStep::choose(const ReplanInputs& in, const std::string&
     out.abort_phase_changed = d.phase_changed;
     c.reference = std::move(d.reference);
     c.given = true;
+    reach_.release();
     return c;
   }
   HoldPlanner::Situation situation;
@@ -121,7 +128,29 @@ ReplanStep::Choice ReplanStep::choose(const ReplanInputs& in, const std::string&
   c.given = decision.holding();
   c.reference = std::move(decision.reference);
   c.camera_target = std::move(decision.camera_target);
+  if (c.given) {
+    keepReachClear(in, worker_p0, c, out);
+  } else {
+    reach_.release();
+  }
   return c;
+}
+
+void ReplanStep::keepReachClear(const ReplanInputs& in, const Eigen::Vector3d& worker_p0, Choice& c,
+                                ReplanOutcome& out) {
+  ReachKeeper::Situation s;
+  s.t_s = in.t_s;
+  s.p_world = in.state.p_world;
+  s.hold_world = hold_.holdPoint().value_or(in.state.p_world);
+  s.fused_s = in.worker->fused_s;
+  const ReachKeeper::Decision d = reach_.decide(s);
+  out.backoff_started = d.started;
+  out.backoff = d.reason;
+  if (!d.goal) return;
+  out.backing_off = true;
+  // An ordinary reference through the planner (verification, fallbacks), camera on the estimate.
+  c.reference = approachReference(in.state.p_world, *d.goal, worker_p0, in.state.heading_rad, config_.abort.speed_mps,
+                                  config_.dt_s, config_.steps);
 }
 
 ReplanOutcome ReplanStep::step(const ReplanInputs& in) {
@@ -134,6 +163,7 @@ ReplanOutcome ReplanStep::step(const ReplanInputs& in) {
     return out;
   }
   const WorkerKnowledge& w = *in.worker;
+  reach_.observe(w);
   // Freshness first, then listening (a UAV listens from its first replanning with data). An
   // aborting UAV does not hold for stale data (it retreats from what it last knew); it listens.
   const std::string stale = holdReason(i, t, w.stamp_s, w.fused_s, config_.freshness);

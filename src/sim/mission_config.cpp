@@ -344,6 +344,7 @@ void readFaults(ConfigReader& r, const std::string& m, MissionConfig& c) {
   readPlannerOutages(r, fk, c.faults.planner_outages);
   readFollowerDropouts(r, fk, c.faults.follower_dropouts);
   readAbortEvent(r, fk + "abort", c.faults.abort);
+  readWorkerApproach(r, fk + "worker_approach", c.faults.worker_approach);
   const std::string k = fk + "range_outliers.";
   rangeOutlierFields().readFields(r, k, c.faults.range_outliers);
   for (const auto& e : c.faults.validate()) r.addError(m + "faults", e);
@@ -359,6 +360,9 @@ void checkUavCount(ConfigReader& r, const std::string& m, const MissionConfig& c
   }
   for (const auto& o : c.faults.planner_outages) {
     if (o.uav >= n_uavs) r.addError(fk + "planner_outages", "uav " + std::to_string(o.uav) + " does not exist");
+  }
+  if (c.faults.worker_approach && c.faults.worker_approach->uav >= n_uavs) {
+    r.addError(fk + "worker_approach.uav", "uav " + std::to_string(c.faults.worker_approach->uav) + " does not exist");
   }
   for (const auto& o : c.faults.follower_dropouts) {
     if (o.uav >= n_uavs) r.addError(fk + "follower_dropouts", "uav " + std::to_string(o.uav) + " does not exist");

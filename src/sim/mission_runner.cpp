@@ -136,6 +136,7 @@ class MissionRun {
   void setMode(int i, double t, const std::string& mode, const std::string& reason);
   void deliverAbort(double t);
   void receiveAbort(int i, const planning::AbortCommand& command, double t);
+  void divertWorker(double t);
 
   const MissionConfig& cfg_;
   const MissionWorld& world_;
@@ -162,6 +163,8 @@ class MissionRun {
   std::vector<std::unique_ptr<Link<planning::AbortCommand>>> abort_links_;   // [i]: ground station → UAV i
   AbortSender abort_sender_{cfg_.faults.abort, cfg_.replan.abort.repeats, cfg_.replan.abort.repeat_period_s};
   std::optional<AbortRecorder> abort_record_;
+  std::optional<ApproachRecorder> approach_record_;  ///< faults.worker_approach
+  bool diverted_ = false;                            ///< the worker left his route (faults.worker_approach)
   MetricsAccumulator metrics_;
   MissionMetrics& M_;
   std::vector<ModeChange> modes_;
@@ -199,6 +202,7 @@ std::string MissionRun::addUavs() {
     rc.uav_index = i;
     rc.uav_count = n_;
     rc.worker_heading = cfg_.formation.worker_heading;
+    rc.reach.worker_min_distance_m = cfg_.formation.limits.safety_distance_m;  // Γ_dis: the reach keeps it
     rc.home_world = s0.p_world;  // the mission starts in the air: its take-off point is where it starts
     planning::RetreatSpace space;
     space.field = world_.field;
@@ -253,6 +257,7 @@ MissionOutput MissionRun::run(double duration_s, std::chrono::steady_clock::time
   StepSchedule timeline_samples(1.0 / cfg_.timeline_rate_hz, dt);
   for (long k = 0; k <= steps; ++k) {
     const double t = static_cast<double>(k) * dt;
+    divertWorker(t);
     const WorkerState ws = worker_.stateAt(t);
     deliverOperatorMessages(t);
     deliverAbort(t);
@@ -267,6 +272,7 @@ MissionOutput MissionRun::run(double duration_s, std::chrono::steady_clock::time
     for (const auto& u : uavs_) p_true.push_back(u->plant.state().p_world);
     metrics_.sampleSafety(t, p_true, ws);
     if (abort_record_) abort_record_->sample(t, p_true, ws.p_world);
+    if (approach_record_) approach_record_->sample(t, p_true, ws.p_world);
     if (timeline_samples.due(k)) sampleTimeline(t, ws);
     if (k == steps) break;
     control(t, dt);
@@ -284,6 +290,7 @@ MissionOutput MissionRun::run(double duration_s, std::chrono::steady_clock::time
   MissionOutput out = metrics_.finish(worker_.episodes(), static_cast<double>(steps) * dt, wall_s);
   out.modes = std::move(modes_);
   if (abort_record_) out.metrics.abort = abort_record_->summary();
+  if (approach_record_) out.metrics.worker_approach = approach_record_->summary();
   if (const std::vector<PerceptionRecord>* records = camera_.perceptionRecords()) {
     out.perception = *records;
     out.metrics.perception = summarizePerception(*records);
@@ -510,6 +517,8 @@ void MissionRun::replan(int i, double t) {
   } else {
     setMode(i, t, planning::toString(out.mode), out.holding() ? out.reason : "fresh data");
   }
+  // A back-off from the worker's reach begins (or finds no goal): a row of the same mode with its reason.
+  if (out.backoff_started) modes_.push_back(ModeChange{t, i, u.mode, out.backoff});
   const planning::PlanResult& res = out.result;
   metrics_.plan(i, t, version, res.status, res.timings.total_ms, res.reason, res.qp_sparse_timeouts);
   if (res.trajectory.empty()) {
@@ -602,6 +611,21 @@ void MissionRun::receiveAbort(int i, const planning::AbortCommand& command, doub
   }
   abort_record_->accepted(i, t);
   setMode(i, t, "abort_accepted", std::string("abort from ") + planning::toString(command.source) + " " + command.id.sender);
+}
+
+void MissionRun::divertWorker(double t) {
+  // faults.worker_approach: at its time the worker turns towards where the UAV is then.
+  const std::optional<WorkerApproach>& a = cfg_.faults.worker_approach;
+  if (!a || diverted_ || t < a->t_s) return;
+  diverted_ = true;
+  const Eigen::Vector3d feet = worker_.stateAt(t).feet_world;
+  const Eigen::Vector3d below_uav = uav(a->uav).plant.state().p_world;
+  const Eigen::Vector2d way = below_uav.head<2>() - feet.head<2>();
+  const double len = way.norm();
+  const Eigen::Vector2d stop = len > a->stop_m ? Eigen::Vector2d(feet.head<2>() + way * ((len - a->stop_m) / len))
+                                               : Eigen::Vector2d(feet.head<2>());
+  worker_.divert(t, Eigen::Vector3d(stop.x(), stop.y(), feet.z()), a->speed_mps);
+  approach_record_.emplace(*a, n_, cfg_.formation.limits.safety_distance_m, cfg_.faults.camera_blackouts);
 }
 
 void MissionRun::setMode(int i, double t, const std::string& mode, const std::string& reason) {

@@ -205,7 +205,36 @@ WorkerModel::WorkerModel(const WorkerConfig& config, std::uint64_t seed)
   leg_heading_rad_.push_back(leg_heading_rad_.empty() ? degToRad(config_.start_facing_deg) : leg_heading_rad_.back());
 }
 
+void WorkerModel::divert(double t_s, const Eigen::Vector3d& to_feet_world, double speed_mps) {
+  Detour d;
+  d.t_s = t_s;
+  d.from_feet_world = stateAt(t_s).feet_world;
+  d.to_feet_world = Eigen::Vector3d(to_feet_world.x(), to_feet_world.y(), d.from_feet_world.z());
+  d.speed_mps = speed_mps;
+  const Eigen::Vector3d way = d.to_feet_world - d.from_feet_world;
+  d.heading_rad = way.head<2>().norm() > 1e-9 ? std::atan2(way.y(), way.x()) : stateAt(t_s).heading_rad;
+  detour_.reset();
+  detour_ = d;
+}
+
+WorkerState WorkerModel::detourStateAt(double t_s) const {
+  const Detour& d = *detour_;
+  WorkerState s;
+  const Eigen::Vector3d way = d.to_feet_world - d.from_feet_world;
+  const double len = way.norm();
+  const double along = std::min(len, (t_s - d.t_s) * d.speed_mps);
+  s.feet_world = len > 1e-9 ? Eigen::Vector3d(d.from_feet_world + way * (along / len)) : d.from_feet_world;
+  const bool walking = along < len;
+  s.v_world = walking ? Eigen::Vector3d(way * (d.speed_mps / len)) : Eigen::Vector3d::Zero();
+  s.kind = walking ? RouteLeg::Kind::kWalk : RouteLeg::Kind::kWait;
+  s.heading_rad = d.heading_rad;
+  s.leg = static_cast<int>(config_.route.size());  // off the route
+  s.p_world = s.feet_world + Eigen::Vector3d(0.0, 0.0, 0.5 * config_.height_m);
+  return s;
+}
+
 WorkerState WorkerModel::stateAt(double t_s) const {
+  if (detour_ && t_s >= detour_->t_s) return detourStateAt(t_s);
   WorkerState s;
   const std::size_t n = config_.route.size();
   std::size_t leg = 0;

@@ -11,9 +11,12 @@ source "$(dirname "$0")/common.bash"
 [ "$(id -u)" -eq 0 ] || { echo "SKIP: needs root (unshare -n keeps LCM on this machine)"; exit 77; }
 make_key "$T/keys"
 mkdir -p "$T/out"
+# The hold rule as such: the worker assumed still (reach_walking_speed_mps 0: no back-off from his
+# growing reach, docs/safety.md §3 — gfctl simulate's WorkerApproachTest and ReplanStepReachTest).
 cat > "$T/blackout.yaml" <<YAML
 faults:
   camera_blackouts: [[8, 14]]
+  reach_walking_speed_mps: 0
 YAML
 cat > "$T/inner.sh" <<INNER
 ip link set lo up && ip route add 224.0.0.0/4 dev lo || exit 1

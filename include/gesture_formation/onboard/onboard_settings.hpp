@@ -8,7 +8,8 @@
 ///   mission.controller.brake_accel_mps2 (where a holding UAV stops);
 ///   mission.faults.{max_share_age_s, max_worker_age_s, max_command_age_s, max_plan_age_s,
 ///     avoid_all_plans, search_timeout_s, search_height_m, search_vertical_speed_mps,
-///     search_period_s, search_horizontal_speed_mps} (the safety rules' limits, docs/safety.md §1);
+///     search_period_s, search_horizontal_speed_mps} (the safety rules' limits, docs/safety.md §1),
+///     {reach_walking_speed_mps, reach_base_m, reach_max_m, reach_margin_m} (the worker's reach, §3);
 ///   mission.formation.*, mission.gestures.* (filter, mapping, view_fusion), mission.planner.*,
 ///   mission.estimator.*, mission.abort.* (each read by its module's own loader; abort's rules
 ///   against the planner's Γ_dis and speed limit checked here).
@@ -43,9 +44,10 @@ inline const common::Range kMaxCommandAgeS = common::Range::positive();
 struct OnboardSettings {
   double replanning_period_s = 0.4;  ///< per UAV, staggered by period·i/n, (0, 5]
   /// horizon_dt_s, horizon_steps, controller.brake_accel_mps2, faults.max_share_age_s,
-  /// faults.max_worker_age_s, faults.avoid_all_plans, faults.max_plan_age_s, faults.search_*
-  /// abort.* (docs/safety.md §2.8). uav_index, uav_count and home_world are the UAV's own;
-  /// worker_heading is formation.worker_heading.
+  /// faults.max_worker_age_s, faults.avoid_all_plans, faults.max_plan_age_s, faults.search_*,
+  /// faults.reach_* (docs/safety.md §3), abort.* (docs/safety.md §2.8). uav_index, uav_count and
+  /// home_world are the UAV's own; worker_heading is formation.worker_heading; reach's
+  /// worker_min_distance_m is formation.limits.safety_distance_m (Γ_dis).
   planning::ReplanConfig replan;
   double max_command_age_s = 5.0;       ///< faults.max_command_age_s: never act on an older command, > 0
   formation::FormationConfig formation;

@@ -12,7 +12,9 @@
 ///   4. the worker's prediction over the horizon: the estimate extrapolated at constant velocity
 ///      from its stamp to now (frozen while holding or when the estimator lost him), the
 ///      worker's heading from this UAV's own formation::WorkerHeading filter;
-///   5. hold / search (planning::HoldPlanner), or track;
+///   5. hold / search (planning::HoldPlanner), or track; while holding or searching, the
+///      worker's predicted reach kept clear by Γ_dis + a margin (planning::ReachKeeper: a back-off
+///      to a goal of the abort's kind along an ordinary verified plan, docs/safety.md §3);
 ///   6. the request (planning::buildPlanRequest: reference + the plans to avoid), with the
 ///      acceleration the UAV's current plan commands now as the start's acceleration (odometry
 ///      carries none), and the planner's verified plan or fallback.
@@ -43,6 +45,7 @@
 #include "gesture_formation/planning/plan_request_builder.hpp"
 #include "gesture_formation/planning/planned_trajectory.hpp"
 #include "gesture_formation/planning/uav_planner.hpp"
+#include "gesture_formation/planning/worker_reach.hpp"
 
 namespace gesture_formation::planning {
 
@@ -107,6 +110,9 @@ struct ReplanConfig {
   double brake_accel_mps2 = 4.0;    ///< where a holding UAV stops (brakingPoint)
   formation::WorkerHeadingConfig worker_heading;  ///< the worker-heading filter (^Hφ)
   AbortConfig abort;                ///< the abort's settings (mission abort.*)
+  /// The worker's reach while holding or searching (faults.reach_*; worker_min_distance_m: the
+  /// formation's limits.safety_distance_m, set by the owner) — planning::ReachKeeper.
+  ReachConfig reach;
   /// The take-off point (abort: return_home, the landing fallback); non-finite: the position of
   /// the first replanning.
   Eigen::Vector3d home_world = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
@@ -119,7 +125,8 @@ struct ReplanConfig {
 /// \brief The one range of each replanning number, keyed as a scenario's `mission` section writes
 /// it: horizon_dt_s, horizon_steps, controller.brake_accel_mps2, faults.max_share_age_s,
 /// faults.max_worker_age_s, faults.max_plan_age_s, faults.search_timeout_s, faults.search_height_m,
-/// faults.search_vertical_speed_mps, faults.search_period_s, faults.search_horizontal_speed_mps.
+/// faults.search_vertical_speed_mps, faults.search_period_s, faults.search_horizontal_speed_mps,
+/// faults.reach_walking_speed_mps, faults.reach_base_m, faults.reach_max_m, faults.reach_margin_m.
 /// The FormationPlanner nodelet's parameters of the same settings are the last segment of each
 /// key (brake_accel_mps2, max_share_age_s, search_period_s, ...). (uav_index, the bool
 /// rule.avoid_all_plans and worker_heading are read by their owners.)
@@ -153,6 +160,10 @@ struct ReplanOutcome {
   formation::ReferenceTrajectory reference; ///< the stage-1 reference (or hold reference)
   AbortPhase abort_phase = AbortPhase::kRetreat;  ///< kAbort only: the abort's phase
   bool abort_phase_changed = false;               ///< kAbort only: the phase began at this replanning
+  /// kHold / kSearch: the UAV backs off from the worker's reach (ReachKeeper).
+  bool backing_off = false;
+  bool backoff_started = false;  ///< the back-off (or the failed search for its goal) began now
+  std::string backoff;           ///< backing off: where to and why; no goal found: why; empty otherwise
   bool planned() const { return mode != ReplanMode::kSkipped; }
   bool holding() const { return mode == ReplanMode::kHold || mode == ReplanMode::kSearch; }
   bool aborting() const { return mode == ReplanMode::kAbort; }
@@ -192,11 +203,14 @@ class ReplanStep {
   /// The hold / search or abort decision of one replanning (its reference, camera target, mode).
   struct Choice;
   Choice choose(const ReplanInputs& in, const std::string& hold, const Eigen::Vector3d& worker_p0, ReplanOutcome& out);
+  /// Holding or searching: the back-off from the worker's reach replaces the hold reference.
+  void keepReachClear(const ReplanInputs& in, const Eigen::Vector3d& worker_p0, Choice& c, ReplanOutcome& out);
 
   ReplanConfig config_;
   std::unique_ptr<Planner> planner_;
   HoldPlanner hold_;
   AbortPlanner abort_;
+  ReachKeeper reach_;
   RetreatSpace space_;
   formation::WorkerHeading heading_;
   PlannedTrajectory flown_;

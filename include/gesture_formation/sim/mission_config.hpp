@@ -35,6 +35,7 @@
 #include "gesture_formation/sim/synthetic_sensors.hpp"
 #include "gesture_formation/sim/tracking_controller.hpp"
 #include "gesture_formation/sim/wind.hpp"
+#include "gesture_formation/sim/worker_approach.hpp"
 #include "gesture_formation/sim/worker_model.hpp"
 #include "gesture_formation/common/config_fields.hpp"
 
@@ -98,6 +99,9 @@ struct FaultConfig {
   /// An abort issued during the mission (`abort: {t_s, source: operator | gesture}`; fault profile
   /// abort_mid_mission; docs/safety.md §2.8). Absent: none.
   std::optional<AbortEvent> abort;
+  /// The worker walks towards a UAV (`worker_approach: {t_s, uav, speed_mps, stop_m}`; fault
+  /// profile worker_approaches_holding_uav; docs/safety.md §3). Absent: he keeps to his route.
+  std::optional<WorkerApproach> worker_approach;
   std::vector<std::string> validate(const std::string& prefix = "") const;
   /// \brief Whether follower `uav`'s computer is down at `t_s` (a follower_dropouts window).
   bool followerOffline(int uav, double t_s) const;

@@ -96,6 +96,9 @@ struct MissionMetrics {
   /// The abort of the mission (faults.abort; docs/safety.md §2.8); absent without one
   /// (metrics.json then has no `abort` key).
   std::optional<AbortSummary> abort;
+  /// The worker's walk towards a UAV (faults.worker_approach; docs/safety.md §3); absent without
+  /// one (metrics.json then has no `worker_approach` key).
+  std::optional<ApproachSummary> worker_approach;
 };
 
 /// \brief One UAV's part of a timeline sample (docs/design.md §8.4 timeline.csv).

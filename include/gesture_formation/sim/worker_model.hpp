@@ -126,6 +126,12 @@ class WorkerModel {
   /// with more than `view` cameras.
   gesture::CalibratedSkeleton calibrated(std::size_t view, const gesture::Skeleton2D& skeleton, const WorkerState& ws) const;
 
+  /// \brief From `t_s` on the worker leaves his route: he walks from where he is then straight
+  /// to `to_feet_world` at `speed_mps` (on the ground: `to_feet_world`'s height is his feet's at
+  /// t_s) and waits there for the rest of the mission (faults.worker_approach). stateAt() before
+  /// t_s is unchanged; call it once, at t_s (later calls replace the detour).
+  void divert(double t_s, const Eigen::Vector3d& to_feet_world, double speed_mps);
+
   /// \brief Gestures started so far, in order.
   const std::vector<GestureEpisode>& episodes() const { return episodes_; }
   /// \brief The gesture (id) being performed at `t_s` (0 = none), from the episodes so far.
@@ -152,6 +158,15 @@ class WorkerModel {
   std::size_t next_gesture_ = 0;
   std::size_t next_work_motion_ = 0;
   std::vector<GestureEpisode> episodes_;
+  struct Detour {
+    double t_s = 0.0;
+    Eigen::Vector3d from_feet_world = Eigen::Vector3d::Zero();
+    Eigen::Vector3d to_feet_world = Eigen::Vector3d::Zero();
+    double speed_mps = 1.0;
+    double heading_rad = 0.0;
+  };
+  std::optional<Detour> detour_;  ///< faults.worker_approach
+  WorkerState detourStateAt(double t_s) const;
 };
 
 /// \brief The motion of gesture id 1..4 (docs/design.md §2).

@@ -89,6 +89,31 @@ Flight fly(const gf::sim::MissionConfig& cfg, double duration_s, std::uint64_t s
   return r;
 }
 
+/// An empty world tall enough for every UAV's retreat layer (the abort's, the back-off's: up to 18 m
+/// plus goal_clearance_m).
+struct TallWorld {
+  gf::planning::OccupancyMap map;
+  gf::planning::DistanceField field;
+  TallWorld() : map(makeMap()), field(map) {}
+  static gf::planning::OccupancyMap makeMap() {
+    gf::planning::MapConfig mc;
+    mc.resolution_m = 0.4;
+    mc.bounds = gf::planning::Aabb{Eigen::Vector3d(-40, -40, 0), Eigen::Vector3d(40, 40, 30)};
+    return gf::planning::OccupancyMap::fromPrimitives(mc, gf::planning::PrimitiveSet{},
+                                                      gf::planning::GroundSpec{true, 0.0});
+  }
+};
+
+Flight flyTall(const gf::sim::MissionConfig& cfg, double duration_s, std::uint64_t seed = 5) {
+  static TallWorld w;
+  Flight r;
+  gf::sim::MissionWorld world{&w.map, &w.field, 0.0};
+  auto calls = r.calls;
+  const gf::sim::PlannerFactory factory = [calls](int) { return std::make_unique<RecordingPlanner>(calls); };
+  r.out = gf::sim::runMission(cfg, world, factory, nullptr, seed, duration_s);
+  return r;
+}
+
 /// The mode of `uav` at `t_s` from the recorded mode changes ("" before the first).
 std::string modeAt(const gf::sim::MissionOutput& out, int uav, double t_s) {
   std::string mode;
@@ -194,6 +219,9 @@ TEST(LinkTest, ReorderAndDuplicateCounted) {
 // when fresh shares arrive.
 TEST(FaultSafetyTest, FollowerHoldsWhenTheLeaderShareIsStaleAndResumes) {
   auto cfg = stationaryWorkerMission();
+  // Rule 3 as such: a worker assumed still (the reach does not grow) — the back-off from a growing
+  // reach is WorkerLostFor60sEveryUavBacksOffOnceFromTheReachThenHolds and the WorkerApproach tests.
+  cfg.replan.reach.walking_speed_mps = 0.0;
   cfg.faults.planner_outages.push_back({0, 10.0, 20.0});  // the leader sends nothing 10..20 s
   const Flight r = fly(cfg, 30.0);
   ASSERT_TRUE(r.out) << r.out.reason();
@@ -229,6 +257,7 @@ TEST(FaultSafetyTest, FollowerHoldsWhenTheLeaderShareIsStaleAndResumes) {
 TEST(FaultSafetyTest, WorkerLostFor60sAllHoldThenResume) {
   auto cfg = stationaryWorkerMission();
   cfg.faults.camera_blackouts = {{10.0, 70.0}};
+  cfg.replan.reach.walking_speed_mps = 0.0;  // rule 3 as such: the worker assumed still (no back-off)
   const Flight r = fly(cfg, 90.0);
   ASSERT_TRUE(r.out) << r.out.reason();
   const double hold_from = 10.0 + cfg.replan.freshness.max_worker_age_s + cfg.replan.freshness.max_share_age_s;
@@ -255,6 +284,70 @@ TEST(FaultSafetyTest, WorkerLostFor60sAllHoldThenResume) {
   EXPECT_GE(r.out->metrics.min_mutual_distance_m, 2.5);
   EXPECT_EQ(r.out->metrics.collisions, 0);
   EXPECT_GT(r.out->metrics.plans_hold, 100);
+}
+
+// §3: the same minute with the worker's reach growing (the default): every UAV that the reach comes
+// near backs off once, along its hold plans, to a goal the largest reach cannot come near, then
+// holds there without drift; all track again when he is seen.
+TEST(FaultSafetyTest, WorkerLostFor60sEveryUavBacksOffOnceFromTheReachThenHolds) {
+  auto cfg = stationaryWorkerMission();
+  cfg.faults.camera_blackouts = {{10.0, 70.0}};
+  const Flight r = flyTall(cfg, 90.0);
+  ASSERT_TRUE(r.out) << r.out.reason();
+  const gf::planning::ReachConfig& reach = cfg.replan.reach;
+  std::vector<int> backoffs(3, 0);
+  for (const auto& m : r.out->modes) {  // a back-off's start: a row of the hold's mode with its reason
+    if (m.reason.rfind("backing off from the worker's reach", 0) == 0) {
+      ++backoffs[static_cast<std::size_t>(m.uav)];
+      EXPECT_TRUE(m.mode == "hold" || m.mode == "search") << m.mode;
+    }
+    EXPECT_EQ(m.reason.find("no back-off goal"), std::string::npos) << m.reason;
+  }
+  const Eigen::Vector3d worker = rowAt(*r.out, 30.0).worker_world;
+  for (int i = 0; i < 3; ++i) {
+    const auto iu = static_cast<std::size_t>(i);
+    EXPECT_EQ(backoffs[iu], 1) << i;  // once per hold: the goal is kept
+    EXPECT_EQ(modeAt(*r.out, i, 60.0), i == 0 ? "search" : "hold") << i;
+    EXPECT_EQ(modeAt(*r.out, i, 80.0), "track") << i;
+    // Settled at its goal by 40 s: clear of the largest reach, still, no drift in the wind.
+    const Eigen::Vector3d p40 = rowAt(*r.out, 40.0).uavs[iu].p_world;
+    EXPECT_GE((p40 - worker).head<2>().norm(),
+              reach.max_radius_m + reach.worker_min_distance_m + reach.margin_m - 1.0) << i;
+    EXPECT_LT(rowAt(*r.out, 60.0).uavs[iu].speed_mps, 0.5) << i;
+    EXPECT_LT((rowAt(*r.out, 65.0).uavs[iu].p_world - p40).norm(), 1.0) << i;
+  }
+  EXPECT_GE(r.out->metrics.min_mutual_distance_m, 2.5);
+  EXPECT_GE(r.out->metrics.min_human_distance_m, cfg.formation.limits.safety_distance_m);
+  EXPECT_EQ(r.out->metrics.collisions, 0);
+}
+
+// §3, faults.worker_approach: the camera blind from 10 s, the UAVs hold from ~13 s; at 15 s the
+// worker walks at 1.2 m/s to the point below follower 1. With the reach no UAV comes within Γ_dis
+// of him while he is unseen; with a walking speed of 0 (the hold keeps its point) he does.
+TEST(WorkerApproachTest, AnUnseenWorkerWalkingToAHoldingFollowerNeverComesWithinGammaDis) {
+  for (const double walking_mps : {1.5, 0.0}) {
+    auto cfg = stationaryWorkerMission();
+    cfg.faults.camera_blackouts = {{10.0, 60.0}};
+    cfg.faults.worker_approach = gf::sim::WorkerApproach{15.0, 1, 1.2, 0.0};
+    cfg.replan.reach.walking_speed_mps = walking_mps;
+    const Flight r = flyTall(cfg, 60.0);
+    ASSERT_TRUE(r.out) << r.out.reason();
+    ASSERT_TRUE(r.out->metrics.worker_approach);
+    const gf::sim::ApproachSummary& a = *r.out->metrics.worker_approach;
+    EXPECT_NEAR(a.unseen_from_s, 15.0, 0.011);
+    EXPECT_NEAR(a.unseen_to_s, 60.0, 0.011);
+    // He did walk there: at the end he stands where follower 1 was at 15 s (horizontally).
+    const auto& end = r.out->timeline.back();
+    EXPECT_LT((end.worker_world - rowAt(*r.out, 15.0).uavs[1].p_world).head<2>().norm(), 0.05);
+    if (walking_mps > 0.0) {
+      EXPECT_EQ(a.violations(), 0);
+      EXPECT_GE(a.minDistance(), cfg.formation.limits.safety_distance_m);
+      EXPECT_EQ(r.out->metrics.collisions, 0);
+      EXPECT_GE(r.out->metrics.min_mutual_distance_m, 2.5);
+    } else {
+      EXPECT_GE(a.uavs[1].gamma_dis_violations, 1) << "min " << a.uavs[1].min_distance_m;  // the test bites
+    }
+  }
 }
 
 // §2.2 (short loss): 2 s without the worker is below max_worker_age_s: the formation keeps tracking.
