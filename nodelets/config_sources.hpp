@@ -188,6 +188,8 @@ inline void loadPlannerSettings(const ros::NodeHandle& pnh, ParamLoader& params,
   params.load("formation_config", formation_file);
   params.load("planner_config", planner_file);
   out.formation_loaded = !formation_file.empty() && loadFormation(formation_file, params, out.formation);
+  // Γ_dis that the worker's reach keeps while holding (as OnboardSettings sets it from a mission).
+  if (out.formation_loaded) out.replan.reach.worker_min_distance_m = out.formation.limits.safety_distance_m;
   if (!planner_file.empty() && loadPlanner(planner_file, params, out.planner)) {
     for (const auto& e : planning::abortPlannerProblems(out.replan.abort, out.planner.mutual_distance_m,
                                                         out.planner.limits.max_speed_mps, "abort/")) {

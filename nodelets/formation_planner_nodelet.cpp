@@ -38,6 +38,7 @@
 #include "gesture_formation/formation/formation_geometry.hpp"
 #include "gesture_formation/formation/worker_heading.hpp"
 #include "gesture_formation/onboard/formation_params_role.hpp"
+#include "gesture_formation/onboard/frame_check.hpp"
 #include "gesture_formation/planning/replan_health.hpp"
 #include "gesture_formation/planning/replan_step.hpp"
 #include "gesture_formation/planning/trajectory_qp.hpp"
@@ -112,6 +113,11 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   }
 
   void onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
+    if (auto e = onboard::checkOdometryFrames("odometry_in", onboard::plannerOdometryFrames(world_frame_),
+                                              msg->header.frame_id, msg->child_frame_id)) {
+      NODELET_ERROR_STREAM_THROTTLE(2.0, "FormationPlanner: odometry refused (nothing from it is used): " << *e);
+      return;
+    }
     std::lock_guard<std::mutex> lock(mutex_);
     odom_ = toKinematicState(*msg);
   }
@@ -220,6 +226,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     const planning::ReplanOutcome out = step_->step(in);
     if (!out.planned()) return;
     if (!out.note.empty()) NODELET_WARN_STREAM("FormationPlanner UAV " << uav_index_ << ": " << out.note);
+    if (out.backoff_started) NODELET_WARN_STREAM("FormationPlanner UAV " << uav_index_ << ": " << out.backoff);
     const std::string mode = planning::toString(out.mode);
     if (out.aborting()) {
       abort_pub_.publish(toAbortState(step_->abort(), uav_index_, t, out.reason, abort_link_sender_, world_frame_));

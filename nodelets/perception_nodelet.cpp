@@ -119,9 +119,10 @@ class PerceptionNodelet : public nodelet::Nodelet {
                                       image_transport::TransportHints(depth_transport_, ros::TransportHints(),
                                                                       getPrivateNodeHandle(), "depth_transport"));
     if (decode_compressed_) {
-      compressed_sub_ = nh.subscribe(nh.resolveName("image_in") + "/compressed", 2, &PerceptionNodelet::onCompressed, this);
+      compressed_sub_ = nh.subscribe(nh.resolveName("image_in") + "/compressed", 2,
+                                     &PerceptionNodelet::onImage<sensor_msgs::CompressedImage>, this);
     } else {
-      image_sub_ = image_it_->subscribe("image_in", 2, &PerceptionNodelet::onImage, this,
+      image_sub_ = image_it_->subscribe("image_in", 2, &PerceptionNodelet::onImage<sensor_msgs::Image>, this,
                                         image_transport::TransportHints(image_transport_, ros::TransportHints(),
                                                                         getPrivateNodeHandle(), "image_transport"));
     }
@@ -158,18 +159,9 @@ class PerceptionNodelet : public nodelet::Nodelet {
     depth_arrived_.notify_all();
   }
 
-  void onCompressed(const sensor_msgs::CompressedImage::ConstPtr& msg) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    auto bgr = toBgr(*msg);
-    if (!bgr) {
-      ++refused_since_report_;
-      NODELET_WARN_STREAM_THROTTLE(5.0, "Perception: compressed image refused: " << bgr.reason());
-      return;
-    }
-    process(msg->header, *bgr);
-  }
-
-  void onImage(const sensor_msgs::Image::ConstPtr& msg) {
+  /// A colour image, raw (sensor_msgs/Image) or compressed (sensor_msgs/CompressedImage).
+  template <class ImageMsg>
+  void onImage(const boost::shared_ptr<const ImageMsg>& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
     auto bgr = toBgr(*msg);
     if (!bgr) {

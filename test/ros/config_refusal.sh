@@ -17,7 +17,7 @@ grep -q "min_agreeing_views: 0" "$T/gestures_vf_broken.yaml" && ! grep -q "eleva
 runs=()
 run() {  # name, nodelet type, then ROS args (in the background; its pid in runs)
   local name=$1 type=$2; shift 2
-  timeout 8 rosrun nodelet nodelet standalone "gesture_formation/$type" __name:="$name" "$@" > "$T/$name.log" 2>&1 &
+  timeout 90 rosrun nodelet nodelet standalone "gesture_formation/$type" __name:="$name" "$@" > "$T/$name.log" 2>&1 &
   runs+=($!)
 }
 run fp_bad FormationPlanner _uav_index:=0 _uav_count:=3 _world_frame:=world \
@@ -32,10 +32,19 @@ make_key "$T/keys"; chmod 644 "$T/keys"
 run lb_bad LcmBridge _sender_id:=1 _known_senders:="[0,1,2]" _lcm_url:="memq://" _channel_prefix:=GF_ \
   _key_file:="$T/keys" _max_age_s:=1.0 _heartbeat_rate_hz:=5.0 _world_frame:=world
 run sw_bad SimWorld
-sleep 6
+# Wait until every nodelet has printed its refusal (a loaded machine takes several seconds to load
+# six nodelet processes), at most 80 s, then give the rest of their messages a second.
+for _ in $(seq 160); do
+  n=0
+  for f in fp_bad gc_bad gc_vf vo_bad lb_bad sw_bad; do grep -q "refuses to start" "$T/$f.log" 2>/dev/null && n=$((n + 1)); done
+  [ $n -eq 6 ] && break
+  sleep 0.5
+done
+sleep 1
 rostopic list 2>/dev/null | grep -q fp_bad_plan && fail "FormationPlanner advertised its output although it refused to start"
 rostopic list 2>/dev/null | grep -q gc_vf_status && fail "GestureCommander advertised its output although it refused to start"
 rostopic list 2>/dev/null | grep -q vo_bad_observation && fail "ViewObserver advertised its output although it refused to start"
+kill "${runs[@]}" 2>/dev/null
 wait "${runs[@]}"
 check() {  # log, pattern, what
   grep -q -- "$2" "$T/$1.log" || { fail "$1: $3 not reported"; sed 's/^/    /' "$T/$1.log" | head -20; }
