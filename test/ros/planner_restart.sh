@@ -38,7 +38,8 @@ while not rospy.is_shutdown() and rospy.get_time() < 16.0:
     time.sleep(0.02)
 remaps = ["odometry_in:=odometry", "worker_state_in:=worker_state", "plans_in:=lcm/plans",
           "wind_estimate_in:=wind_estimation", "plan_out:=plan", "formation_params_in:=formation_params",
-          "formation_params_out:=formation_params", "formation_command_in:=formation_command"]
+          "formation_params_out:=formation_params", "formation_command_in:=formation_command",
+          "abort_in:=abort", "abort_state_out:=abort_state"]
 env = dict(os.environ, ROS_NAMESPACE="/uav2")
 subprocess.Popen(["rosrun", "nodelet", "nodelet", "load", "gesture_formation/FormationPlanner", "manager",
                   "__name:=formation_planner"] + remaps, env=env)
@@ -99,5 +100,6 @@ exit \$rc
 INNER
 timeout 100 unshare -n bash "$T/inner.sh"
 rc=$?
-[ $rc -eq 0 ] || { echo "--- launch.log (errors, FormationPlanner)"; grep -aE "ERROR|refuses|uav2|UAV 2" "$T/launch.log" | head -30; }
+[ $rc -eq 0 ] || { echo "--- launch.log (errors, warnings, follower 2; not the parameter dump)"
+  grep -aE "ERROR|WARN|refuses|uav2|UAV 2" "$T/launch.log" | grep -avE '^ \* /' | head -40; }
 exit $rc

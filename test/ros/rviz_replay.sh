@@ -2,12 +2,13 @@
 # replay.launch under Xvfb: rviz loads config/rviz/gesture_formation.rviz and renders a bag
 # replay (rosbag play --clock); the screenshot must show the Visualizer's colours: leader red,
 # follower 1 green, follower 2 blue, the worker's covariance yellow, the map grey.
-# Optional third argument: a bag to replay instead of the synthetic one (e.g. a mission bag);
+# Optional fourth argument (after SRC BUILD DEVEL): a bag to replay instead of the synthetic one
+# (e.g. a mission bag);
 # GF_RVIZ_SHOT=path keeps the screenshot; GF_RVIZ_SCENARIO=scenario.yaml replays a bag without
 # markers (record.launch) through the Visualizer with that site's map.
 set -o pipefail
 source "$(dirname "$0")/common.bash"
-BAG=${3:+$(realpath "$3")}
+BAG=${4:+$(realpath "$4")}
 START=${GF_RVIZ_START:-0}
 if [ -z "$BAG" ]; then
   BAG=$T/markers.bag
