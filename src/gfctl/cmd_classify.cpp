@@ -1,6 +1,9 @@
 // gfctl classify --in skeletons.csv --out gestures.csv [--model FILE]   (docs/design.md §8.7)
 // Buffers N = 9 frames per sequence (the optional `sequence` column; without it the whole
 // file is one sequence) and writes t,gesture_id,p0..p4 for every row once the window is full.
+// The optional `segment` column restarts the window within a sequence when it changes (as the
+// perception pipeline's FIFO restarts when the worker is lost or another person is chosen:
+// `gfctl render-gestures` writes it).
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
@@ -32,6 +35,7 @@ int cmdClassify(const Args& args) {
   }
   if (!in.requireColumns(columns)) return badInput(args, in.error());
   const bool has_sequence = in.column("sequence") >= 0;
+  const bool has_segment = in.column("segment") >= 0;
   std::ofstream out(args.get("out"));
   if (!out) return badInput(args, args.get("out") + ": cannot open for writing");
   out << "t,gesture_id,p0,p1,p2,p3,p4\n";
@@ -62,7 +66,8 @@ int cmdClassify(const Args& args) {
       in.fail("w", "the box must be finite with positive size");
     }
     if (!in.error().empty()) return badInput(args, in.error());
-    const std::string seq = has_sequence ? in.field(in.column("sequence")) : std::string();
+    std::string seq = has_sequence ? in.field(in.column("sequence")) : std::string();
+    if (has_segment) seq += "/" + in.field(in.column("segment"));
     if (seq != current_sequence) {
       window.clear();
       current_sequence = seq;

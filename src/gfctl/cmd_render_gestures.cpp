@@ -1,0 +1,293 @@
+// gfctl render-gestures --seed S --count N --out DIR [--config FILE] [--views D1,D2,…]
+//                       [--motions M1,M2,…] [--models DIR]
+// The gesture generator's performances (gesture::SkeletonSynthesizer, the same 3-D bodies and
+// timing as `gfctl synth-gestures`) RENDERED — the skinned mannequin posed every frame from the
+// generator's 3-D body, dressed per sequence (render::Appearance) — from one camera per view, and
+// each view's pixels put through the real perception pipeline (MoveNet multipose detector ⇄ KCF
+// tracker → MoveNet lightning; docs/perception.md), as onboard. Writes per view (suffix "" for
+// the leader, "_view1", … for the further views, as synth-gestures):
+//   skeletons*.csv  the pipeline's skeletons (design.md §8.7 + label, sequence, segment): one row
+//                   per frame in which the pipeline found the worker; `segment` changes whenever the
+//                   pipeline lost the worker or started another identity (its FIFO restarts there;
+//                   `gfctl classify` restarts its window the same way);
+//   sequences*.csv  what produced each sequence, the view's camera pose (cam_* columns: the pose the
+//                   image was rendered from, in the body frame) — the columns of synth-gestures —
+//                   plus outfit, skin_tone, frames_found;
+//   truth*.csv      every rendered frame: found, segment, the truth's visible box and the 17 truth
+//                   keypoints (u, v, visible) of the posed mesh (render::WorkerTruth).
+// Viewpoints: the leader's distance, elevation and azimuth drawn in the config's ranges; each
+// further view at its azimuth offset from the leader with its OWN distance and elevation drawn in
+// the same ranges (formation-like: the followers fly their own heights). Motions: cycled through
+// --motions (default: all of gesture::Motion), so every gesture and work motion is present.
+// The world: open ground (z = 0), sky, no obstacles. Exit 0; 2 bad input; 1 no EGL / OpenGL here.
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <random>
+
+#include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "commands.hpp"
+#include "gesture_formation/common/config_fields.hpp"
+#include "gesture_formation/common/config_reader.hpp"
+#include "gesture_formation/common/csv.hpp"
+#include "gesture_formation/gesture/skeleton_synth.hpp"
+#include "gesture_formation/gesture/view_triangulation.hpp"
+#include "gesture_formation/perception/perception_pipeline.hpp"
+#include "gesture_formation/render/renderer.hpp"
+
+namespace gesture_formation::gfctl {
+namespace {
+
+int cmdRenderGestures(const Args& args);
+const Registrar kRegistrar{
+    "render-gestures",
+    "--seed S --count N --out DIR [--config FILE] [--views D1,D2] [--motions M1,M2] [--models DIR]   generator "
+    "performances rendered per view and put through the real detector + tracker + MoveNet (docs/gestures.md §9)",
+    cmdRenderGestures};
+
+constexpr int kExitNoRenderer = 1;  ///< no EGL display or OpenGL 3.3 context here
+
+std::optional<gesture::Motion> parseMotion(const std::string& name) {
+  for (int m = 0; m < static_cast<int>(gesture::Motion::kCount); ++m) {
+    if (name == gesture::toString(static_cast<gesture::Motion>(m))) return static_cast<gesture::Motion>(m);
+  }
+  return std::nullopt;
+}
+
+/// The parsed command line.
+struct Options {
+  std::uint64_t seed = 0;
+  int count = 0;
+  std::string dir, models;
+  std::vector<double> offsets_deg;
+  std::vector<gesture::Motion> motions;
+  gesture::SynthConfig synth;
+};
+
+std::string parseOptions(const Args& args, Options& o) {
+  const auto seed = common::parseDouble(args.get("seed"));
+  const auto count = common::parseDouble(args.get("count"));
+  if (!seed || *seed < 0 || *seed > 1e15 || *seed != std::floor(*seed)) {
+    return "--seed: expected a non-negative integer, got '" + args.get("seed") + "'";
+  }
+  if (!count || *count < 1 || *count > 1e5 || *count != std::floor(*count)) {
+    return "--count: expected an integer in [1, 100000], got '" + args.get("count") + "'";
+  }
+  o.seed = static_cast<std::uint64_t>(*seed);
+  o.count = static_cast<int>(*count);
+  const auto items = [&](const char* key) { return args.has(key) ? common::splitCsvLine(args.get(key)) : std::vector<std::string>{}; };
+  for (const std::string& item : items("views")) {
+    const auto v = common::parseDouble(item);
+    if (!v || !std::isfinite(*v) || *v < -360.0 || *v > 360.0) {
+      return "--views: expected comma-separated azimuth offsets in [-360, 360] deg, got '" + item + "'";
+    }
+    o.offsets_deg.push_back(*v);
+  }
+  if (o.offsets_deg.size() > 8) return "--views: at most 8 further views, got " + std::to_string(o.offsets_deg.size());
+  for (const std::string& item : items("motions")) {
+    const auto m = parseMotion(item);
+    if (!m) return "--motions: unknown motion '" + item + "'";
+    o.motions.push_back(*m);
+  }
+  if (o.motions.empty()) {
+    for (int m = 0; m < static_cast<int>(gesture::Motion::kCount); ++m) o.motions.push_back(static_cast<gesture::Motion>(m));
+  }
+  if (args.has("config")) {
+    using common::ConfigReader;
+    ConfigReader r = ConfigReader::fromFile(args.get("config"), ConfigReader::MissingKeys::kUseDefaults);
+    gesture::synthConfigFields().readFields(r, "", o.synth);
+    common::addProblems(r, "", gesture::synthConfigProblems(o.synth));
+    if (!r.ok()) return "invalid configuration " + args.get("config") + ":\n" + r.errorReport();
+  }
+  o.synth.camera.distortion.fill(0.0);  // the rendered image is the rectified one
+  o.dir = args.get("out");
+  o.models = modelsRoot(args);
+  std::error_code ec;
+  std::filesystem::create_directories(o.dir, ec);
+  if (ec || !std::filesystem::is_directory(o.dir)) return o.dir + ": cannot create directory";
+  return "";
+}
+
+/// One view's output files and its perception pipeline.
+struct ViewOut {
+  std::unique_ptr<perception::PerceptionPipeline> pipeline;
+  std::ofstream skeletons, sequences, truth;
+  long frames = 0, found = 0;
+};
+
+void writeHeaders(ViewOut& v) {
+  v.skeletons << "t,u,v,w,h";
+  for (int k = 0; k < gesture::kNumKeypoints; ++k) v.skeletons << ",x" << k << ",y" << k << ",c" << k;
+  v.skeletons << ",label,sequence,segment\n";
+  v.sequences << "sequence,motion,gesture_id,left_arm,height_m,distance_m,elevation_deg,azimuth_deg,frames,motion_start_s,"
+                 "motion_end_s,cam_x,cam_y,cam_z,cam_qw,cam_qx,cam_qy,cam_qz,cam_fx,cam_fy,cam_cx,cam_cy,cam_width,cam_height,"
+                 "outfit,skin_tone,frames_found\n";
+  v.truth << "sequence,t,label,found,segment,box_u,box_v,box_w,box_h";
+  for (int k = 0; k < gesture::kNumKeypoints; ++k) v.truth << ",tu" << k << ",tv" << k << ",tvis" << k;
+  v.truth << '\n';
+}
+
+/// The leader's viewpoint and each further view's (own distance and elevation), from `rng`.
+std::vector<gesture::SkeletonSynthesizer::View> drawViews(const Options& o, std::mt19937_64& rng) {
+  const gesture::SynthConfig& c = o.synth;
+  std::uniform_real_distribution<double> ud(c.distance_min_m, c.distance_max_m), ue(c.elevation_min_deg, c.elevation_max_deg),
+      ua(c.azimuth_min_deg, c.azimuth_max_deg);
+  std::vector<gesture::SkeletonSynthesizer::View> views{{ud(rng), ue(rng), ua(rng)}};
+  for (const double off : o.offsets_deg) {
+    const double d = ud(rng), e = ue(rng);
+    views.push_back({d, e, std::remainder(views[0].azimuth_deg + off, 360.0)});
+  }
+  return views;
+}
+
+/// One frame of one view: the pipeline on the rendered pixels, a skeleton row when the worker was
+/// found, a truth row always.
+struct FrameState {
+  int segment = 0;
+  bool in_segment = false;
+  int last_id = -1;
+};
+
+std::string processFrame(ViewOut& v, const render::RenderedFrame& frame, const gesture::SynthSequence& seq, std::size_t k,
+                         FrameState& st) {
+  cv::Mat bgr;
+  cv::cvtColor(frame.rgb, bgr, cv::COLOR_RGB2BGR);
+  auto pf = v.pipeline->step(bgr);
+  if (!pf) return pf.reason();
+  const bool found = pf->track.found && pf->has_skeleton;
+  if (!found || pf->track.identity_changed || pf->track.id != st.last_id) {
+    if (st.in_segment) ++st.segment;  // the FIFO restarts: a new window segment
+    st.in_segment = false;
+  }
+  const auto f = [](double x) { return common::formatDouble(x); };
+  const gesture::SynthFrame& sf = seq.frames[k];
+  ++v.frames;
+  if (found) {
+    st.in_segment = true;
+    st.last_id = pf->track.id;
+    ++v.found;
+    const cv::Rect2f& b = pf->track.box_px;
+    v.skeletons << f(sf.t_s) << ',' << f(b.x) << ',' << f(b.y) << ',' << f(b.width) << ',' << f(b.height);
+    for (const perception::Keypoint& p : pf->skeleton) v.skeletons << ',' << f(p.x) << ',' << f(p.y) << ',' << f(p.c);
+    v.skeletons << ',' << sf.label << ',' << seq.id << ',' << st.segment << '\n';
+  } else {
+    st.last_id = -1;
+  }
+  const render::WorkerTruth& t = frame.worker;
+  v.truth << seq.id << ',' << f(sf.t_s) << ',' << sf.label << ',' << (found ? 1 : 0) << ',' << st.segment << ','
+          << t.visible_box_px.x << ',' << t.visible_box_px.y << ',' << t.visible_box_px.width << ',' << t.visible_box_px.height;
+  for (const render::KeypointTruth& kt : t.keypoints) {
+    v.truth << ',' << f(kt.uv_px.x()) << ',' << f(kt.uv_px.y()) << ',' << (kt.visible ? 1 : 0);
+  }
+  v.truth << '\n';
+  return "";
+}
+
+void writeSequenceRow(ViewOut& v, const gesture::SynthSequence& s, const gesture::CalibratedSkeleton& cam,
+                      const render::Appearance& look, long found) {
+  const auto f = [](double x) { return common::formatDouble(x); };
+  const Eigen::Quaterniond q(cam.R_world_camera);
+  const estimation::CameraIntrinsics& in = cam.intrinsics;
+  v.sequences << s.id << ',' << gesture::toString(s.motion) << ',' << gesture::gestureIdOf(s.motion) << ',' << (s.left_arm ? 1 : 0)
+              << ',' << f(s.height_m) << ',' << f(s.distance_m) << ',' << f(s.elevation_deg) << ',' << f(s.azimuth_deg) << ','
+              << s.frames.size() << ',' << f(s.motion_start_s) << ',' << f(s.motion_end_s) << ',' << f(cam.p_world_camera.x())
+              << ',' << f(cam.p_world_camera.y()) << ',' << f(cam.p_world_camera.z()) << ',' << f(q.w()) << ',' << f(q.x()) << ','
+              << f(q.y()) << ',' << f(q.z()) << ',' << f(in.fx) << ',' << f(in.fy) << ',' << f(in.cx) << ',' << f(in.cy) << ','
+              << in.width_px << ',' << in.height_px << ',' << render::toString(look.outfit) << ',' << look.skin_tone << ','
+              << found << '\n';
+}
+
+/// Renders every frame of one performance from every view and runs each view's pipeline.
+std::string renderSequence(render::Renderer& renderer, std::vector<ViewOut>& out, const std::vector<gesture::SynthSequence>& seqs,
+                           const estimation::CameraIntrinsics& intrinsics, const render::Appearance& look) {
+  const gesture::SynthSequence& s0 = seqs.front();
+  std::vector<render::CameraView> cams;
+  std::vector<gesture::CalibratedSkeleton> poses;
+  for (const gesture::SynthSequence& s : seqs) {
+    poses.push_back(gesture::cameraAround(s.distance_m, s.elevation_deg, s.azimuth_deg, 0.55 * s.height_m, intrinsics));
+    render::CameraView cam;
+    cam.intrinsics = intrinsics;
+    cam.T_world_camera.linear() = poses.back().R_world_camera;
+    cam.T_world_camera.translation() = poses.back().p_world_camera;
+    cams.push_back(cam);
+  }
+  std::vector<FrameState> states(seqs.size());
+  for (ViewOut& v : out) v.pipeline->reset();  // every performance starts with no track
+  std::vector<long> found_before;
+  for (const ViewOut& v : out) found_before.push_back(v.found);
+  for (std::size_t k = 0; k < s0.frames.size() && k < s0.bodies.size(); ++k) {
+    auto r = renderer.setWorker(render::WorkerJoints::fromBody(s0.bodies[k], Eigen::Vector3d::Zero(), 0.0), s0.height_m, look);
+    if (!r) return "sequence " + std::to_string(s0.id) + " frame " + std::to_string(k) + ": " + r.reason();
+    for (std::size_t v = 0; v < seqs.size(); ++v) {
+      auto frame = renderer.render(cams[v]);
+      if (!frame) return "sequence " + std::to_string(s0.id) + " view " + std::to_string(v) + ": " + frame.reason();
+      const std::string e = processFrame(out[v], *frame, seqs[v], k, states[v]);
+      if (!e.empty()) return "sequence " + std::to_string(s0.id) + " view " + std::to_string(v) + ": " + e;
+    }
+  }
+  for (std::size_t v = 0; v < seqs.size(); ++v) {
+    writeSequenceRow(out[v], seqs[v], poses[v], look, out[v].found - found_before[v]);
+    for (std::ofstream* f : {&out[v].skeletons, &out[v].sequences, &out[v].truth}) f->flush();
+  }
+  return "";
+}
+
+int cmdRenderGestures(const Args& args) {
+  if (!checkOptions(args, {"seed", "count", "out"}, {"config", "views", "motions", "models"})) return kExitBadInput;
+  Options o;
+  if (const std::string e = parseOptions(args, o); !e.empty()) return badInput(args, e);
+  render::RendererConfig rc;
+  rc.worker_asset_path = o.models + "/mannequin/wooden_mannequin.glb";
+  auto renderer = render::Renderer::create(rc);
+  if (!renderer && renderer.reason().rfind("worker asset", 0) == 0) return badInput(args, renderer.reason());
+  if (!renderer) {  // no EGL display / OpenGL context: not the input's fault
+    std::cerr << "gfctl render-gestures: " << renderer.reason() << "\n";
+    return kExitNoRenderer;
+  }
+  if (auto r = (*renderer)->setWorldMesh(render::TriangleMesh{}, 0.0, Eigen::Vector3d::Zero()); !r) return badInput(args, r.reason());
+  (*renderer)->setUavs({});
+  perception::PerceptionConfig pc;
+  pc.models_root = o.models;
+  const std::size_t n_views = 1 + o.offsets_deg.size();
+  std::vector<ViewOut> out(n_views);
+  for (std::size_t v = 0; v < n_views; ++v) {
+    auto p = perception::PerceptionPipeline::create(pc);
+    if (!p) return badInput(args, p.reason() + " (models root: " + o.models + ")");
+    out[v].pipeline = std::move(*p);
+    const std::string suffix = v == 0 ? "" : "_view" + std::to_string(v);
+    out[v].skeletons.open(o.dir + "/skeletons" + suffix + ".csv");
+    out[v].sequences.open(o.dir + "/sequences" + suffix + ".csv");
+    out[v].truth.open(o.dir + "/truth" + suffix + ".csv");
+    if (!out[v].skeletons || !out[v].sequences || !out[v].truth) return badInput(args, o.dir + ": cannot write the view's files");
+    writeHeaders(out[v]);
+  }
+  gesture::SkeletonSynthesizer synth(o.synth, o.seed);
+  std::seed_seq ss{o.seed, std::uint64_t{0x7e4d3e5du}};
+  std::mt19937_64 view_rng(ss);
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int i = 0; i < o.count; ++i) {
+    const gesture::Motion motion = o.motions[static_cast<std::size_t>(i) % o.motions.size()];
+    const std::vector<gesture::SynthSequence> seqs = synth.generateViewsFrom(motion, drawViews(o, view_rng));
+    const render::Appearance look = render::Appearance::fromSeed(o.seed * 1000003ULL + static_cast<std::uint64_t>(seqs[0].id));
+    if (const std::string e = renderSequence(**renderer, out, seqs, o.synth.camera, look); !e.empty()) return badInput(args, e);
+    const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::cout << "render-gestures: sequence " << i + 1 << "/" << o.count << " " << gesture::toString(motion) << ", "
+              << seqs[0].frames.size() << " frames x " << n_views << " views, " << common::formatDouble(wall_s) << " s\n"
+              << std::flush;
+  }
+  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  long frames = 0, found = 0;
+  for (const ViewOut& v : out) frames += v.frames, found += v.found;
+  std::cout << "gfctl render-gestures: " << o.count << " sequences, " << frames << " view-frames (worker found in " << found
+            << ") in " << common::formatDouble(wall_s) << " s = " << common::formatDouble(frames / std::max(wall_s, 1e-9))
+            << " view-frames/s; " << (*renderer)->glRenderer() << " -> " << o.dir << "\n";
+  return kExitOk;
+}
+
+}  // namespace
+}  // namespace gesture_formation::gfctl
