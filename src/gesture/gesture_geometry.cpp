@@ -31,7 +31,6 @@ ArmMeasures measureArm(const Skeleton3D& s, const BodyFrame& f, bool left, const
   a.elevation_deg = angleDeg(upper, -Eigen::Vector3d::UnitZ());
   const double outward = upper.y() * (left ? 1.0 : -1.0);
   a.horizontal_abduction_deg = common::radToDeg(std::atan2(outward, std::abs(upper.x())));
-  a.arm_elevation_deg = angleDeg(upper + fore, -Eigen::Vector3d::UnitZ());
   a.elbow_deg = angleDeg(s.p_world[sh] - s.p_world[el], s.p_world[wr] - s.p_world[el]);
   a.forearm_from_horizontal_deg = std::abs(common::radToDeg(std::asin(std::clamp(fore.normalized().z(), -1.0, 1.0))));
   a.wrist_height_H = height_H(s.p_world[wr]);
@@ -80,10 +79,9 @@ Test extendArm(const ArmMeasures& a, const GestureGeometryNumbers& n) {
 
 Test raiseArm(const ArmMeasures& a, const GestureGeometryNumbers& n) {
   if (!a.valid) return Test::kOut;
-  const double el = a.arm_elevation_deg;  // the arm's line shoulder → wrist (file comment)
-  if (el >= n.raise_min_elevation_deg && a.elbow_deg >= n.raise_min_elbow_deg) return Test::kInside;
-  if (el > n.reach_max_elevation_deg && a.elbow_deg >= n.reach_max_elbow_deg) return Test::kBand;
-  if (a.elevation_deg > 90.0) return Test::kNearMiss;  // upper arm above the shoulder, but part-way or bent: reaching
+  if (a.elevation_deg >= n.raise_min_elevation_deg && a.elbow_deg >= n.raise_min_elbow_deg) return Test::kInside;
+  if (a.elevation_deg > n.reach_max_elevation_deg && a.elbow_deg >= n.reach_max_elbow_deg) return Test::kBand;
+  if (a.elevation_deg > 90.0) return Test::kNearMiss;  // above the shoulder, but part-way or bent: reaching
   return Test::kOut;
 }
 

@@ -27,14 +27,8 @@
 ///    straight forward (or back) towards its own side: 90° straight sideways, 0° pointing forward
 ///    (≥ 70°; pointing ≤ 55°). So an arm pointing forward, or forward-outward up to 55° from forward,
 ///    is the near-miss at any elevation up to 125°, never "extend to the side";
-///  - raise an arm up (4): the arm ≥ 150° from hanging (elevation, any plane), elbow ≥ 150°;
+///  - raise an arm up (4): upper arm ≥ 150° from hanging (elevation, any plane), elbow ≥ 150°;
 ///    near-miss "reaching": elevation ≤ 130° or elbow < 120°; band: elevation 130–150° or elbow 120–150°.
-///    design.md §2's "one arm straight up above the head" is measured on the line shoulder → wrist
-///    (ArmMeasures::arm_elevation_deg), which for a straight arm is the upper arm's elevation: on
-///    skeletons MoveNet extracted from rendered frames (docs/gestures.md §9, tuning set) the upper
-///    arm of a raised arm reads ~30° low (its shoulder and elbow keypoints), the shoulder → wrist
-///    line ~18° low (0 % of the frames of a raise in the region measured on the upper arm, 81 % on
-///    that line; no work motion in it either way).
 /// A one-arm gesture needs exactly one arm in its region; two arms in gesture regions of different
 /// gestures (or a one-arm and a two-arm gesture at once) are ambiguous: none.
 /// Thread safety: free functions without state.
@@ -77,7 +71,6 @@ struct ArmMeasures {
   double elevation_deg = 0.0;         ///< upper arm (shoulder → elbow) from hanging down: 0 down, 90 horizontal, 180 up
   double horizontal_abduction_deg = 0.0;  ///< upper arm's horizontal direction from forward/back towards its own side:
                                          ///< 90 sideways, 0 forward or back, < 0 across the body (file comment)
-  double arm_elevation_deg = 0.0;     ///< the line shoulder → wrist from hanging down (raise's elevation)
   double elbow_deg = 180.0;           ///< inner elbow angle (180: straight)
   double forearm_from_horizontal_deg = 90.0;  ///< |angle| of elbow → wrist to the body's horizontal plane
   double wrist_height_H = 0.0;        ///< h(wrist)
