@@ -31,6 +31,7 @@ import heldout_eval as he  # noqa: E402
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 PROTOCOL = os.path.join(ROOT, "tools/gesture/heldout/protocol_v2_rendered.yaml")
+DATA_DIR = "/work/gestrend_data"  # default cache of the rendered sets (--data)
 CLASSES = ev.CLASSES
 
 
@@ -425,6 +426,13 @@ def report(protocol, protocol_path, tuning_errors, tuning_eval, heldout_eval, ou
              "", "Sets rendered by `gfctl render-gestures` (the mannequin posed from the generator's 3-D bodies, three "
              "formation-like views, the real MoveNet multipose + KCF + MoveNet lightning on the pixels); definitions: "
              "docs/gestures.md §9 and the protocol file.", ""]
+    for name, spec in protocol["sets"].items():
+        log = os.path.join(DATA_DIR, os.path.basename(set_dir("", name, spec)), "render.log")
+        if os.path.exists(log):
+            with open(log) as f:
+                text = [ln.strip() for ln in f if ln.startswith("#") or ln.startswith("gfctl render-gestures")]
+            lines.append(f"Render of {name} (its log): " + " / ".join(t.lstrip("# ") for t in text) + ".")
+    lines.append("")
     if tuning_errors:
         lines += ["## Tuning set: the networks' systematic errors against the renderer's truth", "",
                   "Frames at the motion's pose (gestures: labelled frames; work motions: the middle half of the motion). "
@@ -441,6 +449,14 @@ def report(protocol, protocol_path, tuning_errors, tuning_eval, heldout_eval, ou
                  eval_lines(r, protocol) + [""]
     with open(out, "w") as f:
         f.write("\n".join(lines))
+    with open(os.path.splitext(out)[0] + ".json", "w") as f:
+        json.dump({"protocol_version": protocol["version"], "tuning_errors": tuning_errors, "tuning_eval": tuning_eval,
+                   "heldout_eval": heldout_eval}, f, indent=1)
+
+
+def set_data_dir(path):
+    global DATA_DIR
+    DATA_DIR = path
 
 
 def main():
@@ -460,6 +476,7 @@ def main():
     ap.add_argument("--out", default=None)
     a = ap.parse_args()
     protocol = load_protocol(a.protocol)
+    set_data_dir(a.data)
     if a.action == "report":
         load = lambda p: json.load(open(p)) if p else None  # noqa: E731
         loads = lambda ps: [load(p) for p in ps.split(",")] if ps else []  # noqa: E731
