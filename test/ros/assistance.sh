@@ -5,7 +5,8 @@
 # the ground station over LCM (/operator/assistance); while it is pending the worker's gesture
 # commands are rejected (the leader's acknowledgement says why) and the operator's applied;
 # `tools/gf_command.py ack-assist` releases it (the leader's state and the ground's say
-# acknowledged) and the worker's gestures are applied again; a second ack-assist is refused.
+# acknowledged) and the worker's gestures are applied again; a second ack-assist is refused. The
+# Visualizer shows a red banner in rviz while the request is pending.
 set -o pipefail
 source "$(dirname "$0")/common.bash"
 [ "$(id -u)" -eq 0 ] || { echo "SKIP: needs root (unshare -n keeps LCM on this machine)"; exit 77; }

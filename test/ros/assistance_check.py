@@ -5,6 +5,7 @@ import time
 
 import rospy
 from gesture_formation.msg import AssistanceState, CommandAck, FormationCommand
+from visualization_msgs.msg import Marker, MarkerArray
 
 SRC = sys.argv[1]
 rospy.init_node("assistance_check", anonymous=True)
@@ -21,6 +22,9 @@ leader_state, ground_state, acks = [], [], {}
 rospy.Subscriber("/uav0/assistance_state", AssistanceState, leader_state.append)
 rospy.Subscriber("/operator/assistance", AssistanceState, ground_state.append)
 rospy.Subscriber("/operator/command_ack", CommandAck, lambda m: acks.__setitem__((m.sender, m.sequence), m))
+banners = []  # the Visualizer's assistance banner (rviz), per marker array
+rospy.Subscriber("/visualization/markers", MarkerArray,
+                 lambda a: banners.extend(m for m in a.markers if m.ns == "assistance"))
 request_pub = rospy.Publisher("/uav0/assistance", AssistanceState, queue_size=5)
 gesture_pub = rospy.Publisher("/uav0/formation_command", FormationCommand, queue_size=5)
 
@@ -62,6 +66,8 @@ check(wait_for(lambda: phase(leader_state) == AssistanceState.PHASE_REQUESTED, 5
 check(wait_for(lambda: phase(ground_state) == AssistanceState.PHASE_REQUESTED, 5)
       and ground_state[-1].requested_at == r.requested_at,
       "the ground station's OperatorInterface got it over LCM (/operator/assistance)")
+check(wait_for(lambda: banners and banners[-1].action == Marker.ADD and "ASSISTANCE REQUESTED" in banners[-1].text, 5),
+      f"rviz: the Visualizer shows the banner: {banners[-1].text if banners else 'no marker'}")
 a = gesture_command(1)
 check(a is not None and a.status == "rejected" and "assistance requested" in a.outcome,
       f"a gesture command while it is pending is rejected: {a.outcome if a else 'no acknowledgement'}")
@@ -74,6 +80,7 @@ check(wait_for(lambda: phase(leader_state) == AssistanceState.PHASE_ACKNOWLEDGED
       and leader_state[-1].acknowledged_by.startswith("operator"),
       f"the leader's planner took the acknowledgement over LCM: {leader_state[-1].acknowledged_by if leader_state else None}")
 check(wait_for(lambda: phase(ground_state) == AssistanceState.PHASE_ACKNOWLEDGED, 5), "the ground station says acknowledged")
+check(wait_for(lambda: banners and banners[-1].action == Marker.DELETE, 5), "rviz: the banner is removed")
 a = gesture_command(2)
 check(a is not None and a.status == "applied", f"a gesture command is applied again: {a.outcome if a else 'no acknowledgement'}")
 cli = subprocess.run([sys.executable, SRC + "/tools/gf_command.py", "ack-assist"], capture_output=True, text=True)
