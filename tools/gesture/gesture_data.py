@@ -26,7 +26,8 @@ def synthesize(gfctl, seed, count, out_dir, config=None, views=None):
 
 
 def load_frames(data_dir):
-    """Returns dict sequence -> (features [T, 51] float32, labels [T] int, t [T])."""
+    """Returns dict sequence (or (sequence, segment) when the file has a `segment` column) -> (features [T, 51]
+    float32, labels [T] int, t [T])."""
     seqs = {}
     with open(os.path.join(data_dir, "skeletons.csv")) as f:
         reader = csv.reader(f)
@@ -40,7 +41,10 @@ def load_frames(data_dir):
                 x, y, c = v[idx[f"x{k}"]], v[idx[f"y{k}"]], v[idx[f"c{k}"]]
                 if c > 0 and w > 0 and h > 0:
                     feat[3 * k:3 * k + 3] = ((x - u) / w, (y - vv) / h, c)
-            seqs.setdefault(int(row[idx["sequence"]]), []).append((feat, int(row[idx["label"]]), v[idx["t"]]))
+            # `gfctl render-gestures` adds a `segment` column: a window never spans the frames in which the
+            # pipeline lost the worker (as its FIFO and `gfctl classify` restart), so each segment is a sequence.
+            key = int(row[idx["sequence"]]) if "segment" not in idx else (int(row[idx["sequence"]]), int(row[idx["segment"]]))
+            seqs.setdefault(key, []).append((feat, int(row[idx["label"]]), v[idx["t"]]))
     out = {}
     for sid, frames in seqs.items():
         out[sid] = (np.stack([f[0] for f in frames]), np.array([f[1] for f in frames]), np.array([f[2] for f in frames]))
