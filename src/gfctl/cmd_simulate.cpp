@@ -294,12 +294,8 @@ int runOne(const Args& args, Loaded& L, std::uint64_t seed, double duration, con
   return kExitOk;
 }
 
-/// The scenario's unmapped obstacles and --mapping / --no-prior-map (after the mission is loaded);
-/// the problem or empty.
-std::string applyMappingOptions(const Args& args, const std::string& path, Loaded& L) {
-  auto unmapped = sim::loadUnmappedObstacles(path);
-  if (!unmapped) return "invalid scenario:\n" + unmapped.reason();
-  L.unmapped = std::move(*unmapped);
+/// --mapping / --no-prior-map (after the mission is loaded); the problem or empty.
+std::string applyMappingOptions(const Args& args, Loaded& L) {
   if (args.has("mapping")) {
     const std::string v = args.get("mapping");
     if (v != "on" && v != "off") return "--mapping: expected on or off, got '" + v + "'";
@@ -403,14 +399,17 @@ int cmdSimulate(const Args& args) {
     if (!fileExists(faults_path)) return badInput(args, "--fault-profile: " + faults_path + " does not exist");
   }
   auto mission = faults_path.empty() ? sim::loadMissionConfig(path) : sim::loadMissionConfig(path, faults_path);
-  if (!sc || !mission) {
-    std::cerr << "gfctl simulate: invalid scenario:\n" << (sc ? "" : sc.reason()) << (mission ? "" : mission.reason());
+  auto unmapped = sim::loadUnmappedObstacles(path);  // unmapped_obstacles: in the world, not in the prior map
+  if (!sc || !mission || !unmapped) {
+    std::cerr << "gfctl simulate: invalid scenario:\n" << (sc ? "" : sc.reason()) << (mission ? "" : mission.reason())
+              << (unmapped ? "" : unmapped.reason());
     return kExitBadInput;
   }
+  L.unmapped = std::move(*unmapped);
   L.scenario = std::move(*sc);
   L.solids = L.scenario.primitives();
   L.mission = std::move(*mission);
-  if (std::string bad = applyMappingOptions(args, path, L); !bad.empty()) return badInput(args, bad);
+  if (std::string bad = applyMappingOptions(args, L); !bad.empty()) return badInput(args, bad);
   if (camera_mode == "rendered") {
     const std::string bad = setUpRendered(args, L);
     if (!bad.empty()) return badInput(args, bad);

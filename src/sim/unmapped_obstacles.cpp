@@ -172,7 +172,7 @@ common::Result<std::vector<UnmappedObstacle>> parseUnmappedObstacles(const std::
     const YAML::Node root = YAML::Load(yaml);
     if (root.IsMap() && root[kSection]) section.reset(root[kSection]);
   } catch (const YAML::Exception& e) {
-    return R::fail(source_name + ": not YAML: " + e.what());
+    return R::fail(source_name + ": not YAML: " + e.what() + "\n");
   }
   std::vector<UnmappedObstacle> out = UnmappedReader(r, section).read();
   if (!r.ok()) return R::fail(r.errorReport());
@@ -181,7 +181,7 @@ common::Result<std::vector<UnmappedObstacle>> parseUnmappedObstacles(const std::
 
 common::Result<std::vector<UnmappedObstacle>> loadUnmappedObstacles(const std::string& scenario_path) {
   std::ifstream f(scenario_path);
-  if (!f) return common::Result<std::vector<UnmappedObstacle>>::fail(scenario_path + ": cannot be read");
+  if (!f) return common::Result<std::vector<UnmappedObstacle>>::fail(scenario_path + ": cannot be read\n");
   std::stringstream ss;
   ss << f.rdbuf();
   return parseUnmappedObstacles(ss.str(), scenario_path);

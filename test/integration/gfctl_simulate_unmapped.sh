@@ -7,6 +7,7 @@
 # mission tests), the arm's sight-to-avoidance time measured. The control: the same seed with
 # --mapping off (the planners blind to it) comes closer to the crane arm than 0.5 m or collides —
 # so the scenario really puts the arm on the route and the first run's result is the mapping's.
+# And a scenario with bad unmapped_obstacles / mission.mapping values is refused naming each.
 # Usage: gfctl_simulate_unmapped.sh GFCTL SRC
 set -euo pipefail
 GFCTL=$1
@@ -14,6 +15,16 @@ SRC=$2
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
 SCEN="$SRC/config/scenarios/construction_site.yaml"
+# Bad unmapped obstacles and mapping settings: refused before any run, every problem named at once.
+sed -e 's/    moves: {from_s: 24.0, to_s: 34.0, velocity_mps: \[2.0, -1.0, 0.0\]}/    moves: {from_s: 24.0, to_s: 14.0, velocity_mps: [2.0, -1.0]}/' \
+    -e 's/    rate_hz: 5.0/    rate_hz: 0/' -e "s#../../third_party_models#$SRC/third_party_models#" "$SCEN" > "$TMP/bad.yaml"
+rc=0
+"$GFCTL" simulate --scenario "$TMP/bad.yaml" --out "$TMP/bad" --duration 1 --no-plot > "$TMP/bad.log" 2>&1 || rc=$?
+for want in "mission.mapping.rate_hz: value 0 is out of range" "unmapped_obstacles[2].moves.velocity_mps: expected 3 numbers, got 2" \
+            "unmapped_obstacles[2].moves.to_s: must be >= from_s (24), got 14"; do
+  grep -qF "$want" "$TMP/bad.log" || { echo "FAIL bad scenario (exit $rc): no '$want' in:"; cat "$TMP/bad.log"; exit 1; }
+done
+[ "$rc" = 2 ] || { echo "FAIL bad scenario: exit $rc, expected 2"; exit 1; }
 for run in on off; do
   "$GFCTL" simulate --scenario "$SCEN" --out "$TMP/$run" --seed 1 --duration 34 --no-plot --mapping "$run" \
     > "$TMP/$run.log" 2>&1 || { echo "FAIL mapping $run: gfctl exited $?"; cat "$TMP/$run.log"; exit 1; }
