@@ -410,10 +410,7 @@ int cmdSimulate(const Args& args) {
   L.solids = L.scenario.primitives();
   L.mission = std::move(*mission);
   if (std::string bad = applyMappingOptions(args, L); !bad.empty()) return badInput(args, bad);
-  if (camera_mode == "rendered") {
-    const std::string bad = setUpRendered(args, L);
-    if (!bad.empty()) return badInput(args, bad);
-  }
+  if (const std::string bad = camera_mode == "rendered" ? setUpRendered(args, L) : ""; !bad.empty()) return badInput(args, bad);
   const std::string model = args.has("model") ? args.get("model") : L.mission.gesture_model;
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   const int threads = threads_arg > 0 ? static_cast<int>(threads_arg)
