@@ -1,6 +1,7 @@
 // gfctl simulate --scenario FILE --out DIR [--seed N] [--seeds A..B] [--duration S] [--model ONNX] [--no-plot]
 //                [--faults FILE | --fault-profile NAME] [--threads N]
 //                [--camera synthetic|rendered] [--camera-rate HZ] [--camera-video DIR] [--models DIR]
+//                [--mapping on|off] [--no-prior-map]
 // (docs/design.md §8.4; docs/simulation.md)
 #include <sys/stat.h>
 
@@ -25,6 +26,8 @@
 #include "gesture_formation/planning/scenario.hpp"
 #include "gesture_formation/sim/mission_runner.hpp"
 #include "gesture_formation/sim/rendered_camera.hpp"
+#include "gesture_formation/sim/site_mapping.hpp"
+#include "gesture_formation/sim/unmapped_obstacles.hpp"
 
 namespace gesture_formation::gfctl {
 
@@ -37,14 +40,17 @@ const Registrar kRegistrar{
     "simulate",
     "--scenario FILE --out DIR [--seed N | --seeds A..B] [--duration S] [--model ONNX] [--no-plot] "
     "[--faults FILE | --fault-profile NAME] [--threads N] [--camera synthetic|rendered] [--camera-rate HZ] "
-    "[--camera-video DIR] [--models DIR]   closed-loop mission: metrics.json, timeline.csv, events.csv, modes.csv, "
+    "[--camera-video DIR] [--models DIR] [--mapping on|off] [--no-prior-map]   closed-loop mission: metrics.json, timeline.csv, events.csv, modes.csv, "
     "timeline.png (docs/design.md §8.4); --faults replaces mission.faults with FILE's faults: section, --fault-profile NAME "
     "uses <scenario dir>/../faults/NAME.yaml (config/faults/; docs/safety.md); --threads N classifies the UAVs' "
     "camera views of a frame on N threads, with --camera rendered also runs their perception pipelines on them (default: "
     "the UAV count, at most the cores; results do not depend on it); "
     "--camera rendered renders every UAV's camera and runs the real perception pipeline on the images (EGL; "
     "docs/simulation.md §8): perception.csv and a metrics.json perception section; --camera-rate lowers its frame "
-    "rate, --camera-video writes each UAV's annotated stream (MJPG .avi)",
+    "rate, --camera-video writes each UAV's annotated stream (MJPG .avi); --mapping on|off overrides mission.mapping.enabled "
+    "(every UAV maps the site from its depth frames and plans on its live map; docs/mapping.md §7), --no-prior-map starts "
+    "the live maps empty (mission.mapping.prior_map false); a scenario's unmapped_obstacles are in the world, not in the "
+    "prior map (docs/simulation.md)",
     cmdSimulate};
 
 bool makeDir(const std::string& path) {
@@ -149,6 +155,7 @@ struct Loaded {
   std::shared_ptr<const planning::DistanceField> field;
   std::unique_ptr<sim::MissionClassifier> classifier;
   planning::PrimitiveSet solids;  ///< exact geometry for the obstacle-distance metric
+  std::vector<sim::UnmappedObstacle> unmapped;  ///< in the world, not in the prior map
   bool rendered = false;          ///< --camera rendered
   sim::RenderedCameraConfig camera;  ///< its settings (video_dir: per run)
 };
@@ -192,6 +199,20 @@ void printPerception(const sim::PerceptionSummary& p) {
   }
 }
 
+void printSiteMapping(const sim::SiteMappingSummary& s) {
+  std::cout << "  site mapping: " << (s.mapping ? "live maps" : "off (planners on the prior map only)")
+            << (s.mapping && !s.prior_map ? " without a prior map" : "") << ", " << s.depth_frames
+            << " depth frames (ray casting median " << s.depth_ms_median << " ms, integrate median "
+            << s.integrate_ms_median << " ms p99 " << s.integrate_ms_p99 << " ms), coverage " << s.coverage
+            << ", min distance to unmapped obstacles " << s.min_unmapped_distance_m << " m\n";
+  for (const auto& o : s.obstacles) {
+    std::cout << "    " << o.name << ": coverage " << o.coverage << " (" << o.surface_voxels_seen << "/" << o.surface_voxels
+              << " surface voxels), first seen " << o.first_seen_s << " s by UAV " << o.first_seen_uav << ", avoided "
+              << o.avoided_s << " s (sight to avoidance " << o.sight_to_avoidance_s << " s), min distance "
+              << o.min_distance_m << " m (UAV " << o.min_distance_uav << " at " << o.min_distance_t_s << " s)\n";
+  }
+}
+
 int runOne(const Args& args, Loaded& L, std::uint64_t seed, double duration, const std::string& dir, bool plot,
            sim::MissionMetrics* metrics_out) {
   if (!makeDir(dir)) return badInput(args, dir + ": cannot create directory");
@@ -200,7 +221,16 @@ int runOne(const Args& args, Loaded& L, std::uint64_t seed, double duration, con
   world.field = L.field.get();
   world.ground_height_m = L.scenario.ground.enabled ? L.scenario.ground.height_m : -1e9;
   world.solids = &L.solids;
-  const auto planners = sim::uavPlannerFactory(L.mission.planner, L.map, L.field);
+  // The unmapped obstacles and the UAVs' live maps: a fresh site per run (site_mapping.hpp).
+  std::unique_ptr<sim::SiteMapping> site;
+  if (!L.unmapped.empty() || L.mission.mapping.enabled) {
+    auto made = sim::SiteMapping::create(L.mission, L.scenario.map, L.map, L.solids, world.ground_height_m, L.unmapped);
+    if (!made) return badInput(args, made.reason());
+    site = std::move(*made);
+    world.site = site.get();
+  }
+  const auto planners = site ? site->plannerFactory(L.mission.planner, L.map, L.field)
+                             : sim::uavPlannerFactory(L.mission.planner, L.map, L.field);
   std::unique_ptr<sim::RenderedCamera> camera;
   if (L.rendered) {
     int rc = kExitOk;
@@ -236,6 +266,7 @@ int runOne(const Args& args, Loaded& L, std::uint64_t seed, double duration, con
             << m.range_outliers << ", inter-UAV messages " << m.messages_sent << " (lost " << m.messages_lost
             << ", duplicated " << m.messages_duplicated << ", reordered " << m.messages_reordered << ")\n";
   if (m.perception) printPerception(*m.perception);
+  if (m.site_mapping) printSiteMapping(*m.site_mapping);
   if (camera && !camera->error().empty()) {
     std::cerr << "gfctl simulate: --camera rendered: a frame failed: " << camera->error() << "\n";
     return kExitNoRenderer;
@@ -261,6 +292,20 @@ int runOne(const Args& args, Loaded& L, std::uint64_t seed, double duration, con
   }
   if (metrics_out) *metrics_out = m;
   return kExitOk;
+}
+
+/// --mapping / --no-prior-map (after the mission is loaded); the problem or empty.
+std::string applyMappingOptions(const Args& args, Loaded& L) {
+  if (args.has("mapping")) {
+    const std::string v = args.get("mapping");
+    if (v != "on" && v != "off") return "--mapping: expected on or off, got '" + v + "'";
+    L.mission.mapping.enabled = v == "on";
+  }
+  if (args.has("no-prior-map")) {
+    if (!L.mission.mapping.enabled) return "--no-prior-map needs mapping (mission.mapping.enabled or --mapping on)";
+    L.mission.mapping.prior_map = false;
+  }
+  return "";
 }
 
 /// --camera synthetic|rendered and the options only the rendered camera takes; the problem or empty.
@@ -300,7 +345,8 @@ std::string setUpRendered(const Args& args, Loaded& L) {
 
 int cmdSimulate(const Args& args) {
   if (!checkOptions(args, {"scenario", "out"}, {"seed", "seeds", "duration", "model", "no-plot", "faults", "fault-profile", "threads",
-                                                 "camera", "camera-rate", "camera-video", "models"})) {
+                                                 "camera", "camera-rate", "camera-video", "models", "mapping",
+                                                 "no-prior-map"})) {
     return kExitBadInput;
   }
   const std::string camera_mode = args.get("camera", "synthetic");
@@ -353,17 +399,18 @@ int cmdSimulate(const Args& args) {
     if (!fileExists(faults_path)) return badInput(args, "--fault-profile: " + faults_path + " does not exist");
   }
   auto mission = faults_path.empty() ? sim::loadMissionConfig(path) : sim::loadMissionConfig(path, faults_path);
-  if (!sc || !mission) {
-    std::cerr << "gfctl simulate: invalid scenario:\n" << (sc ? "" : sc.reason()) << (mission ? "" : mission.reason());
+  auto unmapped = sim::loadUnmappedObstacles(path);  // unmapped_obstacles: in the world, not in the prior map
+  if (!sc || !mission || !unmapped) {
+    std::cerr << "gfctl simulate: invalid scenario:\n" << (sc ? "" : sc.reason()) << (mission ? "" : mission.reason())
+              << (unmapped ? "" : unmapped.reason());
     return kExitBadInput;
   }
+  L.unmapped = std::move(*unmapped);
   L.scenario = std::move(*sc);
   L.solids = L.scenario.primitives();
   L.mission = std::move(*mission);
-  if (camera_mode == "rendered") {
-    const std::string bad = setUpRendered(args, L);
-    if (!bad.empty()) return badInput(args, bad);
-  }
+  if (std::string bad = applyMappingOptions(args, L); !bad.empty()) return badInput(args, bad);
+  if (const std::string bad = camera_mode == "rendered" ? setUpRendered(args, L) : ""; !bad.empty()) return badInput(args, bad);
   const std::string model = args.has("model") ? args.get("model") : L.mission.gesture_model;
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   const int threads = threads_arg > 0 ? static_cast<int>(threads_arg)

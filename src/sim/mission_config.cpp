@@ -457,6 +457,7 @@ common::Result<MissionConfig> parseMissionConfig(const std::string& yaml, const 
   readWind(r, m + "wind.", c.wind);
   readSensorsAndLinks(r, m, c);
   readFaults(r, m, c);
+  c.mapping = readSiteMappingConfig(r, m + "mapping.");  // the UAVs' online mapping (site_mapping_config.hpp)
 
   c.camera.camera = c.estimator.camera;  // one camera: what the sensor sees is what the estimator models
   c.worker.synth.camera = c.estimator.camera;

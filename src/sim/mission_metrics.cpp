@@ -56,8 +56,9 @@ constexpr double kWorkerCylinderRadiusM = 0.3;  ///< docs/simulation.md §4 coll
 
 double ObstacleDistance::operator()(const Eigen::Vector3d& p) const {
   const double d_field = field->clearance(p);
-  if (solids == nullptr || d_field >= kExactWithinM) return d_field;
-  return std::min(solids->distance(p), p.z() - ground_height_m);
+  const double d_extra = extra ? extra(p) : std::numeric_limits<double>::infinity();
+  if (solids == nullptr || d_field >= kExactWithinM) return std::min(d_field, d_extra);
+  return std::min({solids->distance(p), p.z() - ground_height_m, d_extra});
 }
 
 std::string describeCommand(const formation::FormationCommand& c, const std::string& target_text) {
@@ -393,12 +394,14 @@ std::string metricsJson(const MissionMetrics& m) {
   if (m.perception) os << "  \"perception\": " << perceptionJson(*m.perception, 2) << ",\n";
   if (m.abort) os << "  \"abort\": " << abortJson(*m.abort, 2) << ",\n";
   if (m.worker_approach) os << "  \"worker_approach\": " << approachJson(*m.worker_approach, 2) << ",\n";
+  if (m.site_mapping) os << "  \"site_mapping\": " << siteMappingJson(*m.site_mapping, 2) << ",\n";
   os << "  \"wall_clock_keys\": [\"planning_ms_median\", \"planning_ms_p99\", \"planning_ms_max\", \"wall_time_s\", \"real_time_factor\"";
   if (m.perception) {
     for (const char* k : {"render_ms_median", "detect_ms_median", "track_ms_median", "skeleton_ms_median", "frame_ms_median"}) {
       os << ", \"perception." << k << '"';
     }
   }
+  if (m.site_mapping) os << ", \"site_mapping.depth_ms_median\", \"site_mapping.integrate_ms_median\", \"site_mapping.integrate_ms_p99\"";
   os << "]\n";
   os << "}\n";
   return os.str();

@@ -18,6 +18,7 @@
 #include "gesture_formation/planning/occupancy_map.hpp"
 #include "gesture_formation/planning/replan_step.hpp"
 #include "gesture_formation/sim/random.hpp"
+#include "gesture_formation/sim/site_mapping.hpp"
 #include "gesture_formation/sim/wind.hpp"
 
 namespace gesture_formation::sim {
@@ -73,6 +74,12 @@ struct UavRuntime {
   std::string mode = "start";                                ///< last mode recorded (ModeChange)
 };
 
+/// The world's obstacle distance: the mapped solids, and the unmapped obstacles (site_mapping.hpp).
+ObstacleDistance obstacleDistance(const MissionWorld& w) {
+  const ObstacleDistance mapped{w.field, w.solids, w.ground_height_m};
+  return w.site != nullptr ? w.site->withUnmapped(mapped) : mapped;
+}
+
 void addCounters(MissionMetrics& M, const LinkCounters& c) {
   M.messages_sent += static_cast<long>(c.sent);
   M.messages_lost += static_cast<long>(c.lost);
@@ -106,7 +113,7 @@ class MissionRun {
         follower_views_(cfg.view_fusion.min_agreeing_views > 1),
         frames_(cfg.gesture_filter, cfg.view_fusion, cfg.gesture_mapping, n_, 0.0),
         operator_link_(cfg.operator_link, makeRng(seed, Stream::kLink, link_index_++)),
-        metrics_(cfg, ObstacleDistance{world.field, world.solids, world.ground_height_m}, seed),
+        metrics_(cfg, obstacleDistance(world), seed),
         M_(metrics_.counters()),
         schedule_(cfg.requests, "operator") {}
 
@@ -205,7 +212,7 @@ std::string MissionRun::addUavs() {
     rc.reach.worker_min_distance_m = cfg_.formation.limits.safety_distance_m;  // Γ_dis: the reach keeps it
     rc.home_world = s0.p_world;  // the mission starts in the air: its take-off point is where it starts
     planning::RetreatSpace space;
-    space.field = world_.field;
+    space.field = world_.site != nullptr && world_.site->field(i) != nullptr ? world_.site->field(i) : world_.field;
     if (world_.map != nullptr) {
       space.bounds = world_.map->gridBounds();
       space.resolution_m = world_.map->resolution();
@@ -247,7 +254,7 @@ void MissionRun::openLinks() {
     abort_links_.push_back(
         std::make_unique<Link<planning::AbortCommand>>(cfg_.operator_link, makeRng(seed_, Stream::kLink, link_index_++)));
   }
-  abort_record_.emplace(*cfg_.faults.abort, n_, ObstacleDistance{world_.field, world_.solids, world_.ground_height_m});
+  abort_record_.emplace(*cfg_.faults.abort, n_, obstacleDistance(world_));
 }
 
 MissionOutput MissionRun::run(double duration_s, std::chrono::steady_clock::time_point wall0) {
@@ -265,6 +272,11 @@ MissionOutput MissionRun::run(double duration_s, std::chrono::steady_clock::time
     deliverUavMessages(t);
     // Odometry of every UAV at this step (used by sensing, planning and control).
     for (auto& u : uavs_) u->est = u->odo.measure(u->plant.state(), dt);
+    if (world_.site != nullptr) {  // the unmapped obstacles' clock and the UAVs' depth frames (site_mapping.hpp)
+      std::vector<MultirotorState> truth;
+      for (const auto& u : uavs_) truth.push_back(u->plant.state());
+      world_.site->step(t, truth);
+    }
     if (camera_frames.due(k)) cameraFrame(t, ws);
     replanDue(t);
     // Safety metrics at every step (true states).
@@ -291,6 +303,7 @@ MissionOutput MissionRun::run(double duration_s, std::chrono::steady_clock::time
   out.modes = std::move(modes_);
   if (abort_record_) out.metrics.abort = abort_record_->summary();
   if (approach_record_) out.metrics.worker_approach = approach_record_->summary();
+  if (world_.site != nullptr) out.metrics.site_mapping = world_.site->summary();
   if (const std::vector<PerceptionRecord>* records = camera_.perceptionRecords()) {
     out.perception = *records;
     out.metrics.perception = summarizePerception(*records);
@@ -520,6 +533,7 @@ void MissionRun::replan(int i, double t) {
   // A back-off from the worker's reach begins (or finds no goal): a row of the same mode with its reason.
   if (out.backoff_started) modes_.push_back(ModeChange{t, i, u.mode, out.backoff});
   const planning::PlanResult& res = out.result;
+  if (world_.site != nullptr) world_.site->planned(i, t, res);  // sight-to-avoidance (site_mapping.hpp)
   metrics_.plan(i, t, version, res.status, res.timings.total_ms, res.reason, res.qp_sparse_timeouts);
   if (res.trajectory.empty()) {
     u.ctl.clearPlan();
@@ -607,7 +621,7 @@ void MissionRun::receiveAbort(int i, const planning::AbortCommand& command, doub
   if (u.step->receiveAbort(command, t) != planning::AbortAcceptance::kAccepted) return;
   if (!abort_record_) {  // an abort not injected by faults.abort (a recognised gesture): measured from here
     abort_record_.emplace(AbortEvent{t, command.source}, n_,
-                          ObstacleDistance{world_.field, world_.solids, world_.ground_height_m});
+                          obstacleDistance(world_));
   }
   abort_record_->accepted(i, t);
   setMode(i, t, "abort_accepted", std::string("abort from ") + planning::toString(command.source) + " " + command.id.sender);

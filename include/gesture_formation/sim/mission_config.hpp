@@ -32,6 +32,7 @@
 #include "gesture_formation/sim/link.hpp"
 #include "gesture_formation/sim/multirotor.hpp"
 #include "gesture_formation/sim/odometry.hpp"
+#include "gesture_formation/sim/site_mapping_config.hpp"
 #include "gesture_formation/sim/synthetic_sensors.hpp"
 #include "gesture_formation/sim/tracking_controller.hpp"
 #include "gesture_formation/sim/wind.hpp"
@@ -145,6 +146,8 @@ struct MissionConfig {
   gesture::GestureMapping gesture_mapping = gesture::GestureMapping::paperDefault();
   planning::PlannerConfig planner;
   estimation::EstimatorConfig estimator;
+  /// The UAVs' online mapping of the site (`mission.mapping.*`, site_mapping_config.hpp).
+  SiteMappingConfig mapping;
   std::vector<OperatorRequest> requests;  ///< ascending t_s
 };
 

@@ -23,6 +23,7 @@
 /// Thread safety: none (one accumulator per mission; the caller serialises).
 
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <map>
 #include <optional>
@@ -40,6 +41,7 @@
 #include "gesture_formation/sim/mission_config.hpp"
 #include "gesture_formation/sim/multirotor.hpp"
 #include "gesture_formation/sim/perception_truth.hpp"
+#include "gesture_formation/sim/site_metrics.hpp"
 #include "gesture_formation/sim/worker_model.hpp"
 
 namespace gesture_formation::planning {
@@ -99,6 +101,10 @@ struct MissionMetrics {
   /// The worker's walk towards a UAV (faults.worker_approach; docs/safety.md §3); absent without
   /// one (metrics.json then has no `worker_approach` key).
   std::optional<ApproachSummary> worker_approach;
+  /// The unmapped obstacles and the UAVs' online mapping (site_mapping.hpp); absent when the
+  /// scenario has no unmapped obstacles and mapping is off (metrics.json then has no
+  /// `site_mapping` key).
+  std::optional<SiteMappingSummary> site_mapping;
 };
 
 /// \brief One UAV's part of a timeline sample (docs/design.md §8.4 timeline.csv).
@@ -181,6 +187,9 @@ struct ObstacleDistance {
   const planning::DistanceField* field = nullptr;  ///< required; must outlive this
   const planning::PrimitiveSet* solids = nullptr;  ///< may be null; must outlive this
   double ground_height_m = 0.0;                    ///< used with solids (−1e9: no ground)
+  /// Obstacles besides the mapped ones (the unmapped obstacles at the mission's clock,
+  /// SiteMapping::withUnmapped): the distance is the least of both. Empty: none.
+  std::function<double(const Eigen::Vector3d&)> extra = nullptr;
   /// \brief [m] from `p_world` (world frame).
   double operator()(const Eigen::Vector3d& p_world) const;
 };

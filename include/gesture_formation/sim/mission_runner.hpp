@@ -51,6 +51,8 @@ class DistanceField;
 
 namespace gesture_formation::sim {
 
+class SiteMapping;  // site_mapping.hpp
+
 /// \brief One UAV's planner as the mission calls it (planning::UavPlanner in the product;
 /// tests may substitute their own): the replanning step's planner interface.
 using MissionPlanner = planning::Planner;
@@ -76,6 +78,10 @@ struct MissionWorld {
   /// field's value. Null: the field's value everywhere (distance to occupied voxel centres,
   /// quantised to the voxel size).
   const planning::PrimitiveSet* solids = nullptr;
+  /// The unmapped obstacles and the UAVs' live maps (site_mapping.hpp; its planners:
+  /// SiteMapping::plannerFactory). Null: none (the world is the scenario's mapped obstacles, every
+  /// UAV plans on the prior map). Must outlive the run; one run per instance.
+  SiteMapping* site = nullptr;
 };
 
 /// \brief Runs one mission. `classifier` may be null (no gesture pipeline: gestures are not

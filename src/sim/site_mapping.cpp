@@ -1,0 +1,267 @@
+#include "gesture_formation/sim/site_mapping.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "gesture_formation/common/csv.hpp"
+#include "gesture_formation/planning/uav_planner.hpp"
+
+namespace gesture_formation::sim {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+double msSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return kNaN;
+  std::sort(v.begin(), v.end());
+  const auto idx = static_cast<std::size_t>(std::max(0.0, std::ceil(q * static_cast<double>(v.size())) - 1.0));
+  return v[std::min(idx, v.size() - 1)];
+}
+
+std::string num(double v) { return std::isfinite(v) ? common::formatDouble(v) : std::string("null"); }
+
+std::string joinLines(const std::vector<std::string>& lines) {
+  std::string out;
+  for (const auto& l : lines) out += (out.empty() ? "" : "; ") + l;
+  return out;
+}
+
+/// The voxel centres (grid of `grid`) whose voxel meets the obstacle's surface at its listed pose:
+/// the centre within half a voxel of the solid, and not every corner of the voxel inside it.
+std::vector<Eigen::Vector3d> surfaceOf(const UnmappedObstacle& o, const planning::MapConfig& grid) {
+  std::vector<Eigen::Vector3d> out;
+  const double res = grid.resolution_m;
+  const planning::Aabb b = o.boundsAt(0.0).inflated(res);
+  const Eigen::Vector3i lo = (b.min_world / res).array().floor().cast<int>();
+  const Eigen::Vector3i hi = (b.max_world / res).array().floor().cast<int>();
+  for (int k = lo.z(); k <= hi.z(); ++k) {
+    for (int j = lo.y(); j <= hi.y(); ++j) {
+      for (int i = lo.x(); i <= hi.x(); ++i) {
+        const Eigen::Vector3d c = (Eigen::Vector3d(i, j, k).array() + 0.5).matrix() * res;
+        if (!grid.bounds.contains(c) || o.distanceAt(c, 0.0) > 0.5 * res) continue;
+        bool all_inside = true;
+        for (int corner = 0; corner < 8 && all_inside; ++corner) {
+          const Eigen::Vector3d d(corner & 1 ? 0.5 : -0.5, corner & 2 ? 0.5 : -0.5, corner & 4 ? 0.5 : -0.5);
+          all_inside = o.distanceAt(c + res * d, 0.0) <= 0.0;
+        }
+        if (!all_inside) out.push_back(c);
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string siteMappingJson(const SiteMappingSummary& s, int indent) {
+  const std::string pad(static_cast<std::size_t>(indent), ' '), in = pad + "  ";
+  std::ostringstream os;
+  os << "{\n" << in << "\"mapping\": " << (s.mapping ? "true" : "false") << ",\n"
+     << in << "\"prior_map\": " << (s.prior_map ? "true" : "false") << ",\n"
+     << in << "\"camera\": \"" << s.camera << "\",\n"
+     << in << "\"clearance_m\": " << num(s.clearance_m) << ",\n"
+     << in << "\"depth_frames\": " << s.depth_frames << ",\n"
+     << in << "\"coverage\": " << num(s.coverage) << ",\n"
+     << in << "\"min_unmapped_distance_m\": " << num(s.min_unmapped_distance_m) << ",\n"
+     << in << "\"depth_ms_median\": " << num(s.depth_ms_median) << ",\n"
+     << in << "\"integrate_ms_median\": " << num(s.integrate_ms_median) << ",\n"
+     << in << "\"integrate_ms_p99\": " << num(s.integrate_ms_p99) << ",\n"
+     << in << "\"obstacles\": [";
+  for (std::size_t i = 0; i < s.obstacles.size(); ++i) {
+    const UnmappedObstacleRecord& r = s.obstacles[i];
+    os << (i ? "," : "") << "\n" << in << "  {\"name\": \"" << r.name << "\", \"surface_voxels\": " << r.surface_voxels
+       << ", \"surface_voxels_seen\": " << r.surface_voxels_seen << ", \"coverage\": " << num(r.coverage)
+       << ", \"first_seen_s\": " << num(r.first_seen_s) << ", \"first_seen_uav\": " << r.first_seen_uav
+       << ", \"avoided_s\": " << num(r.avoided_s) << ", \"sight_to_avoidance_s\": " << num(r.sight_to_avoidance_s)
+       << ", \"min_distance_m\": " << num(r.min_distance_m) << ", \"min_distance_uav\": " << r.min_distance_uav
+       << ", \"min_distance_t_s\": " << num(r.min_distance_t_s) << "}";
+  }
+  os << (s.obstacles.empty() ? "" : "\n" + in) << "]\n" << pad << "}";
+  return os.str();
+}
+
+SiteMapping::SiteMapping(const MissionConfig& mission, const planning::PrimitiveSet& solids, double ground_height_m,
+                         std::vector<UnmappedObstacle> unmapped)
+    : config_(mission.mapping),
+      intrinsics_(mission.estimator.camera),
+      clearance_m_(mission.planner.obstacle_clearance_m),
+      n_(static_cast<int>(mission.uavs.size())),
+      unmapped_(std::move(unmapped)),
+      raycaster_(solids, ground_height_m) {}
+
+common::Result<std::unique_ptr<SiteMapping>> SiteMapping::create(const MissionConfig& mission, const planning::MapConfig& grid,
+                                                                 std::shared_ptr<const planning::OccupancyMap> prior,
+                                                                 const planning::PrimitiveSet& solids, double ground_height_m,
+                                                                 std::vector<UnmappedObstacle> unmapped) {
+  using R = common::Result<std::unique_ptr<SiteMapping>>;
+  const std::vector<std::string> bad = mission.mapping.validate("mission.mapping.");
+  if (!bad.empty()) return R::fail(joinLines(bad));
+  std::unique_ptr<SiteMapping> s(new SiteMapping(mission, solids, ground_height_m, std::move(unmapped)));
+  const auto n = static_cast<std::size_t>(s->n_);
+  if (mission.mapping.enabled) {
+    for (std::size_t i = 0; i < n; ++i) {
+      auto live = mapping::LiveMap::create(mission.mapping.live, grid, mission.mapping.prior_map ? prior : nullptr);
+      if (!live) return R::fail("mission.mapping: " + live.reason());
+      s->live_.push_back(std::move(*live));
+      // Staggered like the replannings: UAV i's frames at (k + i/n) / rate.
+      s->next_frame_s_.push_back(static_cast<double>(i) / (static_cast<double>(n) * mission.mapping.rate_hz));
+    }
+  }
+  s->surfaceVoxels(grid);
+  const std::size_t m = s->unmapped_.size();
+  s->seen_s_.assign(n, std::vector<double>(m, kNaN));
+  s->avoided_s_.assign(n, std::vector<double>(m, kNaN));
+  return R::ok(std::move(s));
+}
+
+void SiteMapping::surfaceVoxels(const planning::MapConfig& grid) {
+  for (const UnmappedObstacle& o : unmapped_) {
+    surface_.push_back(surfaceOf(o, grid));
+    surface_seen_.emplace_back(surface_.back().size(), false);
+    UnmappedObstacleRecord r;
+    r.name = o.name;
+    r.surface_voxels = static_cast<int>(surface_.back().size());
+    records_.push_back(r);
+  }
+}
+
+const planning::DistanceField* SiteMapping::field(int uav) const {
+  if (live_.empty() || uav < 0 || uav >= static_cast<int>(live_.size())) return nullptr;
+  return live_[static_cast<std::size_t>(uav)]->field().get();
+}
+
+PlannerFactory SiteMapping::plannerFactory(const planning::PlannerConfig& config,
+                                           std::shared_ptr<const planning::OccupancyMap> prior_map,
+                                           std::shared_ptr<const planning::DistanceField> prior_field) const {
+  if (live_.empty()) return uavPlannerFactory(config, std::move(prior_map), std::move(prior_field));
+  std::vector<std::shared_ptr<const planning::OccupancyMap>> maps;
+  std::vector<std::shared_ptr<const planning::DistanceField>> fields;
+  for (const auto& l : live_) {
+    maps.push_back(l->map());
+    fields.push_back(l->field());
+  }
+  return [config, maps, fields](int i) -> std::unique_ptr<MissionPlanner> {
+    const auto u = static_cast<std::size_t>(i);
+    return std::make_unique<planning::UavPlannerAdapter>(std::make_unique<planning::UavPlanner>(config, maps.at(u), fields.at(u)));
+  };
+}
+
+ObstacleDistance SiteMapping::withUnmapped(ObstacleDistance base) const {
+  if (!unmapped_.empty()) base.extra = [this](const Eigen::Vector3d& p) { return unmappedDistanceNow(p); };
+  return base;
+}
+
+void SiteMapping::step(double t_s, const std::vector<MultirotorState>& uavs) {
+  clock_s_ = t_s;
+  for (int i = 0; i < n_ && i < static_cast<int>(uavs.size()); ++i) {
+    const MultirotorState& s = uavs[static_cast<std::size_t>(i)];
+    for (std::size_t j = 0; j < unmapped_.size(); ++j) {
+      const double d = unmapped_[j].distanceAt(s.p_world, t_s);
+      UnmappedObstacleRecord& r = records_[j];
+      if (d < r.min_distance_m) {
+        r.min_distance_m = d;
+        r.min_distance_uav = i;
+        r.min_distance_t_s = t_s;
+      }
+    }
+    if (live_.empty() || t_s + 1e-9 < next_frame_s_[static_cast<std::size_t>(i)]) continue;
+    next_frame_s_[static_cast<std::size_t>(i)] += 1.0 / config_.rate_hz;
+    depthFrame(i, t_s, s);
+  }
+}
+
+void SiteMapping::depthFrame(int uav, double t_s, const MultirotorState& state) {
+  planning::PrimitiveSet now;
+  for (const UnmappedObstacle& o : unmapped_) now.append(o.primitivesAt(t_s));
+  mapping::DepthFrame frame;
+  frame.T_world_camera = opticalPoseFromHeadingPitch(state.p_world, state.heading_rad, state.pitch_rad);
+  frame.intrinsics = mapping::PinholeIntrinsics{intrinsics_.fx, intrinsics_.fy, intrinsics_.cx, intrinsics_.cy};
+  const auto t0 = std::chrono::steady_clock::now();
+  frame.depth_m = raycaster_.render(intrinsics_, frame.T_world_camera, config_.live.pixel_stride, config_.camera_range_m, now);
+  depth_ms_.push_back(msSince(t0));
+  const auto t1 = std::chrono::steady_clock::now();
+  const auto update = live_[static_cast<std::size_t>(uav)]->integrate(frame);
+  integrate_ms_.push_back(msSince(t1));
+  if (!update) return;  // a bad frame changes nothing (cannot happen with a finite pose)
+  recordSightings(uav, t_s, state.p_world);
+}
+
+void SiteMapping::recordSightings(int uav, double t_s, const Eigen::Vector3d& p_world) {
+  const mapping::LiveMap& live = *live_[static_cast<std::size_t>(uav)];
+  const double reach = config_.camera_range_m + 1.0;
+  for (std::size_t j = 0; j < unmapped_.size(); ++j) {
+    const UnmappedObstacle& o = unmapped_[j];
+    if (!o.presentAt(t_s)) continue;
+    const planning::Aabb b = o.boundsAt(t_s);
+    if ((b.min_world - p_world).cwiseMax(p_world - b.max_world).cwiseMax(0.0).norm() > reach) continue;
+    const Eigen::Vector3d offset = o.motion.offsetAt(t_s);
+    const bool at_listed_pose = offset.isZero();
+    double& seen = seen_s_[static_cast<std::size_t>(uav)][j];
+    std::vector<bool>& marks = surface_seen_[j];
+    for (std::size_t v = 0; v < surface_[j].size(); ++v) {
+      if (!std::isnan(seen) && (!at_listed_pose || marks[v])) continue;  // nothing left to learn from it
+      if (live.observed(surface_[j][v] + offset) != mapping::Observed::kOccupied) continue;
+      if (std::isnan(seen)) seen = t_s;
+      if (at_listed_pose) marks[v] = true;
+    }
+  }
+}
+
+void SiteMapping::planned(int uav, double t_s, const planning::PlanResult& result) {
+  if (uav < 0 || uav >= n_ || !result.verified || result.trajectory.empty()) return;
+  const auto u = static_cast<std::size_t>(uav);
+  const planning::PlannedTrajectory& plan = result.trajectory;
+  for (std::size_t j = 0; j < unmapped_.size(); ++j) {
+    if (std::isnan(seen_s_[u][j]) || !std::isnan(avoided_s_[u][j])) continue;
+    double least = std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < plan.samples.size(); ++k) {
+      const double tk = plan.t0_s + plan.dt_s * static_cast<double>(k);
+      least = std::min(least, unmapped_[j].distanceAt(plan.samples[k].p_world, tk));
+    }
+    if (least >= clearance_m_) avoided_s_[u][j] = t_s;
+  }
+}
+
+SiteMappingSummary SiteMapping::summary() const {
+  SiteMappingSummary s;
+  s.mapping = mapping();
+  s.prior_map = config_.prior_map;
+  s.camera = "synthetic";
+  s.clearance_m = clearance_m_;
+  s.depth_frames = static_cast<int>(integrate_ms_.size());
+  s.depth_ms_median = quantile(depth_ms_, 0.5);
+  s.integrate_ms_median = quantile(integrate_ms_, 0.5);
+  s.integrate_ms_p99 = quantile(integrate_ms_, 0.99);
+  int surface = 0, seen = 0;
+  for (std::size_t j = 0; j < records_.size(); ++j) {
+    UnmappedObstacleRecord r = records_[j];
+    r.surface_voxels_seen = static_cast<int>(std::count(surface_seen_[j].begin(), surface_seen_[j].end(), true));
+    r.coverage = r.surface_voxels > 0 ? static_cast<double>(r.surface_voxels_seen) / r.surface_voxels : 0.0;
+    surface += r.surface_voxels;
+    seen += r.surface_voxels_seen;
+    for (int i = 0; i < n_; ++i) {  // the first UAV to see it
+      const double t = seen_s_[static_cast<std::size_t>(i)][j];
+      if (!std::isnan(t) && (std::isnan(r.first_seen_s) || t < r.first_seen_s)) {
+        r.first_seen_s = t;
+        r.first_seen_uav = i;
+      }
+    }
+    if (r.first_seen_uav >= 0) {
+      r.avoided_s = avoided_s_[static_cast<std::size_t>(r.first_seen_uav)][j];
+      r.sight_to_avoidance_s = r.avoided_s - r.first_seen_s;
+    }
+    s.min_unmapped_distance_m = std::min(s.min_unmapped_distance_m, r.min_distance_m);
+    s.obstacles.push_back(r);
+  }
+  s.coverage = surface > 0 ? static_cast<double>(seen) / surface : 0.0;
+  return s;
+}
+
+}  // namespace gesture_formation::sim

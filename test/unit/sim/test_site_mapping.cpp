@@ -1,0 +1,121 @@
+// sim::SiteMapping (docs/mapping.md §7): a UAV whose camera looks at an unmapped box maps it at
+// its depth frames' rate, its live field sees the box, the world's obstacle distance counts it, a
+// plan through the box is not "avoiding" it and one clear of it is; without mapping nothing is seen.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "gesture_formation/sim/site_mapping.hpp"
+#include "sim_test_support.hpp"
+
+namespace gf = gesture_formation;
+
+namespace {
+
+std::vector<gf::sim::UnmappedObstacle> wallAhead() {
+  gf::sim::UnmappedObstacle o;
+  o.name = "wall";
+  o.box.center_world = Eigen::Vector3d(6.0, 0.0, 3.0);
+  o.box.size_m = Eigen::Vector3d(0.8, 6.0, 4.0);
+  return {o};
+}
+
+gf::planning::MapConfig grid() {
+  gf::planning::MapConfig mc;
+  mc.resolution_m = 0.4;
+  mc.bounds = gf::planning::Aabb{Eigen::Vector3d(-30, -30, 0), Eigen::Vector3d(30, 30, 20)};
+  return mc;
+}
+
+/// UAV i at (0, −10 + 10i, 3), level, looking along +x: only UAV 1 has the wall in view.
+std::vector<gf::sim::MultirotorState> uavsLookingEast(int n) {
+  std::vector<gf::sim::MultirotorState> s(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    s[static_cast<std::size_t>(i)].p_world = Eigen::Vector3d(0.0, -10.0 + 10.0 * i, 3.0);
+    s[static_cast<std::size_t>(i)].heading_rad = 0.0;
+  }
+  return s;
+}
+
+gf::planning::PlanResult straightPlan(double t0, const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
+  gf::planning::PlanResult r;
+  r.status = gf::planning::PlanStatus::kOptimized;
+  r.verified = true;
+  r.trajectory.t0_s = t0;
+  r.trajectory.dt_s = 0.2;
+  for (int k = 0; k <= 10; ++k) {
+    gf::planning::TrajectorySample s;
+    s.p_world = from + (to - from) * (k / 10.0);
+    r.trajectory.samples.push_back(s);
+  }
+  return r;
+}
+
+}  // namespace
+
+TEST(SiteMappingTest, DiscoversAndMeasuresAvoidance) {
+  const gf::sim::test::EmptyWorld w;
+  gf::sim::MissionConfig cfg = gf::sim::test::openFieldWithoutRequests();
+  cfg.mapping.enabled = true;
+  cfg.mapping.rate_hz = 5.0;
+  auto prior = std::make_shared<const gf::planning::OccupancyMap>(w.map);
+  auto site = gf::sim::SiteMapping::create(cfg, grid(), prior, gf::planning::PrimitiveSet{}, 0.0, wallAhead());
+  ASSERT_TRUE(static_cast<bool>(site)) << site.reason();
+  gf::sim::SiteMapping& s = **site;
+  ASSERT_TRUE(s.mapping());
+  const int n = static_cast<int>(cfg.uavs.size());
+  ASSERT_NE(s.field(1), nullptr);
+  // UAV 1 (at y = 0) faces the wall; for UAVs 0 and 2 (y = ∓10) it is outside their ±27.5° view.
+  const Eigen::Vector3d before_wall(5.2, 0.0, 3.0);  // 0.4 m in front of the wall, on UAV 1's line
+  EXPECT_GT(s.field(1)->clearance(before_wall), 2.0);  // not in the prior map: free for the planner
+  // The world's obstacle distance counts the wall.
+  const gf::sim::ObstacleDistance d = s.withUnmapped(gf::sim::ObstacleDistance{&w.field, nullptr, 0.0});
+  EXPECT_NEAR(d(before_wall), 0.4, 1e-9);
+  // A plan through the wall made before anyone saw it: not counted (nothing seen yet).
+  s.planned(1, 0.0, straightPlan(0.0, Eigen::Vector3d(0, 0, 3), Eigen::Vector3d(10, 0, 3)));
+  // One second of steps at 100 Hz: 5 frames per UAV.
+  for (int k = 0; k <= 100; ++k) s.step(k * 0.01, uavsLookingEast(n));
+  EXPECT_LT(s.field(1)->clearance(before_wall), 0.5);  // now it is in UAV 1's live field
+  EXPECT_GT(s.field(0)->clearance(before_wall), 2.0);  // not in UAV 0's: it never saw it
+  const gf::sim::SiteMappingSummary before = s.summary();
+  EXPECT_EQ(before.depth_frames, 5 * n + 1);  // UAV i at (k + i/n)/5 s: UAV 0 also at 1.0 s
+  ASSERT_EQ(before.obstacles.size(), 1u);
+  EXPECT_EQ(before.obstacles[0].first_seen_uav, 1);
+  EXPECT_NEAR(before.obstacles[0].first_seen_s, 0.07, 1e-9);  // UAV 1's first frame: the step at 1/15 s
+  EXPECT_GT(before.coverage, 0.05);  // its west face (of six) seen
+  EXPECT_LT(before.coverage, 0.6);
+  EXPECT_TRUE(std::isnan(before.obstacles[0].avoided_s));
+  // A plan through the wall is not avoiding it, nor one ending 0.7 m before it (< the clearance
+  // planner.obstacle_clearance_m 0.8); one that stays 2 m before it is.
+  s.planned(1, 1.0, straightPlan(1.0, Eigen::Vector3d(0, 0, 3), Eigen::Vector3d(10, 0, 3)));
+  s.planned(1, 1.2, straightPlan(1.2, Eigen::Vector3d(0, 0, 3), Eigen::Vector3d(4.9, 0, 3)));
+  EXPECT_TRUE(std::isnan(s.summary().obstacles[0].avoided_s));
+  s.planned(0, 1.3, straightPlan(1.3, Eigen::Vector3d(0, -10, 3), Eigen::Vector3d(3.6, -10, 3)));  // not the UAV that saw it
+  EXPECT_TRUE(std::isnan(s.summary().obstacles[0].avoided_s));
+  s.planned(1, 1.4, straightPlan(1.4, Eigen::Vector3d(0, 0, 3), Eigen::Vector3d(3.6, 0, 3)));
+  const gf::sim::SiteMappingSummary after = s.summary();
+  EXPECT_DOUBLE_EQ(after.obstacles[0].avoided_s, 1.4);
+  EXPECT_NEAR(after.obstacles[0].sight_to_avoidance_s, 1.4 - after.obstacles[0].first_seen_s, 1e-12);
+  EXPECT_NEAR(after.obstacles[0].min_distance_m, 5.6, 1e-9);  // UAV 1 at x = 0, the wall's face at 5.6
+}
+
+TEST(SiteMappingTest, WithoutMappingNothingIsSeenAndBadSettingsAreRefused) {
+  const gf::sim::test::EmptyWorld w;
+  gf::sim::MissionConfig cfg = gf::sim::test::openFieldWithoutRequests();
+  auto prior = std::make_shared<const gf::planning::OccupancyMap>(w.map);
+  auto site = gf::sim::SiteMapping::create(cfg, grid(), prior, gf::planning::PrimitiveSet{}, 0.0, wallAhead());
+  ASSERT_TRUE(static_cast<bool>(site)) << site.reason();
+  EXPECT_FALSE((*site)->mapping());
+  EXPECT_EQ((*site)->field(0), nullptr);
+  for (int k = 0; k <= 100; ++k) (*site)->step(k * 0.01, uavsLookingEast(static_cast<int>(cfg.uavs.size())));
+  const auto s = (*site)->summary();
+  EXPECT_EQ(s.depth_frames, 0);
+  EXPECT_EQ(s.coverage, 0.0);
+  EXPECT_TRUE(std::isnan(s.obstacles[0].first_seen_s));
+  cfg.mapping.enabled = true;
+  cfg.mapping.rate_hz = -1.0;
+  const auto bad = gf::sim::SiteMapping::create(cfg, grid(), prior, gf::planning::PrimitiveSet{}, 0.0, wallAhead());
+  ASSERT_FALSE(static_cast<bool>(bad));
+  EXPECT_NE(bad.reason().find("mission.mapping.rate_hz"), std::string::npos) << bad.reason();
+  EXPECT_NE(bad.reason().find("-1"), std::string::npos) << bad.reason();
+}
