@@ -41,6 +41,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     roundTrip<AbortMessage>(payload, n);
     return 0;
   }
+  if (data[0] == 253) {  // (before the acknowledgement payload a formation params, as 253 % 5)
+    roundTrip<CommandAckMessage>(payload, n);
+    return 0;
+  }
   switch (data[0] % 5) {
     case 0: roundTrip<Heartbeat>(payload, n); break;
     case 1: roundTrip<WorkerStateMessage>(payload, n); break;

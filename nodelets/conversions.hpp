@@ -16,6 +16,7 @@
 #include <trajectory_msgs/MultiDOFJointTrajectory.h>
 
 #include "gesture_formation/AbortCommand.h"
+#include "gesture_formation/CommandAck.h"
 #include "gesture_formation/AbortState.h"
 #include "gesture_formation/FormationCommand.h"
 #include "gesture_formation/FormationParams.h"
@@ -338,6 +339,54 @@ inline gesture_formation::AbortCommand toMsg(const planning::AbortCommand& c, in
   m.link_sender = link_sender;
   return m;
 }
+/// A command acknowledgement from ROS as it travels; fails naming the field.
+inline common::Result<comm::CommandAckMessage> toWire(const gesture_formation::CommandAck& m) {
+  using R = common::Result<comm::CommandAckMessage>;
+  comm::CommandAckMessage wire;
+  wire.id = formation::CommandId{m.sender, m.sequence};
+  if (m.source == "gesture") wire.source = formation::CommandSource::kGesture;
+  else if (m.source != "operator") return R::fail("source: '" + m.source + "' is not operator or gesture");
+  bool known = false;
+  for (auto s : {formation::CommandStatus::kApplied, formation::CommandStatus::kDuplicate, formation::CommandStatus::kRejected}) {
+    if (m.status == formation::toString(s)) {
+      wire.status = s;
+      known = true;
+    }
+  }
+  if (!known) return R::fail("status: '" + m.status + "' is not applied, duplicate or rejected");
+  wire.params_version = m.params_version;
+  wire.command_stamp_s = m.command_stamp.toSec();
+  wire.outcome = m.outcome.substr(0, comm::kMaxAckOutcomeBytes);
+  if (auto e = comm::encodePayload(wire); !e) return R::fail(e.reason());  // the wire's rules
+  return R::ok(std::move(wire));
+}
+/// The leader's acknowledgement of `command`: what became of it (`status`, `outcome`) and the
+/// parameter version it left; stamped `now`.
+inline gesture_formation::CommandAck toAck(const gesture_formation::FormationCommand& command, const std::string& status,
+                                           const std::string& outcome, std::uint64_t version, const ros::Time& now) {
+  gesture_formation::CommandAck m;
+  m.header.stamp = now;
+  m.sender = command.sender;
+  m.sequence = command.sequence;
+  m.source = command.source;
+  m.status = status;
+  m.outcome = outcome;
+  m.params_version = version;
+  m.command_stamp = command.header.stamp;
+  return m;
+}
+inline gesture_formation::CommandAck fromWire(const comm::CommandAckMessage& a) {
+  gesture_formation::CommandAck m;
+  m.sender = a.id.sender;
+  m.sequence = a.id.sequence;
+  m.source = formation::toString(a.source);
+  m.status = formation::toString(a.status);
+  m.outcome = a.outcome;
+  m.params_version = a.params_version;
+  m.command_stamp = ros::Time(std::max(a.command_stamp_s, 0.0));
+  return m;
+}
+
 inline std::uint8_t toMsgPhase(planning::AbortPhase p) {
   using S = gesture_formation::AbortState;
   switch (p) {

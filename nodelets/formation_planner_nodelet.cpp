@@ -15,7 +15,8 @@
 //   abort_in (AbortCommand: every copy, from the LcmBridge and on the leader the GestureCommander)
 //   → plan_out (PlannedTrajectory; mode track | hold | search | abort and its reason), trajectory_out
 //   (trajectory_msgs/MultiDOFJointTrajectory), formation_params_out (leader, latched), abort_state_out
-//   (AbortState, latched: on acceptance and at every replanning while aborting; docs/safety.md §2.8).
+//   (AbortState, latched: on acceptance and at every replanning while aborting; docs/safety.md §2.8),
+//   command_ack_out (leader: CommandAck per command handled, to the operator; docs/safety.md §2.9).
 // Parameters (all required unless noted): ~uav_index, ~uav_count, ~world_frame, ~scenario_file
 //   (the map), ~params_rate_hz, ~max_wind_estimate_age_s, and the settings of
 //   loadPlannerSettings (config_sources.hpp): ~mission_file (optional; simulation: the mission's
@@ -99,6 +100,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     if (uav_index_ == formation::kLeader) {
       params_pub_ = nh.advertise<gesture_formation::FormationParams>("formation_params_out", 5, true);
       command_sub_ = nh.subscribe("formation_command_in", 20, &FormationPlannerNodelet::onCommand, this);
+      ack_pub_ = nh.advertise<gesture_formation::CommandAck>("command_ack_out", 20);
       params_timer_ = nh.createTimer(ros::Duration(1.0 / params_rate_hz), [this](const ros::TimerEvent&) {
         std::lock_guard<std::mutex> lock(mutex_);
         publishParams();
@@ -164,6 +166,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     const auto& r = role_->apply(fromMsg(*msg), text, msg->source, msg->header.stamp.toSec());
     NODELET_INFO_STREAM("FormationPlanner: command " << r.text << " → " << r.outcome);
     publishParams();
+    ack_pub_.publish(toAck(*msg, r.status, r.outcome, role_->version(), ros::Time::now()));  // to the operator
   }
   void publishParams() {
     const onboard::CommandRecord& r = role_->last();
@@ -289,7 +292,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   std::optional<gesture_formation::WorkerState> worker_;
   std::vector<std::optional<planning::ReceivedPlan>> received_;  ///< by sender; [0] the leader's plan
   int abort_link_sender_ = -1;  ///< who delivered the accepted abort (LCM sender id; -1: ROS)
-  ros::Publisher plan_pub_, traj_pub_, params_pub_, abort_pub_;
+  ros::Publisher plan_pub_, traj_pub_, params_pub_, abort_pub_, ack_pub_;
   ros::Subscriber odom_sub_, worker_sub_, plans_sub_, params_sub_, command_sub_, wind_sub_, abort_sub_;
   ros::Timer timer_, params_timer_;
 };

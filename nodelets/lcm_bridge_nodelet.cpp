@@ -5,11 +5,13 @@
 //     in a heartbeat sent just before it), formation_params_in, formation_command_in (each sent
 //     ~command_repeats times ~command_repeat_period_s apart: comm::OutgoingRepeats),
 //     gesture_observation_in, abort_in (sent as it comes: the OperatorInterface repeats it), the
-//     leader's accepted abort (abort_relay_in: its AbortState) after every worker state, and a
-//     heartbeat at ~heartbeat_rate_hz.
+//     leader's accepted abort (abort_relay_in: its AbortState) after every worker state, the
+//     leader's command acknowledgements (command_ack_in, repeated like commands), and a heartbeat
+//     at ~heartbeat_rate_hz.
 //   LCM → ROS (what each envelope yields: comm::LinkInbox): worker_state_out, plans_out,
 //     formation_params_out, formation_command_out (first copy of each id, named NAME@ID),
-//     gesture_observations_out, abort_out (every copy; the UAV acts on the first it accepts).
+//     gesture_observations_out, abort_out (every copy; the UAV acts on the first it accepts),
+//     command_ack_out (first copy of each command id).
 // Start-up (keys, boot counter, high-water marks, verifier): lcm_bridge::startLink; stamps use ROS
 // time (sim time in simulation).
 // Parameters (required): ~sender_id, ~known_senders, ~lcm_url, ~channel_prefix, ~key_file
@@ -124,6 +126,10 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     abort_pub_ = nh.advertise<gesture_formation::AbortCommand>("abort_out", 100);
     abort_sub_ = nh.subscribe("abort_in", 100, &LcmBridgeNodelet::onAbort, this);
     relay_sub_ = nh.subscribe("abort_relay_in", 5, &LcmBridgeNodelet::onAbortState, this);
+    ack_pub_ = nh.advertise<gesture_formation::CommandAck>("command_ack_out", 50);
+    ack_sub_ = nh.subscribe<gesture_formation::CommandAck>("command_ack_in", 50, [this](const auto& msg) {
+      sendChecked(toWire(*msg), "command acknowledgement", command_repeats_, command_repeat_period_s_);
+    });
     drain_timer_ = nh.createWallTimer(ros::WallDuration(0.005), [this](const ros::WallTimerEvent&) {
       std::lock_guard<std::mutex> lock(mutex_);
       if (transport_) transport_->drain(kMaxDrainPerTick);
@@ -239,6 +245,10 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
       observations_pub_.publish(fromWire(*o));
     } else if (const auto* a = std::get_if<planning::AbortCommand>(&item)) {
       abort_pub_.publish(toMsg(*a, e.sender_id));  // every copy: the UAV acts on the first it accepts
+    } else if (const auto* k = std::get_if<comm::CommandAckMessage>(&item)) {
+      auto m = fromWire(*k);
+      m.header.stamp = ros::Time(e.stamp_s);
+      ack_pub_.publish(m);
     }
     if (inbox_.lastWasDecodeFailure()) link_->verifier().countDecodeFailure(e.sender_id);
     if (!inbox_.lastRefusal().empty()) {
@@ -283,8 +293,8 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
   static constexpr int kMaxDrainPerTick = 2000;
   lcm_bridge::HighWaterMarkSaver marks_;  ///< high_water_file, saved when the marks changed
   std::optional<comm::RejectionReport> report_;  ///< /diagnostics: counts and refusals since the last report
-  ros::Publisher worker_pub_, plans_pub_, params_pub_, command_pub_, observations_pub_, abort_pub_;
-  ros::Subscriber worker_sub_, plan_sub_, params_sub_, command_sub_, observation_sub_, abort_sub_, relay_sub_;
+  ros::Publisher worker_pub_, plans_pub_, params_pub_, command_pub_, observations_pub_, abort_pub_, ack_pub_;
+  ros::Subscriber worker_sub_, plan_sub_, params_sub_, command_sub_, observation_sub_, abort_sub_, relay_sub_, ack_sub_;
   ros::WallTimer drain_timer_;
   DiagnosticsPublisher diagnostics_;  ///< /diagnostics every wall second (also saves the high-water marks)
   ros::Timer heartbeat_timer_, repeat_timer_;

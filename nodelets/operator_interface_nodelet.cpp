@@ -9,8 +9,14 @@
 // abort) publishes one AbortCommand (source operator, the next sequence number) on abort_out — to
 // the ground station's LcmBridge, which sends every copy to every UAV — ~abort_repeats times,
 // ~abort_repeat_period_s apart, each copy stamped when sent (as gfctl simulate's AbortSender).
+// Acknowledgements (docs/safety.md §2.9): the leader's CommandAck for every command it handled
+// arrives on command_ack_in (the ground LcmBridge); each is logged — the operator's own commands with
+// the time since sending, the worker's gesture commands as such — and republished on command_ack_out
+// (tools/gf_command.py waits there for its command's). A command of its own without an
+// acknowledgement within kAckTimeoutS (5 s) is reported once.
 // Parameters (required): ~sender_name, ~uav_count, ~abort_repeats, ~abort_repeat_period_s; with
 // ~mission_file (simulation; optional ~faults_file) the mission's abort.repeats / repeat_period_s win.
+#include <map>
 #include <mutex>
 
 #include <nodelet/nodelet.h>
@@ -57,6 +63,40 @@ class OperatorInterfaceNodelet : public nodelet::Nodelet {
     abort_pub_ = nh.advertise<gesture_formation::AbortCommand>("abort_out", 20);
     abort_service_ = nh.advertiseService("send_abort", &OperatorInterfaceNodelet::onAbort, this);
     abort_timer_ = nh.createTimer(ros::Duration(abort_period_s_), &OperatorInterfaceNodelet::repeatAbort, this);
+    ack_pub_ = nh.advertise<gesture_formation::CommandAck>("command_ack_out", 20);
+    ack_sub_ = nh.subscribe("command_ack_in", 50, &OperatorInterfaceNodelet::onAck, this);
+    ack_timer_ = nh.createTimer(ros::Duration(0.5), &OperatorInterfaceNodelet::checkAcks, this);
+  }
+
+  // The leader's acknowledgement: ours (the name the leader saw is ours, or ours@LINK_ID over LCM) or the worker's.
+  void onAck(const gesture_formation::CommandAck::ConstPtr& m) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const bool ours = m->source == "operator" && (m->sender == sender_ || m->sender.rfind(sender_ + "@", 0) == 0);
+    const auto sent = ours ? unacked_.find(m->sequence) : unacked_.end();
+    if (sent != unacked_.end()) {
+      NODELET_INFO_STREAM("OperatorInterface: command #" << m->sequence << " acknowledged by the leader "
+                                                         << (ros::Time::now() - sent->second).toSec() << " s after sending: "
+                                                         << m->outcome << " (parameters version " << m->params_version << ")");
+      unacked_.erase(sent);
+    } else if (m->source == "gesture") {
+      NODELET_INFO_STREAM("OperatorInterface: the worker's gesture command " << m->sender << "#" << m->sequence << ": "
+                                                                         << m->outcome << " (parameters version "
+                                                                         << m->params_version << ")");
+    }
+    ack_pub_.publish(*m);
+  }
+  void checkAcks(const ros::TimerEvent&) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const ros::Time now = ros::Time::now();
+    for (auto it = unacked_.begin(); it != unacked_.end();) {
+      if ((now - it->second).toSec() <= kAckTimeoutS) {
+        ++it;
+        continue;
+      }
+      NODELET_WARN_STREAM("OperatorInterface: command #" << it->first << " not acknowledged by the leader within "
+                                                         << kAckTimeoutS << " s (lost on the link, or no leader)");
+      it = unacked_.erase(it);
+    }
   }
 
   bool onAbort(gesture_formation::SendAbort::Request&, gesture_formation::SendAbort::Response& res) {
@@ -100,6 +140,7 @@ class OperatorInterfaceNodelet : public nodelet::Nodelet {
     const auto uavs = cmd->target.resolve(uav_count_);
     if (!uavs) return "target: " + uavs.reason();
     command_pub_.publish(msg);
+    unacked_[msg.sequence] = ros::Time::now();
     if (sequence != nullptr) *sequence = msg.sequence;
     NODELET_INFO_STREAM("OperatorInterface: sent " << msg.target << "." << msg.parameter << " " << msg.kind << " "
                                                    << msg.amount << " (#" << msg.sequence << ")");
@@ -146,10 +187,12 @@ class OperatorInterfaceNodelet : public nodelet::Nodelet {
   double abort_period_s_ = 0.2;
   int abort_copies_left_ = 0;  ///< copies of abort_ still to send
   gesture_formation::AbortCommand abort_;
-  ros::Publisher command_pub_, abort_pub_;
-  ros::Subscriber command_sub_;
+  static constexpr double kAckTimeoutS = 5.0;  ///< a command of ours unacknowledged this long is reported
+  std::map<std::uint64_t, ros::Time> unacked_;  ///< our commands sent and not yet acknowledged
+  ros::Publisher command_pub_, abort_pub_, ack_pub_;
+  ros::Subscriber command_sub_, ack_sub_;
   ros::ServiceServer service_, abort_service_;
-  ros::Timer abort_timer_;
+  ros::Timer abort_timer_, ack_timer_;
 };
 
 }  // namespace gesture_formation::nodelets

@@ -12,10 +12,16 @@ a view adaptation (gesture_formation/SendCommand) or an abort (gesture_formation
 
   e.g. tools/gf_command.py followers distance_m 1      tools/gf_command.py leader beta_deg 120 --set
        tools/gf_command.py abort
-Exit 0 when the command was sent, 1 when refused (the reason is printed), 2 on bad arguments
-or when the service is unreachable."""
+A view adaptation then waits (--ack-timeout, 5 s; 0: do not wait) for the leader's acknowledgement
+(docs/safety.md §2.9), which the OperatorInterface republishes on --ack-topic (default: the
+service's namespace + /command_ack), and prints what became of the command.
+Exit 0 when the command was sent (and acknowledged as applied or duplicate), 1 when refused by the
+interface or rejected by the leader (the reason is printed), 2 on bad arguments or when the service
+is unreachable, 3 when no acknowledgement came in time."""
 import argparse
 import sys
+import threading
+import time
 
 
 def call(service, srv_type, timeout, *args):
@@ -27,6 +33,36 @@ def call(service, srv_type, timeout, *args):
     except (rospy.ROSException, rospy.ServiceException) as e:
         print(f"gf_command: {service}: {e}", file=sys.stderr)
         return None
+
+
+class AckWaiter:
+    """Subscribes (before the command is sent) to the acknowledgements the OperatorInterface
+    republishes and hands out the one of a sequence number."""
+
+    def __init__(self, topic):
+        import rospy
+        from gesture_formation.msg import CommandAck
+        rospy.init_node("gf_command", anonymous=True, disable_signals=True)
+        self._acks = {}
+        self._cond = threading.Condition()
+        self._sub = rospy.Subscriber(topic, CommandAck, self._on_ack, queue_size=50)
+        deadline = time.monotonic() + 2.0  # the connection to the interface's publisher
+        while self._sub.get_num_connections() == 0 and time.monotonic() < deadline:
+            time.sleep(0.02)
+
+    def _on_ack(self, m):
+        if m.source != "operator":
+            return
+        with self._cond:
+            self._acks[m.sequence] = m
+            self._cond.notify_all()
+
+    def wait(self, sequence, timeout_s):
+        deadline = time.monotonic() + timeout_s
+        with self._cond:
+            while sequence not in self._acks and time.monotonic() < deadline:
+                self._cond.wait(timeout=max(0.0, deadline - time.monotonic()))
+            return self._acks.get(sequence)
 
 
 def main():
@@ -41,6 +77,9 @@ def main():
         ap.add_argument("amount", type=float)
         ap.add_argument("--set", action="store_true", help="set the value instead of incrementing it")
         ap.add_argument("--service", default="/operator/send_command")
+        ap.add_argument("--ack-timeout", type=float, default=5.0,
+                        help="wait this long for the leader's acknowledgement [s, wall]; 0: do not wait")
+        ap.add_argument("--ack-topic", default=None, help="the OperatorInterface's command_ack_out topic")
     ap.add_argument("--timeout", type=float, default=5.0, help="wait this long for the service [s]")
     a = ap.parse_args()
     try:
@@ -56,12 +95,21 @@ def main():
             print(f"abort sent #{res.sequence} ({res.copies} copies)")
             return 0
     else:
+        acks = AckWaiter(a.ack_topic or a.service.rsplit("/", 1)[0] + "/command_ack") if a.ack_timeout > 0 else None
         res = call(a.service, SendCommand, a.timeout, a.target, a.parameter, "set" if a.set else "increment", a.amount)
         if res is None:
             return 2
         if res.accepted:
-            print(f"sent #{res.sequence}: {a.target}.{a.parameter} {'=' if a.set else '+='} {a.amount:g}")
-            return 0
+            print(f"sent #{res.sequence}: {a.target}.{a.parameter} {'=' if a.set else '+='} {a.amount:g}", flush=True)
+            if acks is None:
+                return 0
+            ack = acks.wait(res.sequence, a.ack_timeout)
+            if ack is None:
+                print(f"no acknowledgement from the leader within {a.ack_timeout:g} s (lost on the link, or no leader)",
+                      file=sys.stderr)
+                return 3
+            print(f"acknowledged by the leader: {ack.outcome} (parameters version {ack.params_version})")
+            return 1 if ack.status == "rejected" else 0
     print(f"refused: {res.message}", file=sys.stderr)
     return 1
 

@@ -50,6 +50,7 @@ PACKAGES=(
   python3-cryptography faketime                 # the attacker test (test/ros/link_attack.sh): its own Ed25519/HMAC envelope builder; a sender restarted with its clock set back
   libcereal-dev libsimde-dev
   python3-venv python3-pip python3-yaml python3-numpy
+  python3-matplotlib                            # the installed review tools (plot_timeline.py …) outside the tools venv
   opencv-doc
   rviz xvfb xauth imagemagick graphviz iproute2
   clang libclang-rt-14-dev                      # libFuzzer + ASan/UBSan runtimes for fuzz/ (tools/fuzz/run_fuzzers.sh)

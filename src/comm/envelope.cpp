@@ -16,6 +16,7 @@ const char* toString(MessageType type) {
     case MessageType::kFormationCommand: return "formation_command";
     case MessageType::kGestureObservation: return "gesture_observation";
     case MessageType::kAbortCommand: return "abort_command";
+    case MessageType::kCommandAck: return "command_ack";
   }
   return "unknown";
 }

@@ -67,6 +67,18 @@ InboxItem LinkInbox::decodeOne(const Envelope& e) {
       if (decoder_.decode(e, a)) return a.command(e.stamp_s);
       return {};
     }
+    case MessageType::kCommandAck: {
+      CommandAckMessage a;
+      if (!decoder_.decode(e, a)) return {};
+      auto key = std::make_pair(a.id.sender, a.id.sequence);
+      if (!acks_seen_.insert(key).second) return {};  // a later copy
+      acks_order_.push_back(std::move(key));
+      if (acks_order_.size() > kAckMemory) {
+        acks_seen_.erase(acks_order_.front());
+        acks_order_.pop_front();
+      }
+      return a;
+    }
   }
   return {};
 }

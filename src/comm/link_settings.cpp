@@ -43,12 +43,17 @@ VerifierConfig verifierConfigOf(const LinkSettings& s, std::vector<common::Confi
     if ((*list)->empty()) problems.push_back({key, "must list at least one sender id (omit it to allow every known sender)"});
     senderList(key, **list, s.sender_id, c.senders_by_type[type], problems);  // own id only → empty: no one else
   }
+  // Command acknowledgements come from the parameter owner: the senders of formation parameters.
+  if (const auto owners = c.senders_by_type.find(MessageType::kFormationParams); owners != c.senders_by_type.end()) {
+    c.senders_by_type[MessageType::kCommandAck] = owners->second;
+  }
   c.own_sender_id = static_cast<std::uint16_t>(std::clamp(s.sender_id, 0, 65535));
   c.max_age_s = age.contains(s.max_age_s) ? s.max_age_s : defaults.max_age_s;
   c.max_age_s_by_type[MessageType::kHeartbeat] = std::max(c.max_age_s, 2.0);
   c.max_age_s_by_type[MessageType::kFormationCommand] =
       age.contains(s.command_max_age_s) ? s.command_max_age_s : defaults.command_max_age_s;
   c.max_age_s_by_type[MessageType::kAbortCommand] = c.max_age_s_by_type[MessageType::kFormationCommand];
+  c.max_age_s_by_type[MessageType::kCommandAck] = c.max_age_s_by_type[MessageType::kFormationCommand];
   c.max_rate_hz = s.max_rate_hz;
   c.burst = s.burst;
   for (const auto& e : c.validate()) problems.push_back({"verifier", e});

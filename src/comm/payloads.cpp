@@ -592,4 +592,86 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, AbortMess
   return d.report(reason);
 }
 
+// ---- command acknowledgement: u8 sender length, sender bytes, u64 sequence, u8 source (0 operator,
+// 1 gesture), u8 status (0 applied, 1 duplicate, 2 rejected), u64 params version, f64 command stamp,
+// u8 outcome length, outcome bytes (UTF-8, no control characters) ----------------------------
+
+namespace {
+
+bool validOutcomeText(const std::string& s) {
+  if (s.size() > kMaxAckOutcomeBytes) return false;
+  for (char c : s) {
+    const auto b = static_cast<unsigned char>(c);
+    if (b < 0x20 || b == 0x7f) return false;
+  }
+  return true;
+}
+
+std::uint8_t wireStatus(formation::CommandStatus s) {
+  switch (s) {
+    case formation::CommandStatus::kApplied: return 0;
+    case formation::CommandStatus::kDuplicate: return 1;
+    case formation::CommandStatus::kRejected: return 2;
+  }
+  return 2;
+}
+
+}  // namespace
+
+EncodeResult encodePayload(const CommandAckMessage& m) {
+  if (!validSenderName(m.id.sender)) {
+    return EncodeResult::fail("command_ack.id.sender must be 1.." + std::to_string(kMaxSenderNameBytes) +
+                              " printable ASCII characters without spaces");
+  }
+  if (!std::isfinite(m.command_stamp_s)) return EncodeResult::fail("command_ack.command_stamp_s must be finite");
+  if (!validOutcomeText(m.outcome)) {
+    return EncodeResult::fail("command_ack.outcome must be at most " + std::to_string(kMaxAckOutcomeBytes) +
+                              " bytes without control characters (" + std::to_string(m.outcome.size()) + " bytes)");
+  }
+  ByteWriter w;
+  w.u8(static_cast<std::uint8_t>(m.id.sender.size()));
+  w.bytes(reinterpret_cast<const std::uint8_t*>(m.id.sender.data()), m.id.sender.size());
+  w.u64(m.id.sequence);
+  w.u8(m.source == formation::CommandSource::kGesture ? 1 : 0);
+  w.u8(wireStatus(m.status));
+  w.u64(m.params_version);
+  w.f64(m.command_stamp_s);
+  w.u8(static_cast<std::uint8_t>(m.outcome.size()));
+  w.bytes(reinterpret_cast<const std::uint8_t*>(m.outcome.data()), m.outcome.size());
+  return EncodeResult::ok(w.release());
+}
+
+PayloadError decodePayload(const std::uint8_t* data, std::size_t size, CommandAckMessage& out, std::string* reason) {
+  Decoder d(data, size);
+  CommandAckMessage m;
+  std::uint8_t name_len = 0, source = 0, status = 0, outcome_len = 0;
+  if (d.u8(name_len, "command_ack.id.sender_length") && (name_len == 0 || name_len > kMaxSenderNameBytes)) {
+    d.fail(name_len == 0 ? PayloadError::kOutOfRange : PayloadError::kOversizeArray, "command_ack.id.sender_length");
+  }
+  const std::uint8_t* bytes = nullptr;
+  if (d.bytes(name_len, bytes, "command_ack.id.sender")) {
+    m.id.sender.assign(reinterpret_cast<const char*>(bytes), name_len);
+    if (!validSenderName(m.id.sender)) d.fail(PayloadError::kOutOfRange, "command_ack.id.sender");
+  }
+  d.u64(m.id.sequence, "command_ack.id.sequence");
+  if (d.u8(source, "command_ack.source") && source > 1) d.fail(PayloadError::kOutOfRange, "command_ack.source");
+  if (d.u8(status, "command_ack.status") && status > 2) d.fail(PayloadError::kOutOfRange, "command_ack.status");
+  d.u64(m.params_version, "command_ack.params_version");
+  d.f64(m.command_stamp_s, "command_ack.command_stamp_s");
+  if (d.u8(outcome_len, "command_ack.outcome_length") && outcome_len > kMaxAckOutcomeBytes) {
+    d.fail(PayloadError::kOversizeArray, "command_ack.outcome_length");
+  }
+  if (d.bytes(outcome_len, bytes, "command_ack.outcome")) {
+    m.outcome.assign(reinterpret_cast<const char*>(bytes), outcome_len);
+    if (!validOutcomeText(m.outcome)) d.fail(PayloadError::kOutOfRange, "command_ack.outcome");
+  }
+  if (d.finish()) {
+    m.source = source == 1 ? formation::CommandSource::kGesture : formation::CommandSource::kOperator;
+    m.status = status == 0 ? formation::CommandStatus::kApplied
+                           : (status == 1 ? formation::CommandStatus::kDuplicate : formation::CommandStatus::kRejected);
+    out = std::move(m);
+  }
+  return d.report(reason);
+}
+
 }  // namespace gesture_formation::comm

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -254,7 +255,7 @@ int cmdDetect(const Args& args) {
             << ", identities " << c.identities << ", lost " << c.lost << "; per frame median "
             << fmt(sorted[sorted.size() / 2]) << " ms, mean " << fmt(sum_ms / static_cast<double>(frames)) << " ms ("
             << (*pipeline)->tracker().detector().name() << " + " << toString(cfg.tracker.tracker) << " + "
-            << (*pipeline)->skeletonExtractor().name() << ")\n";
+            << (*pipeline)->skeletonExtractor().name() << "; models " << cfg.models_root << ")\n";
   return kExitOk;
 }
 
@@ -264,6 +265,14 @@ std::string modelsRoot(const Args& args) {
   if (args.has("models")) return args.get("models");
   const char* env = std::getenv("GF_MODELS_DIR");
   if (env != nullptr && *env != '\0') return env;
+  // An installed gfctl (<prefix>/lib/gesture_formation/gfctl) uses its package's share directory,
+  // whether or not the source tree it was built from still exists.
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const auto share = exe.parent_path().parent_path().parent_path() / "share" / "gesture_formation" / "third_party_models";
+    if (std::filesystem::is_directory(share, ec)) return share.string();
+  }
 #ifdef GF_DEFAULT_MODELS_DIR
   return GF_DEFAULT_MODELS_DIR;
 #else

@@ -40,7 +40,8 @@ struct Registrar {
   Registrar(const char* name, const char* usage, CommandFn run) { commandRegistry().push_back({name, usage, run}); }
 };
 
-/// \brief Where the models are: --models, else $GF_MODELS_DIR, else the source tree's
+/// \brief Where the models are: --models, else $GF_MODELS_DIR, else the install space's
+/// share/gesture_formation/third_party_models next to this executable, else the source tree's
 /// third_party_models (set by CMake), else ./third_party_models.
 std::string modelsRoot(const Args& args);
 

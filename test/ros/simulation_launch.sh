@@ -20,7 +20,8 @@ for _ in \$(seq 50); do rosparam get /use_sim_time > /dev/null 2>&1 && break; sl
 timeout 80 python3 "$SRC/test/ros/sim_check.py"
 rc=\$?
 timeout 20 python3 "$SRC/test/ros/diagnostics_check.py" || rc=\$((rc+1))
-# The operator's CLI: a valid command is sent (and reaches follower 2 over LCM), a bad one refused.
+# The operator's CLI: a valid command is sent (reaches follower 2 over LCM and is acknowledged by
+# the leader), a bad one refused.
 # The mission's own request at t = 20 s (all.distance_m -1) changes the distances too: the command
 # is sent once that request has been applied (sim time >= 21 s; the next request is at 40 s), and
 # follower 2's distance must go from its value then (8 = 8 + 1 (gesture) - 1 (request)) up by 1.
@@ -43,7 +44,11 @@ after = [d for d in seen[n:] if d != before]
 print(before, after[0] if after else None)" > "$T/d2.txt" 2>/dev/null &
 watch=\$!
 for _ in \$(seq 400); do [ -f "$T/d2.ready" ] && break; sleep 0.1; done
-python3 "$SRC/tools/gf_command.py" followers distance_m 1 || { echo "FAIL: gf_command.py followers distance_m 1"; rc=\$((rc+1)); }
+python3 "$SRC/tools/gf_command.py" followers distance_m 1 > "$T/ack.txt" 2>&1 || { echo "FAIL: gf_command.py followers distance_m 1: \$(cat "$T/ack.txt")"; rc=\$((rc+1)); }
+# ... and the leader acknowledges it over LCM (docs/safety.md §2.9): gf_command.py prints the outcome.
+grep -q "^acknowledged by the leader: applied (parameters version [0-9]*)$" "$T/ack.txt" \
+  && echo "PASS: the leader acknowledged the operator's command: \$(tail -1 "$T/ack.txt")" \
+  || { echo "FAIL: no acknowledgement of the operator's command: \$(cat "$T/ack.txt")"; rc=\$((rc+1)); }
 wait \$watch
 d2=\$(cat "$T/d2.txt")
 [ "\$d2" = "8.0 9.0" ] && echo "PASS: operator command via tools/gf_command.py at sim t >= 21 s: follower 2 d 8.0 -> 9.0 m over LCM" \

@@ -7,11 +7,14 @@
 /// comm::CommandIntake (first copy of each id, name bound to the envelope sender), gesture
 /// observations refused when the observing UAV is not the envelope's sender or the frame time is
 /// not a valid time, abort commands handed on at every copy with sent_s = the envelope's stamp (the
-/// UAV's ReplanStep acts on the first it accepts; docs/safety.md §2.8).
+/// UAV's ReplanStep acts on the first it accepts; docs/safety.md §2.8), command acknowledgements
+/// handed on once per command id (the leader repeats them like commands; docs/safety.md §2.9).
 /// Thread safety: none (the caller's lock).
 
 #include <cstdint>
+#include <deque>
 #include <map>
+#include <set>
 #include <string>
 #include <variant>
 
@@ -30,7 +33,8 @@ struct ReceivedPlanMessage {
 /// \brief What one envelope yields to hand on (monostate: nothing — a heartbeat, a command's copy,
 /// a refusal).
 using InboxItem = std::variant<std::monostate, WorkerStateMessage, ReceivedPlanMessage, formation::FormationParams,
-                               formation::FormationCommand, GestureObservationMessage, planning::AbortCommand>;
+                               formation::FormationCommand, GestureObservationMessage, planning::AbortCommand,
+                               CommandAckMessage>;
 
 class LinkInbox {
  public:
@@ -52,6 +56,10 @@ class LinkInbox {
   PayloadDecoder decoder_;
   CommandIntake intake_;
   std::map<std::uint16_t, Heartbeat> peers_;  ///< each sender's last heartbeat
+  /// The ids of the last kAckMemory acknowledgements handed on (later copies are dropped).
+  static constexpr std::size_t kAckMemory = 256;
+  std::set<std::pair<std::string, std::uint64_t>> acks_seen_;
+  std::deque<std::pair<std::string, std::uint64_t>> acks_order_;
   std::uint64_t observations_refused_ = 0;
   std::string last_refusal_;
   bool last_decode_failure_ = false;

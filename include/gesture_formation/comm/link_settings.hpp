@@ -24,7 +24,8 @@ struct LinkSettings {
   int recv_buf_bytes = 4194304;         ///< UDP receive buffer to ask for, ≥ 65536
   double max_rate_hz = 400.0;           ///< per-sender verification budget
   double burst = 200.0;
-  /// Who may send formation commands / parameters / abort commands (absent: any known sender).
+  /// Who may send formation commands / parameters / abort commands (absent: any known sender);
+  /// command acknowledgements (MessageType::kCommandAck) come from the params_senders.
   std::optional<std::vector<int>> command_senders, params_senders, abort_senders;
 };
 

@@ -104,6 +104,23 @@ struct AbortMessage {
   planning::AbortCommand command(double sent_s) const { return planning::AbortCommand{id, source, sent_s}; }
 };
 
+/// Largest outcome text of a command acknowledgement [bytes].
+constexpr std::size_t kMaxAckOutcomeBytes = 255;
+
+/// \brief The leader's acknowledgement of a formation command it handled (docs/safety.md §2.9):
+/// which command, what became of it and the parameter version it left. Sent by the parameter owner
+/// (link setting params_senders) like a command: repeated, acted on once per id.
+struct CommandAckMessage {
+  formation::CommandId id;  ///< the command's id (sender name as in the command, sequence)
+  formation::CommandSource source = formation::CommandSource::kOperator;
+  formation::CommandStatus status = formation::CommandStatus::kRejected;
+  std::uint64_t params_version = 0;  ///< the leader's parameter version after handling it
+  double command_stamp_s = 0.0;      ///< the command's stamp (sent by the operator / fired by the gesture filter)
+  /// formation::CommandOutcome::describe() (status, reason, clamps): 0..kMaxAckOutcomeBytes bytes,
+  /// UTF-8 text without control characters.
+  std::string outcome;
+};
+
 /// Largest gesture id and number of class probabilities on the wire.
 constexpr int kMaxGestureId = 15;
 constexpr std::size_t kMaxGestureClasses = 16;
@@ -131,6 +148,7 @@ common::Result<std::vector<std::uint8_t>> encodePayload(const formation::Formati
 common::Result<std::vector<std::uint8_t>> encodePayload(const formation::FormationCommand& m);
 common::Result<std::vector<std::uint8_t>> encodePayload(const GestureObservationMessage& m);
 common::Result<std::vector<std::uint8_t>> encodePayload(const AbortMessage& m);
+common::Result<std::vector<std::uint8_t>> encodePayload(const CommandAckMessage& m);
 
 /// \brief The envelope type of each payload.
 inline MessageType messageTypeOf(const Heartbeat&) { return MessageType::kHeartbeat; }
@@ -140,6 +158,7 @@ inline MessageType messageTypeOf(const formation::FormationParams&) { return Mes
 inline MessageType messageTypeOf(const formation::FormationCommand&) { return MessageType::kFormationCommand; }
 inline MessageType messageTypeOf(const GestureObservationMessage&) { return MessageType::kGestureObservation; }
 inline MessageType messageTypeOf(const AbortMessage&) { return MessageType::kAbortCommand; }
+inline MessageType messageTypeOf(const CommandAckMessage&) { return MessageType::kCommandAck; }
 
 // ---- decoders: `out` written only on kNone; `reason` (optional) names the field ---------
 PayloadError decodePayload(const std::uint8_t* data, std::size_t size, Heartbeat& out, std::string* reason = nullptr);
@@ -154,6 +173,8 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, formation
 PayloadError decodePayload(const std::uint8_t* data, std::size_t size, GestureObservationMessage& out,
                            std::string* reason = nullptr);
 PayloadError decodePayload(const std::uint8_t* data, std::size_t size, AbortMessage& out, std::string* reason = nullptr);
+PayloadError decodePayload(const std::uint8_t* data, std::size_t size, CommandAckMessage& out,
+                           std::string* reason = nullptr);
 
 /// \brief One counter per PayloadError (kNone counts successful decodes).
 struct PayloadCounters {

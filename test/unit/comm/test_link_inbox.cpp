@@ -99,6 +99,30 @@ TEST(LinkInboxTest, EveryAbortCopyIsHandedOnStampedWithItsEnvelope) {
   }
 }
 
+TEST(LinkInboxTest, AnAcknowledgementIsHandedOnOncePerCommandId) {
+  LinkInbox inbox;
+  CommandAckMessage a;
+  a.id = {"operator@100", 41};
+  a.status = formation::CommandStatus::kApplied;
+  a.params_version = 3;
+  a.outcome = "applied";
+  const auto first = inbox.take(envelopeOf(a, 0, 20.0));
+  ASSERT_TRUE(std::holds_alternative<CommandAckMessage>(first));
+  EXPECT_EQ(std::get<CommandAckMessage>(first).params_version, 3u);
+  EXPECT_TRUE(std::holds_alternative<std::monostate>(inbox.take(envelopeOf(a, 0, 20.1))));  // the leader's repeat
+  a.id.sequence = 42;
+  EXPECT_TRUE(std::holds_alternative<CommandAckMessage>(inbox.take(envelopeOf(a, 0, 20.2))));
+  // The memory is bounded: after 256 other ids the first is forgotten (handed on again).
+  for (std::uint64_t s = 100; s < 100 + 256; ++s) {
+    a.id.sequence = s;
+    inbox.take(envelopeOf(a, 0, 21.0));
+  }
+  a.id.sequence = 41;
+  EXPECT_TRUE(std::holds_alternative<CommandAckMessage>(inbox.take(envelopeOf(a, 0, 22.0))));
+  a.id.sequence = 100 + 255;
+  EXPECT_TRUE(std::holds_alternative<std::monostate>(inbox.take(envelopeOf(a, 0, 22.1))));  // still remembered
+}
+
 TEST(LinkInboxTest, AnUndecodablePayloadIsADecodeFailureNamingTheField) {
   LinkInbox inbox;
   Envelope e = envelopeOf(plan(1), 1);

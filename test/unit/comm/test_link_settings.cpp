@@ -41,6 +41,22 @@ TEST(LinkSettingsTest, AGoodSettingGivesTheBridgesVerifier) {
   EXPECT_EQ(c.senders_by_type.count(MessageType::kAbortCommand), 0u);  // absent: any known sender
 }
 
+// Acknowledgements come from the parameter owner: the params_senders, with the command age limit.
+TEST(LinkSettingsTest, AcknowledgementsComeFromTheParamsSenders) {
+  LinkSettings s;
+  s.sender_id = 100;
+  s.known_senders = {0, 1, 2, 100};
+  s.command_max_age_s = 4.0;
+  s.params_senders = std::vector<int>{0};
+  std::vector<ConfigError> problems;
+  const VerifierConfig c = verifierConfigOf(s, problems);
+  EXPECT_TRUE(problems.empty());
+  EXPECT_EQ(c.senders_by_type.at(MessageType::kCommandAck), (std::vector<std::uint16_t>{0}));
+  EXPECT_DOUBLE_EQ(c.max_age_s_by_type.at(MessageType::kCommandAck), 4.0);
+  s.params_senders.reset();
+  EXPECT_EQ(verifierConfigOf(s, problems).senders_by_type.count(MessageType::kCommandAck), 0u);  // any known sender
+}
+
 // Aborts come from the ground station and the leader's relay: their own sender list.
 TEST(LinkSettingsTest, AbortSendersAreTheirOwnList) {
   LinkSettings s;

@@ -311,6 +311,82 @@ TEST(CommPayloadsTest, AbortCommandRefusals) {
   EXPECT_EQ(d.id.sender, "untouched");  // written only on success
 }
 
+TEST(CommPayloadsTest, CommandAckRoundTripAndByteLayout) {
+  CommandAckMessage m;
+  m.id = {"op@100", 0x0102030405060708ull};
+  m.source = formation::CommandSource::kGesture;
+  m.status = formation::CommandStatus::kDuplicate;
+  m.params_version = 7;
+  m.command_stamp_s = 2.0;
+  m.outcome = "dup";
+  const auto b = encoded(m);
+  // u8 length, sender, u64 sequence, u8 source, u8 status, u64 version, f64 stamp, u8 length, outcome
+  const std::vector<std::uint8_t> expected{6, 'o', 'p', '@', '1', '0', '0', 1, 2, 3, 4, 5, 6, 7, 8, 1, 1,
+                                           0, 0, 0, 0, 0, 0, 0, 7, 0x40, 0, 0, 0, 0, 0, 0, 0, 3, 'd', 'u', 'p'};
+  EXPECT_EQ(b, expected);
+  CommandAckMessage d;
+  ASSERT_EQ(decode(b, d), PayloadError::kNone);
+  EXPECT_EQ(d.id.sender, "op@100");
+  EXPECT_EQ(d.id.sequence, m.id.sequence);
+  EXPECT_EQ(d.source, formation::CommandSource::kGesture);
+  EXPECT_EQ(d.status, formation::CommandStatus::kDuplicate);
+  EXPECT_EQ(d.params_version, 7u);
+  EXPECT_EQ(d.command_stamp_s, 2.0);
+  EXPECT_EQ(d.outcome, "dup");
+  // Every status and an outcome with UTF-8 (the clamp rules name γ) and no text at all.
+  for (const auto status : {formation::CommandStatus::kApplied, formation::CommandStatus::kRejected}) {
+    m.status = status;
+    m.outcome = status == formation::CommandStatus::kApplied ? "applied (clamped by limits.\xce\xb3_max)" : "";
+    ASSERT_EQ(decode(encoded(m), d), PayloadError::kNone);
+    EXPECT_EQ(d.status, status);
+    EXPECT_EQ(d.outcome, m.outcome);
+  }
+}
+
+TEST(CommPayloadsTest, CommandAckRefusals) {
+  CommandAckMessage m;
+  m.id = {"has space", 1};
+  EXPECT_FALSE(encodePayload(m));
+  m.id.sender = "op";
+  m.outcome = "line\nbreak";
+  auto e = encodePayload(m);
+  ASSERT_FALSE(e);
+  EXPECT_NE(e.reason().find("command_ack.outcome"), std::string::npos) << e.reason();
+  m.outcome = std::string(kMaxAckOutcomeBytes + 1, 'a');
+  EXPECT_FALSE(encodePayload(m));
+  m.outcome = "ok";
+  m.command_stamp_s = std::nan("");
+  EXPECT_FALSE(encodePayload(m));
+  m.command_stamp_s = 1.0;
+  const auto b = encoded(m);
+  CommandAckMessage d;
+  d.outcome = "untouched";
+  const std::size_t source_at = 1 + 2 + 8, status_at = source_at + 1, stamp_at = status_at + 1 + 8;
+  auto bad = b;
+  bad[source_at] = 2;
+  std::string reason;
+  EXPECT_EQ(decodePayload(bad.data(), bad.size(), d, &reason), PayloadError::kOutOfRange);
+  EXPECT_NE(reason.find("command_ack.source"), std::string::npos) << reason;
+  bad = b;
+  bad[status_at] = 3;
+  EXPECT_EQ(decodePayload(bad.data(), bad.size(), d, &reason), PayloadError::kOutOfRange);
+  EXPECT_NE(reason.find("command_ack.status"), std::string::npos) << reason;
+  bad = b;
+  for (std::size_t k = 0; k < 8; ++k) bad[stamp_at + k] = 0xff;  // NaN
+  EXPECT_EQ(decode(bad, d), PayloadError::kNonFinite);
+  bad = b;
+  bad[bad.size() - 2] = 0x07;  // a control character in the outcome
+  EXPECT_EQ(decodePayload(bad.data(), bad.size(), d, &reason), PayloadError::kOutOfRange);
+  EXPECT_NE(reason.find("command_ack.outcome"), std::string::npos) << reason;
+  bad = b;
+  bad.push_back('x');
+  EXPECT_EQ(decode(bad, d), PayloadError::kTrailingBytes);
+  bad = b;
+  bad.pop_back();
+  EXPECT_EQ(decode(bad, d), PayloadError::kTruncated);
+  EXPECT_EQ(d.outcome, "untouched");  // written only on success
+}
+
 TEST(CommPayloadsTest, FormationCommandRefusals) {
   auto c = command();
   c.amount = kNaN;
