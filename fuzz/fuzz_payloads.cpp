@@ -41,6 +41,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     roundTrip<AbortMessage>(payload, n);
     return 0;
   }
+  if (data[0] == 252) {  // (before the assistance payload a planned trajectory, as 252 % 5)
+    roundTrip<AssistanceMessage>(payload, n);
+    return 0;
+  }
   if (data[0] == 253) {  // (before the acknowledgement payload a formation params, as 253 % 5)
     roundTrip<CommandAckMessage>(payload, n);
     return 0;

@@ -16,6 +16,7 @@
 #include <trajectory_msgs/MultiDOFJointTrajectory.h>
 
 #include "gesture_formation/AbortCommand.h"
+#include "gesture_formation/AssistanceState.h"
 #include "gesture_formation/CommandAck.h"
 #include "gesture_formation/AbortState.h"
 #include "gesture_formation/FormationCommand.h"
@@ -385,6 +386,29 @@ inline gesture_formation::CommandAck fromWire(const comm::CommandAckMessage& a) 
   m.params_version = a.params_version;
   m.command_stamp = ros::Time(std::max(a.command_stamp_s, 0.0));
   return m;
+}
+
+inline gesture_formation::AssistanceState toMsg(const formation::AssistanceState& a, const ros::Time& now) {
+  gesture_formation::AssistanceState m;
+  m.header.stamp = now;
+  m.phase = static_cast<std::uint8_t>(a.phase);
+  m.requested_at = ros::Time(std::max(a.requested_s, 0.0));
+  m.requested_by = a.requested_by;
+  m.acknowledged_at = ros::Time(std::max(a.acknowledged_s, 0.0));
+  m.acknowledged_by = a.acknowledged_by;
+  return m;
+}
+/// An assistance state from ROS as it travels; fails naming the field.
+inline common::Result<comm::AssistanceMessage> toWire(const gesture_formation::AssistanceState& m) {
+  using R = common::Result<comm::AssistanceMessage>;
+  if (m.phase > gesture_formation::AssistanceState::PHASE_ACKNOWLEDGED) {
+    return R::fail("phase: " + std::to_string(m.phase) + " is not 0 (none), 1 (requested) or 2 (acknowledged)");
+  }
+  comm::AssistanceMessage wire{formation::AssistanceState{static_cast<formation::AssistancePhase>(m.phase),
+                                                          m.requested_at.toSec(), m.requested_by,
+                                                          m.acknowledged_at.toSec(), m.acknowledged_by}};
+  if (auto e = comm::encodePayload(wire); !e) return R::fail(e.reason());  // the wire's rules
+  return R::ok(std::move(wire));
 }
 
 inline std::uint8_t toMsgPhase(planning::AbortPhase p) {

@@ -16,7 +16,9 @@
 //   → plan_out (PlannedTrajectory; mode track | hold | search | abort and its reason), trajectory_out
 //   (trajectory_msgs/MultiDOFJointTrajectory), formation_params_out (leader, latched), abort_state_out
 //   (AbortState, latched: on acceptance and at every replanning while aborting; docs/safety.md §2.8),
-//   command_ack_out (leader: CommandAck per command handled, to the operator; docs/safety.md §2.9).
+//   command_ack_out (leader: CommandAck per command handled, to the operator; docs/safety.md §2.9);
+//   leader: assistance_in (AssistanceState: the worker's request, the operator's acknowledgement) →
+//   assistance_state_out (latched; while requested the worker's gesture commands are refused, §2.10).
 // Parameters (all required unless noted): ~uav_index, ~uav_count, ~world_frame, ~scenario_file
 //   (the map), ~params_rate_hz, ~max_wind_estimate_age_s, and the settings of
 //   loadPlannerSettings (config_sources.hpp): ~mission_file (optional; simulation: the mission's
@@ -101,6 +103,9 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
       params_pub_ = nh.advertise<gesture_formation::FormationParams>("formation_params_out", 5, true);
       command_sub_ = nh.subscribe("formation_command_in", 20, &FormationPlannerNodelet::onCommand, this);
       ack_pub_ = nh.advertise<gesture_formation::CommandAck>("command_ack_out", 20);
+      assistance_pub_ = nh.advertise<gesture_formation::AssistanceState>("assistance_state_out", 5, true);
+      assistance_pub_.publish(toMsg(role_->assistance().state(), ros::Time::now()));
+      assistance_sub_ = nh.subscribe("assistance_in", 20, &FormationPlannerNodelet::onAssistance, this);
       params_timer_ = nh.createTimer(ros::Duration(1.0 / params_rate_hz), [this](const ros::TimerEvent&) {
         std::lock_guard<std::mutex> lock(mutex_);
         publishParams();
@@ -167,6 +172,20 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     NODELET_INFO_STREAM("FormationPlanner: command " << r.text << " → " << r.outcome);
     publishParams();
     ack_pub_.publish(toAck(*msg, r.status, r.outcome, role_->version(), ros::Time::now()));  // to the operator
+  }
+  // The worker's request (GestureCommander) or the operator's acknowledgement (over LCM) → the latch.
+  void onAssistance(const gesture_formation::AssistanceState::ConstPtr& m) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto& latch = role_->assistance();
+    const bool changed = m->phase == m->PHASE_REQUESTED ? latch.request(m->requested_at.toSec(), m->requested_by)
+                         : m->phase == m->PHASE_ACKNOWLEDGED
+                             ? latch.acknowledge(m->requested_at.toSec(), m->acknowledged_at.toSec(), m->acknowledged_by)
+                             : false;
+    if (!changed) return;
+    NODELET_WARN_STREAM("FormationPlanner: assistance " << formation::toString(latch.state().phase) << " (requested at "
+                                                        << latch.state().requested_s << " s by " << latch.state().requested_by
+                                                        << "; the worker's gestures are refused while requested)");
+    assistance_pub_.publish(toMsg(latch.state(), ros::Time::now()));
   }
   void publishParams() {
     const onboard::CommandRecord& r = role_->last();
@@ -292,8 +311,8 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   std::optional<gesture_formation::WorkerState> worker_;
   std::vector<std::optional<planning::ReceivedPlan>> received_;  ///< by sender; [0] the leader's plan
   int abort_link_sender_ = -1;  ///< who delivered the accepted abort (LCM sender id; -1: ROS)
-  ros::Publisher plan_pub_, traj_pub_, params_pub_, abort_pub_, ack_pub_;
-  ros::Subscriber odom_sub_, worker_sub_, plans_sub_, params_sub_, command_sub_, wind_sub_, abort_sub_;
+  ros::Publisher plan_pub_, traj_pub_, params_pub_, abort_pub_, ack_pub_, assistance_pub_;
+  ros::Subscriber odom_sub_, worker_sub_, plans_sub_, params_sub_, command_sub_, wind_sub_, abort_sub_, assistance_sub_;
   ros::Timer timer_, params_timer_;
 };
 

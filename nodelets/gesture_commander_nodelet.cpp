@@ -14,7 +14,9 @@
 // Topics: observation_in (GestureObservation: the leader's own ViewObserver), peer_observations_in
 //   (GestureObservation: the followers', from the LcmBridge) → formation_command_out
 //   (FormationCommand), abort_out (AbortCommand, source gesture: a fired {event: abort}; to the
-//   leader's FormationPlanner), gesture_status_out (GestureStatus, one per fused frame).
+//   leader's FormationPlanner), assistance_out (AssistanceState PHASE_REQUESTED: a fired
+//   {event: assist_requested}; to the leader's FormationPlanner), gesture_status_out (GestureStatus,
+//   one per fused frame).
 // Parameters (required): ~gesture_config (config/gestures.yaml: filter, mapping, view_fusion.*)
 //   or ~mission_file (a scenario's mission.gestures), ~uav_count, ~sender_name, ~frame_wait_s.
 //   Command sequence numbers start at the wall clock in microseconds, so a restarted commander
@@ -93,6 +95,7 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
     command_pub_ = nh.advertise<gesture_formation::FormationCommand>("formation_command_out", 10);
     status_pub_ = nh.advertise<gesture_formation::GestureStatus>("gesture_status_out", 10);
     abort_pub_ = nh.advertise<gesture_formation::AbortCommand>("abort_out", 10);
+    assistance_pub_ = nh.advertise<gesture_formation::AssistanceState>("assistance_out", 10);
     own_sub_ = nh.subscribe("observation_in", 50, &GestureCommanderNodelet::onObservation, this);
     peer_sub_ = nh.subscribe("peer_observations_in", 100, &GestureCommanderNodelet::onObservation, this);
     timer_ = nh.createTimer(ros::Duration(0.01), [this](const ros::TimerEvent&) {
@@ -177,6 +180,13 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
           abort.stamp = st.header.stamp;  // when the filter fired: the frame's time
           abort.link_sender = -1;
           abort_pub_.publish(abort);
+        } else {  // {event: assist_requested}: the leader's planner latches it (docs/safety.md §2.10)
+          gesture_formation::AssistanceState request;
+          request.header.stamp = st.header.stamp;
+          request.phase = gesture_formation::AssistanceState::PHASE_REQUESTED;
+          request.requested_at = st.header.stamp;  // when the filter fired
+          request.requested_by = sender_;
+          assistance_pub_.publish(request);
         }
       } else {
         auto cmd = toMsg(gesture::toCommand(*f.action, ++sequence_));
@@ -203,7 +213,7 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
   std::optional<gesture::GestureFrames> frames_;  ///< vote, filter, mapping (shared with gfctl simulate)
   std::uint64_t sequence_ = 0;
   std::string last_fired_;
-  ros::Publisher command_pub_, status_pub_, abort_pub_;
+  ros::Publisher command_pub_, status_pub_, abort_pub_, assistance_pub_;
   ros::Subscriber own_sub_, peer_sub_;
   ros::Timer timer_;
 };

@@ -6,12 +6,13 @@
 //     ~command_repeats times ~command_repeat_period_s apart: comm::OutgoingRepeats),
 //     gesture_observation_in, abort_in (sent as it comes: the OperatorInterface repeats it), the
 //     leader's accepted abort (abort_relay_in: its AbortState) after every worker state, the
-//     leader's command acknowledgements (command_ack_in, repeated like commands), and a heartbeat
-//     at ~heartbeat_rate_hz.
+//     leader's command acknowledgements (command_ack_in, repeated like commands), assistance_in (the
+//     leader's assistance state, re-sent with every worker state while requested; the ground
+//     station's acknowledgement), and a heartbeat at ~heartbeat_rate_hz.
 //   LCM → ROS (what each envelope yields: comm::LinkInbox): worker_state_out, plans_out,
 //     formation_params_out, formation_command_out (first copy of each id, named NAME@ID),
 //     gesture_observations_out, abort_out (every copy; the UAV acts on the first it accepts),
-//     command_ack_out (first copy of each command id).
+//     command_ack_out (first copy of each command id), assistance_out (every copy).
 // Start-up (keys, boot counter, high-water marks, verifier): lcm_bridge::startLink; stamps use ROS
 // time (sim time in simulation).
 // Parameters (required): ~sender_id, ~known_senders, ~lcm_url, ~channel_prefix, ~key_file
@@ -130,6 +131,15 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     ack_sub_ = nh.subscribe<gesture_formation::CommandAck>("command_ack_in", 50, [this](const auto& msg) {
       sendChecked(toWire(*msg), "command acknowledgement", command_repeats_, command_repeat_period_s_);
     });
+    // The leader's assistance state (sent on change, and with every worker state while requested) or
+    // the operator's acknowledgement (repeated like a command); every copy received is handed on.
+    assistance_pub_ = nh.advertise<gesture_formation::AssistanceState>("assistance_out", 20);
+    assistance_sub_ = nh.subscribe<gesture_formation::AssistanceState>("assistance_in", 20, [this](const auto& msg) {
+      auto a = toWire(*msg);
+      sendChecked(a, "assistance", command_repeats_, command_repeat_period_s_);
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (a) assistance_ = *a;
+    });
     drain_timer_ = nh.createWallTimer(ros::WallDuration(0.005), [this](const ros::WallTimerEvent&) {
       std::lock_guard<std::mutex> lock(mutex_);
       if (transport_) transport_->drain(kMaxDrainPerTick);
@@ -172,6 +182,7 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     heartbeat_.worker_visible = !msg->lost;
     send(toWire(*msg), "worker state");
     if (relay_) send(*relay_, "abort (relay)");  // the leader's accepted abort travels with every share
+    if (assistance_ && assistance_->state.phase == formation::AssistancePhase::kRequested) send(*assistance_, "assistance");
   }
   void onPlan(const gesture_formation::PlannedTrajectory::ConstPtr& msg) {
     auto plan = fromMsg(*msg);
@@ -245,6 +256,8 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
       observations_pub_.publish(fromWire(*o));
     } else if (const auto* a = std::get_if<planning::AbortCommand>(&item)) {
       abort_pub_.publish(toMsg(*a, e.sender_id));  // every copy: the UAV acts on the first it accepts
+    } else if (const auto* s = std::get_if<comm::AssistanceMessage>(&item)) {
+      assistance_pub_.publish(toMsg(s->state, ros::Time(e.stamp_s)));
     } else if (const auto* k = std::get_if<comm::CommandAckMessage>(&item)) {
       auto m = fromWire(*k);
       m.header.stamp = ros::Time(e.stamp_s);
@@ -288,13 +301,14 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
   int command_repeats_ = 1;
   double command_repeat_period_s_ = 0.1;
   comm::OutgoingRepeats repeats_;  ///< copies of single events still to send
+  std::optional<comm::AssistanceMessage> assistance_;  ///< the last assistance state sent (leader: re-sent while requested)
   std::optional<comm::AbortMessage> relay_;  ///< the leader's accepted abort, sent after every worker state
   /// LCM messages handled per 5 ms drain: bounded, so a flood cannot keep the mutex from heartbeats.
   static constexpr int kMaxDrainPerTick = 2000;
   lcm_bridge::HighWaterMarkSaver marks_;  ///< high_water_file, saved when the marks changed
   std::optional<comm::RejectionReport> report_;  ///< /diagnostics: counts and refusals since the last report
-  ros::Publisher worker_pub_, plans_pub_, params_pub_, command_pub_, observations_pub_, abort_pub_, ack_pub_;
-  ros::Subscriber worker_sub_, plan_sub_, params_sub_, command_sub_, observation_sub_, abort_sub_, relay_sub_, ack_sub_;
+  ros::Publisher worker_pub_, plans_pub_, params_pub_, command_pub_, observations_pub_, abort_pub_, ack_pub_, assistance_pub_;
+  ros::Subscriber worker_sub_, plan_sub_, params_sub_, command_sub_, observation_sub_, abort_sub_, relay_sub_, ack_sub_, assistance_sub_;
   ros::WallTimer drain_timer_;
   DiagnosticsPublisher diagnostics_;  ///< /diagnostics every wall second (also saves the high-water marks)
   ros::Timer heartbeat_timer_, repeat_timer_;

@@ -14,10 +14,16 @@
 // the time since sending, the worker's gesture commands as such — and republished on command_ack_out
 // (tools/gf_command.py waits there for its command's). A command of its own without an
 // acknowledgement within kAckTimeoutS (5 s) is reported once.
+// Assistance (docs/safety.md §2.10): the leader's assistance state arrives on assistance_in (the
+// ground LcmBridge; every copy); a new request is logged as a warning and every change republished
+// latched on assistance_state_out (for the operator's displays); the service acknowledge_assistance
+// (AcknowledgeAssistance; tools/gf_command.py ack-assist) sends the acknowledgement of the pending
+// request on assistance_ack_out (to the ground LcmBridge → the leader's planner).
 // Parameters (required): ~sender_name, ~uav_count, ~abort_repeats, ~abort_repeat_period_s; with
 // ~mission_file (simulation; optional ~faults_file) the mission's abort.repeats / repeat_period_s win.
 #include <map>
 #include <mutex>
+#include <optional>
 
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
@@ -25,6 +31,7 @@
 
 #include "config_sources.hpp"
 #include "conversions.hpp"
+#include "gesture_formation/AcknowledgeAssistance.h"
 #include "gesture_formation/SendAbort.h"
 #include "gesture_formation/SendCommand.h"
 #include "param_loader.hpp"
@@ -66,6 +73,45 @@ class OperatorInterfaceNodelet : public nodelet::Nodelet {
     ack_pub_ = nh.advertise<gesture_formation::CommandAck>("command_ack_out", 20);
     ack_sub_ = nh.subscribe("command_ack_in", 50, &OperatorInterfaceNodelet::onAck, this);
     ack_timer_ = nh.createTimer(ros::Duration(0.5), &OperatorInterfaceNodelet::checkAcks, this);
+    assistance_state_pub_ = nh.advertise<gesture_formation::AssistanceState>("assistance_state_out", 5, true);
+    assistance_ack_pub_ = nh.advertise<gesture_formation::AssistanceState>("assistance_ack_out", 20);
+    assistance_sub_ = nh.subscribe("assistance_in", 50, &OperatorInterfaceNodelet::onAssistance, this);
+    assistance_service_ = nh.advertiseService("acknowledge_assistance", &OperatorInterfaceNodelet::onAcknowledge, this);
+  }
+
+  void onAssistance(const gesture_formation::AssistanceState::ConstPtr& m) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (assistance_ && assistance_->phase == m->phase && assistance_->requested_at == m->requested_at) return;  // a copy
+    assistance_ = *m;
+    assistance_state_pub_.publish(*m);
+    if (m->phase == m->PHASE_REQUESTED) {
+      NODELET_WARN_STREAM("OperatorInterface: ASSISTANCE REQUESTED by the worker (" << m->requested_by << ") at "
+                                                                                   << m->requested_at.toSec()
+                                                                                   << " s: the formation holds its views; "
+                                                                                      "acknowledge with tools/gf_command.py ack-assist");
+    } else if (m->phase == m->PHASE_ACKNOWLEDGED) {
+      NODELET_INFO_STREAM("OperatorInterface: assistance request of " << m->requested_at.toSec() << " s acknowledged by "
+                                                                      << m->acknowledged_by << " (the leader confirms)");
+    }
+  }
+  bool onAcknowledge(gesture_formation::AcknowledgeAssistance::Request&, gesture_formation::AcknowledgeAssistance::Response& res) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!assistance_ || assistance_->phase != gesture_formation::AssistanceState::PHASE_REQUESTED) {
+      res.accepted = false;
+      res.message = "no request for assistance is pending";
+      return true;
+    }
+    gesture_formation::AssistanceState ack = *assistance_;
+    ack.header.stamp = ros::Time::now();
+    ack.phase = gesture_formation::AssistanceState::PHASE_ACKNOWLEDGED;
+    ack.acknowledged_at = ack.header.stamp;
+    ack.acknowledged_by = sender_;
+    assistance_ack_pub_.publish(ack);
+    res.accepted = true;
+    res.message = "acknowledgement sent";
+    res.requested_at = ack.requested_at;
+    NODELET_INFO_STREAM("OperatorInterface: acknowledging the request for assistance of " << ack.requested_at.toSec() << " s");
+    return true;
   }
 
   // The leader's acknowledgement: ours (the name the leader saw is ours, or ours@LINK_ID over LCM) or the worker's.
@@ -189,9 +235,10 @@ class OperatorInterfaceNodelet : public nodelet::Nodelet {
   gesture_formation::AbortCommand abort_;
   static constexpr double kAckTimeoutS = 5.0;  ///< a command of ours unacknowledged this long is reported
   std::map<std::uint64_t, ros::Time> unacked_;  ///< our commands sent and not yet acknowledged
-  ros::Publisher command_pub_, abort_pub_, ack_pub_;
-  ros::Subscriber command_sub_, ack_sub_;
-  ros::ServiceServer service_, abort_service_;
+  std::optional<gesture_formation::AssistanceState> assistance_;  ///< the leader's last assistance state
+  ros::Publisher command_pub_, abort_pub_, ack_pub_, assistance_state_pub_, assistance_ack_pub_;
+  ros::Subscriber command_sub_, ack_sub_, assistance_sub_;
+  ros::ServiceServer service_, abort_service_, assistance_service_;
   ros::Timer abort_timer_, ack_timer_;
 };
 

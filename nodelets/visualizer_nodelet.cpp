@@ -4,11 +4,12 @@
 // references (stage-1 references), plans (planned trajectories), paths (stage-2 paths:
 // the centre lines of the safe corridors), modes (the plan's mode and reason above a UAV that does
 // not track: hold, search), map (occupied voxels of ~scenario_file), status
-// (gesture filter and last command text). Colours per UAV: leader red, follower 1 green,
+// (gesture filter and last command text), assistance (a red banner while the worker's request for
+// assistance is pending). Colours per UAV: leader red, follower 1 green,
 // follower 2 blue, then orange, purple.
 //
 // Topics: uav<i>/odometry, uav<i>/plan (i < ~uav_count), worker_state_in, worker_truth_in,
-//   formation_params_in, gesture_status_in → markers_out (MarkerArray at ~rate_hz), map_out
+//   formation_params_in, gesture_status_in, assistance_in (the leader's AssistanceState) → markers_out (MarkerArray at ~rate_hz), map_out
 //   (latched MarkerArray, published on the first tick with a valid time). Markers carry the time
 //   they were drawn (ros::Time::now(): sim time in simulation and replay). No math beyond drawing (the ellipsoid's axes: eigen decomposition
 //   of the 3×3 position covariance).
@@ -105,6 +106,11 @@ class VisualizerNodelet : public nodelet::Nodelet {
         "gesture_status_in", 5, [this](const gesture_formation::GestureStatus::ConstPtr& m) {
           std::lock_guard<std::mutex> lock(mutex_);
           gesture_ = m;
+        }));
+    subs_.push_back(nh.subscribe<gesture_formation::AssistanceState>(
+        "assistance_in", 5, [this](const gesture_formation::AssistanceState::ConstPtr& m) {
+          std::lock_guard<std::mutex> lock(mutex_);
+          assistance_ = m;
         }));
     pub_ = nh.advertise<visualization_msgs::MarkerArray>("markers_out", 2);
     map_pub_ = nh.advertise<visualization_msgs::MarkerArray>("map_out", 1, true);
@@ -267,6 +273,19 @@ class VisualizerNodelet : public nodelet::Nodelet {
       t.text = text;
       a.markers.push_back(t);
     }
+    // The worker's pending request for assistance: a red banner above the status (safety.md §2.10).
+    auto banner = marker("assistance", 0, visualization_msgs::Marker::TEXT_VIEW_FACING, now);
+    if (assistance_ && assistance_->phase == gesture_formation::AssistanceState::PHASE_REQUESTED) {
+      banner.pose.position = text_at;
+      banner.pose.position.z += 9.0;
+      banner.scale.z = 1.6;
+      banner.color = rgba(1.0f, 0.1f, 0.1f, 1.0f);
+      banner.text = "ASSISTANCE REQUESTED at " + std::to_string(assistance_->requested_at.toSec()).substr(0, 6) +
+                    " s (gf_command.py ack-assist)";
+    } else {
+      banner.action = visualization_msgs::Marker::DELETE;
+    }
+    a.markers.push_back(banner);
     pub_.publish(a);
   }
 
@@ -280,6 +299,7 @@ class VisualizerNodelet : public nodelet::Nodelet {
   nav_msgs::Odometry::ConstPtr truth_;
   gesture_formation::FormationParams::ConstPtr params_;
   gesture_formation::GestureStatus::ConstPtr gesture_;
+  gesture_formation::AssistanceState::ConstPtr assistance_;
   std::shared_ptr<const planning::OccupancyMap> map_;  ///< to publish once (then released)
   std::vector<ros::Subscriber> subs_;
   ros::Publisher pub_, map_pub_;

@@ -9,6 +9,9 @@ a view adaptation (gesture_formation/SendCommand) or an abort (gesture_formation
   tools/gf_command.py abort [--service /operator/send_abort]
     every UAV that accepts it flies to its own retreat goal (docs/safety.md §2.8); the ground
     station sends it abort.repeats times
+  tools/gf_command.py ack-assist [--service /operator/acknowledge_assistance]
+    acknowledges the worker's pending request for assistance (docs/safety.md §2.10): the leader
+    then accepts the worker's gesture commands again
 
   e.g. tools/gf_command.py followers distance_m 1      tools/gf_command.py leader beta_deg 120 --set
        tools/gf_command.py abort
@@ -67,8 +70,12 @@ class AckWaiter:
 
 def main():
     abort = len(sys.argv) > 1 and sys.argv[1] == "abort"
+    ack_assist = len(sys.argv) > 1 and sys.argv[1] == "ack-assist"
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    if abort:
+    if ack_assist:
+        ap.add_argument("ack_assist", choices=["ack-assist"])
+        ap.add_argument("--service", default="/operator/acknowledge_assistance")
+    elif abort:
         ap.add_argument("abort", choices=["abort"])
         ap.add_argument("--service", default="/operator/send_abort")
     else:
@@ -83,11 +90,18 @@ def main():
     ap.add_argument("--timeout", type=float, default=5.0, help="wait this long for the service [s]")
     a = ap.parse_args()
     try:
-        from gesture_formation.srv import SendAbort, SendCommand
+        from gesture_formation.srv import AcknowledgeAssistance, SendAbort, SendCommand
     except ImportError as e:
         print(f"gf_command: {e} (source the workspace's devel/setup.bash)", file=sys.stderr)
         return 2
-    if abort:
+    if ack_assist:
+        res = call(a.service, AcknowledgeAssistance, a.timeout)
+        if res is None:
+            return 2
+        if res.accepted:
+            print(f"assistance request of {res.requested_at.to_sec():.2f} s acknowledged")
+            return 0
+    elif abort:
         res = call(a.service, SendAbort, a.timeout)
         if res is None:
             return 2

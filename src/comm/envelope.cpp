@@ -17,6 +17,7 @@ const char* toString(MessageType type) {
     case MessageType::kGestureObservation: return "gesture_observation";
     case MessageType::kAbortCommand: return "abort_command";
     case MessageType::kCommandAck: return "command_ack";
+    case MessageType::kAssistance: return "assistance";
   }
   return "unknown";
 }

@@ -79,6 +79,11 @@ InboxItem LinkInbox::decodeOne(const Envelope& e) {
       }
       return a;
     }
+    case MessageType::kAssistance: {
+      AssistanceMessage a;
+      if (decoder_.decode(e, a)) return a;  // every copy: the state is idempotent
+      return {};
+    }
   }
   return {};
 }

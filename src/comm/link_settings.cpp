@@ -43,9 +43,20 @@ VerifierConfig verifierConfigOf(const LinkSettings& s, std::vector<common::Confi
     if ((*list)->empty()) problems.push_back({key, "must list at least one sender id (omit it to allow every known sender)"});
     senderList(key, **list, s.sender_id, c.senders_by_type[type], problems);  // own id only → empty: no one else
   }
-  // Command acknowledgements come from the parameter owner: the senders of formation parameters.
-  if (const auto owners = c.senders_by_type.find(MessageType::kFormationParams); owners != c.senders_by_type.end()) {
+  // Command acknowledgements come from the parameter owner: the senders of formation parameters;
+  // the assistance state from the parameter owner (the request) and the command senders (the
+  // operator's acknowledgement).
+  const auto owners = c.senders_by_type.find(MessageType::kFormationParams);
+  const auto commanders = c.senders_by_type.find(MessageType::kFormationCommand);
+  if (owners != c.senders_by_type.end()) {
     c.senders_by_type[MessageType::kCommandAck] = owners->second;
+    if (commanders != c.senders_by_type.end()) {
+      auto both = owners->second;
+      both.insert(both.end(), commanders->second.begin(), commanders->second.end());
+      std::sort(both.begin(), both.end());
+      both.erase(std::unique(both.begin(), both.end()), both.end());
+      c.senders_by_type[MessageType::kAssistance] = both;
+    }
   }
   c.own_sender_id = static_cast<std::uint16_t>(std::clamp(s.sender_id, 0, 65535));
   c.max_age_s = age.contains(s.max_age_s) ? s.max_age_s : defaults.max_age_s;
@@ -54,6 +65,7 @@ VerifierConfig verifierConfigOf(const LinkSettings& s, std::vector<common::Confi
       age.contains(s.command_max_age_s) ? s.command_max_age_s : defaults.command_max_age_s;
   c.max_age_s_by_type[MessageType::kAbortCommand] = c.max_age_s_by_type[MessageType::kFormationCommand];
   c.max_age_s_by_type[MessageType::kCommandAck] = c.max_age_s_by_type[MessageType::kFormationCommand];
+  c.max_age_s_by_type[MessageType::kAssistance] = c.max_age_s_by_type[MessageType::kFormationCommand];
   c.max_rate_hz = s.max_rate_hz;
   c.burst = s.burst;
   for (const auto& e : c.validate()) problems.push_back({"verifier", e});

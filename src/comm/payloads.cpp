@@ -674,4 +674,59 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, CommandAc
   return d.report(reason);
 }
 
+// ---- assistance: u8 phase (0 none, 1 requested, 2 acknowledged), f64 requested_s, u8 L, L bytes
+// requested_by, f64 acknowledged_s, u8 M, M bytes acknowledged_by ---------------------------------
+
+namespace {
+
+bool validOptionalName(const std::string& s) { return s.empty() || validSenderName(s); }
+
+}  // namespace
+
+EncodeResult encodePayload(const AssistanceMessage& m) {
+  const auto& a = m.state;
+  if (!std::isfinite(a.requested_s) || !std::isfinite(a.acknowledged_s)) {
+    return EncodeResult::fail("assistance.requested_s / acknowledged_s must be finite");
+  }
+  if (!validOptionalName(a.requested_by) || !validOptionalName(a.acknowledged_by)) {
+    return EncodeResult::fail("assistance.requested_by / acknowledged_by must be 0.." + std::to_string(kMaxSenderNameBytes) +
+                              " printable ASCII characters without spaces");
+  }
+  ByteWriter w;
+  w.u8(static_cast<std::uint8_t>(a.phase));
+  w.f64(a.requested_s);
+  w.u8(static_cast<std::uint8_t>(a.requested_by.size()));
+  w.bytes(reinterpret_cast<const std::uint8_t*>(a.requested_by.data()), a.requested_by.size());
+  w.f64(a.acknowledged_s);
+  w.u8(static_cast<std::uint8_t>(a.acknowledged_by.size()));
+  w.bytes(reinterpret_cast<const std::uint8_t*>(a.acknowledged_by.data()), a.acknowledged_by.size());
+  return EncodeResult::ok(w.release());
+}
+
+PayloadError decodePayload(const std::uint8_t* data, std::size_t size, AssistanceMessage& out, std::string* reason) {
+  Decoder d(data, size);
+  AssistanceMessage m;
+  auto& a = m.state;
+  std::uint8_t phase = 0;
+  if (d.u8(phase, "assistance.phase") && phase > 2) d.fail(PayloadError::kOutOfRange, "assistance.phase");
+  d.f64(a.requested_s, "assistance.requested_s");
+  auto name = [&d](std::string& into, const char* length_field, const char* field) {
+    std::uint8_t n = 0;
+    if (d.u8(n, length_field) && n > kMaxSenderNameBytes) d.fail(PayloadError::kOversizeArray, length_field);
+    const std::uint8_t* bytes = nullptr;
+    if (d.bytes(n, bytes, field)) {
+      into.assign(reinterpret_cast<const char*>(bytes), n);
+      if (!validOptionalName(into)) d.fail(PayloadError::kOutOfRange, field);
+    }
+  };
+  name(a.requested_by, "assistance.requested_by_length", "assistance.requested_by");
+  d.f64(a.acknowledged_s, "assistance.acknowledged_s");
+  name(a.acknowledged_by, "assistance.acknowledged_by_length", "assistance.acknowledged_by");
+  if (d.finish()) {
+    a.phase = static_cast<formation::AssistancePhase>(phase);
+    out = std::move(m);
+  }
+  return d.report(reason);
+}
+
 }  // namespace gesture_formation::comm

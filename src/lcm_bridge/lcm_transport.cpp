@@ -34,6 +34,7 @@ constexpr ChannelSuffix kChannels[] = {
     {comm::MessageType::kGestureObservation, "GESTURE_OBSERVATION"},
     {comm::MessageType::kAbortCommand, "ABORT_COMMAND"},
     {comm::MessageType::kCommandAck, "COMMAND_ACK"},
+    {comm::MessageType::kAssistance, "ASSISTANCE"},
 };
 
 /// LCM's fixed part of gf_lcm::envelope_t: 8-byte fingerprint + int32 length.
@@ -245,7 +246,7 @@ common::Result<std::unique_ptr<LcmTransport>> LcmTransport::create(const std::st
   }
   // One regex subscription for our channels (LCM anchors it with ^...$).
   lcm::Subscription* sub = t->impl_->lcm.subscribe(
-      channel_prefix + "(HEARTBEAT|WORKER_STATE|PLANNED_TRAJECTORY|FORMATION_PARAMS|FORMATION_COMMAND|GESTURE_OBSERVATION|ABORT_COMMAND|COMMAND_ACK)",
+      channel_prefix + "(HEARTBEAT|WORKER_STATE|PLANNED_TRAJECTORY|FORMATION_PARAMS|FORMATION_COMMAND|GESTURE_OBSERVATION|ABORT_COMMAND|COMMAND_ACK|ASSISTANCE)",
       &Impl::onMessage, t->impl_.get());
   // LCM's default holds 30 undispatched messages and drops the rest unseen: room for a burst.
   if (sub != nullptr) sub->setQueueCapacity(kQueueCapacity);

@@ -20,6 +20,9 @@ const CommandRecord& FormationParamsRole::apply(const common::Result<formation::
   } else if (!command) {
     last_.outcome = "rejected: " + command.reason();
     last_.status = formation::toString(formation::CommandStatus::kRejected);
+  } else if (const auto held = assistance_.refusal(command->source)) {
+    last_.outcome = "rejected: " + *held;
+    last_.status = formation::toString(formation::CommandStatus::kRejected);
   } else {
     const auto out = state_->apply(*command);
     last_.outcome = out.describe();

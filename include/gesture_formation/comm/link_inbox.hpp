@@ -34,7 +34,7 @@ struct ReceivedPlanMessage {
 /// a refusal).
 using InboxItem = std::variant<std::monostate, WorkerStateMessage, ReceivedPlanMessage, formation::FormationParams,
                                formation::FormationCommand, GestureObservationMessage, planning::AbortCommand,
-                               CommandAckMessage>;
+                               CommandAckMessage, AssistanceMessage>;
 
 class LinkInbox {
  public:

@@ -22,6 +22,7 @@
 
 #include "gesture_formation/comm/envelope.hpp"
 #include "gesture_formation/common/result.hpp"
+#include "gesture_formation/formation/assistance.hpp"
 #include "gesture_formation/formation/formation_commands.hpp"
 #include "gesture_formation/formation/formation_params.hpp"
 #include "gesture_formation/gesture/view_triangulation.hpp"
@@ -121,6 +122,15 @@ struct CommandAckMessage {
   std::string outcome;
 };
 
+/// \brief The worker's request for assistance as it travels (docs/safety.md §2.10): the leader's
+/// state (sent on every change and with every worker state while requested) and the operator's
+/// acknowledgement (phase kAcknowledged, from the ground station, repeated like a command). From the
+/// params_senders and the command_senders only. Names: 0..kMaxSenderNameBytes printable ASCII
+/// without spaces.
+struct AssistanceMessage {
+  formation::AssistanceState state;
+};
+
 /// Largest gesture id and number of class probabilities on the wire.
 constexpr int kMaxGestureId = 15;
 constexpr std::size_t kMaxGestureClasses = 16;
@@ -149,6 +159,7 @@ common::Result<std::vector<std::uint8_t>> encodePayload(const formation::Formati
 common::Result<std::vector<std::uint8_t>> encodePayload(const GestureObservationMessage& m);
 common::Result<std::vector<std::uint8_t>> encodePayload(const AbortMessage& m);
 common::Result<std::vector<std::uint8_t>> encodePayload(const CommandAckMessage& m);
+common::Result<std::vector<std::uint8_t>> encodePayload(const AssistanceMessage& m);
 
 /// \brief The envelope type of each payload.
 inline MessageType messageTypeOf(const Heartbeat&) { return MessageType::kHeartbeat; }
@@ -159,6 +170,7 @@ inline MessageType messageTypeOf(const formation::FormationCommand&) { return Me
 inline MessageType messageTypeOf(const GestureObservationMessage&) { return MessageType::kGestureObservation; }
 inline MessageType messageTypeOf(const AbortMessage&) { return MessageType::kAbortCommand; }
 inline MessageType messageTypeOf(const CommandAckMessage&) { return MessageType::kCommandAck; }
+inline MessageType messageTypeOf(const AssistanceMessage&) { return MessageType::kAssistance; }
 
 // ---- decoders: `out` written only on kNone; `reason` (optional) names the field ---------
 PayloadError decodePayload(const std::uint8_t* data, std::size_t size, Heartbeat& out, std::string* reason = nullptr);
@@ -174,6 +186,8 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, GestureOb
                            std::string* reason = nullptr);
 PayloadError decodePayload(const std::uint8_t* data, std::size_t size, AbortMessage& out, std::string* reason = nullptr);
 PayloadError decodePayload(const std::uint8_t* data, std::size_t size, CommandAckMessage& out,
+                           std::string* reason = nullptr);
+PayloadError decodePayload(const std::uint8_t* data, std::size_t size, AssistanceMessage& out,
                            std::string* reason = nullptr);
 
 /// \brief One counter per PayloadError (kNone counts successful decodes).

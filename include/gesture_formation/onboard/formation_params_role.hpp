@@ -4,7 +4,8 @@
 /// state), ROS-free: the leader owns them (formation::FormationState applies and clamps every
 /// command, each applied command bumps the version, the last command and its outcome are kept for
 /// the operator); a follower holds the parameters it last received from the leader, refusing a set
-/// for another number of UAVs.
+/// for another number of UAVs. While the worker's request for assistance is pending
+/// (formation::AssistanceLatch) the leader refuses the worker's gesture commands.
 /// Thread safety: none (the caller's lock).
 
 #include <cstdint>
@@ -13,6 +14,7 @@
 #include <vector>
 
 #include "gesture_formation/common/result.hpp"
+#include "gesture_formation/formation/assistance.hpp"
 #include "gesture_formation/formation/formation_commands.hpp"
 #include "gesture_formation/formation/formation_config.hpp"
 
@@ -45,12 +47,16 @@ class FormationParamsRole {
   /// \brief The leader: the version of its parameters (applied commands); a follower: the version received.
   std::uint64_t version() const { return version_; }
   const CommandRecord& last() const { return last_; }
+  /// \brief The leader's assistance latch (docs/safety.md §2.10).
+  formation::AssistanceLatch& assistance() { return assistance_; }
+  const formation::AssistanceLatch& assistance() const { return assistance_; }
 
  private:
   formation::FormationParams params_;
   std::optional<formation::FormationState> state_;
   std::uint64_t version_ = 0;
   CommandRecord last_;
+  formation::AssistanceLatch assistance_;
 };
 
 }  // namespace gesture_formation::onboard

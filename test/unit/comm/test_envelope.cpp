@@ -145,7 +145,7 @@ TEST(CommEnvelopeTest, SealRefusesWhatReceiversWouldRefuse) {
   e.stamp_s = std::numeric_limits<double>::infinity();
   EXPECT_FALSE(sealEnvelope(e, k.data(), k.size()));
   e.stamp_s = 0;
-  e.type = static_cast<MessageType>(9);
+  e.type = static_cast<MessageType>(kMaxMessageType + 1);  // the first unknown type
   EXPECT_FALSE(sealEnvelope(e, k.data(), k.size()));
 }
 

@@ -53,6 +53,13 @@ TEST(LinkSettingsTest, AcknowledgementsComeFromTheParamsSenders) {
   EXPECT_TRUE(problems.empty());
   EXPECT_EQ(c.senders_by_type.at(MessageType::kCommandAck), (std::vector<std::uint16_t>{0}));
   EXPECT_DOUBLE_EQ(c.max_age_s_by_type.at(MessageType::kCommandAck), 4.0);
+  EXPECT_EQ(c.senders_by_type.count(MessageType::kAssistance), 0u);  // command senders absent: any known sender
+  // The assistance state: the parameter owner (the request) and the command senders (the operator's acknowledgement).
+  // (Own id 100 is never received: dropped from every list.)
+  s.command_senders = std::vector<int>{100, 2};
+  const VerifierConfig both = verifierConfigOf(s, problems);
+  EXPECT_EQ(both.senders_by_type.at(MessageType::kAssistance), (std::vector<std::uint16_t>{0, 2}));
+  s.command_senders.reset();
   s.params_senders.reset();
   EXPECT_EQ(verifierConfigOf(s, problems).senders_by_type.count(MessageType::kCommandAck), 0u);  // any known sender
 }

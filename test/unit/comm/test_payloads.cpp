@@ -387,6 +387,47 @@ TEST(CommPayloadsTest, CommandAckRefusals) {
   EXPECT_EQ(d.outcome, "untouched");  // written only on success
 }
 
+TEST(CommPayloadsTest, AssistanceRoundTripAndRefusals) {
+  AssistanceMessage m;
+  m.state = formation::AssistanceState{formation::AssistancePhase::kAcknowledged, 2.0, "g", 0.0, "op"};
+  const auto b = encoded(m);
+  // u8 phase, f64 requested_s, u8 L, requested_by, f64 acknowledged_s, u8 M, acknowledged_by
+  const std::vector<std::uint8_t> expected{2, 0x40, 0, 0, 0, 0, 0, 0, 0, 1, 'g', 0, 0, 0, 0, 0, 0, 0, 0, 2, 'o', 'p'};
+  EXPECT_EQ(b, expected);
+  AssistanceMessage d;
+  ASSERT_EQ(decode(b, d), PayloadError::kNone);
+  EXPECT_EQ(d.state.phase, formation::AssistancePhase::kAcknowledged);
+  EXPECT_EQ(d.state.requested_s, 2.0);
+  EXPECT_EQ(d.state.requested_by, "g");
+  EXPECT_EQ(d.state.acknowledged_by, "op");
+  m.state = formation::AssistanceState{};  // no request yet: empty names
+  ASSERT_EQ(decode(encoded(m), d), PayloadError::kNone);
+  EXPECT_EQ(d.state.phase, formation::AssistancePhase::kNone);
+  m.state.requested_by = "with space";
+  EXPECT_FALSE(encodePayload(m));
+  m.state.requested_by = "g";
+  m.state.acknowledged_s = std::nan("");
+  EXPECT_FALSE(encodePayload(m));
+  auto bad = b;
+  bad[0] = 3;
+  std::string reason;
+  EXPECT_EQ(decodePayload(bad.data(), bad.size(), d, &reason), PayloadError::kOutOfRange);
+  EXPECT_NE(reason.find("assistance.phase"), std::string::npos) << reason;
+  bad = b;
+  bad[10] = ' ';
+  EXPECT_EQ(decodePayload(bad.data(), bad.size(), d, &reason), PayloadError::kOutOfRange);
+  EXPECT_NE(reason.find("assistance.requested_by"), std::string::npos) << reason;
+  bad = b;
+  bad[9] = kMaxSenderNameBytes + 1;
+  EXPECT_EQ(decode(bad, d), PayloadError::kOversizeArray);
+  bad = b;
+  bad.push_back('x');
+  EXPECT_EQ(decode(bad, d), PayloadError::kTrailingBytes);
+  bad = b;
+  bad.pop_back();
+  EXPECT_EQ(decode(bad, d), PayloadError::kTruncated);
+}
+
 TEST(CommPayloadsTest, FormationCommandRefusals) {
   auto c = command();
   c.amount = kNaN;

@@ -69,3 +69,33 @@ TEST(FormationParamsRoleTest, AFollowerTakesTheLeadersParametersForItsUavCountOn
   EXPECT_EQ(role.last().status, "rejected");
   EXPECT_EQ(role.params().uav(2).distance_m, p.followers[1].distance_m);
 }
+
+// docs/safety.md §2.10: while the worker's request for assistance is pending, the worker's gesture
+// commands are refused and the operator's applied; the operator's acknowledgement (of that request)
+// releases the views; a repeated request keeps the first time.
+TEST(FormationParamsRoleTest, AnAssistanceRequestHoldsTheViewsAgainstGesturesUntilAcknowledged) {
+  FormationParamsRole role(formation::FormationConfig{}, 0);
+  auto gesture = distancePlusOne(10);
+  gesture.id = {"gesture", 10};
+  gesture.source = formation::CommandSource::kGesture;
+  ASSERT_TRUE(role.assistance().request(20.0, "gesture"));
+  EXPECT_FALSE(role.assistance().request(25.0, "gesture"));  // the worker repeats it
+  EXPECT_DOUBLE_EQ(role.assistance().state().requested_s, 20.0);
+  role.apply(common::Result<formation::FormationCommand>::ok(gesture), "gesture #10", "gesture", 21.0);
+  EXPECT_EQ(role.last().status, "rejected");
+  EXPECT_NE(role.last().outcome.find("assistance requested at 20"), std::string::npos) << role.last().outcome;
+  EXPECT_EQ(role.version(), 0u);
+  role.apply(common::Result<formation::FormationCommand>::ok(distancePlusOne(11)), "op #11", "operator", 22.0);
+  EXPECT_EQ(role.last().status, "applied");  // the operator's commands pass
+  EXPECT_EQ(role.version(), 1u);
+  EXPECT_FALSE(role.assistance().acknowledge(19.0, 23.0, "gcs"));  // another (older) request's acknowledgement
+  EXPECT_EQ(role.assistance().state().phase, formation::AssistancePhase::kRequested);
+  ASSERT_TRUE(role.assistance().acknowledge(20.0, 23.0, "gcs"));
+  EXPECT_EQ(role.assistance().state().acknowledged_by, "gcs");
+  gesture.id.sequence = 12;
+  role.apply(common::Result<formation::FormationCommand>::ok(gesture), "gesture #12", "gesture", 24.0);
+  EXPECT_EQ(role.last().status, "applied");
+  EXPECT_EQ(role.version(), 2u);
+  EXPECT_TRUE(role.assistance().request(30.0, "gesture"));  // a new request latches again
+  EXPECT_EQ(role.assistance().state().phase, formation::AssistancePhase::kRequested);
+}
