@@ -30,13 +30,14 @@ PlanRequest buildPlanRequest(const PlanRequestInputs& in) {
   req.wind_estimate_mps = in.wind_estimate_mps;
   req.worker = in.worker;
   if (in.camera_target != nullptr) req.camera_target = *in.camera_target;
+  const int slot = in.slot >= 0 ? in.slot : i;  // the reference flown (a hand-over moves it)
   const bool hold = in.hold_reference != nullptr;
-  const bool has_leader_plan = i != 0 && in.leader_plan != nullptr && !in.leader_plan->empty();
+  const bool has_leader_plan = slot != 0 && in.leader_plan != nullptr && !in.leader_plan->empty();
   const bool leader_plan_fresh = has_leader_plan && in.t_s - in.leader_plan->t0_s <= in.leader_plan_max_age_s;
   if (hold) {
     req.reference = *in.hold_reference;
     if (has_leader_plan) req.higher_priority_plans.push_back(*in.leader_plan);
-  } else if (i == 0) {
+  } else if (slot == 0) {
     formation::leaderHorizon(in.worker, in.params->leader, req.reference);
   } else {
     formation::LeaderPlan lp;
@@ -50,13 +51,13 @@ PlanRequest buildPlanRequest(const PlanRequestInputs& in) {
       }
     }
     formation::followerHorizon(in.worker, in.params->leader, leader_plan_fresh ? &lp : nullptr,
-                               in.params->followers[static_cast<std::size_t>(i - 1)], req.reference);
+                               in.params->followers[static_cast<std::size_t>(slot - 1)], req.reference);
     if (has_leader_plan) req.higher_priority_plans.push_back(*in.leader_plan);
   }
   if (in.received == nullptr) return req;
-  for (int j = 1; j < static_cast<int>(in.received->size()); ++j) {
+  for (int j = 0; j < static_cast<int>(in.received->size()); ++j) {
     const auto& m = (*in.received)[static_cast<std::size_t>(j)];
-    if (j == i || !m || m->plan.empty()) continue;
+    if (j == i || j == in.leader_index || !m || m->plan.empty()) continue;  // the leader's plan: leader_plan
     // A UAV not heard from for max_plan_age_s (dropout, outage, lost link) cannot be expected
     // to dodge: it has right of way, like one that fell back.
     const bool silent = in.t_s - m->plan.t0_s > in.rule.max_plan_age_s;

@@ -109,7 +109,7 @@ ReplanStep::Choice ReplanStep::choose(const ReplanInputs& in, const std::string&
     return c;
   }
   HoldPlanner::Situation situation;
-  situation.uav_index = config_.uav_index;
+  situation.uav_index = in.slot >= 0 ? in.slot : config_.uav_index;  // the leader's slot searches
   situation.t_s = in.t_s;
   situation.dt_s = config_.dt_s;
   situation.steps = config_.steps;
@@ -156,17 +156,18 @@ void ReplanStep::keepReachClear(const ReplanInputs& in, const Eigen::Vector3d& w
 ReplanOutcome ReplanStep::step(const ReplanInputs& in) {
   ReplanOutcome out;
   const int i = config_.uav_index;
+  const int role = in.slot >= 0 ? in.slot : i;  // 0: plans as the leader (a hand-over moves the slot)
   const double t = in.t_s;
   if (!home_) home_ = config_.home_world.allFinite() ? config_.home_world : in.state.p_world;
   if (in.worker == nullptr) {
-    out.reason = i == 0 ? "no confirmed worker estimate yet" : "no leader share received yet";
+    out.reason = role == 0 ? "no confirmed worker estimate yet" : "no leader share received yet";
     return out;
   }
   const WorkerKnowledge& w = *in.worker;
   reach_.observe(w);
   // Freshness first, then listening (a UAV listens from its first replanning with data). An
   // aborting UAV does not hold for stale data (it retreats from what it last knew); it listens.
-  const std::string stale = holdReason(i, t, w.stamp_s, w.fused_s, config_.freshness);
+  const std::string stale = holdReason(role, t, w.stamp_s, w.fused_s, config_.freshness);
   std::string hold = abort_.aborting() ? std::string() : stale;
   if (hold.empty()) {
     const double since = listen_since_s_;
@@ -192,6 +193,8 @@ ReplanOutcome ReplanStep::step(const ReplanInputs& in) {
 
   PlanRequestInputs req_in;
   req_in.uav_index = i;
+  req_in.slot = in.slot;
+  req_in.leader_index = in.leader_index;
   req_in.t_s = t;
   req_in.dt_s = config_.dt_s;
   req_in.state = in.state;

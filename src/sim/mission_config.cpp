@@ -345,6 +345,7 @@ void readFaults(ConfigReader& r, const std::string& m, MissionConfig& c) {
   readFollowerDropouts(r, fk, c.faults.follower_dropouts);
   readAbortEvent(r, fk + "abort", c.faults.abort);
   readWorkerApproach(r, fk + "worker_approach", c.faults.worker_approach);
+  readLeaderSilence(r, fk + "leader_silence", c.faults.leader_silence);
   const std::string k = fk + "range_outliers.";
   rangeOutlierFields().readFields(r, k, c.faults.range_outliers);
   for (const auto& e : c.faults.validate()) r.addError(m + "faults", e);
@@ -464,6 +465,7 @@ common::Result<MissionConfig> parseMissionConfig(const std::string& yaml, const 
   c.worker.synth.fps = c.camera.rate_hz;
   checkUavCount(r, m, c);
   readRequests(r, m, c.formation.params.uavCount(), c.requests);
+  readLeadership(r, m, c.formation.params.uavCount(), c.leadership);
 
   for (const auto& e : c.worker.validate(m + "worker.")) r.addError(m + "worker", e);
   c.duration_s = c.worker.routeDuration();

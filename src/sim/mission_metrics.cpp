@@ -145,8 +145,12 @@ void MetricsAccumulator::sampleTimeline(const TimelineInput& in) {
   const Eigen::Vector3d& w = in.worker.p_world;
   const formation::UavReference lref = formation::leaderReference(w, in.human_heading_rad, P.leader);
   const int n = std::min(n_, static_cast<int>(in.uavs.size()));
-  for (int i = 0; i < n; ++i) {
-    const MultirotorState& s = in.uavs[static_cast<std::size_t>(i)];
+  for (int u = 0; u < n; ++u) {
+    const MultirotorState& s = in.uavs[static_cast<std::size_t>(u)];
+    // The slot it flies (a leader hand-over moves slots): its references and errors are that slot's;
+    // a UAV flying none (silent, or not yet told whose slot to take) has none and no errors.
+    const bool no_slot = static_cast<std::size_t>(u) < in.slots.size() && in.slots[static_cast<std::size_t>(u)] < 0;
+    const int i = static_cast<std::size_t>(u) < in.slots.size() && !no_slot ? in.slots[static_cast<std::size_t>(u)] : u;
     const formation::UavReference ref =
         i == 0 ? lref
                : formation::followerReference(w, lref.heading_rad, lref.pitch_rad,
@@ -165,16 +169,20 @@ void MetricsAccumulator::sampleTimeline(const TimelineInput& in) {
     us.heading_deg = radToDeg(s.heading_rad);
     us.pitch_deg = radToDeg(s.pitch_rad);
     us.speed_mps = s.v_world.norm();
-    us.plan_status = last_status_[static_cast<std::size_t>(i)];
+    us.plan_status = last_status_[static_cast<std::size_t>(u)];
+    if (no_slot) us.d_ref = us.phi_ref_deg = us.elev_ref_deg = std::numeric_limits<double>::quiet_NaN();
     row.uavs.push_back(us);
-    dist_sq_ += (us.d_t - us.d_ref) * (us.d_t - us.d_ref);
-    const double ae = radToDeg(wrapAngle(common::degToRad(us.phi_deg - us.phi_ref_deg)));
-    angle_sq_ += ae * ae;
-    ++dist_n_;
-    for (int j = i + 1; j < n; ++j) {
+    if (!no_slot) {
+      dist_sq_ += (us.d_t - us.d_ref) * (us.d_t - us.d_ref);
+      const double ae = radToDeg(wrapAngle(common::degToRad(us.phi_deg - us.phi_ref_deg)));
+      angle_sq_ += ae * ae;
+      ++dist_n_;
+    }
+    for (int j = u + 1; j < n; ++j) {
       row.mutual_m.push_back((s.p_world - in.uavs[static_cast<std::size_t>(j)].p_world).norm());
     }
   }
+  row.acting = in.acting;
   timeline_.push_back(std::move(row));
 }
 
@@ -395,6 +403,7 @@ std::string metricsJson(const MissionMetrics& m) {
   if (m.abort) os << "  \"abort\": " << abortJson(*m.abort, 2) << ",\n";
   if (m.worker_approach) os << "  \"worker_approach\": " << approachJson(*m.worker_approach, 2) << ",\n";
   if (m.site_mapping) os << "  \"site_mapping\": " << siteMappingJson(*m.site_mapping, 2) << ",\n";
+  if (m.leadership) os << "  \"leadership\": " << handoverJson(*m.leadership, 2) << ",\n";
   os << "  \"wall_clock_keys\": [\"planning_ms_median\", \"planning_ms_p99\", \"planning_ms_max\", \"wall_time_s\", \"real_time_factor\"";
   if (m.perception) {
     for (const char* k : {"render_ms_median", "detect_ms_median", "track_ms_median", "skeleton_ms_median", "frame_ms_median"}) {
@@ -447,6 +456,9 @@ bool writeTimelineCsv(const std::string& path, const MissionOutput& out, int uav
     for (int i = 0; i < uav_count; ++i) {
       for (int j = i + 1; j < uav_count; ++j) f << ",d_m_" << formation::uavLabel(i) << '_' << formation::uavLabel(j);
     }
+    // Who acts as leader (docs/safety.md §1.2): last, so that the columns before keep their places.
+    const bool acting = !out.timeline.empty() && !out.timeline.front().acting.empty();
+    for (int i = 0; acting && i < uav_count; ++i) f << ",acting_" << formation::uavLabel(i);
     f << '\n';
     for (const auto& r : out.timeline) {
       f << formatDouble(r.t_s);
@@ -462,6 +474,9 @@ bool writeTimelineCsv(const std::string& path, const MissionOutput& out, int uav
         f << ',' << u.plan_status;
       }
       for (double d : r.mutual_m) f << ',' << formatDouble(d);
+      for (std::size_t i = 0; acting && i < static_cast<std::size_t>(uav_count); ++i) {
+        f << ',' << (i < r.acting.size() ? r.acting[i] : 0);
+      }
       f << '\n';
     }
   });

@@ -17,6 +17,7 @@
 #include "gesture_formation/planning/distance_field.hpp"
 #include "gesture_formation/planning/occupancy_map.hpp"
 #include "gesture_formation/planning/replan_step.hpp"
+#include "gesture_formation/sim/leader_handover.hpp"
 #include "gesture_formation/sim/random.hpp"
 #include "gesture_formation/sim/site_mapping.hpp"
 #include "gesture_formation/sim/wind.hpp"
@@ -44,6 +45,7 @@ struct LeaderShare {
   /// The abort the leader accepted, relayed in every share from then on (the repetition that
   /// reaches a follower across losses; docs/safety.md §2.8).
   std::optional<planning::AbortCommand> abort;
+  int from = 0;  ///< the sending (acting) leader
 };
 
 /// A follower's plan with its planner status: a UAV that could not plan (braking or on its
@@ -120,15 +122,25 @@ class MissionRun {
   /// UAVs at the formation references around the worker's start; empty or why not.
   std::string addUavs();
   void openLinks();
+  /// The leadership's links and those a leader other than UAV 0 needs (leader_handover.hpp).
+  void openHandoverLinks();
   MissionOutput run(double duration_s, std::chrono::steady_clock::time_point wall0);
 
  private:
   UavRuntime& uav(int i) { return *uavs_[static_cast<std::size_t>(i)]; }
+  bool silentAt(int i, double t) const;
+  int slotOf(int i);
+  void stepLeadership(double t);
+  void takeOver(int k, double t);
+  Link<LeaderShare>& shareLink(int from, int to);
+  Link<gesture::ViewObservation>* voteLink(int from, int to);
+  Link<OperatorMessage>& operatorLink(int to);
+  void receiveShare(int i, LeaderShare s, double t);
   void deliverOperatorMessages(double t);
   void updateDropouts(double t);
   void deliverUavMessages(double t);
   void cameraFrame(double t, const WorkerState& ws);
-  gesture::ViewObservation observation(int view, double t, const gesture::Classification& c,
+  gesture::ViewObservation observation(int uav_index, int view, double t, const gesture::Classification& c,
                                        const gesture::CalibratedSkeleton& cal,
                                        const std::optional<Eigen::Vector3d>& worker_est);
   std::vector<gesture::GestureFrame> aggregateViews(double t, const LeaderCameraFrame& cf);
@@ -181,6 +193,19 @@ class MissionRun {
   double last_ratio_ = 0.0;
   double last_fused_s_ = -std::numeric_limits<double>::infinity();  // the leader's last fused worker measurement
   std::optional<planning::WorkerKnowledge> leader_knowledge_;        // the leader's last confirmed estimate
+  // Leader hand-over (leader_handover.hpp): the estimator, the gesture frames, the FormationState
+  // and the share are the work of owner_, the UAV that acted as leader last; its outputs (share,
+  // commands, the abort relay) go out only while it acts.
+  std::unique_ptr<LeadershipNet> lead_;
+  std::optional<HandoverRecorder> handover_;
+  std::vector<bool> acting_;  ///< per UAV, at the current step
+  int owner_ = 0;
+  double took_over_s_ = -std::numeric_limits<double>::infinity();  ///< commands sent before are the previous leader's
+  int silenced_ = -1;                                                ///< faults.leader_silence's UAV
+  std::uint64_t handover_link_index_ = 0;
+  std::vector<std::unique_ptr<Link<OperatorMessage>>> operator_links_;            // [i]: ground station → UAV i ≥ 1
+  std::vector<std::vector<std::unique_ptr<Link<LeaderShare>>>> share_from_;      // [from ≥ 1][to]
+  std::vector<std::vector<std::unique_ptr<Link<gesture::ViewObservation>>>> vote_to_;  // [to ≥ 1][from]
 };
 
 std::string MissionRun::addUavs() {
@@ -257,6 +282,109 @@ void MissionRun::openLinks() {
   abort_record_.emplace(*cfg_.faults.abort, n_, obstacleDistance(world_));
 }
 
+void MissionRun::openHandoverLinks() {
+  // Own random streams (Stream::kHandover): the other links' draws are unchanged.
+  const auto next = [this] { return makeRng(seed_, Stream::kHandover, handover_link_index_++); };
+  formation::LeadershipConfig lc = cfg_.leadership;
+  lc.uav_count = n_;
+  std::vector<std::mt19937_64> rngs;
+  for (int i = 0; i < n_ * (n_ - 1); ++i) rngs.push_back(next());
+  lead_ = std::make_unique<LeadershipNet>(lc, cfg_.link, std::move(rngs), cfg_.step_s);
+  handover_.emplace(n_);
+  acting_.assign(static_cast<std::size_t>(n_), false);
+  const auto n = static_cast<std::size_t>(n_);
+  operator_links_.resize(n);
+  share_from_.resize(n);
+  vote_to_.resize(n);
+  for (std::size_t i = 1; i < n; ++i) {
+    operator_links_[i] = std::make_unique<Link<OperatorMessage>>(cfg_.operator_link, next());
+    share_from_[i].resize(n);
+    vote_to_[i].resize(n);
+    for (std::size_t j = 0; j < n; ++j) {
+      if (j == i) continue;
+      share_from_[i][j] = std::make_unique<Link<LeaderShare>>(cfg_.link, next());
+      if (follower_views_) vote_to_[i][j] = std::make_unique<Link<gesture::ViewObservation>>(cfg_.link, next());
+    }
+  }
+}
+
+Link<LeaderShare>& MissionRun::shareLink(int from, int to) {
+  return from == 0 ? *share_links_[static_cast<std::size_t>(to)]
+                   : *share_from_[static_cast<std::size_t>(from)][static_cast<std::size_t>(to)];
+}
+
+Link<gesture::ViewObservation>* MissionRun::voteLink(int from, int to) {
+  return to == 0 ? vote_links_[static_cast<std::size_t>(from)].get()
+                 : vote_to_[static_cast<std::size_t>(to)][static_cast<std::size_t>(from)].get();
+}
+
+Link<OperatorMessage>& MissionRun::operatorLink(int to) {
+  return to == 0 ? operator_link_ : *operator_links_[static_cast<std::size_t>(to)];
+}
+
+int MissionRun::slotOf(int i) {
+  // The leader flies the leader's slot; a follower its own; UAV 0, which has none, the slot its
+  // successor left (the share's sender's); −1: none yet.
+  const UavRuntime& u = uav(i);
+  return i == owner_ ? 0 : (i != 0 ? i : (u.share ? u.share->from : -1));
+}
+
+bool MissionRun::silentAt(int i, double t) const {
+  return silenced_ == i && cfg_.faults.leader_silence && cfg_.faults.leader_silence->silentAt(t);
+}
+
+void MissionRun::stepLeadership(double t) {
+  // faults.leader_silence: at its time the acting leader (else the UAV doing the leader's work) goes silent.
+  const std::optional<LeaderSilence>& silence = cfg_.faults.leader_silence;
+  if (silence && silenced_ < 0 && t >= silence->t_s) {
+    silenced_ = owner_;
+    for (int i = 0; i < n_; ++i) {
+      if (acting_[static_cast<std::size_t>(i)]) silenced_ = i;
+    }
+    handover_->silenced(silenced_, t, *silence);
+  }
+  std::vector<double> age(static_cast<std::size_t>(n_), std::numeric_limits<double>::infinity());
+  std::vector<bool> up(static_cast<std::size_t>(n_), true);
+  for (int i = 0; i < n_; ++i) {
+    const UavRuntime& u = uav(i);
+    const double fused = i == owner_ ? last_fused_s_ : (u.share ? u.share->worker.fused_s : std::nan(""));
+    if (std::isfinite(fused)) age[static_cast<std::size_t>(i)] = std::max(0.0, t - fused);
+    up[static_cast<std::size_t>(i)] = !silentAt(i, t) && !cfg_.faults.followerOffline(i, t);
+  }
+  lead_->step(t, age, up);
+  for (int i = 0; i < n_; ++i) acting_[static_cast<std::size_t>(i)] = lead_->acting(i, t);
+  for (int i = 0; i < n_; ++i) {
+    if (acting_[static_cast<std::size_t>(i)] && i != owner_) takeOver(i, t);
+  }
+  handover_->sample(t, acting_);
+}
+
+void MissionRun::takeOver(int k, double t) {
+  // A new leader: its estimator starts from the last share it received (then fuses its own
+  // camera), the parameters and their version from that share, fresh gesture frames and filter.
+  owner_ = k;
+  took_over_s_ = t;
+  const UavRuntime& u = uav(k);
+  kf_ = estimation::HumanKalman(cfg_.estimator.filter);
+  leader_knowledge_.reset();
+  last_fused_s_ = -std::numeric_limits<double>::infinity();
+  if (u.share) {
+    const planning::WorkerKnowledge& w = u.share->worker;
+    const double fused = std::isfinite(w.fused_s) ? std::min(w.fused_s, w.stamp_s) : w.stamp_s;
+    if (kf_.adopt(w.stamp_s, w.p_world, w.lost ? Eigen::Vector3d::Zero() : w.v_world, Eigen::Matrix3d::Identity(), fused)) {
+      last_fused_s_ = w.fused_s;
+    }
+    auto fs = formation::FormationState::create(u.share->params, cfg_.formation.limits, cfg_.formation.duplicates);
+    if (fs) {
+      fstate_ = std::move(*fs);
+      params_version_ = u.share->params_version;
+    }
+  }
+  frames_ = gesture::GestureFrames(cfg_.gesture_filter, cfg_.view_fusion, cfg_.gesture_mapping, n_, 0.0);
+  modes_.push_back(ModeChange{t, k, uav(k).mode, "acting as leader (term " + std::to_string(lead_->member(k).term()) +
+                                                     "): estimator, gestures, parameters and share taken over"});
+}
+
 MissionOutput MissionRun::run(double duration_s, std::chrono::steady_clock::time_point wall0) {
   const double dt = cfg_.step_s;
   const long steps = std::lround(duration_s / dt);
@@ -266,6 +394,7 @@ MissionOutput MissionRun::run(double duration_s, std::chrono::steady_clock::time
     const double t = static_cast<double>(k) * dt;
     divertWorker(t);
     const WorkerState ws = worker_.stateAt(t);
+    stepLeadership(t);
     deliverOperatorMessages(t);
     deliverAbort(t);
     updateDropouts(t);
@@ -290,6 +419,16 @@ MissionOutput MissionRun::run(double duration_s, std::chrono::steady_clock::time
     control(t, dt);
   }
   for (const auto& l : share_links_) addCounters(M_, l->counters());
+  for (const auto& row : share_from_) {
+    for (const auto& l : row) {
+      if (l) addCounters(M_, l->counters());
+    }
+  }
+  for (const auto& row : vote_to_) {
+    for (const auto& l : row) {
+      if (l) addCounters(M_, l->counters());
+    }
+  }
   for (const auto& l : vote_links_) {
     if (l) addCounters(M_, l->counters());
   }
@@ -304,6 +443,11 @@ MissionOutput MissionRun::run(double duration_s, std::chrono::steady_clock::time
   if (abort_record_) out.metrics.abort = abort_record_->summary();
   if (approach_record_) out.metrics.worker_approach = approach_record_->summary();
   if (world_.site != nullptr) out.metrics.site_mapping = world_.site->summary();
+  std::vector<std::pair<double, bool>> operator_requests;
+  for (const RequestRecord& r : out.requests) {
+    if (r.source == "operator") operator_requests.emplace_back(r.t_s, r.status == "applied");
+  }
+  out.metrics.leadership = handover_->finish(static_cast<double>(steps) * dt, operator_requests, *lead_);
   if (const std::vector<PerceptionRecord>* records = camera_.perceptionRecords()) {
     out.perception = *records;
     out.metrics.perception = summarizePerception(*records);
@@ -313,24 +457,38 @@ MissionOutput MissionRun::run(double duration_s, std::chrono::steady_clock::time
 
 void MissionRun::deliverOperatorMessages(double t) {
   // Operator requests → operator link → the leader's FormationState.
-  for (const auto& d : schedule_.due(t)) operator_link_.send(t, OperatorMessage{metrics_.addRequest(d.record), t, d.command});
-  for (const auto& msg : operator_link_.receive(t)) {
-    RequestRecord& rec = metrics_.request(msg.record);
-    if (t - msg.sent_s > cfg_.faults.max_command_age_s) {  // never act on a command older than its age
-      ++M_.commands_stale;
-      if (rec.status == "lost") rec.status = "stale";
-      continue;
+  // The ground station sends to every UAV; only the acting leader applies, and a new leader only
+  // what was sent after it took over (older commands were its predecessor's, and the parameters
+  // it took over carry those it applied).
+  for (const auto& d : schedule_.due(t)) {
+    const OperatorMessage msg{metrics_.addRequest(d.record), t, d.command};
+    for (int i = 0; i < n_; ++i) operatorLink(i).send(t, msg);
+  }
+  for (int i = 0; i < n_; ++i) {
+    for (const auto& msg : operatorLink(i).receive(t)) {
+      if (uav(i).offline || !acting_[static_cast<std::size_t>(i)] || i != owner_ || msg.sent_s < took_over_s_) continue;
+      RequestRecord& rec = metrics_.request(msg.record);
+      if (t - msg.sent_s > cfg_.faults.max_command_age_s) {  // never act on a command older than its age
+        ++M_.commands_stale;
+        if (rec.status == "lost") rec.status = "stale";
+        continue;
+      }
+      applyCommand(msg.record, msg.command, t);
     }
-    applyCommand(msg.record, msg.command, t);
   }
 }
 
 void MissionRun::updateDropouts(double t) {
   // Follower dropouts: offline → nothing runs; back online → a rebooted computer with no memory.
-  for (int i = 1; i < n_; ++i) {
+  // The leader's silence (faults.leader_silence): the same, its radio dead both ways; it rejoins as
+  // a follower that listens first (its Leadership learns the newer term from the others).
+  for (int i = 0; i < n_; ++i) {
     UavRuntime& u = uav(i);
-    const bool off = cfg_.faults.followerOffline(i, t);
-    if (off && !u.offline) {
+    const bool silent = silentAt(i, t);
+    const bool off = cfg_.faults.followerOffline(i, t) || silent;
+    if (off && !u.offline && silent) {
+      setMode(i, t, "silent", "leader silence: radio dead both ways; the loaded plan is flown to its end and held");
+    } else if (off && !u.offline) {
       setMode(i, t, "offline", "follower dropout: the loaded plan is flown to its end and held");
     } else if (!off && u.offline) {
       u.share.reset();
@@ -344,17 +502,15 @@ void MissionRun::updateDropouts(double t) {
 
 void MissionRun::deliverUavMessages(double t) {
   // Inter-UAV messages (an offline UAV's radio drops what arrives).
-  for (int i = 1; i < n_; ++i) {
-    UavRuntime& u = uav(i);
-    for (auto& s : share_links_[static_cast<std::size_t>(i)]->receive(t)) {
-      if (u.offline) continue;
-      if (s.abort) receiveAbort(i, *s.abort, t);  // a relayed abort counts whatever the share's age
-      if (!u.share || s.worker.stamp_s > u.share->worker.stamp_s) u.share = std::move(s);
+  for (int i = 0; i < n_; ++i) {
+    for (int from = 0; from < n_; ++from) {
+      if (from == i) continue;
+      for (auto& s : shareLink(from, i).receive(t)) receiveShare(i, std::move(s), t);
     }
   }
   for (int i = 0; i < n_; ++i) {
     UavRuntime& u = uav(i);
-    for (int j = 1; j < n_; ++j) {
+    for (int j = 0; j < n_; ++j) {
       if (j == i) continue;
       for (auto& p : plan_links_[static_cast<std::size_t>(j)][static_cast<std::size_t>(i)]->receive(t)) {
         if (u.offline) continue;
@@ -365,21 +521,31 @@ void MissionRun::deliverUavMessages(double t) {
   }
 }
 
+void MissionRun::receiveShare(int i, LeaderShare s, double t) {
+  UavRuntime& u = uav(i);
+  if (u.offline) return;
+  if (s.abort) receiveAbort(i, *s.abort, t);  // a relayed abort counts whatever the share's age
+  if (!u.share || s.worker.stamp_s > u.share->worker.stamp_s) u.share = std::move(s);
+}
+
 void MissionRun::cameraFrame(double t, const WorkerState& ws) {
-  // Leader camera frame: box → estimator; skeleton → classifier → filter → command.
+  // Leader camera frame: box → estimator; skeleton → classifier → filter → command. The leader's
+  // camera is the one of the UAV doing the leader's work (owner_; the simulator gives every UAV
+  // the leader's sensors), the others' cameras vote.
   std::vector<MultirotorState> follower_states;
   std::vector<bool> online;
   if (follower_views_) {
-    for (int i = 1; i < n_; ++i) {
+    for (int i = 0; i < n_; ++i) {
+      if (i == owner_) continue;
       follower_states.push_back(uav(i).plant.state());
       online.push_back(!uav(i).offline);
     }
   }
-  const LeaderCameraFrame cf = camera_.frame(t, uavs_[0]->plant.state(), follower_states, online, ws, worker_, classifier_);
+  const LeaderCameraFrame cf = camera_.frame(t, uav(owner_).plant.state(), follower_states, online, ws, worker_, classifier_);
   const SensorFrame& frame = cf.sensors;
   M_.range_outliers += cf.range_outliers;
   if (frame.visible()) {
-    const UavRuntime& L = *uavs_[0];
+    const UavRuntime& L = uav(owner_);
     const estimation::CameraPose est_pose = cameraPose(L.est.p_world, L.est.heading_rad, L.est.pitch_rad);
     const auto meas = estimation::makeMeasurement(cam_model_, est_pose, frame.box, frame.d_uwb_m, frame.d_stereo_m,
                                                   cfg_.estimator.human_height_m, cfg_.estimator.noise);
@@ -392,7 +558,7 @@ void MissionRun::cameraFrame(double t, const WorkerState& ws) {
   metrics_.cameraFrame(frame.visible(), kf_.confirmed() ? &estimate : nullptr, ws.p_world);
 }
 
-gesture::ViewObservation MissionRun::observation(int view, double t, const gesture::Classification& c,
+gesture::ViewObservation MissionRun::observation(int uav_index, int view, double t, const gesture::Classification& c,
                                                  const gesture::CalibratedSkeleton& cal,
                                                  const std::optional<Eigen::Vector3d>& worker_est) {
   gesture::ViewObservation o;
@@ -401,7 +567,7 @@ gesture::ViewObservation MissionRun::observation(int view, double t, const gestu
   o.gesture_id = c.gesture_id;
   o.distance_m = std::nan("");
   o.elevation_deg = std::nan("");
-  const UavRuntime& u = uav(view);
+  const UavRuntime& u = uav(uav_index);
   if (worker_est) {
     const formation::ViewGeometry g = formation::viewGeometry(u.est.p_world, *worker_est);
     o.distance_m = g.distance_m;
@@ -433,15 +599,20 @@ std::vector<gesture::GestureFrame> MissionRun::aggregateViews(double t, const Le
   const auto take = [&closed](std::vector<gesture::GestureFrame> frames_closed) {
     for (auto& f : frames_closed) closed.push_back(std::move(f));
   };
-  if (cf.classification) take(frames_.observe(observation(0, t, *cf.classification, cf.calibrated, worker_est)));
-  for (std::size_t i = 0; i < cf.followers.size(); ++i) {
-    if (cf.followers[i].classification) {
-      vote_links_[i + 1]->send(t, observation(static_cast<int>(i) + 1, t, *cf.followers[i].classification,
-                                              cf.followers[i].calibrated, worker_est));
+  // Views are numbered by UAV (one camera only: the leader's is view 0).
+  const int own_view = follower_views_ ? owner_ : 0;
+  if (cf.classification) take(frames_.observe(observation(owner_, own_view, t, *cf.classification, cf.calibrated, worker_est)));
+  for (std::size_t f = 0; f < cf.followers.size(); ++f) {
+    const int i = static_cast<int>(f) < owner_ ? static_cast<int>(f) : static_cast<int>(f) + 1;  // the UAV of view f
+    if (cf.followers[f].classification && !uav(i).offline) {
+      voteLink(i, owner_)->send(t, observation(i, i, t, *cf.followers[f].classification, cf.followers[f].calibrated, worker_est));
     }
   }
-  for (int i = 1; follower_views_ && i < n_; ++i) {
-    for (const auto& o : vote_links_[static_cast<std::size_t>(i)]->receive(t)) take(frames_.observe(o));
+  for (int i = 0; follower_views_ && i < n_; ++i) {
+    if (i == owner_) continue;
+    for (const auto& o : voteLink(i, owner_)->receive(t)) {
+      if (!uav(owner_).offline) take(frames_.observe(o));  // a dead radio drops what arrives
+    }
   }
   take(frames_.closeDue(t));
   return closed;
@@ -453,10 +624,11 @@ void MissionRun::actOnFrames(double t, const std::vector<gesture::GestureFrame>&
     last_ratio_ = f.filter.dominant_ratio;
     if (!f.filter.fired) continue;
     const std::size_t record = metrics_.addRequest(firedGestureRecord(t, f.filter.dominant_id, cfg_.gesture_mapping));
+    if (!acting_[static_cast<std::size_t>(owner_)]) continue;  // no lease: the leader's commands wait for it
     if (f.action != nullptr && f.action->kind != gesture::GestureAction::Kind::kEvent) {
       applyCommand(record, gesture::toCommand(*f.action, ++gesture_seq_), t);
     } else if (f.action != nullptr && f.action->event == gesture::GestureEvent::kAbort) {
-      receiveAbort(0, planning::AbortCommand{{"gesture", ++gesture_seq_}, planning::AbortSource::kGesture, t}, t);
+      receiveAbort(owner_, planning::AbortCommand{{"gesture", ++gesture_seq_}, planning::AbortSource::kGesture, t}, t);
     }
   }
 }
@@ -491,7 +663,8 @@ void MissionRun::replan(int i, double t) {
   const LeaderShare* share = nullptr;
   const formation::FormationParams* params = &fstate_.params();
   std::uint64_t version = params_version_;
-  if (i == 0) {
+  const bool leads = i == owner_;  // flies the leader's slot from its own estimator
+  if (leads) {
     if (kf_.confirmed()) {
       planning::WorkerKnowledge w;
       w.stamp_s = t;
@@ -513,14 +686,20 @@ void MissionRun::replan(int i, double t) {
   in.state.heading_rad = u.est.heading_rad;
   in.state.pitch_rad = u.est.pitch_rad;
   in.wind_estimate_mps = u.wind_estimate.value();
-  in.worker = i == 0 ? (leader_knowledge_ ? &*leader_knowledge_ : nullptr) : (share != nullptr ? &share->worker : nullptr);
+  in.worker = leads ? (leader_knowledge_ ? &*leader_knowledge_ : nullptr) : (share != nullptr ? &share->worker : nullptr);
   in.params = params;
   in.leader_plan = share != nullptr ? &share->plan : nullptr;
   in.received = &u.received;
+  in.slot = slotOf(i);
+  in.leader_index = leads ? i : (share != nullptr ? share->from : 0);
+  if (share != nullptr) {  // the leader's newer plan, when its copy on the plan link is newer than the share's
+    const auto& direct = u.received[static_cast<std::size_t>(share->from)];
+    if (direct && direct->plan.t0_s > share->plan.t0_s) in.leader_plan = &direct->plan;
+  }
   const planning::ReplanOutcome out = u.step->step(in);
   if (!out.planned()) {
     ++M_.plans_skipped;  // nothing known about the worker: the controller holds (its plan's end, or brakes)
-    if (i != 0) setMode(i, t, "hold", out.reason);
+    if (!leads) setMode(i, t, "hold", out.reason);
     return;
   }
   if (out.holding()) ++M_.plans_hold;
@@ -545,17 +724,21 @@ void MissionRun::replan(int i, double t) {
 
 void MissionRun::sendPlan(int i, double t, const planning::ReplanOutcome& out, const formation::FormationParams& params,
                           std::uint64_t version) {
-  if (i == 0) {
+  if (i == owner_ && acting_[static_cast<std::size_t>(i)] && leader_knowledge_) {
     LeaderShare s;
     s.worker = *leader_knowledge_;  // the estimator's state, as the WorkerEstimator's over LCM
     s.params = params;
     s.params_version = version;
     s.plan = out.result.trajectory;
-    s.abort = uav(0).step->abort().command();
+    s.abort = uav(i).step->abort().command();
     if (s.abort) s.abort->sent_s = t;  // each relayed copy is stamped when it is sent (its age: the share's)
-    for (int j = 1; j < n_; ++j) share_links_[static_cast<std::size_t>(j)]->send(t, s);
-    return;
+    s.from = i;
+    for (int j = 0; j < n_; ++j) {
+      if (j != i) shareLink(i, j).send(t, s);
+    }
   }
+  // Every UAV's plan to every other (the leader's too, as the ROS PlannedTrajectory): after a
+  // hand-over the others still know the old leader's last plan.
   const PlanMessage msg{out.result.trajectory, out.fallback};
   for (int j = 0; j < n_; ++j) {
     if (j != i) plan_links_[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)]->send(t, msg);
@@ -573,7 +756,11 @@ void MissionRun::sampleTimeline(double t, const WorkerState& ws) {
   in.gesture_class = last_class_;
   in.dominant_ratio = last_ratio_;
   in.params = fstate_.params();
-  in.human_heading_rad = uavs_[0]->step->workerHeading();
+  in.human_heading_rad = uav(owner_).step->workerHeading();
+  for (int i = 0; i < n_; ++i) {
+    in.acting.push_back(acting_[static_cast<std::size_t>(i)] ? 1 : 0);
+    in.slots.push_back(slotOf(i));
+  }
   for (const auto& u : uavs_) in.uavs.push_back(u->plant.state());
   metrics_.sampleTimeline(in);
 }
@@ -593,8 +780,14 @@ void MissionRun::applyCommand(std::size_t record, const formation::FormationComm
   if (outcome.status == formation::CommandStatus::kDuplicate) ++M_.commands_duplicate;
   if (metrics_.request(record).status == "applied") return;  // a duplicate copy of an applied command changes nothing
   const bool applied = outcome.status == formation::CommandStatus::kApplied;
-  std::vector<int> addressed;
-  for (const auto& ch : outcome.changes) addressed.push_back(ch.uav);
+  std::vector<int> addressed;  // the UAVs flying the changed slots (a hand-over moves slots)
+  for (const auto& ch : outcome.changes) {
+    int flying = ch.uav;
+    for (int u = 0; u < n_; ++u) {
+      if (slotOf(u) == ch.uav) flying = u;
+    }
+    addressed.push_back(flying);
+  }
   metrics_.requestOutcome(record, formation::toString(outcome.status), t, applied ? ++params_version_ : 0, addressed);
 }
 
@@ -603,8 +796,8 @@ void MissionRun::deliverAbort(double t) {
   // gesture accepted by the leader's pipeline at its time.
   const std::optional<AbortEvent>& event = cfg_.faults.abort;
   if (!event) return;
-  if (event->source == planning::AbortSource::kGesture && t >= event->t_s && !uav(0).step->abort().aborting()) {
-    receiveAbort(0, planning::AbortCommand{{"gesture", ++gesture_seq_}, planning::AbortSource::kGesture, event->t_s}, t);
+  if (event->source == planning::AbortSource::kGesture && t >= event->t_s && !uav(owner_).step->abort().aborting()) {
+    receiveAbort(owner_, planning::AbortCommand{{"gesture", ++gesture_seq_}, planning::AbortSource::kGesture, event->t_s}, t);
   }
   for (const auto& c : abort_sender_.due(t)) {
     for (auto& link : abort_links_) link->send(t, c);
@@ -666,6 +859,7 @@ common::Result<MissionOutput> runMission(const MissionConfig& cfg, const Mission
   const std::string bad_start = mission.addUavs();
   if (!bad_start.empty()) return R::fail(bad_start);
   mission.openLinks();
+  mission.openHandoverLinks();
   return R::ok(mission.run(duration, wall0));
 }
 

@@ -140,6 +140,33 @@ class HumanKalman {
     consecutive_rejections_ = 0;
   }
 
+  /// \brief Takes over another filter's published estimate (a new leader starts from the last
+  /// shared state, docs/safety.md §1.2): position `p_world` and velocity `v_world` at `t_s`,
+  /// position covariance `cov_p_world` (velocity: σ_v0² I, no correlation), last fused at
+  /// `fused_s` (≤ t_s; lost() counts from it). The track counts as confirmed — only a confirmed
+  /// track is published. Returns false and changes nothing for non-finite or inconsistent input.
+  bool adopt(double t_s, const Eigen::Vector3d& p_world, const Eigen::Vector3d& v_world,
+             const Eigen::Matrix3d& cov_p_world, double fused_s) {
+    if (!std::isfinite(t_s) || !std::isfinite(fused_s) || fused_s > t_s || !p_world.allFinite() ||
+        !v_world.allFinite() || !cov_p_world.allFinite() || cov_p_world.llt().info() != Eigen::Success) {
+      ++counters_.invalid;
+      return false;
+    }
+    x_.head<3>() = p_world;
+    x_.tail<3>() = v_world;
+    P_.setZero();
+    P_.topLeftCorner<3, 3>() = 0.5 * (cov_p_world + cov_p_world.transpose());
+    const double s0 = config_.initial_velocity_std_mps;
+    P_.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity() * (s0 * s0);
+    t_ = t_s;
+    t_last_fused_ = fused_s;
+    initialized_ = true;
+    consecutive_rejections_ = 0;
+    accepted_since_init_ = std::max(1, config_.confirm_measurements);
+    ++counters_.initializations;
+    return true;
+  }
+
   /// \brief Predicts the state to `t_s` (≥ time()), adding Q once (scaled by
   /// dt / reference_period_s when that is > 0, dt = t_s − time()). Returns false and changes
   /// nothing when not initialised, `t_s` is not finite, or `t_s` < time().

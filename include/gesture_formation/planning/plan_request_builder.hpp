@@ -43,6 +43,13 @@ struct AvoidanceRule {
 /// \brief What one replanning of UAV `uav_index` starts from.
 struct PlanRequestInputs {
   int uav_index = 0;                 ///< 0 = leader, i = follower i (priority order)
+  /// The formation slot whose reference the UAV flies: 0 the leader's, j follower j's; −1: its own
+  /// (uav_index). A UAV that took over the leadership flies slot 0; one that handed it over may fly
+  /// the new leader's former slot (docs/safety.md §1.2).
+  int slot = -1;
+  /// The UAV whose plan leader_plan is (the acting leader): its entry of `received` is not avoided a
+  /// second time. 0 unless the leadership changed hands.
+  int leader_index = 0;
   double t_s = 0.0;                  ///< now; sample 0 of the reference
   double dt_s = 0.2;                 ///< horizon step [s]
   UavKinematicState state;  ///< the UAV's current (estimated) state
@@ -56,8 +63,8 @@ struct PlanRequestInputs {
   /// The leader's plan shapes the reference only while t_s − its t0_s ≤ this (an older plan's
   /// heading and pitch are not the leader's now); it is avoided whatever its age (right of way).
   double leader_plan_max_age_s = std::numeric_limits<double>::infinity();
-  /// The plans received from the followers, indexed by sender (entries 0 and uav_index are
-  /// ignored); may be null.
+  /// The plans received from the other UAVs, indexed by sender (entries leader_index and
+  /// uav_index are ignored); may be null.
   const std::vector<std::optional<ReceivedPlan>>* received = nullptr;
   /// Non-null: the UAV holds — this is its reference, and it avoids every received plan.
   const formation::ReferenceTrajectory* hold_reference = nullptr;
@@ -68,7 +75,7 @@ struct PlanRequestInputs {
 };
 
 /// \brief The request (see the file comment). Preconditions: params non-null with a
-/// follower entry for uav_index; worker.steps() ≥ 1.
+/// follower entry for the slot flown; worker.steps() ≥ 1.
 PlanRequest buildPlanRequest(const PlanRequestInputs& in);
 
 // ---- hold (docs/safety.md §1 rules 2–4), shared by gfctl simulate and the FormationPlanner ----

@@ -143,6 +143,10 @@ struct ReplanInputs {
   const WorkerKnowledge* worker = nullptr;                    ///< null: nothing known yet → skipped
   const formation::FormationParams* params = nullptr;         ///< required
   const PlannedTrajectory* leader_plan = nullptr;             ///< followers: the leader's last plan (null: none)
+  /// The formation slot flown (PlanRequestInputs::slot): 0 = the leader's — the UAV then plans as
+  /// the leader (its own estimate's freshness, the search) —, j = follower j's; −1: its own index.
+  int slot = -1;
+  int leader_index = 0;  ///< whose plan leader_plan is (PlanRequestInputs::leader_index)
   const std::vector<std::optional<ReceivedPlan>>* received = nullptr;  ///< plans by sender (may be null)
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };

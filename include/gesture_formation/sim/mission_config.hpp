@@ -29,6 +29,7 @@
 #include "gesture_formation/sim/abort_drill.hpp"
 #include "gesture_formation/planning/planner_config.hpp"
 #include "gesture_formation/planning/replan_step.hpp"
+#include "gesture_formation/sim/leader_handover.hpp"
 #include "gesture_formation/sim/link.hpp"
 #include "gesture_formation/sim/multirotor.hpp"
 #include "gesture_formation/sim/odometry.hpp"
@@ -103,6 +104,9 @@ struct FaultConfig {
   /// The worker walks towards a UAV (`worker_approach: {t_s, uav, speed_mps, stop_m}`; fault
   /// profile worker_approaches_holding_uav; docs/safety.md §3). Absent: he keeps to his route.
   std::optional<WorkerApproach> worker_approach;
+  /// The leader's radio dies (`leader_silence: {t_s, duration_s}`; fault profiles leader_dropout_*;
+  /// docs/safety.md §1.2). Absent: none.
+  std::optional<LeaderSilence> leader_silence;
   std::vector<std::string> validate(const std::string& prefix = "") const;
   /// \brief Whether follower `uav`'s computer is down at `t_s` (a follower_dropouts window).
   bool followerOffline(int uav, double t_s) const;
@@ -149,6 +153,8 @@ struct MissionConfig {
   /// The UAVs' online mapping of the site (`mission.mapping.*`, site_mapping_config.hpp).
   SiteMappingConfig mapping;
   std::vector<OperatorRequest> requests;  ///< ascending t_s
+  /// `leadership.*`: every UAV's formation::Leadership (uav_count: the formation's).
+  formation::LeadershipConfig leadership;
 };
 
 /// \brief Reads `mission` of a scenario file. Fails listing every problem (file: key: message).

@@ -105,6 +105,9 @@ struct MissionMetrics {
   /// scenario has no unmapped obstacles and mapping is off (metrics.json then has no
   /// `site_mapping` key).
   std::optional<SiteMappingSummary> site_mapping;
+  /// Who acted as leader when, and the hand-over after faults.leader_silence (docs/safety.md
+  /// §1.2); absent where not measured (the ROS simulation: metrics.json then has no `leadership`).
+  std::optional<HandoverSummary> leadership;
 };
 
 /// \brief One UAV's part of a timeline sample (docs/design.md §8.4 timeline.csv).
@@ -129,6 +132,7 @@ struct TimelineRow {
   double dominant_ratio = 0.0;  ///< gesture filter f_d
   std::vector<UavSample> uavs;
   std::vector<double> mutual_m;  ///< pairs (0,1), (0,2), …, (1,2), …
+  std::vector<int> acting;       ///< per UAV: 1 while it acts as leader (empty: not recorded)
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
 
@@ -207,6 +211,11 @@ struct TimelineInput {
   formation::FormationParams params;   ///< the leader's current parameters
   double human_heading_rad = 0.0;      ///< ^Hφ the leader uses
   std::vector<MultirotorState> uavs;   ///< true states, uavs[0] the leader
+  std::vector<int> acting;             ///< per UAV: 1 while it acts as leader (empty: not recorded)
+  /// Per UAV: the formation slot it flies (0 the leader's; −1: none — its references are NaN and it
+  /// adds no tracking error; empty: every UAV its own index) — the references of d_ref, phi_ref,
+  /// elev_ref and the tracking errors.
+  std::vector<int> slots;
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
 

@@ -17,6 +17,11 @@
 /// k·period + i·period/n. A plan is executed only as returned by the planner (verified); a UAV
 /// without a plan brakes to hover (TrackingController).
 ///
+/// "The leader" is the UAV acting as leader (formation::Leadership on every UAV, its messages over
+/// the inter-UAV links; leader_handover.hpp, docs/safety.md §1.2): UAV 0 from the start; after a
+/// leader's silence (faults.leader_silence) the UAV elected in its place, which takes the estimator
+/// over from the last share it received and flies the leader's slot.
+///
 /// The parts the ROS simulation (SimWorld, FormationPlanner nodelets) runs too: the metrics
 /// (MetricsAccumulator, mission_metrics.hpp), the leader's camera (LeaderCamera,
 /// leader_camera.hpp) and the planning request (buildPlanRequest, planning/plan_request_builder.hpp).

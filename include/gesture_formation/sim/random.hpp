@@ -30,6 +30,7 @@ enum class Stream : std::uint64_t {
   kLink = 30,        ///< + link index
   kFault = 40,       ///< injected sensor faults (range outliers)
   kFollowerCamera = 50,  ///< + follower index: the followers' cameras (gesture views)
+  kHandover = 60,        ///< + link index: the leadership's links and the links a new leader needs
 };
 
 /// \brief The RNG of stream `stream` (+ `index`) of a mission with seed `seed`.

@@ -37,6 +37,24 @@ TEST(HumanKalmanTest, FirstMeasurementInitialises) {
   EXPECT_LT((kf.covariance() - P0).norm(), 1e-15);
 }
 
+// A new leader takes over the shared estimate (docs/safety.md §1.2): confirmed at once, predicts
+// from the shared velocity, lost() counts from the shared last fusion, and the next measurement
+// updates it (not a re-initialisation). Bad input changes nothing.
+TEST(HumanKalmanTest, AdoptTakesOverASharedEstimate) {
+  HumanKalman kf;
+  const Eigen::Matrix3d cov = Eigen::Matrix3d::Identity();
+  EXPECT_FALSE(kf.adopt(10.0, Eigen::Vector3d(1, 2, 0), Eigen::Vector3d(1, 0, 0), cov, 10.5));  // fused after the stamp
+  EXPECT_FALSE(kf.adopt(10.0, Eigen::Vector3d(1, 2, 0), Eigen::Vector3d(1, 0, 0), -cov, 9.5));  // not a covariance
+  EXPECT_FALSE(kf.initialized());
+  ASSERT_TRUE(kf.adopt(10.0, Eigen::Vector3d(1, 2, 0), Eigen::Vector3d(1, 0, 0), cov, 9.5));
+  EXPECT_TRUE(kf.confirmed());
+  EXPECT_TRUE(kf.predicted(11.0).p_world.isApprox(Eigen::Vector3d(2, 2, 0), 1e-12));
+  EXPECT_FALSE(kf.lost(9.5 + kf.config().lost_timeout_s - 0.01));
+  EXPECT_TRUE(kf.lost(9.5 + kf.config().lost_timeout_s + 0.01));
+  EXPECT_EQ(kf.step(10.5, meas(Eigen::Vector3d(1.6, 2.0, 0.0))), UpdateOutcome::kFused);
+  EXPECT_NEAR(kf.state()(0), 1.5, 0.1);
+}
+
 TEST(HumanKalmanTest, PredictInflatesCovarianceByFPFtPlusQ) {
   HumanKalman kf;
   kf.step(0.0, meas(Eigen::Vector3d(0, 0, 0)));

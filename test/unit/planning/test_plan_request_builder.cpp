@@ -112,3 +112,43 @@ TEST(PlanRequestBuilderTest, ReferencesAndHold) {
   EXPECT_TRUE(req3.reference.p_world.isApprox(hold.p_world));
   EXPECT_EQ(senders(req3), std::vector<int>({0, 2}));
 }
+
+// A hand-over (docs/safety.md §1.2): follower 1 leads — it flies the leader's slot and avoids UAV 0's
+// last plan and follower 2's; follower 2 follows UAV 1's plan (leader_index 1), avoids it once (as
+// the leader's plan, not again as received[1]) and avoids UAV 0's last plan; UAV 0, back as a
+// follower, flies the slot UAV 1 left.
+TEST(PlanRequestBuilderTest, SlotsAndTheLeadersPlanAfterAHandOver) {
+  RequestFixture f;
+  f.received[0] = gf::planning::ReceivedPlan{planOf(0, 9.0, 0.7), false};
+  auto lead = f.inputs(1, true);
+  lead.slot = 0;
+  lead.leader_index = 1;
+  lead.leader_plan = nullptr;
+  const auto req_lead = gf::planning::buildPlanRequest(lead);
+  gf::formation::ReferenceTrajectory expected_lead;
+  gf::formation::leaderHorizon(lead.worker, f.params.leader, expected_lead);
+  EXPECT_TRUE(req_lead.reference.p_world.isApprox(expected_lead.p_world, 1e-12));
+  EXPECT_EQ(req_lead.uav_index, 1);  // its identity (priority, abort layer) is unchanged
+  EXPECT_EQ(senders(req_lead), std::vector<int>({0, 2}));
+  const gf::planning::PlannedTrajectory new_leader = planOf(1, 10.0, 0.4);
+  auto follower = f.inputs(2, true);
+  follower.leader_plan = &new_leader;
+  follower.leader_index = 1;
+  EXPECT_EQ(senders(gf::planning::buildPlanRequest(follower)), std::vector<int>({1, 0}));
+  auto back = f.inputs(0, true);
+  back.slot = 1;
+  back.leader_index = 1;
+  back.leader_plan = &new_leader;
+  const auto req_back = gf::planning::buildPlanRequest(back);
+  gf::formation::LeaderPlan lp;
+  lp.heading_rad.resize(1, 10);
+  lp.pitch_rad.resize(1, 10);
+  lp.heading_rad.setConstant(0.4);
+  lp.pitch_rad.setConstant(-0.1);
+  gf::formation::ReferenceTrajectory expected_back;
+  gf::formation::followerHorizon(back.worker, f.params.leader, &lp, f.params.followers[0], expected_back);
+  EXPECT_TRUE(req_back.reference.p_world.isApprox(expected_back.p_world, 1e-12));
+  EXPECT_EQ(senders(req_back), std::vector<int>({1, 2}));
+  // Without a hand-over (leader_index 0) a received copy of the leader's plan is not avoided twice.
+  EXPECT_EQ(senders(gf::planning::buildPlanRequest(f.inputs(1, true))), std::vector<int>({0, 2}));
+}
