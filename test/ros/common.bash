@@ -31,3 +31,20 @@ start_master() {
 make_key() {  # a fresh owner-only key file
   (umask 077; printf '1 %s active\n' "$(od -An -N32 -tx1 /dev/urandom | tr -d ' \n')" > "$1")
 }
+# LCM multicast stays on this machine: tests that run the simulation do so in a private network
+# namespace (unshare -n), which needs root; without it they are skipped.
+need_netns() { [ "$(id -u)" -eq 0 ] || { echo "SKIP: needs root (unshare -n keeps LCM on this machine)"; exit 77; }; }
+# Writes the start of $T/inner.sh, the script a test runs in its namespace: loopback multicast,
+# simulation.launch with per-sender keys ($T/keys), outputs in $T/out, real-time factor 1.5 and the
+# given extra arguments (log $T/launch.log, pid in $launch), then a wait for sim time. The test
+# appends its checks (cat >> "$T/inner.sh") and stops the launch itself.
+sim_inner_start() {
+  "$SRC/tools/make_fleet_keys.sh" "$T/keys" 0 1 2 100 > /dev/null
+  mkdir -p "$T/out"
+  cat > "$T/inner.sh" <<SIMSTART
+ip link set lo up && ip route add 224.0.0.0/4 dev lo || exit 1
+roslaunch -p $PORT gesture_formation simulation.launch key_dir:=$T/keys output_dir:=$T/out real_time_factor:=1.5 $* > "$T/launch.log" 2>&1 &
+launch=\$!
+for _ in \$(seq 50); do rosparam get /use_sim_time > /dev/null 2>&1 && break; sleep 0.2; done
+SIMSTART
+}

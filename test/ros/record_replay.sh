@@ -5,15 +5,9 @@
 # (body, frustum, plan), the worker and its covariance, and the map again from the bag.
 set -o pipefail
 source "$(dirname "$0")/common.bash"
-[ "$(id -u)" -eq 0 ] || { echo "SKIP: needs root (unshare -n keeps LCM on this machine)"; exit 77; }
-"$SRC/tools/make_fleet_keys.sh" "$T/keys" 0 1 2 100 > /dev/null
-mkdir -p "$T/out"
-cat > "$T/inner.sh" <<INNER
-ip link set lo up && ip route add 224.0.0.0/4 dev lo || exit 1
-roslaunch -p $PORT gesture_formation simulation.launch key_dir:=$T/keys output_dir:=$T/out duration:=25 \
-  real_time_factor:=1.5 > "$T/launch.log" 2>&1 &
-launch=\$!
-for _ in \$(seq 50); do rosparam get /use_sim_time > /dev/null 2>&1 && break; sleep 0.2; done
+need_netns
+sim_inner_start duration:=25
+cat >> "$T/inner.sh" <<INNER
 roslaunch gesture_formation record.launch bag:=$T/flight.bag > "$T/record.log" 2>&1 &
 record=\$!
 while kill -0 \$launch 2>/dev/null && [ ! -f "$T/out/metrics.json" ]; do sleep 1; done

@@ -8,15 +8,9 @@
 # metrics, with the requests followed to their adaptation (test/ros/check_sim_metrics.py).
 set -o pipefail
 source "$(dirname "$0")/common.bash"
-[ "$(id -u)" -eq 0 ] || { echo "SKIP: needs root (unshare -n keeps LCM on this machine)"; exit 77; }
-"$SRC/tools/make_fleet_keys.sh" "$T/keys" 0 1 2 100 > /dev/null  # per-sender Ed25519 keys, as tools/run_ros_mission.sh
-mkdir -p "$T/out"
-cat > "$T/inner.sh" <<INNER
-ip link set lo up && ip route add 224.0.0.0/4 dev lo || exit 1
-roslaunch -p $PORT gesture_formation simulation.launch key_dir:=$T/keys output_dir:=$T/out duration:=40 \
-  real_time_factor:=1.5 gesture_prefix:=/world/unused > "$T/launch.log" 2>&1 &
-launch=\$!
-for _ in \$(seq 50); do rosparam get /use_sim_time > /dev/null 2>&1 && break; sleep 0.2; done
+need_netns
+sim_inner_start duration:=40 gesture_prefix:=/world/unused
+cat >> "$T/inner.sh" <<INNER
 timeout 80 python3 "$SRC/test/ros/sim_check.py"
 rc=\$?
 timeout 20 python3 "$SRC/test/ros/diagnostics_check.py" || rc=\$((rc+1))
