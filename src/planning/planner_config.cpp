@@ -48,6 +48,7 @@ const common::FieldTable<PlannerConfig>& fields() {
       {"qp.corridor_margin_m", Range::nonNegative(), [](C& c) { return &c.corridor_margin_m; }},
       {"qp.mutual_distance_m", Range::positive(), [](C& c) { return &c.mutual_distance_m; }},
       {"qp.age_margin_speed_mps", Range::nonNegative(), [](C& c) { return &c.age_margin_speed_mps; }},
+      {"qp.age_margin_max_m", Range::nonNegative(), [](C& c) { return &c.age_margin_max_m; }},
       {"qp.brake_envelope_age_s", Range::nonNegative(), [](C& c) { return &c.brake_envelope_age_s; }},
       {"qp.brake_envelope_lead_s", Range::nonNegative(), [](C& c) { return &c.brake_envelope_lead_s; }},
       {"qp.worker_safety_distance_m", Range::positive(), [](C& c) { return &c.worker_safety_distance_m; }},
@@ -86,6 +87,8 @@ void crossFieldProblems(const PlannerConfig& c, std::vector<common::ConfigError>
        "must be >= path.obstacle_clearance_m");
   rule(c.tracking_allowance_max_m >= c.tracking_allowance_min_m, "path.tracking_allowance_max_m",
        c.tracking_allowance_max_m, "must be >= path.tracking_allowance_min_m");
+  rule(c.age_margin_max_m >= c.tracking_allowance_max_m + c.wind_allowance_max_m, "qp.age_margin_max_m", c.age_margin_max_m,
+       "must be >= path.tracking_allowance_max_m + path.wind_allowance_max_m (a silent UAV's reach off its last plan)");
   rule(c.corridor_margin_m < c.corridor_box_margin_m, "qp.corridor_margin_m", c.corridor_margin_m,
        "must be < qp.corridor_box_margin_m");
 }

@@ -175,7 +175,7 @@ VerificationReport TrajectoryVerifier::verify(const PlannedTrajectory& tr, doubl
   // Required distances to the other plans (age margin; recovery: requiredUavDistance) and to the worker.
   std::vector<double> required(others.size());
   for (std::size_t j = 0; j < others.size(); ++j) {
-    required[j] = config_.mutual_distance_m + config_.age_margin_speed_mps * std::max(0.0, t_now - others[j].t0_s);
+    required[j] = uavKeepOutDistance(config_, t_now - others[j].t0_s);
   }
   const TrajectoryPoint start = evaluateTrajectory(tr, tr.t0_s);
   std::vector<double> start_dist(others.size());

@@ -229,7 +229,7 @@ std::optional<PlannedTrajectory> UavPlanner::separateHoldPoint(const PlanRequest
     const double age = std::isfinite(req.t_now_s) ? std::max(0.0, req.t_now_s - other.t0_s) : 0.0;
     keep.push_back({[&other](double t) { return evaluateTrajectory(other, t).p; },
                     config_.mutual_distance_m + config_.qp_distance_buffer_m,
-                    config_.mutual_distance_m + config_.age_margin_speed_mps * age + config_.qp_distance_buffer_m,
+                    uavKeepOutDistance(config_, age) + config_.qp_distance_buffer_m,
                     "UAV " + std::to_string(other.uav_index)});
   }
   if (req.worker.steps() > 0 && req.worker.p_world.allFinite()) {
@@ -895,7 +895,7 @@ void UavPlanner::addSeparationRows(PlanContext& c) const {
   };
   for (const auto& other : req.higher_priority_plans) {
     const double age = std::max(0.0, req.t_now_s - other.t0_s);
-    const double margin = config_.mutual_distance_m + config_.age_margin_speed_mps * age + config_.qp_distance_buffer_m;
+    const double margin = uavKeepOutDistance(config_, age) + config_.qp_distance_buffer_m;
     const double d0 = (c.p0 - evaluateTrajectory(other, req.t_now_s).p).norm();
     for (int k = 1; k <= c.N; ++k) {
       // Already inside at t0: recover at 1.2× the verifier's pace (recoveringDistance).

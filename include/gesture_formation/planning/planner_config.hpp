@@ -97,9 +97,18 @@ struct PlannerConfig {
   /// Γ_dis: distance (m) kept from every higher-priority UAV's planned position at the same
   /// time (paper Table II: 2.5 m), > 0.
   double mutual_distance_m = 2.5;
-  /// An older plan of another UAV gets margin Γ_dis + age_margin_speed_mps·age (its UAV may
-  /// have replanned since and moved at up to this speed), ≥ 0.
+  /// An older plan of another UAV gets margin Γ_dis + min(age_margin_speed_mps·age,
+  /// age_margin_max_m) (uavKeepOutDistance(): its UAV may have replanned since and moved at up to
+  /// this speed), ≥ 0.
   double age_margin_speed_mps = 5.0;
+  /// Bound (m) of the age term: a UAV whose plans stopped arriving flies its last verified plan,
+  /// then hovers at its end (the fallback contract, docs/safety.md §1 rule 5, "The silent UAV's
+  /// keep-out"), so it stays within its tracking error of that plan — at most
+  /// tracking_allowance_max_m + wind_allowance_max_m (1.5 m) — and its braking stops are the
+  /// braking envelope (brake_envelope_age_s). The default, reached at 1 s of age (the default
+  /// faults.max_plan_age_s, after which a silent UAV has right of way), is a conservative cap over
+  /// that bound. Finite, ≥ tracking_allowance_max_m + wind_allowance_max_m.
+  double age_margin_max_m = 5.0;
   /// Another UAV's plan older than this (s, ≥ 0) may already have been replaced by one that did
   /// not arrive — typically a brake plan lost on the link: its UAV stopped while the old plan
   /// flies on, and the recovery rule (verify.recovery_*), which only asks a UAV already inside
@@ -192,6 +201,15 @@ inline double recoveringDistance(const PlannerConfig& c, double limit_m, double 
   const double recover = qp_form ? d0_m - 0.5 * c.recovery_slack_m + 1.2 * recoveryAllowance(c, tau_s)
                                  : d0_m - c.recovery_slack_m + recoveryAllowance(c, tau_s);
   return std::min(limit_m, recover);
+}
+
+/// \brief The distance (m) kept from another UAV's plan of age `age_s` (t_now − its t0) at the same
+/// time: Γ_dis + min(age_margin_speed_mps · age, age_margin_max_m) (negative ages count as 0).
+/// The one rule of the QP, the verifier and the brake-point mover (docs/safety.md §1 rule 1,
+/// "The silent UAV's keep-out").
+inline double uavKeepOutDistance(const PlannerConfig& c, double age_s) {
+  const double age = age_s > 0.0 ? age_s : 0.0;
+  return c.mutual_distance_m + std::min(c.age_margin_speed_mps * age, c.age_margin_max_m);
 }
 
 /// \brief Reads every key of PlannerConfig (the layout of config/planner.yaml) under

@@ -10,7 +10,8 @@
 ///     ball/cube test where the field cannot decide);
 ///   - ‖v‖ ≤ max_speed, |v_z| ≤ max_vertical_speed, ‖a‖ ≤ max_acceleration, |a_z| ≤ max
 ///     vertical acceleration (relative tolerance), heading/pitch steps within their rate limits;
-///   - distance ≥ Γ_dis + age_margin_speed·age to every other plan at the same time, and ≥ Γ_dis
+///   - distance ≥ uavKeepOutDistance(age) = Γ_dis + min(age_margin_speed·age, age_margin_max) to
+///     every other plan at the same time, and ≥ Γ_dis
 ///     to the braking envelope (keptBrakeEnvelope()) of every other plan older than
 ///     brake_envelope_age_s and of every lower-priority UAV's plan (brake_envelope_lead_s);
 ///   - distance ≥ worker_safety_distance_m to the worker's predicted position.

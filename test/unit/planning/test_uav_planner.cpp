@@ -1295,3 +1295,74 @@ TEST(UavPlannerTest, CorridorsOfTheQpStageAreReported) {
   EXPECT_NE(b.status, PlanStatus::kOptimized);
   EXPECT_TRUE(b.corridors.empty());
 }
+
+// The silent UAV's keep-out (docs/safety.md §1, "The silent UAV's keep-out"): the age term of the
+// distance kept from another UAV's plan grows at age_margin_speed_mps and stops at
+// age_margin_max_m; a cap below a silent UAV's reach off its plan is refused.
+TEST(UavPlannerTest, KeepOutOfAnOldPlanStopsGrowingAtItsBound) {
+  PlannerConfig cfg = testConfig();
+  EXPECT_DOUBLE_EQ(uavKeepOutDistance(cfg, -1.0), cfg.mutual_distance_m);
+  EXPECT_DOUBLE_EQ(uavKeepOutDistance(cfg, 0.0), 2.5);
+  EXPECT_DOUBLE_EQ(uavKeepOutDistance(cfg, 0.4), 2.5 + 5.0 * 0.4);  // still growing below the bound
+  EXPECT_DOUBLE_EQ(uavKeepOutDistance(cfg, 1.0), 2.5 + 5.0);          // the bound reached at 1 s
+  for (double age : {1.5, 10.0, 60.0, 3600.0}) EXPECT_DOUBLE_EQ(uavKeepOutDistance(cfg, age), 7.5) << "age " << age;
+  cfg.age_margin_max_m = 2.0;
+  EXPECT_DOUBLE_EQ(uavKeepOutDistance(cfg, 0.2), 3.5);
+  EXPECT_DOUBLE_EQ(uavKeepOutDistance(cfg, 60.0), 4.5);
+  EXPECT_TRUE(cfg.validate().empty());
+  cfg.age_margin_max_m = 1.4;  // < tracking_allowance_max_m 0.5 + wind_allowance_max_m 1.0
+  ASSERT_EQ(cfg.validate().size(), 1u);
+  EXPECT_NE(cfg.validate().front().find("qp.age_margin_max_m"), std::string::npos) << cfg.validate().front();
+  EXPECT_NE(cfg.validate().front().find("1.4"), std::string::npos) << cfg.validate().front();
+}
+
+// A UAV silent for 60 s (its last plan ended 52 s ago: it hovers at the plan's end) is kept out of
+// its hover point by Γ_dis + age_margin_max_m — not of a 300-m ball (Γ_dis + 5 m/s · 60 s), which
+// the unbounded rule asked and which pushed the formation 30 m off (leader_dropout_60s seed 2).
+TEST(UavPlannerTest, UavSilentFor60sIsKeptOutOfItsHoverPointOnly) {
+  const World& w = towers();
+  const double t = 60.0;
+  const Eigen::Vector3d from(-8, -12, 10), to(-2, -12, 10);
+  const auto planTowards = [&](const PlannerConfig& cfg, const Eigen::Vector3d& hover) {
+    UavPlanner p(cfg, w.map, w.field);
+    auto req = straightRequest(1, t, stateAt(from, t), from, to, 1.5, Eigen::Vector3d(-5, -3, 1));
+    req.higher_priority_plans = {standingPlan(0, hover, 0.0)};
+    return p.plan(req);
+  };
+  const PlannerConfig cfg = testConfig();
+  const double keep = uavKeepOutDistance(cfg, t);
+  ASSERT_DOUBLE_EQ(keep, 7.5);
+  {  // the reference ends 9 m from the hover point: reached
+    const Eigen::Vector3d hover = to + Eigen::Vector3d(9, 0, 0);
+    const PlanResult r = planTowards(cfg, hover);
+    ASSERT_EQ(r.status, PlanStatus::kOptimized) << r.reason;
+    EXPECT_LT((r.trajectory.samples.back().p_world - to).norm(), 0.3);
+    for (const auto& s : r.trajectory.samples) EXPECT_GE((s.p_world - hover).norm(), keep - 1e-3);
+  }
+  {  // 5 m from it: the plan stops at the keep-out's edge, not 300 m away
+    const Eigen::Vector3d hover = to + Eigen::Vector3d(5, 0, 0);
+    const PlanResult r = planTowards(cfg, hover);
+    ASSERT_EQ(r.status, PlanStatus::kOptimized) << r.reason;
+    const double end_gap = (r.trajectory.samples.back().p_world - hover).norm();
+    EXPECT_GE(end_gap, keep - 1e-3);
+    EXPECT_LT(end_gap, keep + 1.0);
+  }
+  {  // the unbounded rule (a cap beyond any age here: 302.5 m): the same reference is not reached,
+     // the UAV comes no closer to the hover point than it starts (it brakes where it is)
+    PlannerConfig unbounded = cfg;
+    unbounded.age_margin_max_m = 1e6;
+    const Eigen::Vector3d hover = to + Eigen::Vector3d(9, 0, 0);
+    const PlanResult r = planTowards(unbounded, hover);
+    EXPECT_NE(r.status, PlanStatus::kOptimized) << r.reason;
+    EXPECT_GT((r.trajectory.samples.back().p_world - to).norm(), 3.0) << r.reason;
+    EXPECT_GE((r.trajectory.samples.back().p_world - hover).norm(), (from - hover).norm() - 1e-6) << r.reason;
+  }
+  // The verifier asks the same: a plan standing 8 m from the hover point passes, 7 m fails.
+  const TrajectoryVerifier verifier(*w.map, *w.field, cfg);
+  const std::vector<PlannedTrajectory> others = {standingPlan(0, to + Eigen::Vector3d(0, 0, 0), 0.0)};
+  const VerificationReport ok = verifier.verify(standingPlan(1, to + Eigen::Vector3d(-8, 0, 0), t), t, others, {}, t, 0.2);
+  EXPECT_TRUE(ok.ok) << ok.reason;
+  const VerificationReport near = verifier.verify(standingPlan(1, to + Eigen::Vector3d(-7, 0, 0), t), t, others, {}, t, 0.2);
+  EXPECT_FALSE(near.ok);
+  EXPECT_NE(near.reason.find("UAV 0's plan"), std::string::npos) << near.reason;
+}
