@@ -11,6 +11,7 @@
 #include "gesture_formation/common/config_fields.hpp"
 #include "gesture_formation/common/config_reader.hpp"
 #include "gesture_formation/common/format_number.hpp"
+#include "gesture_formation/sim/assistance_drill.hpp"
 #include "gesture_formation/formation/formation_geometry.hpp"
 #include "gesture_formation/onboard/onboard_settings.hpp"
 
@@ -465,6 +466,7 @@ common::Result<MissionConfig> parseMissionConfig(const std::string& yaml, const 
   c.worker.synth.fps = c.camera.rate_hz;
   checkUavCount(r, m, c);
   readRequests(r, m, c.formation.params.uavCount(), c.requests);
+  readAssistanceAcks(r, m + "assistance_acks_s", c.assistance_acks_s);
   readLeadership(r, m, c.formation.params.uavCount(), c.leadership);
 
   for (const auto& e : c.worker.validate(m + "worker.")) r.addError(m + "worker", e);

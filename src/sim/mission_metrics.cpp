@@ -404,6 +404,7 @@ std::string metricsJson(const MissionMetrics& m) {
   if (m.worker_approach) os << "  \"worker_approach\": " << approachJson(*m.worker_approach, 2) << ",\n";
   if (m.site_mapping) os << "  \"site_mapping\": " << siteMappingJson(*m.site_mapping, 2) << ",\n";
   if (m.leadership) os << "  \"leadership\": " << handoverJson(*m.leadership, 2) << ",\n";
+  if (m.assistance) os << "  \"assistance\": " << assistanceJson(*m.assistance, 2) << ",\n";
   os << "  \"wall_clock_keys\": [\"planning_ms_median\", \"planning_ms_p99\", \"planning_ms_max\", \"wall_time_s\", \"real_time_factor\"";
   if (m.perception) {
     for (const char* k : {"render_ms_median", "detect_ms_median", "track_ms_median", "skeleton_ms_median", "frame_ms_median"}) {

@@ -183,6 +183,7 @@ class MissionRun {
   AbortSender abort_sender_{cfg_.faults.abort, cfg_.replan.abort.repeats, cfg_.replan.abort.repeat_period_s};
   std::optional<AbortRecorder> abort_record_;
   std::optional<ApproachRecorder> approach_record_;  ///< faults.worker_approach
+  AssistanceDrill assistance_{cfg_.assistance_acks_s};  ///< the acting leader's latch (docs/safety.md §2.10)
   bool diverted_ = false;                            ///< the worker left his route (faults.worker_approach)
   MetricsAccumulator metrics_;
   MissionMetrics& M_;
@@ -381,6 +382,7 @@ void MissionRun::takeOver(int k, double t) {
     }
   }
   frames_ = gesture::GestureFrames(cfg_.gesture_filter, cfg_.view_fusion, cfg_.gesture_mapping, n_, 0.0);
+  assistance_.leaderChanged();
   modes_.push_back(ModeChange{t, k, uav(k).mode, "acting as leader (term " + std::to_string(lead_->member(k).term()) +
                                                      "): estimator, gestures, parameters and share taken over"});
 }
@@ -442,6 +444,7 @@ MissionOutput MissionRun::run(double duration_s, std::chrono::steady_clock::time
   out.modes = std::move(modes_);
   if (abort_record_) out.metrics.abort = abort_record_->summary();
   if (approach_record_) out.metrics.worker_approach = approach_record_->summary();
+  out.metrics.assistance = assistance_.summary();
   if (world_.site != nullptr) out.metrics.site_mapping = world_.site->summary();
   std::vector<std::pair<double, bool>> operator_requests;
   for (const RequestRecord& r : out.requests) {
@@ -460,6 +463,9 @@ void MissionRun::deliverOperatorMessages(double t) {
   // The ground station sends to every UAV; only the acting leader applies, and a new leader only
   // what was sent after it took over (older commands were its predecessor's, and the parameters
   // it took over carry those it applied).
+  // The operator's acknowledgement of an assistance request reaches the leader while it acts (the
+  // ground station repeats it until then).
+  if (acting_[static_cast<std::size_t>(owner_)] && !uav(owner_).offline) assistance_.acknowledgeDue(t);
   for (const auto& d : schedule_.due(t)) {
     const OperatorMessage msg{metrics_.addRequest(d.record), t, d.command};
     for (int i = 0; i < n_; ++i) operatorLink(i).send(t, msg);
@@ -473,6 +479,7 @@ void MissionRun::deliverOperatorMessages(double t) {
         if (rec.status == "lost") rec.status = "stale";
         continue;
       }
+      if (assistance_.refusal(formation::CommandSource::kOperator)) continue;  // never: the operator's pass (counted)
       applyCommand(msg.record, msg.command, t);
     }
   }
@@ -626,7 +633,13 @@ void MissionRun::actOnFrames(double t, const std::vector<gesture::GestureFrame>&
     const std::size_t record = metrics_.addRequest(firedGestureRecord(t, f.filter.dominant_id, cfg_.gesture_mapping));
     if (!acting_[static_cast<std::size_t>(owner_)]) continue;  // no lease: the leader's commands wait for it
     if (f.action != nullptr && f.action->kind != gesture::GestureAction::Kind::kEvent) {
+      if (assistance_.refusal(formation::CommandSource::kGesture)) {  // the views are held until acknowledged
+        metrics_.requestOutcome(record, formation::toString(formation::CommandStatus::kRejected), t, 0, {});
+        continue;
+      }
       applyCommand(record, gesture::toCommand(*f.action, ++gesture_seq_), t);
+    } else if (f.action != nullptr && f.action->event == gesture::GestureEvent::kAssistRequested) {
+      assistance_.request(t);
     } else if (f.action != nullptr && f.action->event == gesture::GestureEvent::kAbort) {
       receiveAbort(owner_, planning::AbortCommand{{"gesture", ++gesture_seq_}, planning::AbortSource::kGesture, t}, t);
     }

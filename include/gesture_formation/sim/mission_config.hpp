@@ -153,6 +153,9 @@ struct MissionConfig {
   /// The UAVs' online mapping of the site (`mission.mapping.*`, site_mapping_config.hpp).
   SiteMappingConfig mapping;
   std::vector<OperatorRequest> requests;  ///< ascending t_s
+  /// `assistance_acks_s`: when the operator's acknowledgement of a pending assistance request reaches
+  /// the acting leader (s, ascending; assistance_drill.hpp). Empty: never acknowledged.
+  std::vector<double> assistance_acks_s;
   /// `leadership.*`: every UAV's formation::Leadership (uav_count: the formation's).
   formation::LeadershipConfig leadership;
 };

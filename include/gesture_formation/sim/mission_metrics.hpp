@@ -38,6 +38,7 @@
 #include "gesture_formation/gesture/gesture_mapping.hpp"
 #include "gesture_formation/planning/shapes.hpp"
 #include "gesture_formation/planning/uav_planner.hpp"
+#include "gesture_formation/sim/assistance_drill.hpp"
 #include "gesture_formation/sim/mission_config.hpp"
 #include "gesture_formation/sim/multirotor.hpp"
 #include "gesture_formation/sim/perception_truth.hpp"
@@ -108,6 +109,9 @@ struct MissionMetrics {
   /// Who acted as leader when, and the hand-over after faults.leader_silence (docs/safety.md
   /// §1.2); absent where not measured (the ROS simulation: metrics.json then has no `leadership`).
   std::optional<HandoverSummary> leadership;
+  /// The worker's assistance requests and the operator's acknowledgements (docs/safety.md §2.10);
+  /// absent when the mission had neither (metrics.json then has no `assistance` key).
+  std::optional<AssistanceSummary> assistance;
 };
 
 /// \brief One UAV's part of a timeline sample (docs/design.md §8.4 timeline.csv).
