@@ -11,8 +11,12 @@ hand-over and how many were applied, collisions, the least mutual distance (Gamm
 least worker distance (Gamma_dis) and obstacle distance (0.5 m), the tracking errors, the wall time
 per mission.
 
+With --baseline STORE (and --baseline-commit PREFIX), a last section compares, per profile over the
+seeds both stores hold, the medians and extremes of the tracking and safety figures of the two
+(e.g. before / after a planner change).
+
   tools/handover_report.py --store FILE [--out docs/results/leader_handover.md] [--commit PREFIX]
-                           [--load "1-min load 8-12 on 2 cores"]
+                           [--load "1-min load 8-12 on 2 cores"] [--baseline FILE --baseline-commit PREFIX]
 """
 import argparse
 import datetime
@@ -91,12 +95,47 @@ def profile_section(name, rows):
     return out
 
 
+COMPARED = [("distance error rms [m]", "distance_error_rms_m", "{:.2f}"),
+            ("angle error rms [deg]", "angle_error_rms_deg", "{:.1f}"),
+            ("min mutual distance [m]", "min_mutual_distance_m", "{:.2f}"),
+            ("min worker distance [m]", "min_human_distance_m", "{:.2f}"),
+            ("min obstacle distance [m]", "min_obstacle_distance_m", "{:.2f}"),
+            ("collisions", "collisions", "{:.0f}"),
+            ("brake fallbacks per mission", "plans_fallback_brake", "{:.0f}"),
+            ("gesture requests applied per mission", "gesture_requests_applied", "{:.0f}"),
+            ("operator requests applied per mission", "operator_requests_applied", "{:.0f}")]
+
+
+def baseline_section(rows, base_rows, base_label):
+    """Per profile, over the seeds both hold: min / median / max of each COMPARED figure, baseline → this."""
+    out = [f"## Against the baseline ({base_label})", "",
+           "Per profile, over the seeds both stores hold: min / median / max over the seeds, baseline → these missions.", ""]
+    for p in PROFILES:
+        mine = {r["seed"]: json.loads(r["metrics_json"]) for r in rows if r["profile"] == p}
+        base = {r["seed"]: json.loads(r["metrics_json"]) for r in base_rows if r["profile"] == p}
+        seeds = sorted(set(mine) & set(base))
+        out += [f"### {p}", ""]
+        if not seeds:
+            out += ["No seed in both stores.", ""]
+            continue
+        out += [f"Seeds: {len(seeds)} ({seeds[0]}..{seeds[-1]})", "", "| figure | baseline | these missions |", "|---|---|---|"]
+        for label, key, fmt in COMPARED:
+            b = sorted(base[s][key] for s in seeds)
+            m = sorted(mine[s][key] for s in seeds)
+            trio = lambda v: " / ".join(fmt.format(x) for x in (v[0], statistics.median(v), v[-1]))
+            out.append(f"| {label} | {trio(b)} | {trio(m)} |")
+        out.append("")
+    return out
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--store", required=True)
     ap.add_argument("--out", default="docs/results/leader_handover.md")
     ap.add_argument("--commit", default="", help="only missions of source commits starting with this")
     ap.add_argument("--load", default="not recorded", help="the machine load while the missions ran")
+    ap.add_argument("--baseline", default="", help="a store to compare with (its leader_dropout missions)")
+    ap.add_argument("--baseline-commit", default="", help="only baseline missions of source commits starting with this")
     a = ap.parse_args(argv)
     if not os.path.exists(a.store):
         print(f"handover_report.py: --store {a.store}: no such file", file=sys.stderr)
@@ -122,6 +161,13 @@ def main(argv=None):
     ]
     for p in PROFILES:
         lines += profile_section(p, [r for r in rows if r["profile"] == p])
+    if a.baseline:
+        if not os.path.exists(a.baseline):
+            print(f"handover_report.py: --baseline {a.baseline}: no such file", file=sys.stderr)
+            return 2
+        base_rows, _ = load(a.baseline, a.baseline_commit)
+        base_commits = sorted({r["source_commit"][:10] for r in base_rows})
+        lines += baseline_section(rows, base_rows, f"store `{os.path.basename(a.baseline)}`, commit(s) {', '.join(base_commits) or 'none'}")
     os.makedirs(os.path.dirname(a.out) or ".", exist_ok=True)
     with open(a.out, "w") as f:
         f.write("\n".join(lines))
