@@ -455,7 +455,23 @@ def v1_lines(runs):
     return lines
 
 
-def report(protocol, protocol_path, tuning_errors, tuning_eval, heldout_eval, out, load_start, v1_runs=()):
+def training_lines(trained):
+    """The candidate models' training (tools/train_gesture_lstm.py's training.json, next to each model's ONNX)."""
+    lines = []
+    for label, path in trained:
+        tr = json.load(open(path))
+        onnx = os.path.join(os.path.dirname(path), "gesture_lstm.onnx")
+        em, rd = tr.get("error_model"), tr.get("rendered")
+        lines.append(f"- {label}: sha256 {he.sha256(onnx)}; `{tr['command']}` — from {tr.get('init_onnx') or 'a random start'}, "
+                     f"{tr['epochs']} epochs, {tr['train']['windows']} training windows"
+                     + (f", error model {em['file']} (seed {em['seed']}, {em['sequences_changed']} sequences changed)" if em else "")
+                     + (f", rendered {', '.join(s['dir'] + '/' + s['file'] for s in rd['sets'])} × {rd['repeat']}" if rd else "")
+                     + f"; validation accuracy {tr['validation']['accuracy']:.4f}; {tr['seconds']} s (torch {tr['torch']}, "
+                     f"{tr.get('threads', 2)} thread(s), shared machine).")
+    return lines
+
+
+def report(protocol, protocol_path, tuning_errors, tuning_eval, heldout_eval, out, load_start, v1_runs=(), trained=()):
     lines = ["# Gestures on rendered frames through the real networks (protocol version 2)", "",
              f"Written by `tools/gesture/rendered_eval.py report` on "
              f"{datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC, commit {he.git('rev-parse', '--short', 'HEAD')}"
@@ -473,6 +489,8 @@ def report(protocol, protocol_path, tuning_errors, tuning_eval, heldout_eval, ou
                 text = [ln.strip() for ln in f if ln.startswith("#") or ln.startswith("gfctl render-gestures")]
             lines.append(f"Render of {name} (its log): " + " / ".join(t.lstrip("# ") for t in text) + ".")
     lines.append("")
+    if trained:
+        lines += ["## Candidate models (not shipped unless third_party_models/gesture_lstm says so)", ""] + training_lines(trained) + [""]
     if tuning_errors:
         lines += ["## Tuning set: the networks' systematic errors against the renderer's truth", "",
                   "Frames at the motion's pose (gestures: labelled frames; work motions: the middle half of the motion). "
@@ -512,6 +530,7 @@ def main():
     ap.add_argument("--heldout-eval", default=None, help="report: evaluate JSONs of the held-out set, comma-separated")
     ap.add_argument("--v1", default=None, help="report: protocol version 1 JSONs (heldout_eval.py) of the same models, "
                     "comma-separated, each as LABEL=PATH")
+    ap.add_argument("--trained", default=None, help="report: candidate models' training.json, comma-separated, each as LABEL=PATH")
     ap.add_argument("--label", default="", help="evaluate: what this run is (model / rule), written into its JSON")
     ap.add_argument("--gfctl")
     ap.add_argument("--set", default=None)
@@ -537,7 +556,14 @@ def main():
             if not label:
                 ap.error(f"--v1 {item}: expected LABEL=PATH")
             v1.append(dict(load(path), label=label))
-        report(protocol, a.protocol, load(a.tuning_errors), loads(a.tuning_eval), loads(a.heldout_eval), out, os.getloadavg(), v1)
+        trained = []
+        for item in (a.trained.split(",") if a.trained else []):
+            label, _, path = item.rpartition("=")
+            if not label:
+                ap.error(f"--trained {item}: expected LABEL=PATH")
+            trained.append((label, path))
+        report(protocol, a.protocol, load(a.tuning_errors), loads(a.tuning_eval), loads(a.heldout_eval), out, os.getloadavg(),
+               v1, trained)
         print(f"wrote {out}")
         return
     if not a.set:
