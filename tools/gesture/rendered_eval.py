@@ -448,7 +448,8 @@ def v1_lines(runs):
         for mode, m in r["three_cameras"].items():
             w, g = m["work"]["three_cameras"], m["gestures"]["three_cameras"]
             met = all(all(v.values()) for v in r["meets_target"].values())
-            lines.append(f"| {r.get('label', '')} | `{r['protocol']}` ({r['single_camera']['seed']}, …) | {r['model_sha256'][:16]}… | "
+            run = r.get("label", "") + (f", rearm {mode}" if len(r["three_cameras"]) > 1 else "")
+            lines.append(f"| {run} | `{r['protocol']}` ({r['single_camera']['seed']}, …) | {r['model_sha256'][:16]}… | "
                          f"{s['accuracy']:.4f} | {s['work_share_read_as_gesture']:.4f} ({s['work_windows_read_as_gesture']} of "
                          f"{s['work_windows']}) | {w['false_adaptations']} ({w['work_minutes']}) | {g['fired']}/{g['gestures']} | "
                          f"{g['mean_latency_s']} s ({g['max_latency_s']}) | {'all met' if met else '**not all met**'} |")
