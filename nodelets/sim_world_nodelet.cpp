@@ -57,7 +57,6 @@ class SimWorldNodelet : public nodelet::Nodelet {
     camera_.emplace(cfg_, world_.map.get(), s);
     camera_frames_.emplace(1.0 / cfg_.camera.rate_hz, set_.clock_step_s);
     timeline_samples_.emplace(1.0 / cfg_.timeline_rate_hz, set_.clock_step_s);
-    schedule_.emplace(cfg_.requests, "mission");
     record_.emplace(cfg_, sim::ObstacleDistance{world_.field.get(), world_.solids.get(), world_.ground_height_m}, s);
     heading_.emplace(cfg_.formation.worker_heading);
     n_ = cfg_.formation.params.uavCount();
@@ -74,6 +73,9 @@ class SimWorldNodelet : public nodelet::Nodelet {
       detection_sub_ = nh.subscribe("detection_in", 20, &SimWorldNodelet::onLeaderDetection, this);
     } else {
       detection_pub_ = nh.advertise<gesture_formation::WorkerDetection>("detection_out", 10);
+      info_pub_ = nh.advertise<sensor_msgs::CameraInfo>("camera_info_out", 2);  // the leader camera's, every frame
+      info_ = toCameraInfo(cfg_.camera.camera);
+      info_.header.frame_id = set_.camera_frame;
       for (int i = 0; i < (follower_views_ ? n_ : 1); ++i) {
         gesture_pubs_.push_back(nh.advertise<gesture_formation::Gesture>("uav" + std::to_string(i) + "/gesture_out", 10));
       }
@@ -137,8 +139,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
     last_class_ = m->gesture_id;
     last_ratio_ = m->dominant_ratio;
     if (finished_ || !m->fired) return;
-    record_->metrics().addRequest(sim::firedGestureRecord(m->header.stamp.toSec(), m->dominant_id, cfg_.gesture_mapping));
-    record_->metrics().resolveOutcomes(sim::WorldRecord::kStampToleranceS);
+    record_->gestureFired(m->header.stamp.toSec(), m->dominant_id, cfg_.gesture_mapping);
   }
 
   void publishClock() {
@@ -170,13 +171,11 @@ class SimWorldNodelet : public nodelet::Nodelet {
     publishClock();
     const sim::WorkerState ws = worker_->stateAt(t_);
     // Operator requests (the OperatorInterface numbers them and sends them over LCM).
-    for (const auto& d : schedule_->due(t_)) {
-      auto m = toMsg(d.command);
+    for (const auto& c : record_->dueRequests(t_)) {
+      auto m = toMsg(c);
       m.header.stamp = ros::Time(t_);
       command_pub_.publish(m);
-      record_->metrics().addRequest(d.record);  // "lost" until the leader says what it did with it
     }
-    record_->metrics().resolveOutcomes(sim::WorldRecord::kStampToleranceS);
     const bool all = record_->sampleSafety(t_, truth_, ws);  // false until every UAV's truth came
     // With the followers' cameras, a frame needs every UAV's truth (LeaderCamera wants the same
     // number of followers at every call); SimWorld starts when every planner is up.
@@ -224,6 +223,8 @@ class SimWorldNodelet : public nodelet::Nodelet {
     }
     if (std::isfinite(cf.sensors.d_uwb_m)) uwb_pub_.publish(toUwbRange(cf.sensors.d_uwb_m, cfg_.uwb.max_range_m, stamp, set_.camera_frame));
     if (set_.rendered) return;  // the Perception nodelets see the rendered images
+    info_.header.stamp = stamp;
+    info_pub_.publish(info_);
     // Each UAV's classifier output, as its Perception nodelet would publish it (the followers'
     // first: the leader's closes the frame at the GestureCommander only when all have reported).
     for (std::size_t i = 0; i < cf.followers.size(); ++i) {
@@ -278,16 +279,15 @@ class SimWorldNodelet : public nodelet::Nodelet {
   std::optional<sim::WorldRecord> record_;  ///< metrics, plans and modes, command outcomes, the files
   std::optional<formation::WorkerHeading> heading_;
   SimWorldSettings set_;  ///< the nodelet's parameters (duration: the mission's if not given)
-  double t_ = 0.0, last_ratio_ = 0.0;
+  double t_ = 0.0, last_ratio_ = 0.0, last_detected_s_ = -1e9;  ///< last detected: the leader's Perception (rendered)
   long k_ = 0;
   int n_ = 0, last_class_ = -1;
   bool finished_ = false, started_ = false, follower_views_ = false;
-  double last_detected_s_ = -1e9;  ///< rendered cameras: the leader's Perception's last find
-  std::optional<sim::OperatorSchedule> schedule_;
   std::vector<std::optional<sim::MultirotorState>> truth_;
   std::optional<gesture_formation::WorkerState> estimate_;
   ros::WallTime wall0_;
-  ros::Publisher clock_pub_, worker_pub_, detection_pub_, uwb_pub_, command_pub_, done_pub_, body_pub_;
+  ros::Publisher clock_pub_, worker_pub_, detection_pub_, uwb_pub_, command_pub_, done_pub_, body_pub_, info_pub_;
+  sensor_msgs::CameraInfo info_;  ///< synthetic camera: the leader camera's intrinsics (the estimator's camera model)
   tf2_ros::TransformBroadcaster tf_;  ///< the gesture cameras (3-D confirmation)
   std::vector<ros::Publisher> gesture_pubs_;  ///< per UAV (only the leader's without follower views)
   std::vector<ros::Subscriber> truth_subs_, plan_subs_;

@@ -7,6 +7,7 @@ namespace gesture_formation::sim {
 WorldRecord::WorldRecord(const MissionConfig& config, const ObstacleDistance& obstacles, std::uint64_t seed)
     : n_(config.formation.params.uavCount()),
       metrics_(config, obstacles, seed),
+      schedule_(config.requests, "mission"),
       versions_(config.formation.params),
       params_(config.formation.params),
       plan_mode_(static_cast<std::size_t>(n_)) {}
@@ -46,6 +47,21 @@ void WorldRecord::params(const ParamsReport& p) {
   metrics_.commandOutcome(
       CommandOutcome{p.last_source, p.last_status, p.last_command_stamp_s, p.stamp_s, p.version, p.last_uavs},
       kStampToleranceS);
+}
+
+std::vector<formation::FormationCommand> WorldRecord::dueRequests(double t_s) {
+  std::vector<formation::FormationCommand> out;
+  for (auto& d : schedule_.due(t_s)) {
+    metrics_.addRequest(d.record);
+    out.push_back(std::move(d.command));
+  }
+  metrics_.resolveOutcomes(kStampToleranceS);
+  return out;
+}
+
+void WorldRecord::gestureFired(double t_s, int gesture_id, const gesture::GestureMapping& mapping) {
+  metrics_.addRequest(firedGestureRecord(t_s, gesture_id, mapping));
+  metrics_.resolveOutcomes(kStampToleranceS);
 }
 
 bool WorldRecord::sampleSafety(double t_s, const std::vector<std::optional<MultirotorState>>& truths,

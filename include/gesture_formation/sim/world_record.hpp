@@ -63,6 +63,12 @@ class WorldRecord {
   /// status), what became of its last command.
   void params(const ParamsReport& p);
 
+  /// \brief The mission's operator requests due at t_s (in order, each once), recorded as pending
+  /// ("lost" until the leader says what it did with them) and resolved with the outcomes known.
+  std::vector<formation::FormationCommand> dueRequests(double t_s);
+  /// \brief A gesture the leader's filter fired at t_s (dominant id `gesture_id`), recorded and
+  /// resolved like a request.
+  void gestureFired(double t_s, int gesture_id, const gesture::GestureMapping& mapping);
   /// \brief Safety at t_s from every UAV's true state: false (nothing sampled) while some UAV has
   /// not reported one yet.
   bool sampleSafety(double t_s, const std::vector<std::optional<MultirotorState>>& truths, const WorkerState& worker);
@@ -86,6 +92,7 @@ class WorldRecord {
 
   int n_;
   MetricsAccumulator metrics_;
+  OperatorSchedule schedule_;  ///< the mission's operator requests
   ParamsVersions versions_;  ///< every parameter version the leader published (0: the mission's)
   formation::FormationParams params_;
   std::vector<std::string> plan_mode_;  ///< per UAV: the mode of its last plan

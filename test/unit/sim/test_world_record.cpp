@@ -149,3 +149,22 @@ TEST(WorldRecordTest, SafetyIsSampledOnlyOnceEveryUavReportedItsTruth) {
   }
   EXPECT_TRUE(r.sampleSafety(0.2, truths, w));
 }
+
+// The mission's operator requests leave once each, in order, and stay pending ("lost") until the
+// leader's outcome names them.
+TEST(WorldRecordTest, OperatorRequestsAreDueOnceEachAndPendingUntilTheirOutcome) {
+  Fixture fx;
+  ASSERT_FALSE(fx.cfg.requests.empty()) << "open_field.yaml schedules operator requests";
+  WorldRecord r(fx.cfg, fx.obstacles(), 1);
+  const double first = fx.cfg.requests.front().t_s;
+  EXPECT_TRUE(r.dueRequests(first - 0.01).empty());
+  const auto due = r.dueRequests(first);
+  ASSERT_GE(due.size(), 1u);
+  EXPECT_TRUE(r.dueRequests(first).empty());  // each once
+  const std::string dir = ::testing::TempDir() + "/world_record_requests";
+  std::filesystem::create_directories(dir);
+  std::string error, warning;
+  ASSERT_TRUE(r.finish({}, first + 1.0, 1.0, dir, &error, &warning)) << error;
+  const std::string events = readFile(dir + "/events.csv");
+  EXPECT_NE(events.find("lost"), std::string::npos) << events;  // no outcome came
+}
