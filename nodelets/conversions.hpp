@@ -33,6 +33,7 @@
 #include "gesture_formation/formation/formation_commands.hpp"
 #include "gesture_formation/formation/formation_params.hpp"
 #include "gesture_formation/gesture/view_fusion.hpp"
+#include "gesture_formation/onboard/formation_params_role.hpp"
 #include "gesture_formation/planning/polytope_edges.hpp"
 #include "gesture_formation/planning/replan_step.hpp"
 #include "gesture_formation/planning/uav_planner.hpp"
@@ -210,6 +211,26 @@ inline gesture_formation::FormationParams toMsg(const formation::FormationParams
     m.uavs.push_back(o);
   }
   return m;
+}
+/// The leader's parameters with the last command it handled (onboard::FormationParamsRole).
+inline gesture_formation::FormationParams toMsg(const onboard::FormationParamsRole& role, const ros::Time& now,
+                                                const std::string& world_frame) {
+  const onboard::CommandRecord& r = role.last();
+  auto m = toMsg(role.params(), role.version());
+  m.header.stamp = now;
+  m.header.frame_id = world_frame;
+  m.last_command = r.text;
+  m.last_outcome = r.outcome;
+  m.last_command_source = r.source;
+  m.last_command_stamp = ros::Time(r.stamp_s);
+  m.last_command_status = r.status;
+  m.last_command_uavs = r.uavs;
+  return m;
+}
+/// A command as the logs name it: "gesture leader#3: uav1.distance_m += 1.000000".
+inline std::string describe(const gesture_formation::FormationCommand& m) {
+  return m.source + " " + m.sender + "#" + std::to_string(m.sequence) + ": " + m.target + "." + m.parameter +
+         (m.kind == "set" ? " = " : " += ") + std::to_string(m.amount);
 }
 /// uavs[0] the leader, uavs[i] follower i (FormationParams.uavs, PlannedTrajectory.formation).
 inline common::Result<formation::FormationParams> fromMsg(const std::vector<gesture_formation::UavObservation>& uavs) {
@@ -398,15 +419,21 @@ inline gesture_formation::AssistanceState toMsg(const formation::AssistanceState
   m.acknowledged_by = a.acknowledged_by;
   return m;
 }
-/// An assistance state from ROS as it travels; fails naming the field.
-inline common::Result<comm::AssistanceMessage> toWire(const gesture_formation::AssistanceState& m) {
-  using R = common::Result<comm::AssistanceMessage>;
+/// An assistance state from ROS; fails naming the field.
+inline common::Result<formation::AssistanceState> fromMsg(const gesture_formation::AssistanceState& m) {
+  using R = common::Result<formation::AssistanceState>;
   if (m.phase > gesture_formation::AssistanceState::PHASE_ACKNOWLEDGED) {
     return R::fail("phase: " + std::to_string(m.phase) + " is not 0 (none), 1 (requested) or 2 (acknowledged)");
   }
-  comm::AssistanceMessage wire{formation::AssistanceState{static_cast<formation::AssistancePhase>(m.phase),
-                                                          m.requested_at.toSec(), m.requested_by,
-                                                          m.acknowledged_at.toSec(), m.acknowledged_by}};
+  return R::ok(formation::AssistanceState{static_cast<formation::AssistancePhase>(m.phase), m.requested_at.toSec(),
+                                          m.requested_by, m.acknowledged_at.toSec(), m.acknowledged_by});
+}
+/// An assistance state from ROS as it travels; fails naming the field.
+inline common::Result<comm::AssistanceMessage> toWire(const gesture_formation::AssistanceState& m) {
+  using R = common::Result<comm::AssistanceMessage>;
+  auto state = fromMsg(m);
+  if (!state) return R::fail(state.reason());
+  comm::AssistanceMessage wire{std::move(*state)};
   if (auto e = comm::encodePayload(wire); !e) return R::fail(e.reason());  // the wire's rules
   return R::ok(std::move(wire));
 }

@@ -26,7 +26,6 @@
 //   ~horizon_steps, ~max_share_age_s, ~max_worker_age_s, ~max_plan_age_s, ~avoid_all_plans,
 //   ~brake_accel_mps2, ~search_*, ~abort (a map), ~formation_config, ~planner_config.
 #include <cmath>
-#include <map>
 #include <mutex>
 #include <optional>
 
@@ -38,13 +37,10 @@
 #include "config_sources.hpp"
 #include "conversions.hpp"
 #include "diagnostics.hpp"
-#include "gesture_formation/formation/formation_geometry.hpp"
-#include "gesture_formation/formation/worker_heading.hpp"
 #include "gesture_formation/onboard/formation_params_role.hpp"
 #include "gesture_formation/onboard/frame_check.hpp"
 #include "gesture_formation/planning/replan_health.hpp"
 #include "gesture_formation/planning/replan_step.hpp"
-#include "gesture_formation/planning/trajectory_qp.hpp"
 #include "param_loader.hpp"
 
 namespace gesture_formation::nodelets {
@@ -164,42 +160,24 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     if (!r) NODELET_WARN_STREAM_THROTTLE(1.0, "FormationPlanner: formation parameters dropped: " << r.reason());
   }
   void onCommand(const gesture_formation::FormationCommand::ConstPtr& msg) {
-    const std::string text = msg->source + " " + msg->sender + "#" + std::to_string(msg->sequence) + ": " +
-                             msg->target + "." + msg->parameter + (msg->kind == "set" ? " = " : " += ") +
-                             std::to_string(msg->amount);
     std::lock_guard<std::mutex> lock(mutex_);
-    const auto& r = role_->apply(fromMsg(*msg), text, msg->source, msg->header.stamp.toSec());
+    const auto& r = role_->apply(fromMsg(*msg), describe(*msg), msg->source, msg->header.stamp.toSec());
     NODELET_INFO_STREAM("FormationPlanner: command " << r.text << " → " << r.outcome);
     publishParams();
     ack_pub_.publish(toAck(*msg, r.status, r.outcome, role_->version(), ros::Time::now()));  // to the operator
   }
   // The worker's request (GestureCommander) or the operator's acknowledgement (over LCM) → the latch.
   void onAssistance(const gesture_formation::AssistanceState::ConstPtr& m) {
+    auto state = fromMsg(*m);
     std::lock_guard<std::mutex> lock(mutex_);
     auto& latch = role_->assistance();
-    const bool changed = m->phase == m->PHASE_REQUESTED ? latch.request(m->requested_at.toSec(), m->requested_by)
-                         : m->phase == m->PHASE_ACKNOWLEDGED
-                             ? latch.acknowledge(m->requested_at.toSec(), m->acknowledged_at.toSec(), m->acknowledged_by)
-                             : false;
-    if (!changed) return;
+    if (!state || !latch.receive(*state)) return;
     NODELET_WARN_STREAM("FormationPlanner: assistance " << formation::toString(latch.state().phase) << " (requested at "
                                                         << latch.state().requested_s << " s by " << latch.state().requested_by
                                                         << "; the worker's gestures are refused while requested)");
     assistance_pub_.publish(toMsg(latch.state(), ros::Time::now()));
   }
-  void publishParams() {
-    const onboard::CommandRecord& r = role_->last();
-    auto m = toMsg(role_->params(), role_->version());
-    m.header.stamp = ros::Time::now();
-    m.header.frame_id = world_frame_;
-    m.last_command = r.text;
-    m.last_outcome = r.outcome;
-    m.last_command_source = r.source;
-    m.last_command_stamp = ros::Time(r.stamp_s);
-    m.last_command_status = r.status;
-    m.last_command_uavs = r.uavs;
-    params_pub_.publish(m);
-  }
+  void publishParams() { params_pub_.publish(toMsg(*role_, ros::Time::now(), world_frame_)); }
 
   // Every copy of an abort (operator over LCM, the leader's relay, the gesture commander): the
   // ReplanStep accepts the first that is fresh enough (planning::AbortPlanner::receive).

@@ -1,30 +1,18 @@
 // LcmBridge nodelet: the only code that touches LCM (lcm_bridge::SecureLink: signed envelopes with
 // sender id, sequence and stamp; docs/security.md). A thin adapter between ROS topics and the link;
-// topics, parameters and their defaults: docs/ros.md "LcmBridge".
-//   ROS → LCM: worker_state_in (the leader's estimate), plan_in (this UAV's plan; its fallback flag
-//     in a heartbeat sent just before it), formation_params_in, formation_command_in (each sent
-//     ~command_repeats times ~command_repeat_period_s apart: comm::OutgoingRepeats),
-//     gesture_observation_in, abort_in (sent as it comes: the OperatorInterface repeats it), the
-//     leader's accepted abort (abort_relay_in: its AbortState) after every worker state, the
-//     leader's command acknowledgements (command_ack_in, repeated like commands), assistance_in (the
-//     leader's assistance state, re-sent with every worker state while requested; the ground
-//     station's acknowledgement), and a heartbeat at ~heartbeat_rate_hz.
-//   LCM → ROS (what each envelope yields: comm::LinkInbox): worker_state_out, plans_out,
-//     formation_params_out, formation_command_out (first copy of each id, named NAME@ID),
-//     gesture_observations_out, abort_out (every copy; the UAV acts on the first it accepts),
-//     command_ack_out (first copy of each command id), assistance_out (every copy).
-// Start-up (keys, boot counter, high-water marks, verifier): lcm_bridge::startLink; stamps use ROS
-// time (sim time in simulation).
-// Parameters (required): ~sender_id, ~known_senders, ~lcm_url, ~channel_prefix, ~key_file
-//   (owner-only), ~max_age_s, ~heartbeat_rate_hz, ~world_frame, ~command_repeats (1..20),
-//   ~command_repeat_period_s. Optional: ~command_max_age_s (5.0), ~sequence_file, ~high_water_file
-//   (in $ROS_HOME/gesture_formation), ~recv_buf_bytes (4194304), ~max_rate_hz (400), ~burst (200),
-//   ~command_senders, ~params_senders, ~abort_senders (absent: any known sender).
-// Diagnostics: /diagnostics at 1 Hz (lcm_bridge::linkDiagnostics); a throttled warning names the
-// sender and the class of each refusal.
+// every topic, parameter and default: docs/ros.md "LcmBridge". ROS → LCM: the share, plans (their
+// fallback flag in a heartbeat sent just before), parameters, gesture observations, aborts (as they
+// come; the leader's accepted abort after every share), and single events repeated like a command
+// (~command_repeats copies, comm::OutgoingRepeats): commands, the leader's acknowledgements and
+// assistance state (also with every share while requested), the ground's acknowledgement of it.
+// LCM → ROS: what each envelope yields (comm::LinkInbox: first copy of each command / ack id, every
+// abort and assistance copy). Start-up (keys, boot counter, high-water marks, verifier):
+// lcm_bridge::startLink; stamps use ROS time (sim time in simulation). Diagnostics: /diagnostics at
+// 1 Hz (lcm_bridge::linkDiagnostics); a throttled warning names the sender and class of each refusal.
 
 #include <mutex>
 #include <optional>
+#include <type_traits>
 #include <variant>
 
 #include <nodelet/nodelet.h>
@@ -38,6 +26,7 @@
 #include "gesture_formation/comm/sequence_store.hpp"
 #include "gesture_formation/lcm_bridge/link_diagnostics.hpp"
 #include "gesture_formation/lcm_bridge/link_startup.hpp"
+#include "link_params.hpp"
 #include "param_loader.hpp"
 
 namespace gesture_formation::nodelets {
@@ -59,33 +48,13 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     ros::NodeHandle& pnh = getPrivateNodeHandle();
     ParamLoader params(pnh);
     lcm_bridge::LinkStartupConfig cfg;
-    comm::LinkSettings& link = cfg.link;
     double heartbeat_hz = 0.0;
-    params.load("sender_id", link.sender_id, 0, 65535);
-    params.load("known_senders", link.known_senders);
-    params.load("lcm_url", cfg.lcm_url);
-    params.load("channel_prefix", cfg.channel_prefix);
-    params.load("key_file", cfg.key_file);
-    params.load("max_age_s", link.max_age_s);  // range: the verifier's, checked with the link's settings
+    loadLinkParams(pnh, params, cfg);
     params.load("heartbeat_rate_hz", heartbeat_hz, 0.1, 50.0);
     params.load("world_frame", world_frame_);
     params.load("command_repeats", command_repeats_, 1, 20);
     params.load("command_repeat_period_s", command_repeat_period_s_, 0.01, 1.0);
-    cfg.state_dir = comm::defaultStateDirectory();
-    const std::string stem = cfg.state_dir + "/lcm_bridge_" + std::to_string(link.sender_id);
-    params.loadOptional("sequence_file", cfg.sequence_file, stem + ".boot");
-    params.loadOptional("high_water_file", cfg.marks_file, stem + ".marks");
-    link.command_max_age_s = pnh.param("command_max_age_s", link.command_max_age_s);
-    link.recv_buf_bytes = pnh.param("recv_buf_bytes", link.recv_buf_bytes);
-    link.max_rate_hz = pnh.param("max_rate_hz", link.max_rate_hz);
-    link.burst = pnh.param("burst", link.burst);
-    for (auto [name, list] : {std::make_pair("command_senders", &link.command_senders),
-                              std::make_pair("params_senders", &link.params_senders),
-                              std::make_pair("abort_senders", &link.abort_senders)}) {
-      std::vector<int> ids;
-      if (pnh.getParam(name, ids)) *list = ids;
-    }
-    params.note(comm::describeOptional(link));
+    params.note(comm::describeOptional(cfg.link));
     // Every problem at once: the link's settings and key file beside the other parameters; the
     // transport and the state files only when all of those are fine (lcm_bridge/link_startup.hpp).
     std::vector<common::ConfigError> problems;
@@ -110,8 +79,8 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     link_->setRejectHandler([this](const comm::VerifyResult& r, std::optional<std::uint16_t> claimed) {
       onRejected(r, claimed);
     });
-    heartbeat_.uav_index = static_cast<std::uint16_t>(std::min(link.sender_id, comm::kMaxUavIndex));
-    report_.emplace("LcmBridge sender " + std::to_string(link.sender_id));
+    heartbeat_.uav_index = static_cast<std::uint16_t>(std::min(cfg.link.sender_id, comm::kMaxUavIndex));
+    report_.emplace("LcmBridge sender " + std::to_string(cfg.link.sender_id));
 
     // Queues hold a burst: every peer's messages of ~1 s (several UAVs, 10–30 Hz each).
     worker_pub_ = nh.advertise<gesture_formation::WorkerState>("worker_state_out", 100);
@@ -121,25 +90,22 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     worker_sub_ = nh.subscribe("worker_state_in", 50, &LcmBridgeNodelet::onWorker, this);
     plan_sub_ = nh.subscribe("plan_in", 50, &LcmBridgeNodelet::onPlan, this);
     params_sub_ = nh.subscribe("formation_params_in", 20, &LcmBridgeNodelet::onParams, this);
-    command_sub_ = nh.subscribe("formation_command_in", 100, &LcmBridgeNodelet::onCommand, this);
     observations_pub_ = nh.advertise<gesture_formation::GestureObservation>("gesture_observations_out", 200);
     observation_sub_ = nh.subscribe("gesture_observation_in", 100, &LcmBridgeNodelet::onObservation, this);
     abort_pub_ = nh.advertise<gesture_formation::AbortCommand>("abort_out", 100);
     abort_sub_ = nh.subscribe("abort_in", 100, &LcmBridgeNodelet::onAbort, this);
     relay_sub_ = nh.subscribe("abort_relay_in", 5, &LcmBridgeNodelet::onAbortState, this);
+    // Single events, sent now and repeated like a command: the operator's and gestures' commands,
+    // the leader's acknowledgements, the leader's assistance state (also re-sent with every worker
+    // state while requested) and the ground station's acknowledgement of it.
+    command_sub_ = subscribeRepeated<gesture_formation::FormationCommand>(
+        nh, "formation_command_in", 100, "command", [](const auto& m) { return fromMsg(m); });
     ack_pub_ = nh.advertise<gesture_formation::CommandAck>("command_ack_out", 50);
-    ack_sub_ = nh.subscribe<gesture_formation::CommandAck>("command_ack_in", 50, [this](const auto& msg) {
-      sendChecked(toWire(*msg), "command acknowledgement", command_repeats_, command_repeat_period_s_);
-    });
-    // The leader's assistance state (sent on change, and with every worker state while requested) or
-    // the operator's acknowledgement (repeated like a command); every copy received is handed on.
-    assistance_pub_ = nh.advertise<gesture_formation::AssistanceState>("assistance_out", 20);
-    assistance_sub_ = nh.subscribe<gesture_formation::AssistanceState>("assistance_in", 20, [this](const auto& msg) {
-      auto a = toWire(*msg);
-      sendChecked(a, "assistance", command_repeats_, command_repeat_period_s_);
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (a) assistance_ = *a;
-    });
+    ack_sub_ = subscribeRepeated<gesture_formation::CommandAck>(nh, "command_ack_in", 50, "command acknowledgement",
+                                                                [](const auto& m) { return toWire(m); });
+    assistance_pub_ = nh.advertise<gesture_formation::AssistanceState>("assistance_out", 20);  // every copy received
+    assistance_sub_ = subscribeRepeated<gesture_formation::AssistanceState>(nh, "assistance_in", 20, "assistance",
+                                                                            [](const auto& m) { return toWire(m); });
     drain_timer_ = nh.createWallTimer(ros::WallDuration(0.005), [this](const ros::WallTimerEvent&) {
       std::lock_guard<std::mutex> lock(mutex_);
       if (transport_) transport_->drain(kMaxDrainPerTick);
@@ -159,6 +125,14 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     });
   }
 
+  // Each message on `topic`, in its wire form (a refusal is logged), is sent now and repeated like a command.
+  template <class Msg, class ToWire>
+  ros::Subscriber subscribeRepeated(ros::NodeHandle& nh, const std::string& topic, int queue, const char* what,
+                                    ToWire to_wire) {
+    return nh.subscribe<Msg>(topic, queue, [this, what, to_wire](const typename Msg::ConstPtr& m) {
+      sendChecked(to_wire(*m), what, command_repeats_, command_repeat_period_s_);
+    });
+  }
   // Sends now; a single event (copies > 1) is repeated period_s apart (comm::OutgoingRepeats).
   template <class T>
   void send(const T& m, const char* what, int copies = 1, double period_s = 0.0) {
@@ -199,9 +173,6 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     std::lock_guard<std::mutex> lock(mutex_);
     send(*p, "formation parameters");
   }
-  void onCommand(const gesture_formation::FormationCommand::ConstPtr& msg) {
-    sendChecked(fromMsg(*msg), "command", command_repeats_, command_repeat_period_s_);
-  }
   // An abort to send (the ground station's copies: the OperatorInterface repeats it).
   void onAbort(const gesture_formation::AbortCommand::ConstPtr& msg) { sendChecked(toWire(*msg), "abort"); }
   template <class T>
@@ -212,6 +183,7 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     }
     std::lock_guard<std::mutex> lock(mutex_);
     send(*m, what, copies, period_s);
+    if constexpr (std::is_same_v<T, comm::AssistanceMessage>) assistance_ = *m;  // re-sent while requested
   }
   // The leader's abort state: once it accepted an abort, the command is relayed (docs/safety.md §2.8).
   void onAbortState(const gesture_formation::AbortState::ConstPtr& msg) {

@@ -23,4 +23,28 @@ inline bool loadMission(const std::string& mission_file, ParamLoader& params, si
   return true;
 }
 
+/// The SimWorld nodelet's own parameters (docs/ros.md "SimWorld"); every problem into `params`.
+struct SimWorldSettings {
+  std::string mission_file, output_dir, world_frame, camera_frame;
+  int seed = 0;
+  double real_time_factor = 1.0, clock_step_s = 0.01, duration_s = 0.0;  ///< duration ≤ 0: the mission's
+  bool rendered = false;  ///< ~camera rendered (default synthetic)
+};
+inline void loadSimWorldSettings(ParamLoader& params, SimWorldSettings& s) {
+  params.load("mission_file", s.mission_file);
+  params.load("seed", s.seed, 0, 1 << 30);
+  params.load("real_time_factor", s.real_time_factor, 0.05, 100.0);
+  params.load("clock_step_s", s.clock_step_s, 0.001, 0.1);
+  params.load("duration_s", s.duration_s, -1.0, 1e5);
+  params.load("output_dir", s.output_dir);
+  params.load("world_frame", s.world_frame);
+  params.load("leader_camera_frame", s.camera_frame);
+  std::string camera_mode;
+  params.loadOptional("camera", camera_mode, "synthetic");
+  if (camera_mode != "synthetic" && camera_mode != "rendered") {
+    params.addError("camera: must be synthetic or rendered, got '" + camera_mode + "'");
+  }
+  s.rendered = camera_mode == "rendered";
+}
+
 }  // namespace gesture_formation::nodelets

@@ -77,45 +77,27 @@ class VisualizerNodelet : public nodelet::Nodelet {
     plans_.resize(static_cast<std::size_t>(uav_count_));
     for (int i = 0; i < uav_count_; ++i) {
       const auto k = static_cast<std::size_t>(i);
-      subs_.push_back(nh.subscribe<nav_msgs::Odometry>("uav" + std::to_string(i) + "/odometry", 5,
-                                                       [this, k](const nav_msgs::Odometry::ConstPtr& m) {
-                                                         std::lock_guard<std::mutex> lock(mutex_);
-                                                         odom_[k] = m;
-                                                       }));
-      subs_.push_back(nh.subscribe<gesture_formation::PlannedTrajectory>(
-          "uav" + std::to_string(i) + "/plan", 5, [this, k](const gesture_formation::PlannedTrajectory::ConstPtr& m) {
-            std::lock_guard<std::mutex> lock(mutex_);
-            plans_[k] = m;
-          }));
+      keepLatest<nav_msgs::Odometry>(nh, "uav" + std::to_string(i) + "/odometry", &odom_[k]);
+      keepLatest<gesture_formation::PlannedTrajectory>(nh, "uav" + std::to_string(i) + "/plan", &plans_[k]);
     }
-    subs_.push_back(nh.subscribe<gesture_formation::WorkerState>("worker_state_in", 5,
-                                                                 [this](const gesture_formation::WorkerState::ConstPtr& m) {
-                                                                   std::lock_guard<std::mutex> lock(mutex_);
-                                                                   worker_ = m;
-                                                                 }));
-    subs_.push_back(nh.subscribe<nav_msgs::Odometry>("worker_truth_in", 5, [this](const nav_msgs::Odometry::ConstPtr& m) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      truth_ = m;
-    }));
-    subs_.push_back(nh.subscribe<gesture_formation::FormationParams>(
-        "formation_params_in", 5, [this](const gesture_formation::FormationParams::ConstPtr& m) {
-          std::lock_guard<std::mutex> lock(mutex_);
-          params_ = m;
-        }));
-    subs_.push_back(nh.subscribe<gesture_formation::GestureStatus>(
-        "gesture_status_in", 5, [this](const gesture_formation::GestureStatus::ConstPtr& m) {
-          std::lock_guard<std::mutex> lock(mutex_);
-          gesture_ = m;
-        }));
-    subs_.push_back(nh.subscribe<gesture_formation::AssistanceState>(
-        "assistance_in", 5, [this](const gesture_formation::AssistanceState::ConstPtr& m) {
-          std::lock_guard<std::mutex> lock(mutex_);
-          assistance_ = m;
-        }));
+    keepLatest<gesture_formation::WorkerState>(nh, "worker_state_in", &worker_);
+    keepLatest<nav_msgs::Odometry>(nh, "worker_truth_in", &truth_);
+    keepLatest<gesture_formation::FormationParams>(nh, "formation_params_in", &params_);
+    keepLatest<gesture_formation::GestureStatus>(nh, "gesture_status_in", &gesture_);
+    keepLatest<gesture_formation::AssistanceState>(nh, "assistance_in", &assistance_);
     pub_ = nh.advertise<visualization_msgs::MarkerArray>("markers_out", 2);
     map_pub_ = nh.advertise<visualization_msgs::MarkerArray>("map_out", 1, true);
     map_ = world.map;
     timer_ = nh.createTimer(ros::Duration(1.0 / rate_hz), &VisualizerNodelet::onTimer, this);
+  }
+
+  /// Subscribes `topic`; its latest message goes to `*latest` (drawn at the next tick).
+  template <class Msg>
+  void keepLatest(ros::NodeHandle& nh, const std::string& topic, typename Msg::ConstPtr* latest) {
+    subs_.push_back(nh.subscribe<Msg>(topic, 5, [this, latest](const typename Msg::ConstPtr& m) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      *latest = m;
+    }));
   }
 
   visualization_msgs::Marker marker(const std::string& ns, int id, int type, const ros::Time& stamp) const {

@@ -2,10 +2,15 @@
 // → WorkerState. A thin adapter over estimation::HumanKalman (docs/estimation.md).
 //
 // Topics: detection_in (gesture_formation/WorkerDetection), uwb_in (sensor_msgs/Range),
+//         camera_info_in (sensor_msgs/CameraInfo of the camera the detections come from),
 //         worker_state_out (gesture_formation/WorkerState).
 // Parameters (all required, listed at once when missing): ~config_file (estimator YAML, every
-// key required), ~world_frame, ~uwb_max_age_s, ~tf_timeout_s, ~publish_rate_hz.
+// key required), ~world_frame, ~uwb_max_age_s, ~tf_timeout_s, ~publish_rate_hz; optional
+// ~intrinsics_source: camera_info (default: the camera model from camera_info_in, detections
+// refused until it has arrived) or config (the YAML's camera section, an explicit override);
+// estimation::CameraModelSource.
 #include <mutex>
+#include <optional>
 
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
@@ -16,6 +21,7 @@
 
 #include "conversions.hpp"
 #include "diagnostics.hpp"
+#include "gesture_formation/estimation/camera_model_source.hpp"
 #include "gesture_formation/estimation/estimator_config.hpp"
 #include "param_loader.hpp"
 
@@ -34,6 +40,10 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
     params.load("tf_timeout_s", tf_timeout_s_, 0.0, 1.0);
     double rate_hz = 0.0;
     params.load("publish_rate_hz", rate_hz, 0.1, 200.0);
+    std::string source_name;
+    params.loadOptional("intrinsics_source", source_name, "camera_info");
+    const auto source = estimation::parseIntrinsicsSource(source_name);
+    if (!source) params.addError("intrinsics_source: " + source.reason());
     if (!config_file.empty()) {
       const auto cfg = estimation::loadEstimatorConfig(config_file, common::ConfigReader::MissingKeys::kError);
       if (cfg) {
@@ -47,8 +57,15 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
       return;  // stays uninitialised: no subscriptions, no output
     }
     NODELET_INFO_STREAM("WorkerEstimator loaded:\n" << params.loaded());
-    camera_ = estimation::CameraModel(config_.camera);
+    camera_.emplace(*source, config_.camera);
     filter_ = estimation::HumanKalman(config_.filter);
+    info_sub_ = nh.subscribe<sensor_msgs::CameraInfo>("camera_info_in", 2, [this](const sensor_msgs::CameraInfo::ConstPtr& m) {
+      auto k = toIntrinsics(*m);
+      std::lock_guard<std::mutex> lock(mutex_);
+      const auto changed = k ? camera_->receive(*k) : common::Result<bool>::fail(k.reason());
+      if (!changed) NODELET_WARN_STREAM_THROTTLE(5.0, "WorkerEstimator: camera_info_in not used: " << changed.reason());
+      else if (*changed) NODELET_INFO_STREAM("WorkerEstimator: camera model from CameraInfo (" << m->header.frame_id << ")");
+    });
     tf_listener_ = std::make_unique<tf2_ros::TransformListener>(tf_buffer_);
     state_pub_ = nh.advertise<gesture_formation::WorkerState>("worker_state_out", 10);
     detection_sub_ = nh.subscribe("detection_in", 10, &WorkerEstimatorNodelet::onDetection, this);
@@ -66,7 +83,8 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
     const double uwb_age_s = last_uwb_stamp_.isZero() ? -1.0 : t - last_uwb_stamp_.toSec();
     const bool lost = filter_.confirmed() && filter_.lost(t);
     Health h("WorkerEstimator", "leader");
-    h.warn(!filter_.confirmed(), "no confirmed track of the worker")
+    h.warn(!camera_->model(), camera_->refusal())
+        .warn(!filter_.confirmed(), "no confirmed track of the worker")
         .warn(lost, "worker lost (no measurement fused for " + std::to_string(fused_age_s) + " s)")
         .warn(rejected_since_report_ > 0, std::to_string(rejected_since_report_) + " detection(s) rejected")
         .value("confirmed", filter_.confirmed() ? 1 : 0)
@@ -101,7 +119,12 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
     const double t = msg->header.stamp.toSec();
     const double uwb_age_s = std::abs((msg->header.stamp - last_uwb_stamp_).toSec());
     const double d_uwb = uwb_age_s <= uwb_max_age_s_ ? last_uwb_m_ : std::nan("");
-    const auto m = estimation::makeMeasurement(camera_, toCameraPose(T_world_camera), toBox(*msg), d_uwb,
+    if (!camera_->model()) {
+      ++rejected_since_report_;
+      NODELET_WARN_STREAM_THROTTLE(1.0, "WorkerEstimator: detection refused: " << camera_->refusal());
+      return;
+    }
+    const auto m = estimation::makeMeasurement(*camera_->model(), toCameraPose(T_world_camera), toBox(*msg), d_uwb,
                                                msg->stereo_distance_m, config_.human_height_m, config_.noise);
     if (!m) {
       ++rejected_since_report_;
@@ -153,7 +176,7 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
   DiagnosticsPublisher diagnostics_;
   int fused_since_report_ = 0, rejected_since_report_ = 0, published_since_report_ = 0;
   estimation::EstimatorConfig config_;
-  estimation::CameraModel camera_;
+  std::optional<estimation::CameraModelSource> camera_;  ///< from CameraInfo, or the config (override)
   estimation::HumanKalman filter_;
   std::string world_frame_;
   double uwb_max_age_s_ = 0.0;
@@ -165,7 +188,7 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
   ros::Publisher state_pub_;
   ros::Subscriber detection_sub_;
-  ros::Subscriber uwb_sub_;
+  ros::Subscriber uwb_sub_, info_sub_;
   ros::Timer timer_;
 };
 

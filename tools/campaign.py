@@ -621,6 +621,7 @@ def main(argv=None):
     p = sub.add_parser("cameras", help="synthetic vs rendered camera per seed (campaign field camera) from the store")
     p.add_argument("campaign", nargs="?", default=None, help="restrict to this campaign's scenarios, profiles and seeds")
     p.add_argument("--commit", help="commit (prefix) of the missions (default: the commit with the most missions)")
+    p.add_argument("--out", help="also write a results page (e.g. docs/results/camera_campaign.md)")
     p.set_defaults(func=cmd_cameras)
 
     p = sub.add_parser("import-csv", help="import runs files of the former tools/run_fault_matrix.sh once")

@@ -16,6 +16,7 @@ import statistics
 import subprocess
 import sys
 import tempfile
+import time
 
 from campaign_store import BASE_CONFIG_HASH, UNKNOWN_BINARY, Store
 
@@ -408,7 +409,8 @@ def _camera_of(row):
 
 def cameras(args, campaign):
     """Per seed and camera (gfctl simulate --camera; the campaign field `camera`): the safety and gesture
-    figures of one commit's missions side by side, and the rendered missions' perception by distance."""
+    figures of one commit's missions side by side, and the rendered missions' perception by distance and
+    by camera elevation. With --out also a results page (a header naming the store, then the same text)."""
     store = Store(args.store, create=False)
     try:
         prefix = args.commit or (store.commits()[0][0] if store.commits() else "")
@@ -422,25 +424,40 @@ def cameras(args, campaign):
     for r in rows:
         by.setdefault((r["scenario"], r["profile"], r["seed"]), {})[_camera_of(r)] = json.loads(r["metrics_json"] or "{}")
     modes = sorted({_camera_of(r) for r in rows}, key=lambda m: (m != "synthetic", m))
-    print(f"commit {rows[0]['source_commit'][:10]}: {len(rows)} missions; each cell: " + " | ".join(modes))
-    print("| scenario | profile | seed | " + " | ".join(label for _, label, _ in CAMERA_FIGURES) + " |")
-    print("|" + " --- |" * (3 + len(CAMERA_FIGURES)))
+    out = [f"commit {rows[0]['source_commit'][:10]}: {len(rows)} missions; each cell: " + " | ".join(modes), "",
+           "| scenario | profile | seed | " + " | ".join(label for _, label, _ in CAMERA_FIGURES) + " |",
+           "|" + " --- |" * (3 + len(CAMERA_FIGURES))]
     for (scenario, profile, seed), per in sorted(by.items()):
         cells = []
         for key, _, fmt in CAMERA_FIGURES:
             vals = [per.get(m, {}).get(key) for m in modes]
             cells.append(" / ".join("–" if v is None else format(v, fmt) for v in vals))
-        print(f"| {os.path.basename(scenario)} | {profile} | {seed} | " + " | ".join(cells) + " |")
+        out.append(f"| {os.path.basename(scenario)} | {profile} | {seed} | " + " | ".join(cells) + " |")
     rendered = [(k, per["rendered"]["perception"]) for k, per in sorted(by.items())
                 if "perception" in per.get("rendered", {})]
-    if rendered:
-        print("\nrendered camera, perception against the truth (detection rate, keypoint error as a fraction of the "
-              "figure) by distance:")
+    for key, unit, title in (("by_distance_m", "m", "distance"), ("by_elevation_deg", "deg", "camera elevation")):
+        if not rendered:
+            break
+        out += ["", "rendered camera, perception against the truth (detection rate / keypoint error as a fraction of "
+                    f"the figure (frames)) by {title}:", ""]
         for (scenario, profile, seed), p in rendered:
-            bins = ", ".join(f"{b['bin']} m: {_fmt(b['detection_rate'])} / {_fmt(b['keypoint_error_fraction_median'])} "
-                             f"({b['frames']})" for b in p["by_distance_m"])
-            print(f"  {os.path.basename(scenario)} {profile} seed {seed}: {bins}; identity switches "
-                  f"{p['identity_switches']}")
+            bins = ", ".join(f"{b['bin']} {unit}: {_fmt(b['detection_rate'])} / {_fmt(b['keypoint_error_fraction_median'])} "
+                             f"({b['frames']})" for b in p.get(key, []))
+            out.append(f"- {os.path.basename(scenario)} {profile} seed {seed}: {bins}; identity switches "
+                       f"{p['identity_switches']}")
+    print("\n".join(out))
+    if getattr(args, "out", None):
+        commit = rows[0]["source_commit"][:10]
+        header = ["# Camera campaign: synthetic vs rendered cameras" + (f" ({os.path.relpath(args.campaign, ROOT)})" if args.campaign else ""),
+                  "",
+                  f"Written by `tools/campaign.py --store {os.path.relpath(args.store, ROOT)} cameras"
+                  + (f" {os.path.relpath(args.campaign, ROOT)}" if args.campaign else "")
+                  + (f" --commit {args.commit}" if args.commit else "") + f" --out {os.path.relpath(args.out, ROOT)}` on "
+                  f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())} from the missions of commit {commit} in the store "
+                  f"(one worker at nice 19 on a shared 2-core machine). Nothing was tuned on these seeds. "
+                  f"Gestures on rendered pixels: docs/results/gestures_rendered.md (issue 33).", ""]
+        with open(args.out, "w") as f:
+            f.write("\n".join(header + out) + "\n")
     return 0
 
 

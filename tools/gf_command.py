@@ -68,64 +68,63 @@ class AckWaiter:
             return self._acks.get(sequence)
 
 
-def main():
-    abort = len(sys.argv) > 1 and sys.argv[1] == "abort"
-    ack_assist = len(sys.argv) > 1 and sys.argv[1] == "ack-assist"
+SERVICES = {"command": "/operator/send_command", "abort": "/operator/send_abort",
+            "ack-assist": "/operator/acknowledge_assistance"}
+
+
+def parse_args(kind):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    if ack_assist:
-        ap.add_argument("ack_assist", choices=["ack-assist"])
-        ap.add_argument("--service", default="/operator/acknowledge_assistance")
-    elif abort:
-        ap.add_argument("abort", choices=["abort"])
-        ap.add_argument("--service", default="/operator/send_abort")
-    else:
+    if kind == "command":
         ap.add_argument("target")
         ap.add_argument("parameter", choices=["beta_deg", "gamma_deg", "distance_m"])
         ap.add_argument("amount", type=float)
         ap.add_argument("--set", action="store_true", help="set the value instead of incrementing it")
-        ap.add_argument("--service", default="/operator/send_command")
         ap.add_argument("--ack-timeout", type=float, default=5.0,
                         help="wait this long for the leader's acknowledgement [s, wall]; 0: do not wait")
         ap.add_argument("--ack-topic", default=None, help="the OperatorInterface's command_ack_out topic")
+    else:
+        ap.add_argument("kind", choices=[kind])
+    ap.add_argument("--service", default=SERVICES[kind])
     ap.add_argument("--timeout", type=float, default=5.0, help="wait this long for the service [s]")
-    a = ap.parse_args()
+    return ap.parse_args()
+
+
+def main():
+    kind = sys.argv[1] if len(sys.argv) > 1 and sys.argv[1] in ("abort", "ack-assist") else "command"
+    a = parse_args(kind)
     try:
         from gesture_formation.srv import AcknowledgeAssistance, SendAbort, SendCommand
     except ImportError as e:
         print(f"gf_command: {e} (source the workspace's devel/setup.bash)", file=sys.stderr)
         return 2
-    if ack_assist:
-        res = call(a.service, AcknowledgeAssistance, a.timeout)
-        if res is None:
-            return 2
-        if res.accepted:
-            print(f"assistance request of {res.requested_at.to_sec():.2f} s acknowledged")
-            return 0
-    elif abort:
-        res = call(a.service, SendAbort, a.timeout)
-        if res is None:
-            return 2
-        if res.accepted:
-            print(f"abort sent #{res.sequence} ({res.copies} copies)")
-            return 0
+    # Per kind: the service type, its request's arguments, what to print when it was accepted.
+    if kind == "command":
+        op = "=" if a.set else "+="
+        spec = (SendCommand, (a.target, a.parameter, "set" if a.set else "increment", a.amount),
+                lambda r: f"sent #{r.sequence}: {a.target}.{a.parameter} {op} {a.amount:g}")
+    elif kind == "abort":
+        spec = (SendAbort, (), lambda r: f"abort sent #{r.sequence} ({r.copies} copies)")
     else:
-        acks = AckWaiter(a.ack_topic or a.service.rsplit("/", 1)[0] + "/command_ack") if a.ack_timeout > 0 else None
-        res = call(a.service, SendCommand, a.timeout, a.target, a.parameter, "set" if a.set else "increment", a.amount)
-        if res is None:
-            return 2
-        if res.accepted:
-            print(f"sent #{res.sequence}: {a.target}.{a.parameter} {'=' if a.set else '+='} {a.amount:g}", flush=True)
-            if acks is None:
-                return 0
-            ack = acks.wait(res.sequence, a.ack_timeout)
-            if ack is None:
-                print(f"no acknowledgement from the leader within {a.ack_timeout:g} s (lost on the link, or no leader)",
-                      file=sys.stderr)
-                return 3
-            print(f"acknowledged by the leader: {ack.outcome} (parameters version {ack.params_version})")
-            return 1 if ack.status == "rejected" else 0
-    print(f"refused: {res.message}", file=sys.stderr)
-    return 1
+        spec = (AcknowledgeAssistance, (), lambda r: f"assistance request of {r.requested_at.to_sec():.2f} s acknowledged")
+    srv_type, args, accepted = spec
+    waits = kind == "command" and a.ack_timeout > 0
+    acks = AckWaiter(a.ack_topic or a.service.rsplit("/", 1)[0] + "/command_ack") if waits else None
+    res = call(a.service, srv_type, a.timeout, *args)
+    if res is None:
+        return 2
+    if not res.accepted:
+        print(f"refused: {res.message}", file=sys.stderr)
+        return 1
+    print(accepted(res), flush=True)
+    if acks is None:
+        return 0
+    ack = acks.wait(res.sequence, a.ack_timeout)
+    if ack is None:
+        print(f"no acknowledgement from the leader within {a.ack_timeout:g} s (lost on the link, or no leader)",
+              file=sys.stderr)
+        return 3
+    print(f"acknowledged by the leader: {ack.outcome} (parameters version {ack.params_version})")
+    return 1 if ack.status == "rejected" else 0
 
 
 if __name__ == "__main__":

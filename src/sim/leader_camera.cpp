@@ -152,6 +152,7 @@ LeaderCameraFrame LeaderCamera::frame(double t, const MultirotorState& leader, c
                                       const std::vector<bool>& online, const WorkerState& ws, WorkerModel& worker,
                                       MissionClassifier* classifier) {
   LeaderCameraFrame out;
+  out.intrinsics = cfg_.camera.camera;
   const FaultConfig& faults = cfg_.faults;
   const estimation::CameraPose true_pose = cameraPose(leader.p_world, leader.heading_rad, leader.pitch_rad);
   bool blackout = false;

@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 
 #include "gesture_formation/common/angles.hpp"
+#include "gesture_formation/estimation/camera_model_source.hpp"
 #include "gesture_formation/estimation/human_kalman.hpp"
 #include "gesture_formation/estimation/measurement_model.hpp"
 #include "gesture_formation/formation/formation_geometry.hpp"
@@ -109,7 +110,7 @@ class MissionRun {
         own_camera_(camera != nullptr ? nullptr : std::make_unique<LeaderCamera>(cfg, world.map, seed)),
         camera_(camera != nullptr ? *camera : *own_camera_),
         kf_(cfg.estimator.filter),
-        cam_model_(cfg.estimator.camera),
+        cam_model_(estimation::IntrinsicsSource::kCameraInfo, cfg.estimator.camera),
         // The formation's cameras vote (docs/gestures.md §4.1); min_agreeing_views 1 = the
         // paper's pipeline on the leader's camera alone.
         follower_views_(cfg.view_fusion.min_agreeing_views > 1),
@@ -170,7 +171,9 @@ class MissionRun {
   std::unique_ptr<LeaderCamera> own_camera_;  ///< the synthetic camera, when no other was given
   CameraSource& camera_;
   estimation::HumanKalman kf_;
-  const estimation::CameraModel cam_model_;
+  /// The estimator's camera model: the leader camera's own intrinsics, from its frames (as the
+  /// WorkerEstimator nodelet takes them from CameraInfo).
+  estimation::CameraModelSource cam_model_;
   bool follower_views_;
   gesture::GestureFrames frames_;
   std::vector<std::unique_ptr<UavRuntime>> uavs_;
@@ -544,10 +547,11 @@ void MissionRun::cameraFrame(double t, const WorkerState& ws) {
   const LeaderCameraFrame cf = camera_.frame(t, uav(owner_).plant.state(), follower_states, online, ws, worker_, classifier_);
   const SensorFrame& frame = cf.sensors;
   M_.range_outliers += cf.range_outliers;
-  if (frame.visible()) {
+  (void)cam_model_.receive(cf.intrinsics);  // invalid intrinsics keep the model held (or none: no measurement)
+  if (frame.visible() && cam_model_.model() != nullptr) {
     const UavRuntime& L = uav(owner_);
     const estimation::CameraPose est_pose = cameraPose(L.est.p_world, L.est.heading_rad, L.est.pitch_rad);
-    const auto meas = estimation::makeMeasurement(cam_model_, est_pose, frame.box, frame.d_uwb_m, frame.d_stereo_m,
+    const auto meas = estimation::makeMeasurement(*cam_model_.model(), est_pose, frame.box, frame.d_uwb_m, frame.d_stereo_m,
                                                   cfg_.estimator.human_height_m, cfg_.estimator.noise);
     if (meas && estimation::accepted(kf_.step(t, *meas))) last_fused_s_ = t;
   }

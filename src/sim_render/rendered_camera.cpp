@@ -338,6 +338,7 @@ LeaderCameraFrame RenderedCamera::frame(double t, const MultirotorState& leader,
                                         const std::vector<bool>& online, const WorkerState& ws, WorkerModel& worker,
                                         MissionClassifier* classifier) {
   LeaderCameraFrame out;
+  out.intrinsics = intrinsics_;  // the rendered (rectified) image's
   // Every UAV's body and camera pose; the worker's performance advances exactly as with the
   // synthetic camera (the same motions and gesture episodes) — its synthetic skeletons are not used.
   std::vector<MultirotorState> states{leader};

@@ -52,6 +52,17 @@ class AssistanceLatch {
     state_.acknowledged_by = std::move(by);
     return true;
   }
+  /// \brief A state as it arrives from elsewhere (the worker's request from the gesture commander,
+  /// the operator's acknowledgement over the link): a request latches, an acknowledgement
+  /// acknowledges the request it names, phase none changes nothing. True when the latch changed.
+  bool receive(const AssistanceState& s) {
+    switch (s.phase) {
+      case AssistancePhase::kRequested: return request(s.requested_s, s.requested_by);
+      case AssistancePhase::kAcknowledged: return acknowledge(s.requested_s, s.acknowledged_s, s.acknowledged_by);
+      case AssistancePhase::kNone: return false;
+    }
+    return false;
+  }
   /// \brief Why a command of `source` must be refused now (nullopt: it may be applied): while a
   /// request is pending the views are held — the worker's gestures are refused, the operator's pass.
   std::optional<std::string> refusal(CommandSource source) const {

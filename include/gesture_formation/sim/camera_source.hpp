@@ -35,6 +35,9 @@ struct FollowerView {
 /// \brief One frame of the leader's camera.
 struct LeaderCameraFrame {
   SensorFrame sensors;         ///< box (when visible) and ranges after the injected faults
+  /// The leader camera's calibration, with every frame as a driver's CameraInfo: the estimator's
+  /// camera model (estimation::CameraModelSource, as the WorkerEstimator nodelet's).
+  estimation::CameraIntrinsics intrinsics;
   gesture::SynthFrame skeleton;  ///< what the worker looked like from the camera
   gesture::CalibratedSkeleton calibrated;  ///< skeleton with the true pose of the camera that rendered it (WorkerModel::calibrated; view_fusion.confirm_3d only)
   int range_outliers = 0;      ///< gross range errors injected into this frame

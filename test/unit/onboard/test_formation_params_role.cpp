@@ -99,3 +99,22 @@ TEST(FormationParamsRoleTest, AnAssistanceRequestHoldsTheViewsAgainstGesturesUnt
   EXPECT_TRUE(role.assistance().request(30.0, "gesture"));  // a new request latches again
   EXPECT_EQ(role.assistance().state().phase, formation::AssistancePhase::kRequested);
 }
+
+// The states as they arrive (AssistanceLatch::receive): a request latches, an acknowledgement acts
+// only on the request it names, "none" changes nothing.
+TEST(FormationParamsRoleTest, ReceivedAssistanceStatesDispatchByPhase) {
+  using formation::AssistancePhase;
+  using formation::AssistanceState;
+  formation::AssistanceLatch latch;
+  EXPECT_FALSE(latch.receive(AssistanceState{AssistancePhase::kNone, 5.0, "gesture", 0.0, ""}));
+  EXPECT_EQ(latch.state().phase, AssistancePhase::kNone);
+  EXPECT_FALSE(latch.receive(AssistanceState{AssistancePhase::kAcknowledged, 5.0, "gesture", 6.0, "gcs"}));
+  ASSERT_TRUE(latch.receive(AssistanceState{AssistancePhase::kRequested, 10.0, "gesture", 0.0, ""}));
+  EXPECT_FALSE(latch.receive(AssistanceState{AssistancePhase::kRequested, 11.0, "gesture", 0.0, ""}));
+  EXPECT_FALSE(latch.receive(AssistanceState{AssistancePhase::kAcknowledged, 9.0, "gesture", 12.0, "gcs"}));
+  EXPECT_EQ(latch.state().phase, AssistancePhase::kRequested);
+  ASSERT_TRUE(latch.receive(AssistanceState{AssistancePhase::kAcknowledged, 10.0, "gesture", 12.0, "gcs"}));
+  EXPECT_EQ(latch.state().phase, AssistancePhase::kAcknowledged);
+  EXPECT_DOUBLE_EQ(latch.state().acknowledged_s, 12.0);
+  EXPECT_EQ(latch.state().acknowledged_by, "gcs");
+}
