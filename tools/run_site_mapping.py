@@ -114,7 +114,7 @@ def main():
     now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     L = [f"## {a.title or f'Seeds {lo}–{hi}'}", "",
          f"Written by `tools/run_site_mapping.py` on {now} at commit {commit}: `gfctl simulate` of each scenario "
-         f"and seed {lo}–{hi}, with mapping (`--mapping on`: every UAV integrates its synthetic depth frames, "
+         f"and seed {lo}–{hi} (variants run: {', '.join(variants)}), with mapping (`--mapping on`: every UAV integrates its synthetic depth frames, "
          "5 per second, into its live map and plans on it; the prior map is the scenario's mapped obstacles) "
          "and without (`--mapping off`: the planners get the prior map only — blind to the unmapped obstacles; the "
          "control), and for the construction site with mapping but no prior map (`--no-prior-map`: the live maps "
