@@ -169,6 +169,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
     ++k_;
     t_ = static_cast<double>(k_) * set_.clock_step_s;
     publishClock();
+    record_->divertWorker(t_, *worker_, truth_);  // faults.worker_approach, at its time
     const sim::WorkerState ws = worker_->stateAt(t_);
     // Operator requests (the OperatorInterface numbers them and sends them over LCM).
     for (const auto& c : record_->dueRequests(t_)) {
@@ -204,11 +205,9 @@ class SimWorldNodelet : public nodelet::Nodelet {
   void cameraFrame(const sim::WorkerState& ws) {
     std::vector<sim::MultirotorState> followers;
     std::vector<bool> online;
-    if (follower_views_) {
-      for (int i = 1; i < n_; ++i) {
-        followers.push_back(*truth_[static_cast<std::size_t>(i)]);
-        online.push_back(!cfg_.faults.followerOffline(i, t_));
-      }
+    for (int i = 1; follower_views_ && i < n_; ++i) {
+      followers.push_back(*truth_[static_cast<std::size_t>(i)]);
+      online.push_back(!cfg_.faults.followerOffline(i, t_));
     }
     // The worker's performance advances in both modes; rendered cameras: only its body leaves.
     const sim::LeaderCameraFrame cf =

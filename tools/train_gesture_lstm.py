@@ -10,10 +10,19 @@ default distribution), an extra training set (seed 1003, 4000 sequences,
 tools/gesture/train_extra.yaml: more work motions, longer holds) and a validation seed
 (1002, 600 sequences, default distribution). Model: LSTM(51 → 128) over N = 9 frames, the final hidden state h_n (not output[:, -1]:
 OpenCV 4.6 rejects the negative-index Slice that exports) → Linear(128 → 5) → softmax.
-Deterministic: fixed torch seed, 2 threads, deterministic algorithms. Writes
+Deterministic: fixed torch seed, --threads threads, deterministic algorithms. Writes
 <out>/gesture_lstm.onnx, <out>/training.json (command, seeds, figures) and the C++/OpenCV
-equality reference test/data/gesture/lstm_reference.csv.
+equality reference (--reference, default test/data/gesture/lstm_reference.csv).
+
+The skeleton network's systematic errors (docs/gestures.md §2, §9): --error-model FILE applies
+tools/gesture/error_model.py with the measured ranges of FILE (tools/gesture/error_model_movenet.yaml)
+to a share of the training and extra sequences (seeded by --error-model-seed; validation stays
+clean), and --rendered DIR,... adds the skeletons MoveNet extracted from a rendered TUNING set
+(`gfctl render-gestures`, all its views; sets of the held-out protocol's seed range are refused),
+each window --rendered-repeat times. --init-onnx FILE fine-tunes from an exported model's weights
+(e.g. the shipped one) instead of a random start.
 """
+import re
 import argparse
 import json
 import os
@@ -26,7 +35,10 @@ import torch
 from torch import nn
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "gesture"))
+import error_model  # noqa: E402
 import gesture_data  # noqa: E402
+
+HELDOUT_SEEDS = range(9000, 10000)  # tools/gesture/heldout/protocol*.yaml: never trained on
 
 CLASSES = ["none", "cross_arms", "extend_arm_side", "palms_together", "raise_arm_up"]
 
@@ -44,6 +56,63 @@ class GestureLstm(nn.Module):
     def logits(self, x):
         _, (h_n, _) = self.lstm(x)
         return self.head(h_n[0])
+
+
+def load_onnx_weights(model, path):
+    """Copies the weights of an ONNX export of GestureLstm (LSTM W, R, B; Gemm head) into model. ONNX orders
+    the gates i, o, f, c; torch i, f, g (= c), o."""
+    import onnx
+    from onnx import numpy_helper
+    g = onnx.load(path).graph
+    init = {i.name: numpy_helper.to_array(i) for i in g.initializer}
+    lstm = next(n for n in g.node if n.op_type == "LSTM")
+    w, r, b = (init[lstm.input[i]][0] for i in (1, 2, 3))  # inputs: X, W, R, B, …
+    hidden = r.shape[1]
+    if hidden != model.lstm.hidden_size or w.shape[1] != gesture_data.N_FEATURES:
+        raise ValueError(f"--init-onnx {path}: LSTM hidden {hidden}, input {w.shape[1]}; the model has "
+                         f"hidden {model.lstm.hidden_size} (--hidden), input {gesture_data.N_FEATURES}")
+    order = lambda m: np.concatenate([m[k * hidden:(k + 1) * hidden] for k in (0, 2, 3, 1)])  # noqa: E731
+    gemm = next(n for n in g.node if n.op_type == "Gemm")
+    with torch.no_grad():
+        model.lstm.weight_ih_l0.copy_(torch.from_numpy(order(w)))
+        model.lstm.weight_hh_l0.copy_(torch.from_numpy(order(r)))
+        model.lstm.bias_ih_l0.copy_(torch.from_numpy(order(b[:4 * hidden])))
+        model.lstm.bias_hh_l0.copy_(torch.from_numpy(order(b[4 * hidden:])))
+        model.head.weight.copy_(torch.from_numpy(np.array(init[gemm.input[1]])))
+        model.head.bias.copy_(torch.from_numpy(np.array(init[gemm.input[2]])))
+
+
+def rendered_windows(dirs, repeat):
+    """Windows of the rendered tuning sets (every view's skeletons*.csv), each repeated `repeat` times."""
+    xs, ys, info = [], [], []
+    for d in dirs:
+        m = re.search(r"_seed(\d+)_", os.path.basename(os.path.normpath(d)) + "_")
+        if m is None:
+            raise ValueError(f"--rendered {d}: no _seed<N>_ in the directory name (rendered_eval.py's cache names)")
+        if int(m.group(1)) in HELDOUT_SEEDS:
+            raise ValueError(f"--rendered {d}: seed {m.group(1)} belongs to the held-out protocol (9000-9999)")
+        for f in sorted(n for n in os.listdir(d) if re.fullmatch(r"skeletons(_view\d+)?\.csv", n)):
+            x, y, _ = gesture_data.windows(gesture_data.load_frames(d, f))
+            xs += [x] * repeat
+            ys += [y] * repeat
+            info.append({"dir": os.path.basename(os.path.normpath(d)), "file": f, "windows": int(len(x))})
+    return np.concatenate(xs), np.concatenate(ys), info
+
+
+def training_windows(data_dir, em_cfg, em_seed, set_index):
+    """Windows of a synthesized set, with the error model applied when em_cfg is given."""
+    if em_cfg is None:
+        return gesture_data.windows(gesture_data.load_frames(data_dir))[:2] + (0,)
+    raw, changed = error_model.augment(gesture_data.load_raw(data_dir), gesture_data.load_motions(data_dir),
+                                       em_cfg, em_seed, set_index)
+    frames = {sid: (gesture_data.features(kp, box), lab, t) for sid, (kp, box, lab, t) in raw.items()}
+    return gesture_data.windows(frames)[:2] + (changed,)
+
+
+def sha256(path):
+    import hashlib
+    with open(path, "rb") as f:
+        return hashlib.sha256(f.read()).hexdigest()
 
 
 def main():
@@ -64,10 +133,22 @@ def main():
     ap.add_argument("--epochs", type=int, default=30)
     ap.add_argument("--hidden", type=int, default=128)
     ap.add_argument("--work", default=None, help="where datasets are cached (default: a temp dir)")
+    ap.add_argument("--threads", type=int, default=2, help="torch threads (1 on a shared machine)")
+    ap.add_argument("--lr", type=float, default=2e-3, help="Adam's initial learning rate (cosine to 0)")
+    ap.add_argument("--init-onnx", default=None, help="fine-tune from this exported model's weights")
+    ap.add_argument("--error-model", default=None,
+                    help="apply the skeleton network's errors (tools/gesture/error_model_movenet.yaml) to the training sets")
+    ap.add_argument("--error-model-seed", type=int, default=11)
+    ap.add_argument("--rendered", default=None, help="rendered TUNING sets to train on, comma-separated directories")
+    ap.add_argument("--rendered-repeat", type=int, default=1)
+    ap.add_argument("--reference", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "test", "data",
+                                                       "gesture", "lstm_reference.csv"),
+                    help="where the C++/OpenCV equality reference is written")
     a = ap.parse_args()
+    em_cfg = error_model.load(a.error_model) if a.error_model else None
     torch.manual_seed(a.torch_seed)
     np.random.seed(a.torch_seed)
-    torch.set_num_threads(2)
+    torch.set_num_threads(a.threads)
     torch.use_deterministic_algorithms(True)
     work = a.work or tempfile.mkdtemp(prefix="gf_lstm_")
     t0 = time.time()
@@ -77,10 +158,14 @@ def main():
         extra_dir = gesture_data.synthesize(a.gfctl, a.extra_seed, a.extra_count,
                                             os.path.join(work, f"extra_{a.extra_seed}"), a.extra_config)
     val_dir = gesture_data.synthesize(a.gfctl, a.val_seed, a.val_count, os.path.join(work, f"val_{a.val_seed}"))
-    xtr, ytr, _ = gesture_data.windows(gesture_data.load_frames(train_dir))
+    xtr, ytr, changed = training_windows(train_dir, em_cfg, a.error_model_seed, 0)
     if extra_dir:
-        xex, yex, _ = gesture_data.windows(gesture_data.load_frames(extra_dir))
-        xtr, ytr = np.concatenate([xtr, xex]), np.concatenate([ytr, yex])
+        xex, yex, changed_ex = training_windows(extra_dir, em_cfg, a.error_model_seed, 1)
+        xtr, ytr, changed = np.concatenate([xtr, xex]), np.concatenate([ytr, yex]), changed + changed_ex
+    rendered_info = []
+    if a.rendered:
+        xre, yre, rendered_info = rendered_windows(a.rendered.split(","), a.rendered_repeat)
+        xtr, ytr = np.concatenate([xtr, xre]), np.concatenate([ytr, yre])
     xva, yva, _ = gesture_data.windows(gesture_data.load_frames(val_dir))
     print(f"windows: train {len(xtr)} {np.bincount(ytr, minlength=5).tolist()}, val {len(xva)} "
           f"{np.bincount(yva, minlength=5).tolist()} ({time.time() - t0:.0f} s)")
@@ -90,7 +175,9 @@ def main():
     weights = (torch.tensor(counts.sum() / (5 * counts), dtype=torch.float32) if a.class_weights == "balanced"
                else torch.ones(5))
     model = GestureLstm(a.hidden)
-    opt = torch.optim.Adam(model.parameters(), lr=2e-3)
+    if a.init_onnx:
+        load_onnx_weights(model, a.init_onnx)
+    opt = torch.optim.Adam(model.parameters(), lr=a.lr)
     sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, a.epochs)
     loss_fn = nn.CrossEntropyLoss(weight=weights)
     xtr_t, ytr_t = torch.from_numpy(xtr), torch.from_numpy(ytr)
@@ -124,12 +211,11 @@ def main():
     except TypeError:
         torch.onnx.export(model, dummy, onnx_path, **kwargs)
     # Reference for the C++/OpenCV equality test: 20 validation windows and PyTorch's output.
-    ref_dir = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "test", "data", "gesture")
-    os.makedirs(ref_dir, exist_ok=True)
+    os.makedirs(os.path.dirname(os.path.abspath(a.reference)), exist_ok=True)
     pick = np.linspace(0, len(xva) - 1, 20).astype(int)
     with torch.no_grad():
         probs = model(torch.from_numpy(xva[pick])).numpy()
-    with open(os.path.join(ref_dir, "lstm_reference.csv"), "w") as f:
+    with open(a.reference, "w") as f:
         f.write(",".join([f"f{i}" for i in range(gesture_data.N_FRAMES * gesture_data.N_FEATURES)] +
                          [f"p{c}" for c in range(5)]) + "\n")
         for x, p in zip(xva[pick], probs):
@@ -140,6 +226,11 @@ def main():
                   "extra": {"seed": a.extra_seed, "sequences": a.extra_count,
                             "config": os.path.relpath(a.extra_config, os.path.join(os.path.dirname(__file__), ".."))}},
         "class_weights": a.class_weights,
+        "init_onnx": ({"path": os.path.basename(a.init_onnx), "sha256": sha256(a.init_onnx)} if a.init_onnx else None),
+        "learning_rate": a.lr, "threads": a.threads,
+        "error_model": ({"file": os.path.basename(a.error_model), "sha256": sha256(a.error_model), "seed": a.error_model_seed,
+                         "sequences_changed": int(changed)} if em_cfg else None),
+        "rendered": ({"sets": rendered_info, "repeat": a.rendered_repeat} if a.rendered else None),
         "validation": {"seed": a.val_seed, "sequences": a.val_count, "windows": int(len(xva)),
                        "accuracy": history[-1]["val_accuracy"]},
         "torch_seed": a.torch_seed, "epochs": a.epochs, "hidden": a.hidden, "torch": torch.__version__,

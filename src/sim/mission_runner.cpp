@@ -829,13 +829,7 @@ void MissionRun::divertWorker(double t) {
   const std::optional<WorkerApproach>& a = cfg_.faults.worker_approach;
   if (!a || diverted_ || t < a->t_s) return;
   diverted_ = true;
-  const Eigen::Vector3d feet = worker_.stateAt(t).feet_world;
-  const Eigen::Vector3d below_uav = uav(a->uav).plant.state().p_world;
-  const Eigen::Vector2d way = below_uav.head<2>() - feet.head<2>();
-  const double len = way.norm();
-  const Eigen::Vector2d stop = len > a->stop_m ? Eigen::Vector2d(feet.head<2>() + way * ((len - a->stop_m) / len))
-                                               : Eigen::Vector2d(feet.head<2>());
-  worker_.divert(t, Eigen::Vector3d(stop.x(), stop.y(), feet.z()), a->speed_mps);
+  divertTowards(worker_, t, *a, uav(a->uav).plant.state().p_world);
   approach_record_.emplace(*a, n_, cfg_.formation.limits.safety_distance_m, cfg_.faults.camera_blackouts);
 }
 

@@ -6,6 +6,7 @@
 
 #include "gesture_formation/common/csv.hpp"
 #include "gesture_formation/sim/mission_config.hpp"
+#include "gesture_formation/sim/worker_model.hpp"
 
 namespace gesture_formation::sim {
 
@@ -43,6 +44,15 @@ int ApproachSummary::violations() const {
   int n = 0;
   for (const auto& u : uavs) n += u.gamma_dis_violations;
   return n;
+}
+
+void divertTowards(WorkerModel& worker, double t_s, const WorkerApproach& a, const Eigen::Vector3d& uav_p_world) {
+  const Eigen::Vector3d feet = worker.stateAt(t_s).feet_world;
+  const Eigen::Vector2d way = uav_p_world.head<2>() - feet.head<2>();
+  const double len = way.norm();
+  const Eigen::Vector2d stop = len > a.stop_m ? Eigen::Vector2d(feet.head<2>() + way * ((len - a.stop_m) / len))
+                                              : Eigen::Vector2d(feet.head<2>());
+  worker.divert(t_s, Eigen::Vector3d(stop.x(), stop.y(), feet.z()), a.speed_mps);
 }
 
 ApproachRecorder::ApproachRecorder(const WorkerApproach& approach, int uav_count, double gamma_dis_m,

@@ -10,7 +10,8 @@ WorldRecord::WorldRecord(const MissionConfig& config, const ObstacleDistance& ob
       schedule_(config.requests, "mission"),
       versions_(config.formation.params),
       params_(config.formation.params),
-      plan_mode_(static_cast<std::size_t>(n_)) {}
+      plan_mode_(static_cast<std::size_t>(n_)),
+      config_(config) {}
 
 std::uint64_t WorldRecord::planVersion(const PlanReport& p) const {
   if (p.uav == formation::kLeader || p.params_version > 0 || !p.formation || p.formation->uavCount() != n_) {
@@ -64,6 +65,15 @@ void WorldRecord::gestureFired(double t_s, int gesture_id, const gesture::Gestur
   metrics_.resolveOutcomes(kStampToleranceS);
 }
 
+void WorldRecord::divertWorker(double t_s, WorkerModel& worker, const std::vector<std::optional<MultirotorState>>& truths) {
+  const std::optional<WorkerApproach>& a = config_.faults.worker_approach;
+  if (!a || approach_ || t_s < a->t_s || a->uav >= static_cast<int>(truths.size())) return;
+  const auto& target = truths[static_cast<std::size_t>(a->uav)];
+  if (!target) return;
+  divertTowards(worker, t_s, *a, target->p_world);
+  approach_.emplace(*a, n_, config_.formation.limits.safety_distance_m, config_.faults.camera_blackouts);
+}
+
 bool WorldRecord::sampleSafety(double t_s, const std::vector<std::optional<MultirotorState>>& truths,
                                const WorkerState& worker) {
   std::vector<Eigen::Vector3d> p_world;
@@ -72,6 +82,7 @@ bool WorldRecord::sampleSafety(double t_s, const std::vector<std::optional<Multi
     p_world.push_back(s->p_world);
   }
   metrics_.sampleSafety(t_s, p_world, worker);
+  if (approach_) approach_->sample(t_s, p_world, worker.p_world);
   return true;
 }
 
@@ -83,6 +94,7 @@ bool WorldRecord::finish(const std::vector<GestureEpisode>& gestures, double sim
                                       "messages_lost", "messages_duplicated", "messages_reordered",
                                       "qp_sparse_timeouts"};
   MissionOutput out = metrics_.finish(gestures, sim_time_s, wall_time_s);
+  if (approach_) out.metrics.worker_approach = approach_->summary();
   out.modes = modes_;  // from the plans' mode fields (the planners' hold decisions)
   const bool ok = writeMissionFiles(dir, out, n_, true, error);
   if (const auto& left = metrics_.unmatchedOutcomes(); !left.empty() && warning != nullptr) {

@@ -25,30 +25,46 @@ def synthesize(gfctl, seed, count, out_dir, config=None, views=None):
     return out_dir
 
 
-def load_frames(data_dir):
-    """Returns dict sequence (or (sequence, segment) when the file has a `segment` column) -> (features [T, 51]
-    float32, labels [T] int, t [T])."""
+def load_raw(data_dir, filename="skeletons.csv"):
+    """Returns dict sequence (or (sequence, segment) when the file has a `segment` column) -> (keypoints
+    [T, 17, 3] float64 in pixels (x, y, c), box [T, 4] (u, v, w, h), labels [T] int, t [T])."""
     seqs = {}
-    with open(os.path.join(data_dir, "skeletons.csv")) as f:
+    with open(os.path.join(data_dir, filename)) as f:
         reader = csv.reader(f)
         header = next(reader)
         idx = {n: i for i, n in enumerate(header)}
+        cols = [idx[f"{a}{k}"] for k in range(17) for a in ("x", "y", "c")]
+        box = [idx[n] for n in ("u", "v", "w", "h")]
         for row in reader:
-            v = np.array([float(x) for x in row[:-2]], dtype=np.float64)
-            u, vv, w, h = v[idx["u"]], v[idx["v"]], v[idx["w"]], v[idx["h"]]
-            feat = np.zeros(N_FEATURES, dtype=np.float32)
-            for k in range(17):
-                x, y, c = v[idx[f"x{k}"]], v[idx[f"y{k}"]], v[idx[f"c{k}"]]
-                if c > 0 and w > 0 and h > 0:
-                    feat[3 * k:3 * k + 3] = ((x - u) / w, (y - vv) / h, c)
+            v = np.array([float(x) for x in row], dtype=np.float64)
             # `gfctl render-gestures` adds a `segment` column: a window never spans the frames in which the
             # pipeline lost the worker (as its FIFO and `gfctl classify` restart), so each segment is a sequence.
             key = int(row[idx["sequence"]]) if "segment" not in idx else (int(row[idx["sequence"]]), int(row[idx["segment"]]))
-            seqs.setdefault(key, []).append((feat, int(row[idx["label"]]), v[idx["t"]]))
-    out = {}
-    for sid, frames in seqs.items():
-        out[sid] = (np.stack([f[0] for f in frames]), np.array([f[1] for f in frames]), np.array([f[2] for f in frames]))
-    return out
+            seqs.setdefault(key, []).append((v[cols].reshape(17, 3), v[box], int(row[idx["label"]]), v[idx["t"]]))
+    return {sid: (np.stack([f[0] for f in fr]), np.stack([f[1] for f in fr]), np.array([f[2] for f in fr]),
+                  np.array([f[3] for f in fr])) for sid, fr in seqs.items()}
+
+
+def features(keypoints, box):
+    """Box-normalised features [T, 51] float32 of raw keypoints [T, 17, 3] and boxes [T, 4] (as
+    gesture::boxNormalizedFeatures: a keypoint with c <= 0, or a degenerate box, gives (0, 0, 0))."""
+    u, v, w, h = (box[:, i:i + 1] for i in range(4))
+    c = keypoints[:, :, 2]
+    present = (c > 0) & (w > 0) & (h > 0)
+    x = np.where(present, (keypoints[:, :, 0] - u) / np.where(w > 0, w, 1), 0.0)
+    y = np.where(present, (keypoints[:, :, 1] - v) / np.where(h > 0, h, 1), 0.0)
+    return np.stack([x, y, np.where(present, c, 0.0)], axis=2).reshape(len(keypoints), N_FEATURES).astype(np.float32)
+
+
+def load_frames(data_dir, filename="skeletons.csv"):
+    """Returns dict sequence (or (sequence, segment)) -> (features [T, 51] float32, labels [T] int, t [T])."""
+    return {sid: (features(kp, box), lab, t) for sid, (kp, box, lab, t) in load_raw(data_dir, filename).items()}
+
+
+def load_motions(data_dir, filename="sequences.csv"):
+    """sequence -> motion name (sequences.csv of synth-gestures / render-gestures)."""
+    with open(os.path.join(data_dir, filename)) as f:
+        return {int(r["sequence"]): r["motion"] for r in csv.DictReader(f)}
 
 
 def windows(seqs):

@@ -85,14 +85,36 @@ def vote_and_3d(fused_csv, meta, gap):
     return out
 
 
-def evaluate(gfctl, protocol, name, data, model, config, tag="shipped"):
-    """classify per view -> fuse-views -> gesture-filter on a rendered set; the figures of protocol v2."""
+def with_labels(view_csv):
+    """A copy of a classified view (classify_view's CSV) whose gesture_id is each frame's label: the classifier
+    replaced by the truth, to measure what the vote, the 3-D check and the filter leave of perfect readings."""
+    vdir = os.path.dirname(view_csv)
+    header, rows = ev.read_csv(os.path.join(vdir, "laid_out.csv"))
+    it, il = header.index("t"), header.index("label")
+    label = {round(float(r[it]), 6): r[il] for r in rows}
+    header, rows = ev.read_csv(view_csv)
+    ig = header.index("gesture_id")
+    out = os.path.join(vdir, "gestures_geometry_labels.csv")
+    with open(out, "w") as f:
+        f.write(",".join(header) + "\n")
+        for r in rows:
+            r = list(r)
+            r[ig] = label[round(float(r[0]), 6)]
+            f.write(",".join(r) + "\n")
+    return out
+
+
+def evaluate(gfctl, protocol, name, data, model, config, tag="shipped", labels_as_classifier=False):
+    """classify per view -> fuse-views -> gesture-filter on a rendered set; the figures of protocol v2.
+    labels_as_classifier: every view's classifications replaced by the frames' labels (a diagnostic)."""
     spec = protocol["sets"][name]
     d = set_dir(data, name, spec)
     fps, gap = protocol["fps"], protocol["sequence_gap_s"]
     he.set_paths(he.PROTOCOL, config)
     _, keys, meta = ev.laid_out(d, fps)
     views = [ev.classify_view(gfctl, model, d, sfx, fps, d) for sfx in VIEW_SUFFIXES(spec)]
+    if labels_as_classifier:
+        views = [with_labels(v) for v in views]
     # window accuracy of the leader's view (label = the newest frame's)
     laid, keys, _ = ev.laid_out(os.path.join(d, "view"), fps)
     _, res = ev.classify(gfctl, model, laid, keys, fps, os.path.join(d, "view"))
@@ -116,8 +138,9 @@ def evaluate(gfctl, protocol, name, data, model, config, tag="shipped"):
             e[0] += int(not any(x["sequence"] == seq for x in three["missed_list"]))
     found = {sfx or "_leader": sum(int(r["frames_found"]) for r in csv_rows(os.path.join(d, f"sequences{sfx}.csv"))) /
              sum(int(r["frames"]) for r in csv_rows(os.path.join(d, f"sequences{sfx}.csv"))) for sfx in VIEW_SUFFIXES(spec)}
-    return {"set": name, "seed": spec["seed"], "sequences": spec["count"], "model": os.path.relpath(model, ROOT),
-            "model_sha256": he.sha256(model), "config": os.path.relpath(config, ROOT), "config_sha256": he.sha256(config),
+    return {"set": name, "seed": spec["seed"], "sequences": spec["count"],
+            "model": "the frames' labels (diagnostic)" if labels_as_classifier else os.path.relpath(model, ROOT),
+            "model_sha256": "n/a" if labels_as_classifier else he.sha256(model), "config": os.path.relpath(config, ROOT), "config_sha256": he.sha256(config),
             "worker_found_share": {k: round(v, 4) for k, v in found.items()},
             "leader_window_accuracy": round(float(np.trace(m) / m.sum()), 4) if m.sum() else None,
             "leader_per_class": ev.per_class(m), "leader_confusion": m.tolist(),
@@ -415,7 +438,41 @@ def eval_lines(r, protocol):
     return lines
 
 
-def report(protocol, protocol_path, tuning_errors, tuning_eval, heldout_eval, out, load_start):
+def v1_lines(runs):
+    """Protocol version 1 (tools/gesture/heldout_eval.py JSONs, each with a `label`) beside the targets: a model's
+    figures on the generator's own skeletons, which a candidate trained on the networks' errors must keep."""
+    lines = ["| run | protocol (seeds) | model sha256 | one camera: accuracy | work windows read as a gesture | "
+             "three cameras: false adaptations (minutes) | gestures fired | mean (max) latency | targets |", "|---|---|---|---|---|---|---|---|---|"]
+    for r in runs:
+        s = r["single_camera"]
+        for mode, m in r["three_cameras"].items():
+            w, g = m["work"]["three_cameras"], m["gestures"]["three_cameras"]
+            met = all(all(v.values()) for v in r["meets_target"].values())
+            run = r.get("label", "") + (f", rearm {mode}" if len(r["three_cameras"]) > 1 else "")
+            lines.append(f"| {run} | `{r['protocol']}` ({r['single_camera']['seed']}, …) | {r['model_sha256'][:16]}… | "
+                         f"{s['accuracy']:.4f} | {s['work_share_read_as_gesture']:.4f} ({s['work_windows_read_as_gesture']} of "
+                         f"{s['work_windows']}) | {w['false_adaptations']} ({w['work_minutes']}) | {g['fired']}/{g['gestures']} | "
+                         f"{g['mean_latency_s']} s ({g['max_latency_s']}) | {'all met' if met else '**not all met**'} |")
+    return lines
+
+
+def training_lines(trained):
+    """The candidate models' training (tools/train_gesture_lstm.py's training.json, next to each model's ONNX)."""
+    lines = []
+    for label, path in trained:
+        tr = json.load(open(path))
+        onnx = os.path.join(os.path.dirname(path), "gesture_lstm.onnx")
+        em, rd = tr.get("error_model"), tr.get("rendered")
+        lines.append(f"- {label}: sha256 {he.sha256(onnx)}; `{tr['command']}` — from {tr.get('init_onnx') or 'a random start'}, "
+                     f"{tr['epochs']} epochs, {tr['train']['windows']} training windows"
+                     + (f", error model {em['file']} (seed {em['seed']}, {em['sequences_changed']} sequences changed)" if em else "")
+                     + (f", rendered {', '.join(s['dir'] + '/' + s['file'] for s in rd['sets'])} × {rd['repeat']}" if rd else "")
+                     + f"; validation accuracy {tr['validation']['accuracy']:.4f}; {tr['seconds']} s (torch {tr['torch']}, "
+                     f"{tr.get('threads', 2)} thread(s), shared machine).")
+    return lines
+
+
+def report(protocol, protocol_path, tuning_errors, tuning_eval, heldout_eval, out, load_start, v1_runs=(), trained=()):
     lines = ["# Gestures on rendered frames through the real networks (protocol version 2)", "",
              f"Written by `tools/gesture/rendered_eval.py report` on "
              f"{datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC, commit {he.git('rev-parse', '--short', 'HEAD')}"
@@ -433,6 +490,8 @@ def report(protocol, protocol_path, tuning_errors, tuning_eval, heldout_eval, ou
                 text = [ln.strip() for ln in f if ln.startswith("#") or ln.startswith("gfctl render-gestures")]
             lines.append(f"Render of {name} (its log): " + " / ".join(t.lstrip("# ") for t in text) + ".")
     lines.append("")
+    if trained:
+        lines += ["## Candidate models (not shipped unless third_party_models/gesture_lstm says so)", ""] + training_lines(trained) + [""]
     if tuning_errors:
         lines += ["## Tuning set: the networks' systematic errors against the renderer's truth", "",
                   "Frames at the motion's pose (gestures: labelled frames; work motions: the middle half of the motion). "
@@ -447,11 +506,16 @@ def report(protocol, protocol_path, tuning_errors, tuning_eval, heldout_eval, ou
     for r in heldout_eval:
         lines += [f"## Held-out set through the chain: {r.get('label', '')} (run once; nothing chosen on it)", ""] + \
                  eval_lines(r, protocol) + [""]
+    if v1_runs:
+        lines += ["## Protocol version 1 with the same models (the generator's own skeletons)", "",
+                  "`tools/gesture/heldout_eval.py` runs (their own JSONs give every figure): a model trained on the networks' "
+                  "errors must keep version 1's targets (one camera: accuracy ≥ 0.95, ≤ 2 % of work windows read as a "
+                  "gesture; three cameras: 0 false adaptations, ≥ 95 % fired, mean latency ≤ 2.5 s).", ""] + v1_lines(v1_runs) + [""]
     with open(out, "w") as f:
         f.write("\n".join(lines))
     with open(os.path.splitext(out)[0] + ".json", "w") as f:
         json.dump({"protocol_version": protocol["version"], "tuning_errors": tuning_errors, "tuning_eval": tuning_eval,
-                   "heldout_eval": heldout_eval}, f, indent=1)
+                   "heldout_eval": heldout_eval, "protocol_v1": list(v1_runs)}, f, indent=1)
 
 
 def set_data_dir(path):
@@ -465,6 +529,9 @@ def main():
     ap.add_argument("--tuning-errors", default=None, help="report: the errors JSON of the tuning set")
     ap.add_argument("--tuning-eval", default=None, help="report: evaluate JSONs of the tuning set, comma-separated")
     ap.add_argument("--heldout-eval", default=None, help="report: evaluate JSONs of the held-out set, comma-separated")
+    ap.add_argument("--v1", default=None, help="report: protocol version 1 JSONs (heldout_eval.py) of the same models, "
+                    "comma-separated, each as LABEL=PATH")
+    ap.add_argument("--trained", default=None, help="report: candidate models' training.json, comma-separated, each as LABEL=PATH")
     ap.add_argument("--label", default="", help="evaluate: what this run is (model / rule), written into its JSON")
     ap.add_argument("--gfctl")
     ap.add_argument("--set", default=None)
@@ -474,6 +541,9 @@ def main():
     ap.add_argument("--model", default=he.MODEL)
     ap.add_argument("--config", default=he.GESTURES_YAML)
     ap.add_argument("--out", default=None)
+    ap.add_argument("--labels-as-classifier", action="store_true",
+                    help="evaluate: replace every view's classifications by the frames' labels (what the vote, the 3-D "
+                         "check and the filter leave of perfect readings; the leader's window figures stay the model's)")
     a = ap.parse_args()
     protocol = load_protocol(a.protocol)
     set_data_dir(a.data)
@@ -481,7 +551,20 @@ def main():
         load = lambda p: json.load(open(p)) if p else None  # noqa: E731
         loads = lambda ps: [load(p) for p in ps.split(",")] if ps else []  # noqa: E731
         out = a.out or os.path.join(ROOT, "docs/results/gestures_rendered.md")
-        report(protocol, a.protocol, load(a.tuning_errors), loads(a.tuning_eval), loads(a.heldout_eval), out, os.getloadavg())
+        v1 = []
+        for item in (a.v1.split(",") if a.v1 else []):
+            label, _, path = item.rpartition("=")
+            if not label:
+                ap.error(f"--v1 {item}: expected LABEL=PATH")
+            v1.append(dict(load(path), label=label))
+        trained = []
+        for item in (a.trained.split(",") if a.trained else []):
+            label, _, path = item.rpartition("=")
+            if not label:
+                ap.error(f"--trained {item}: expected LABEL=PATH")
+            trained.append((label, path))
+        report(protocol, a.protocol, load(a.tuning_errors), loads(a.tuning_eval), loads(a.heldout_eval), out, os.getloadavg(),
+               v1, trained)
         print(f"wrote {out}")
         return
     if not a.set:
@@ -495,7 +578,8 @@ def main():
             with open(a.out, "w") as f:
                 json.dump(r, f, indent=1)
     else:
-        r = evaluate(a.gfctl, protocol, a.set, a.data, a.model, os.path.abspath(a.config))
+        r = evaluate(a.gfctl, protocol, a.set, a.data, a.model, os.path.abspath(a.config),
+                     tag="labels" if a.labels_as_classifier else "shipped", labels_as_classifier=a.labels_as_classifier)
         r["label"] = a.label
         r["commit"] = he.git("rev-parse", "--short", "HEAD")
         r["date_utc"] = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M")

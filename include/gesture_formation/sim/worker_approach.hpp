@@ -37,6 +37,13 @@ const common::FieldTable<WorkerApproach>& workerApproachFields();
 /// empty. Problems recorded in `r`, each naming its key.
 void readWorkerApproach(common::ConfigReader& r, const std::string& key, std::optional<WorkerApproach>& out);
 
+class WorkerModel;
+
+/// \brief The approach itself, at its time: `worker` leaves his route at t_s and walks on the ground
+/// towards the point below `uav_p_world` (where UAV `approach.uav` is then), stopping
+/// `approach.stop_m` short of it (horizontally). Shared by gfctl simulate and the ROS SimWorld.
+void divertTowards(WorkerModel& worker, double t_s, const WorkerApproach& approach, const Eigen::Vector3d& uav_p_world);
+
 /// \brief One UAV's figures of the unseen approach.
 struct UavApproachRecord {
   double min_distance_m = std::numeric_limits<double>::infinity();  ///< least true distance to the worker [m]

@@ -13,6 +13,8 @@
 
 #include "gesture_formation/sim/mission_metrics.hpp"
 #include "gesture_formation/sim/multirotor.hpp"
+#include "gesture_formation/sim/worker_approach.hpp"
+#include "gesture_formation/sim/worker_model.hpp"
 
 namespace gesture_formation::sim {
 
@@ -69,8 +71,11 @@ class WorldRecord {
   /// \brief A gesture the leader's filter fired at t_s (dominant id `gesture_id`), recorded and
   /// resolved like a request.
   void gestureFired(double t_s, int gesture_id, const gesture::GestureMapping& mapping);
-  /// \brief Safety at t_s from every UAV's true state: false (nothing sampled) while some UAV has
-  /// not reported one yet.
+  /// \brief faults.worker_approach at its time (once, when UAV `uav`'s truth is known): the worker
+  /// turns towards that UAV (divertTowards); its unseen phase is then recorded with the safety.
+  void divertWorker(double t_s, WorkerModel& worker, const std::vector<std::optional<MultirotorState>>& truths);
+  /// \brief Safety at t_s from every UAV's true state (and the approach's figures): false (nothing
+  /// sampled) while some UAV has not reported one yet.
   bool sampleSafety(double t_s, const std::vector<std::optional<MultirotorState>>& truths, const WorkerState& worker);
 
   MetricsAccumulator& metrics() { return metrics_; }
@@ -98,6 +103,8 @@ class WorldRecord {
   std::vector<std::string> plan_mode_;  ///< per UAV: the mode of its last plan
   std::vector<ModeChange> modes_;       ///< every planner mode change
   std::string last_outcome_key_;        ///< the last (command, status) counted
+  const MissionConfig& config_;
+  std::optional<ApproachRecorder> approach_;  ///< faults.worker_approach, once the worker turned
 };
 
 }  // namespace gesture_formation::sim

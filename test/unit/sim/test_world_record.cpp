@@ -168,3 +168,37 @@ TEST(WorldRecordTest, OperatorRequestsAreDueOnceEachAndPendingUntilTheirOutcome)
   const std::string events = readFile(dir + "/events.csv");
   EXPECT_NE(events.find("lost"), std::string::npos) << events;  // no outcome came
 }
+
+// faults.worker_approach in the ROS world: at its time (once the target UAV's truth is known) the
+// worker turns towards the point below that UAV; the unseen phase is recorded in metrics.json.
+TEST(WorldRecordTest, TheWorkerApproachTurnsTheWorkerTowardsTheUavAndIsRecorded) {
+  Fixture fx;
+  fx.cfg.faults.worker_approach = gf::sim::WorkerApproach{1.0, 1, 1.2, 0.0};
+  fx.cfg.faults.camera_blackouts = {{0.5, 100.0}};
+  WorldRecord r(fx.cfg, fx.obstacles(), 1);
+  gf::sim::WorkerModel worker(fx.cfg.worker, 7);
+  gf::sim::WorkerModel untouched(fx.cfg.worker, 7);
+  std::vector<std::optional<gf::sim::MultirotorState>> truths(3);
+  r.divertWorker(1.0, worker, truths);  // UAV 1's truth not known yet: nothing happens
+  r.divertWorker(0.9, worker, truths);
+  for (int i = 0; i < 3; ++i) {
+    truths[static_cast<std::size_t>(i)] = gf::sim::MultirotorState{};
+    truths[static_cast<std::size_t>(i)]->p_world = Eigen::Vector3d(-30.0 + 10.0 * i, 25.0, 6.0);
+  }
+  r.divertWorker(0.9, worker, truths);  // before its time
+  EXPECT_TRUE((worker.stateAt(6.0).feet_world - untouched.stateAt(6.0).feet_world).norm() < 1e-9);
+  r.divertWorker(1.0, worker, truths);
+  const Eigen::Vector3d start = worker.stateAt(1.0).feet_world;
+  const Eigen::Vector3d later = worker.stateAt(6.0).feet_world;
+  const Eigen::Vector2d towards = (truths[1]->p_world.head<2>() - start.head<2>()).normalized();
+  EXPECT_NEAR((later - start).head<2>().dot(towards), 1.2 * 5.0, 0.05) << "walks 1.2 m/s towards UAV 1";
+  gf::sim::WorkerState ws;
+  ws.p_world = later + Eigen::Vector3d(0, 0, 0.9);
+  ASSERT_TRUE(r.sampleSafety(6.0, truths, ws));
+  const std::string dir = ::testing::TempDir() + "/world_record_approach";
+  std::filesystem::create_directories(dir);
+  std::string error, warning;
+  ASSERT_TRUE(r.finish({}, 6.0, 1.0, dir, &error, &warning)) << error;
+  const std::string metrics = readFile(dir + "/metrics.json");
+  EXPECT_NE(metrics.find("\"worker_approach\""), std::string::npos);
+}
