@@ -54,7 +54,9 @@ LiveMap::LiveMap(const MappingConfig& config, std::shared_ptr<planning::Occupanc
       map_(std::move(map)),
       field_(std::move(field)),
       prior_(std::move(prior)),
+      seen_(std::make_shared<planning::SeenSpace>(*map_, config.seen)),
       tree_(std::make_unique<octomap::OcTree>(map_->resolution())) {
+  if (prior_) seen_->markOccupied(*prior_);  // surveyed geometry
   tree_->setProbHit(config_.prob_hit);
   tree_->setProbMiss(config_.prob_miss);
   tree_->setClampingThresMin(config_.clamping_min);
@@ -194,6 +196,8 @@ common::Result<FrameUpdate> LiveMap::integrate(const DepthFrame& frame) {
   const std::vector<planning::VoxelChange> changes = fusedChanges(out.observed_changes);
   std::unique_lock<std::shared_mutex> lock(mutex_);
   const std::vector<planning::VoxelIndex> changed = map_->setOccupancy(changes);
+  for (const auto& cell : free_cells_) seen_->markLinear(static_cast<std::size_t>(cell.second));  // castRays' cells
+  for (const auto& cell : occupied_cells_) seen_->markLinear(static_cast<std::size_t>(cell.second));
   out.map_changes = static_cast<int>(changed.size());
   out.map_ms = msSince(t2);
 

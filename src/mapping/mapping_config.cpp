@@ -17,6 +17,8 @@ const common::FieldTable<MappingConfig>& mappingConfigFields() {
       {"octomap.clamping_min", Range{0.0, 0.5, false, false}, [](C& c) { return &c.clamping_min; }},
       {"octomap.clamping_max", Range{0.5, 1.0, false, false}, [](C& c) { return &c.clamping_max; }},
       {"field.range_m", Range::positive(), [](C& c) { return &c.field_range_m; }},
+      {"seen.margin_m", Range::positive(), [](C& c) { return &c.seen.margin_m; }},
+      {"seen.horizon_s", Range::positive(), [](C& c) { return &c.seen.horizon_s; }},
   }};
   return t;
 }

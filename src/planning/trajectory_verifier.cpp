@@ -134,8 +134,40 @@ std::vector<Eigen::Vector3d> keptBrakeEnvelope(const PlannedTrajectory& other, i
   return {};
 }
 
-TrajectoryVerifier::TrajectoryVerifier(const OccupancyMap& map, const DistanceField& field, const PlannerConfig& config)
-    : map_(map), field_(field), config_(config), fcl_(map) {}
+TrajectoryVerifier::TrajectoryVerifier(const OccupancyMap& map, const DistanceField& field, const PlannerConfig& config,
+                                       const SeenSpace* seen)
+    : map_(map), field_(field), config_(config), fcl_(map), seen_(seen) {}
+
+std::string TrajectoryVerifier::seenViolation(const PlannedTrajectory& tr) const {
+  // From every point within the horizon (samples and substeps), the straight braking path to
+  // brakeStop() must run through observed space (seen_space.hpp); the plan's start is exempt
+  // within the margin (the UAV is there).
+  const Eigen::Vector3d start = tr.samples.front().p_world;
+  const double step = 0.5 * seen_->resolution();
+  const int sub = config_.verify_substeps;
+  const int intervals = static_cast<int>(tr.samples.size()) - 1;
+  for (int k = 0; k < intervals; ++k) {
+    for (int q = (k == 0 ? 0 : 1); q <= sub; ++q) {
+      const double tau = (k + static_cast<double>(q) / sub) * tr.dt_s;
+      if (tau > seen_->rule().horizon_s + 1e-9) return {};
+      const TrajectoryPoint x = evaluateTrajectory(tr, tr.t0_s + tau);
+      const Eigen::Vector3d stop = brakeStop(x.p, x.v, config_.limits, tr.dt_s);
+      const double length = (stop - x.p).norm();
+      const int n = std::max(1, static_cast<int>(std::ceil(length / step)));
+      for (int i = 0; i <= n; ++i) {
+        const Eigen::Vector3d p = x.p + (stop - x.p) * (static_cast<double>(i) / n);
+        const auto unseen = seen_->unseenNear(p, start);
+        if (!unseen) continue;
+        std::ostringstream os;
+        os.precision(4);
+        os << "verify: braking from t=" << tr.t0_s + tau << " passes (" << p.transpose() << "), within "
+           << seen_->rule().margin_m << " m of the unobserved voxel (" << unseen->transpose() << ")";
+        return os.str();
+      }
+    }
+  }
+  return {};
+}
 
 TrajectoryVerifier::~TrajectoryVerifier() = default;
 
@@ -265,6 +297,10 @@ VerificationReport TrajectoryVerifier::verify(const PlannedTrajectory& tr, doubl
         }
       }
     }
+  }
+  if (seen_ != nullptr) {
+    const std::string unseen = seenViolation(tr);
+    if (!unseen.empty()) return fail(unseen);
   }
   rep.ok = true;
   return rep;

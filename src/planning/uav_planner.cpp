@@ -118,8 +118,8 @@ std::string checkRequest(const PlanRequest& r) {
 // ---- construction -------------------------------------------------------------------------
 
 UavPlanner::UavPlanner(const PlannerConfig& config, std::shared_ptr<const OccupancyMap> map,
-                       std::shared_ptr<const DistanceField> field)
-    : config_(config), map_(std::move(map)), field_(std::move(field)) {
+                       std::shared_ptr<const DistanceField> field, std::shared_ptr<const SeenSpace> seen)
+    : config_(config), map_(std::move(map)), field_(std::move(field)), seen_(std::move(seen)) {
   auto errors = config_.validate();
   if (!map_ || !field_) errors.push_back("map and distance field must be given");
   config_error_ = joinErrors(errors);
@@ -134,7 +134,7 @@ UavPlanner::UavPlanner(const PlannerConfig& config, std::shared_ptr<const Occupa
   corridors_ = std::make_unique<CorridorBuilder>(cc);
   qp_ = std::make_unique<TrajectoryQp>();
   if (map_ && field_) {
-    verifier_ = std::make_unique<TrajectoryVerifier>(*map_, *field_, config_);
+    verifier_ = std::make_unique<TrajectoryVerifier>(*map_, *field_, config_, seen_.get());
     search_ = std::make_unique<GridPathSearch>(*map_, *field_);
   }
 }

@@ -729,7 +729,7 @@ void MissionRun::replan(int i, double t) {
   // A back-off from the worker's reach begins (or finds no goal): a row of the same mode with its reason.
   if (out.backoff_started) modes_.push_back(ModeChange{t, i, u.mode, out.backoff});
   const planning::PlanResult& res = out.result;
-  if (world_.site != nullptr) world_.site->planned(i, t, res);  // sight-to-avoidance (site_mapping.hpp)
+  if (world_.site != nullptr) world_.site->planned(i, t, res, out.reference, cfg_.replan.dt_s);  // site_mapping.hpp
   metrics_.plan(i, t, version, res.status, res.timings.total_ms, res.reason, res.qp_sparse_timeouts);
   if (res.trajectory.empty()) {
     u.ctl.clearPlan();

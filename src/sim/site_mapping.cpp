@@ -114,6 +114,13 @@ common::Result<std::unique_ptr<SiteMapping>> SiteMapping::create(const MissionCo
       s->next_frame_s_.push_back(static_cast<double>(i) / (static_cast<double>(n) * mission.mapping.rate_hz));
     }
   }
+  s->travel_target_.assign(n, Eigen::Vector3d::Constant(kNaN));
+  s->travel_dir_.assign(n, {kNaN, kNaN});
+  if (mission.mapping.travel_camera_hfov_deg > 0.0) {
+    estimation::CameraIntrinsics& c = s->travel_intrinsics_;
+    c = estimation::CameraIntrinsics{};  // 640 × 480, centred, square pixels, no distortion
+    c.fx = c.fy = 0.5 * c.width_px / std::tan(0.5 * mission.mapping.travel_camera_hfov_deg * M_PI / 180.0);
+  }
   s->surfaceVoxels(grid);
   const std::size_t m = s->unmapped_.size();
   s->seen_s_.assign(n, std::vector<double>(m, kNaN));
@@ -143,13 +150,16 @@ PlannerFactory SiteMapping::plannerFactory(const planning::PlannerConfig& config
   if (live_.empty()) return uavPlannerFactory(config, std::move(prior_map), std::move(prior_field));
   std::vector<std::shared_ptr<const planning::OccupancyMap>> maps;
   std::vector<std::shared_ptr<const planning::DistanceField>> fields;
+  std::vector<std::shared_ptr<const planning::SeenSpace>> seen;
   for (const auto& l : live_) {
     maps.push_back(l->map());
     fields.push_back(l->field());
+    seen.push_back(l->seen());
   }
-  return [config, maps, fields](int i) -> std::unique_ptr<MissionPlanner> {
+  return [config, maps, fields, seen](int i) -> std::unique_ptr<MissionPlanner> {
     const auto u = static_cast<std::size_t>(i);
-    return std::make_unique<planning::UavPlannerAdapter>(std::make_unique<planning::UavPlanner>(config, maps.at(u), fields.at(u)));
+    return std::make_unique<planning::UavPlannerAdapter>(
+        std::make_unique<planning::UavPlanner>(config, maps.at(u), fields.at(u), seen.at(u)));
   };
 }
 
@@ -178,19 +188,40 @@ void SiteMapping::step(double t_s, const std::vector<MultirotorState>& uavs) {
 }
 
 void SiteMapping::depthFrame(int uav, double t_s, const MultirotorState& state) {
+  integrateFrame(uav, t_s, opticalPoseFromHeadingPitch(state.p_world, state.heading_rad, state.pitch_rad), intrinsics_);
+  if (config_.travel_camera_hfov_deg > 0.0) {
+    const auto [heading, pitch] = travelDirection(uav, state);
+    integrateFrame(uav, t_s, opticalPoseFromHeadingPitch(state.p_world, heading, pitch), travel_intrinsics_);
+  }
+  recordSightings(uav, t_s, state.p_world);
+}
+
+void SiteMapping::integrateFrame(int uav, double t_s, const Eigen::Isometry3d& T_world_camera,
+                                 const estimation::CameraIntrinsics& intrinsics) {
   planning::PrimitiveSet now;
   for (const UnmappedObstacle& o : unmapped_) now.append(o.primitivesAt(t_s));
   mapping::DepthFrame frame;
-  frame.T_world_camera = opticalPoseFromHeadingPitch(state.p_world, state.heading_rad, state.pitch_rad);
-  frame.intrinsics = mapping::PinholeIntrinsics{intrinsics_.fx, intrinsics_.fy, intrinsics_.cx, intrinsics_.cy};
+  frame.T_world_camera = T_world_camera;
+  frame.intrinsics = mapping::PinholeIntrinsics{intrinsics.fx, intrinsics.fy, intrinsics.cx, intrinsics.cy};
   const auto t0 = std::chrono::steady_clock::now();
-  frame.depth_m = raycaster_.render(intrinsics_, frame.T_world_camera, config_.live.pixel_stride, config_.camera_range_m, now);
+  frame.depth_m = raycaster_.render(intrinsics, frame.T_world_camera, config_.live.pixel_stride, config_.camera_range_m, now);
   depth_ms_.push_back(msSince(t0));
   const auto t1 = std::chrono::steady_clock::now();
-  const auto update = live_[static_cast<std::size_t>(uav)]->integrate(frame);
+  live_[static_cast<std::size_t>(uav)]->integrate(frame);  // a bad frame changes nothing (cannot happen: finite pose)
   integrate_ms_.push_back(msSince(t1));
-  if (!update) return;  // a bad frame changes nothing (cannot happen with a finite pose)
-  recordSightings(uav, t_s, state.p_world);
+}
+
+std::pair<double, double> SiteMapping::travelDirection(int uav, const MultirotorState& state) {
+  const auto u = static_cast<std::size_t>(uav);
+  Eigen::Vector3d d = travel_target_[u] - state.p_world;
+  if (!d.allFinite() || d.norm() < 0.3) d = state.v_world;
+  if (d.allFinite() && d.norm() >= 0.3) {
+    const double pitch_limit = 1.2;  // rad (69°): a camera looking straight down sees no route
+    travel_dir_[u] = {std::atan2(d.y(), d.x()), std::clamp(std::atan2(d.z(), d.head<2>().norm()), -pitch_limit, pitch_limit)};
+  } else if (!std::isfinite(travel_dir_[u].first)) {
+    travel_dir_[u] = {state.heading_rad, 0.0};
+  }
+  return travel_dir_[u];
 }
 
 void SiteMapping::recordSightings(int uav, double t_s, const Eigen::Vector3d& p_world) {
@@ -214,9 +245,15 @@ void SiteMapping::recordSightings(int uav, double t_s, const Eigen::Vector3d& p_
   }
 }
 
-void SiteMapping::planned(int uav, double t_s, const planning::PlanResult& result) {
-  if (uav < 0 || uav >= n_ || !result.verified || result.trajectory.empty()) return;
+void SiteMapping::planned(int uav, double t_s, const planning::PlanResult& result, const formation::ReferenceTrajectory& reference,
+                          double reference_dt_s) {
+  if (uav < 0 || uav >= n_) return;
   const auto u = static_cast<std::size_t>(uav);
+  if (reference.steps() > 0 && reference_dt_s > 0.0) {
+    const int k = std::min(reference.steps() - 1, static_cast<int>(std::lround(config_.travel_lookahead_s / reference_dt_s)));
+    travel_target_[u] = reference.p_world.col(k);
+  }
+  if (!result.verified || result.trajectory.empty()) return;
   const planning::PlannedTrajectory& plan = result.trajectory;
   for (std::size_t j = 0; j < unmapped_.size(); ++j) {
     if (std::isnan(seen_s_[u][j]) || !std::isnan(avoided_s_[u][j])) continue;

@@ -11,6 +11,8 @@ const common::FieldTable<SiteMappingConfig>& siteMappingConfigFields() {
   static const common::FieldTable<C> t{{
       {"rate_hz", Range::openClosed(0.0, 30.0), [](C& c) { return &c.rate_hz; }},
       {"camera_range_m", Range::closed(1.0, 100.0), [](C& c) { return &c.camera_range_m; }},
+      {"travel_camera_hfov_deg", Range::closed(0.0, 120.0), [](C& c) { return &c.travel_camera_hfov_deg; }},
+      {"travel_lookahead_s", Range::openClosed(0.0, 10.0), [](C& c) { return &c.travel_lookahead_s; }},
   }};
   return t;
 }

@@ -39,6 +39,7 @@
 #include "gesture_formation/planning/distance_field.hpp"
 #include "gesture_formation/planning/occupancy_map.hpp"
 #include "gesture_formation/planning/scenario.hpp"
+#include "gesture_formation/planning/seen_space.hpp"
 
 
 namespace gesture_formation::mapping {
@@ -82,6 +83,9 @@ class LiveMap {
   std::shared_ptr<const planning::OccupancyMap> map() const { return map_; }
   /// \brief The planner's distance field over map(), truncated at config().field_range_m.
   std::shared_ptr<const planning::DistanceField> field() const { return field_; }
+  /// \brief The space observed so far (every voxel a ray crossed or ended in, and the prior's
+  /// occupied voxels), for the planners' seen-space rule (planning/seen_space.hpp).
+  std::shared_ptr<const planning::SeenSpace> seen() const { return seen_; }
   /// \brief A shared lock on the map and field: hold it while planning on another thread.
   std::shared_lock<std::shared_mutex> readLock() const { return std::shared_lock<std::shared_mutex>(mutex_); }
 
@@ -113,6 +117,7 @@ class LiveMap {
   std::shared_ptr<planning::OccupancyMap> map_;
   std::shared_ptr<planning::DistanceField> field_;
   std::shared_ptr<const planning::OccupancyMap> prior_;
+  std::shared_ptr<planning::SeenSpace> seen_;
   std::unique_ptr<octomap::OcTree> tree_;
   octomap::KeyRay keyray_;  ///< castRays' scratch
   std::vector<std::pair<octomap::OcTreeKey, std::ptrdiff_t>> free_cells_, occupied_cells_;  ///< castRays' scratch

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "gesture_formation/common/config_reader.hpp"
+#include "gesture_formation/planning/seen_space.hpp"
 
 namespace gesture_formation::common {
 template <class Config>
@@ -44,6 +45,9 @@ struct MappingConfig {
   /// 2.5 m with config/planner.yaml; an abort goal's goal_clearance_m, 3 m): a larger clearance
   /// is never found. The update's cost grows with range³.
   double field_range_m = 3.5;
+  /// The seen-space rule the planners on this live map verify (planning/seen_space.hpp):
+  /// `seen.margin_m` (> 0, default 0.3) and `seen.horizon_s` (> 0, default 1.0).
+  planning::SeenRule seen;
 
   /// \brief Every problem, each "<prefix><key> must be ..., got v"; empty when valid.
   std::vector<std::string> validate(const std::string& prefix = "") const;
@@ -51,7 +55,7 @@ struct MappingConfig {
 
 /// \brief MappingConfig's numbers with their ranges (keys `depth.pixel_stride`,
 /// `depth.min_range_m`, `depth.max_range_m`, `octomap.prob_hit`, `octomap.prob_miss`,
-/// `octomap.clamping_min`, `octomap.clamping_max`, `field.range_m`).
+/// `octomap.clamping_min`, `octomap.clamping_max`, `field.range_m`, `seen.margin_m`, `seen.horizon_s`).
 const common::FieldTable<MappingConfig>& mappingConfigFields();
 
 /// \brief Reads a MappingConfig under `prefix` (missing keys per the reader's mode); every

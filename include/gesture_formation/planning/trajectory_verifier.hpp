@@ -14,7 +14,9 @@
 ///     every other plan at the same time, and ≥ Γ_dis
 ///     to the braking envelope (keptBrakeEnvelope()) of every other plan older than
 ///     brake_envelope_age_s and of every lower-priority UAV's plan (brake_envelope_lead_s);
-///   - distance ≥ worker_safety_distance_m to the worker's predicted position.
+///   - distance ≥ worker_safety_distance_m to the worker's predicted position;
+///   - given a SeenSpace (online mapping): the seen-space rule (seen_space.hpp) — from every point
+///     within SeenRule::horizon_s of the start, the braking path runs through observed space.
 /// On the first interval [t0, t0+dt], which starts from the measured state, a limit the state
 /// itself already violates only has to not get worse (min(limit, value at t0)); a separation
 /// from another plan, its braking envelope or the worker that the start violates must recover at
@@ -30,6 +32,7 @@
 #include "gesture_formation/planning/distance_field.hpp"
 #include "gesture_formation/planning/occupancy_map.hpp"
 #include "gesture_formation/planning/planner_config.hpp"
+#include "gesture_formation/planning/seen_space.hpp"
 #include "gesture_formation/planning/shapes.hpp"  // closestPointOnSegment, distanceToPolyline
 #include "gesture_formation/planning/uav_planner.hpp"
 
@@ -99,7 +102,9 @@ struct VerificationReport {
 
 class TrajectoryVerifier {
  public:
-  TrajectoryVerifier(const OccupancyMap& map, const DistanceField& field, const PlannerConfig& config);
+  /// \brief `seen` (may be null: no seen-space rule) must outlive the verifier.
+  TrajectoryVerifier(const OccupancyMap& map, const DistanceField& field, const PlannerConfig& config,
+                     const SeenSpace* seen = nullptr);
   ~TrajectoryVerifier();
   TrajectoryVerifier(const TrajectoryVerifier&) = delete;
   TrajectoryVerifier& operator=(const TrajectoryVerifier&) = delete;
@@ -110,10 +115,14 @@ class TrajectoryVerifier {
                             const formation::WorkerHorizon& worker, double worker_t0_s, double worker_dt_s) const;
 
  private:
+  /// The seen-space rule: empty when it holds, else the first violation (time, point, voxel).
+  std::string seenViolation(const PlannedTrajectory& trajectory) const;
+
   const OccupancyMap& map_;
   const DistanceField& field_;
   PlannerConfig config_;
   FclClearance fcl_;
+  const SeenSpace* seen_ = nullptr;
 };
 
 }  // namespace gesture_formation::planning

@@ -39,6 +39,7 @@ namespace gesture_formation::planning {
 
 class OccupancyMap;
 class DistanceField;
+class SeenSpace;
 
 /// \brief Everything one replanning needs besides the map.
 struct PlanRequest {
@@ -138,8 +139,10 @@ class UavPlanner {
  public:
   /// \brief `config` must be valid; otherwise `configError()` names every bad field and
   /// every `plan()` returns a braking plan with that reason.
+  /// `seen` (online mapping, may be null): the space observed so far; every plan then also
+  /// passes the seen-space rule (seen_space.hpp, docs/mapping.md §3.1).
   UavPlanner(const PlannerConfig& config, std::shared_ptr<const OccupancyMap> map,
-             std::shared_ptr<const DistanceField> field);
+             std::shared_ptr<const DistanceField> field, std::shared_ptr<const SeenSpace> seen = nullptr);
   ~UavPlanner();
   UavPlanner(const UavPlanner&) = delete;
   UavPlanner& operator=(const UavPlanner&) = delete;
@@ -201,6 +204,7 @@ class UavPlanner {
   std::string config_error_;
   std::shared_ptr<const OccupancyMap> map_;
   std::shared_ptr<const DistanceField> field_;
+  std::shared_ptr<const SeenSpace> seen_;
   std::unique_ptr<TrajectoryVerifier> verifier_;
   std::unique_ptr<CorridorBuilder> corridors_;
   std::unique_ptr<GridPathSearch> search_;

@@ -26,6 +26,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -70,8 +71,10 @@ class SiteMapping {
 
   /// \brief Every plant step, before the safety sample: the clock, due depth frames, distances.
   void step(double t_s, const std::vector<MultirotorState>& uavs);
-  /// \brief After UAV i's replanning at t_s.
-  void planned(int uav, double t_s, const planning::PlanResult& result);
+  /// \brief After UAV i's replanning at t_s; `reference` (stage 1, steps of `reference_dt_s` from
+  /// t_s) gives the travel camera its direction.
+  void planned(int uav, double t_s, const planning::PlanResult& result, const formation::ReferenceTrajectory& reference = {},
+               double reference_dt_s = 0.0);
   SiteMappingSummary summary() const;
 
   /// \brief Distance (m) from p to the nearest unmapped obstacle at the clock (+inf: none).
@@ -82,6 +85,10 @@ class SiteMapping {
   SiteMapping(const MissionConfig& mission, const planning::PrimitiveSet& solids, double ground_height_m,
               std::vector<UnmappedObstacle> unmapped);
   void depthFrame(int uav, double t_s, const MultirotorState& state);
+  /// One frame of UAV i's camera at `T_world_camera` with `intrinsics` into its live map.
+  void integrateFrame(int uav, double t_s, const Eigen::Isometry3d& T_world_camera, const estimation::CameraIntrinsics& intrinsics);
+  /// The travel camera's heading and pitch for UAV i now (travel_camera_hfov_deg).
+  std::pair<double, double> travelDirection(int uav, const MultirotorState& state);
   /// Marks what UAV i's live map now holds of the obstacles near `p_world`.
   void recordSightings(int uav, double t_s, const Eigen::Vector3d& p_world);
   void surfaceVoxels(const planning::MapConfig& grid);
@@ -94,6 +101,9 @@ class SiteMapping {
   DepthRaycaster raycaster_;
   std::vector<std::unique_ptr<mapping::LiveMap>> live_;  ///< per UAV (empty: no mapping)
   std::vector<double> next_frame_s_;
+  estimation::CameraIntrinsics travel_intrinsics_;
+  std::vector<Eigen::Vector3d> travel_target_;  ///< per UAV: its reference travel_lookahead_s ahead (NaN: none)
+  std::vector<std::pair<double, double>> travel_dir_;  ///< per UAV: the last travel heading, pitch (rad)
   double clock_s_ = 0.0;
   /// Per obstacle: its surface voxels' centres at the listed pose and whether any UAV saw each.
   std::vector<std::vector<Eigen::Vector3d>> surface_;

@@ -32,7 +32,15 @@ struct SiteMappingConfig {
   /// `camera_range_m` [20]: the synthetic depth camera's range (m, in [1, 100]): farther, or
   /// nothing hit, is +Inf (free space up to `depth.max_range_m`).
   double camera_range_m = 20.0;
-  /// `depth.*`, `octomap.*`, `field.*`: the live map's settings (mapping::MappingConfig, defaults
+  /// `travel_camera_hfov_deg` [0: none]: a second depth camera per UAV (640×480, square pixels,
+  /// this horizontal field of view, in [0, 120]; 87: a RealSense D435's depth FOV) that looks along
+  /// the UAV's intended direction of travel — from the UAV to its stage-1 reference
+  /// `travel_lookahead_s` [1.5, in (0, 10]] ahead (its velocity when that is nearer than 0.3 m, else
+  /// the last direction) — so that the braking paths the seen-space rule checks lie in view
+  /// (docs/mapping.md §7). Its frames are integrated at `rate_hz` like the worker camera's.
+  double travel_camera_hfov_deg = 0.0;
+  double travel_lookahead_s = 1.5;
+  /// `depth.*`, `octomap.*`, `field.*`, `seen.*`: the live map's settings (mapping::MappingConfig, defaults
   /// there: docs/mapping.md §4).
   mapping::MappingConfig live;
 

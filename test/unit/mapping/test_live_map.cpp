@@ -394,3 +394,29 @@ TEST(MappingConfigTest, YamlReaderUsesTheSameRanges) {
   ASSERT_EQ(reader.problems().size(), 1u);
   EXPECT_EQ(reader.problems()[0].key, "mapping.field.range_m");
 }
+
+TEST(LiveMapTest, FrameMarksWhatItsRaysCrossOrEndInAsSeen) {
+  auto live = makeLiveMap();
+  ASSERT_TRUE(live);
+  const planning::SeenSpace& seen = *live->seen();
+  EXPECT_EQ(seen.seenCount(), 0u);
+  DepthFrame a = cameraAt(kCamera);
+  renderBox(a, kBoxALo, kBoxAHi);
+  ASSERT_TRUE(live->integrate(a));
+  EXPECT_GT(seen.seenCount(), 1000u);
+  EXPECT_TRUE(seen.seen(kCamera + Eigen::Vector3d(2.0, 0.0, 0.0)));  // on the rays to the box
+  EXPECT_TRUE(seen.seen(Eigen::Vector3d(4.7 + 0.05, 0.0, 1.5)));      // the box's front face (hit)
+  EXPECT_FALSE(seen.seen(Eigen::Vector3d(6.5, 0.0, 1.5)));            // behind the box
+  EXPECT_FALSE(seen.seen(kCamera - Eigen::Vector3d(1.0, 0.0, 0.0)));  // behind the camera
+  EXPECT_FALSE(seen.seen(kCamera + Eigen::Vector3d(1.0, 3.0, 0.0)));  // outside the field of view
+}
+
+TEST(MappingConfigTest, SeenRuleKeysAreRangeChecked) {
+  MappingConfig c;
+  c.seen.margin_m = 0.0;
+  c.seen.horizon_s = -1.0;
+  const auto problems = c.validate();
+  ASSERT_EQ(problems.size(), 2u) << ::testing::PrintToString(problems);
+  EXPECT_NE(problems[0].find("seen.margin_m must be > 0, got 0"), std::string::npos) << problems[0];
+  EXPECT_NE(problems[1].find("seen.horizon_s must be > 0, got -1"), std::string::npos) << problems[1];
+}

@@ -118,3 +118,36 @@ TEST(LiveMapPlannerTest, PlannerOnTheLiveMapAvoidsAWallSeenAfterItsFirstPlan) {
   EXPECT_GE(planClearance(second.trajectory, *(*live)->map()), cfg.verify_clearance_m + rho - 1e-6);
   EXPECT_EQ(second.status, PlanStatus::kOptimized) << second.reason;
 }
+
+// The seen-space rule (planning/seen_space.hpp): a planner given the live map's SeenSpace does not
+// fly off into space no depth frame has covered; one frame along the route (nothing within range:
+// free space up to depth.max_range_m) lets it go, and its plan's braking paths stay in that view.
+TEST(LiveMapPlannerTest, SeenSpaceRuleKeepsThePlannerInsideWhatItsCameraHasSeen) {
+  MapConfig grid;
+  grid.resolution_m = 0.2;
+  grid.bounds = Aabb{Eigen::Vector3d(-2.0, -8.0, -1.0), Eigen::Vector3d(30.0, 8.0, 9.0)};
+  auto live = mapping::LiveMap::create(mapping::MappingConfig{}, grid);
+  ASSERT_TRUE(live) << live.reason();
+  PlannerConfig cfg;
+  cfg.time_budget_ms = 0.0;
+  UavPlanner blind(cfg, (*live)->map(), (*live)->field());
+  UavPlanner planner(cfg, (*live)->map(), (*live)->field(), (*live)->seen());
+  const Eigen::Vector3d start(0.0, 0.0, 4.0), goal(24.0, 0.0, 4.0), worker(-1.0, 7.0, 0.0);
+  UavKinematicState state;
+  state.p_world = start;
+  const PlanRequest request = straightRequest(0.0, state, start, goal, 3.0, worker);
+  ASSERT_EQ(blind.plan(request).status, PlanStatus::kOptimized) << "without the rule the same request must be planned";
+  const PlanResult first = planner.plan(request);
+  EXPECT_NE(first.status, PlanStatus::kOptimized) << "nothing seen: the plan must not be flown";
+  EXPECT_NE(first.reason.find("unobserved"), std::string::npos) << first.reason;
+
+  // One frame looking along +x from the start (the box behind the camera: every pixel +Inf).
+  ASSERT_TRUE((*live)->integrate(wallFrame(start, Eigen::Vector3d(-2.0, -1.0, 3.0), Eigen::Vector3d(-1.5, 1.0, 5.0))));
+  const PlanResult second = planner.plan(straightRequest(0.0, state, start, goal, 3.0, worker));
+  ASSERT_EQ(second.status, PlanStatus::kOptimized) << second.reason;
+  const planning::SeenSpace& seen = *(*live)->seen();
+  for (double t = 0.0; t <= cfg.limits.max_speed_mps && t <= 1.0; t += 0.05) {
+    const TrajectoryPoint x = evaluateTrajectory(second.trajectory, t);
+    EXPECT_TRUE(seen.seen(brakeStop(x.p, x.v, cfg.limits, 0.2))) << "braking from t=" << t << " ends unseen";
+  }
+}

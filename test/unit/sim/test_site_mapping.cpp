@@ -119,3 +119,45 @@ TEST(SiteMappingTest, WithoutMappingNothingIsSeenAndBadSettingsAreRefused) {
   EXPECT_NE(bad.reason().find("mission.mapping.rate_hz"), std::string::npos) << bad.reason();
   EXPECT_NE(bad.reason().find("-1"), std::string::npos) << bad.reason();
 }
+
+// The travel camera (mission.mapping.travel_camera_hfov_deg): UAV 0 looks north (its worker
+// camera) but its reference lies east, where the wall is: only with the travel camera does its
+// live map hold the wall.
+TEST(SiteMappingTest, TravelCameraLooksWhereTheReferenceLeads) {
+  const gf::sim::test::EmptyWorld w;
+  auto prior = std::make_shared<const gf::planning::OccupancyMap>(w.map);
+  for (const double hfov : {0.0, 87.0}) {
+    gf::sim::MissionConfig cfg = gf::sim::test::openFieldWithoutRequests();
+    cfg.mapping.enabled = true;
+    cfg.mapping.travel_camera_hfov_deg = hfov;
+    auto site = gf::sim::SiteMapping::create(cfg, grid(), prior, gf::planning::PrimitiveSet{}, 0.0, wallAhead());
+    ASSERT_TRUE(static_cast<bool>(site)) << site.reason();
+    gf::sim::SiteMapping& s = **site;
+    const int n = static_cast<int>(cfg.uavs.size());
+    std::vector<gf::sim::MultirotorState> uavs = uavsLookingEast(n);
+    uavs[0].p_world = Eigen::Vector3d(0.0, 0.0, 3.0);  // in front of the wall, camera north
+    uavs[0].heading_rad = M_PI / 2;
+    gf::formation::ReferenceTrajectory ref;
+    ref.resize(11);
+    for (int k = 0; k <= 10; ++k) {
+      ref.p_world.col(k) = Eigen::Vector3d(0.5 * k, 0.0, 3.0);
+      ref.heading_rad(k) = M_PI / 2;
+      ref.pitch_rad(k) = 0.0;
+    }
+    s.planned(0, 0.0, gf::planning::PlanResult{}, ref, 0.2);
+    for (int k = 0; k <= 100; ++k) s.step(k * 0.01, uavs);
+    const Eigen::Vector3d before_wall(5.2, 0.0, 3.0);
+    if (hfov > 0.0) {
+      EXPECT_LT(s.field(0)->clearance(before_wall), 0.5) << "the travel camera must see the wall";
+      EXPECT_EQ(s.summary().obstacles[0].first_seen_uav, 0);
+    } else {
+      EXPECT_GT(s.field(0)->clearance(before_wall), 2.0) << "the worker camera looks north: no wall";
+    }
+  }
+  gf::sim::MissionConfig bad = gf::sim::test::openFieldWithoutRequests();
+  bad.mapping.enabled = true;
+  bad.mapping.travel_camera_hfov_deg = 150.0;
+  const auto refused = gf::sim::SiteMapping::create(bad, grid(), prior, gf::planning::PrimitiveSet{}, 0.0, wallAhead());
+  ASSERT_FALSE(static_cast<bool>(refused));
+  EXPECT_NE(refused.reason().find("mission.mapping.travel_camera_hfov_deg"), std::string::npos) << refused.reason();
+}
