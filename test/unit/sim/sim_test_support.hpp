@@ -1,11 +1,13 @@
 #pragma once
 // Shared by the sim unit tests: an empty 60 × 60 × 20 m world with ground, the open-field
-// mission, and the test-only stand-in planner's plan (the stage-1 reference itself, safe in an
-// empty world; the product uses planning::UavPlanner).
+// mission, and the test-only stand-in planner (the plan is the stage-1 reference itself, safe in
+// an empty world; the product uses planning::UavPlanner) that records every request it gets.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "gesture_formation/planning/distance_field.hpp"
 #include "gesture_formation/planning/occupancy_map.hpp"
@@ -54,5 +56,42 @@ inline planning::PlanResult referenceAsPlan(const planning::PlanRequest& r) {
   }
   return res;
 }
+
+/// One request the recording planner got.
+struct PlanCall {
+  int uav = 0;
+  double t_s = 0.0;
+  bool constant_reference = false;  ///< every step at one point (hold)
+  Eigen::Vector3d reference0 = Eigen::Vector3d::Zero();
+  Eigen::Vector3d state_p = Eigen::Vector3d::Zero();
+  std::vector<int> avoided;        ///< uav_index of each plan in higher_priority_plans
+  std::vector<double> avoided_t0;  ///< and its t0_s
+};
+
+/// Test-only stand-in planner: returns the reference as the plan (referenceAsPlan) and records the request.
+class RecordingPlanner : public MissionPlanner {
+ public:
+  explicit RecordingPlanner(std::shared_ptr<std::vector<PlanCall>> calls) : calls_(std::move(calls)) {}
+  planning::PlanResult plan(const planning::PlanRequest& r) override {
+    PlanCall c;
+    c.uav = r.uav_index;
+    c.t_s = r.t_now_s;
+    c.reference0 = r.reference.p_world.col(0);
+    c.state_p = r.state.p_world;
+    c.constant_reference = true;
+    for (int k = 1; k < r.reference.steps(); ++k) {
+      c.constant_reference = c.constant_reference && (r.reference.p_world.col(k) - c.reference0).norm() < 1e-12;
+    }
+    for (const auto& p : r.higher_priority_plans) {
+      c.avoided.push_back(p.uav_index);
+      c.avoided_t0.push_back(p.t0_s);
+    }
+    calls_->push_back(c);
+    return referenceAsPlan(r);
+  }
+
+ private:
+  std::shared_ptr<std::vector<PlanCall>> calls_;
+};
 
 }  // namespace gesture_formation::sim::test

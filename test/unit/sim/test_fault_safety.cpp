@@ -20,41 +20,8 @@ namespace gf = gesture_formation;
 
 namespace {
 
-struct Call {
-  int uav = 0;
-  double t_s = 0.0;
-  bool constant_reference = false;  ///< every step at one point (hold)
-  Eigen::Vector3d reference0 = Eigen::Vector3d::Zero();
-  Eigen::Vector3d state_p = Eigen::Vector3d::Zero();
-  std::vector<int> avoided;  ///< uav_index of each plan in higher_priority_plans
-  std::vector<double> avoided_t0;  ///< and its t0_s
-};
-
-/// Test-only: returns the reference as the plan and records the request.
-class RecordingPlanner : public gf::sim::MissionPlanner {
- public:
-  explicit RecordingPlanner(std::shared_ptr<std::vector<Call>> calls) : calls_(std::move(calls)) {}
-  gf::planning::PlanResult plan(const gf::planning::PlanRequest& r) override {
-    Call c;
-    c.uav = r.uav_index;
-    c.t_s = r.t_now_s;
-    c.reference0 = r.reference.p_world.col(0);
-    c.state_p = r.state.p_world;
-    c.constant_reference = true;
-    for (int k = 1; k < r.reference.steps(); ++k) {
-      c.constant_reference = c.constant_reference && (r.reference.p_world.col(k) - c.reference0).norm() < 1e-12;
-    }
-    for (const auto& p : r.higher_priority_plans) {
-      c.avoided.push_back(p.uav_index);
-      c.avoided_t0.push_back(p.t0_s);
-    }
-    calls_->push_back(c);
-    return gf::sim::test::referenceAsPlan(r);
-  }
-
- private:
-  std::shared_ptr<std::vector<Call>> calls_;
-};
+using Call = gf::sim::test::PlanCall;
+using gf::sim::test::RecordingPlanner;
 
 using World = gf::sim::test::EmptyWorld;
 

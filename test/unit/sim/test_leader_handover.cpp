@@ -19,27 +19,8 @@ namespace gf = gesture_formation;
 
 namespace {
 
-struct Call {
-  int uav = 0;
-  double t_s = 0.0;
-  std::vector<int> avoided;  ///< uav_index of each plan in higher_priority_plans
-};
-
-class RecordingPlanner : public gf::sim::MissionPlanner {
- public:
-  explicit RecordingPlanner(std::shared_ptr<std::vector<Call>> calls) : calls_(std::move(calls)) {}
-  gf::planning::PlanResult plan(const gf::planning::PlanRequest& r) override {
-    Call c;
-    c.uav = r.uav_index;
-    c.t_s = r.t_now_s;
-    for (const auto& p : r.higher_priority_plans) c.avoided.push_back(p.uav_index);
-    calls_->push_back(c);
-    return gf::sim::test::referenceAsPlan(r);
-  }
-
- private:
-  std::shared_ptr<std::vector<Call>> calls_;
-};
+using Call = gf::sim::test::PlanCall;
+using gf::sim::test::RecordingPlanner;
 
 struct Flight {
   std::shared_ptr<std::vector<Call>> calls = std::make_shared<std::vector<Call>>();
