@@ -23,6 +23,10 @@ cleanup() {
 }
 trap cleanup EXIT
 fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+# matches ARGS...: grep that reads its whole input. The tests run under pipefail, where `cmd | grep -q`
+# can fail on a match: grep -q exits at the first matching line and a writer still writing (bash's
+# echo writes line by line) dies of SIGPIPE, status 141 (ros_onboard_launch failed so in CI).
+matches() { grep "$@" > /dev/null; }
 start_master() {
   roscore -p "$PORT" > "$T/roscore.log" 2>&1 & pids+=($!)
   for _ in $(seq 50); do rosparam list > /dev/null 2>&1 && return 0; sleep 0.2; done

@@ -41,9 +41,9 @@ for _ in $(seq 160); do
   sleep 0.5
 done
 sleep 1
-rostopic list 2>/dev/null | grep -q fp_bad_plan && fail "FormationPlanner advertised its output although it refused to start"
-rostopic list 2>/dev/null | grep -q gc_vf_status && fail "GestureCommander advertised its output although it refused to start"
-rostopic list 2>/dev/null | grep -q vo_bad_observation && fail "ViewObserver advertised its output although it refused to start"
+rostopic list 2>/dev/null | matches fp_bad_plan && fail "FormationPlanner advertised its output although it refused to start"
+rostopic list 2>/dev/null | matches gc_vf_status && fail "GestureCommander advertised its output although it refused to start"
+rostopic list 2>/dev/null | matches vo_bad_observation && fail "ViewObserver advertised its output although it refused to start"
 kill "${runs[@]}" 2>/dev/null
 wait "${runs[@]}"
 check() {  # log, pattern, what

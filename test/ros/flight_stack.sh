@@ -11,7 +11,7 @@ source "$(dirname "$0")/common.bash"
 start_master
 roslaunch -p "$PORT" gesture_formation flight_stack.launch flight_stack:=mavros setpoints:=both rate_hz:=50 \
   camera_mount_rpy_rad:="[0.0, 0.3490658503988659, 0.0]" > "$T/launch.log" 2>&1 & pids+=($!)
-for _ in $(seq 100); do rostopic list 2>/dev/null | grep -q "^/gimbal/target$" && rostopic list 2>/dev/null | grep -q "^/odometry$" && break; sleep 0.3; done
+for _ in $(seq 100); do rostopic list 2>/dev/null | matches "^/gimbal/target$" && rostopic list 2>/dev/null | matches "^/odometry$" && break; sleep 0.3; done
 timeout 60 python3 "$SRC/test/ros/flight_stack_check.py" || fails=$((fails + $?))
 grep -q "refuses to start" "$T/launch.log" && fail "a nodelet refused to start: $(grep -A4 refuses "$T/launch.log" | head -6)"
 # The refusal is named and rate-limited: 30 wrong messages in 1.5 s, at most one line per 2 s.

@@ -20,7 +20,7 @@ clean_env() {  # a shell that knows only the install space (no devel space, no s
 }
 pkg=$(clean_env "rospack find gesture_formation" 2>&1)
 [ "$pkg" = "$PREFIX/share/gesture_formation" ] || fail "the package resolves to '$pkg', not the install space"
-clean_env "rospack plugins --attrib=plugin nodelet" 2>&1 | grep -q "^gesture_formation $PREFIX/share/gesture_formation/nodelet_plugins.xml$" \
+clean_env "rospack plugins --attrib=plugin nodelet" 2>&1 | matches "^gesture_formation $PREFIX/share/gesture_formation/nodelet_plugins.xml$" \
   || fail "the nodelet plugins are not the installed ones"
 for f in launch/onboard.launch launch/flight_stack.launch config/ros/nodelets.yaml third_party_models/MODELS.md \
          third_party_models/movenet_lightning/movenet_lightning.onnx; do
@@ -30,7 +30,7 @@ done
 GFCTL=$PREFIX/lib/gesture_formation/gfctl
 [ -x "$GFCTL" ] || fail "no installed gfctl at $GFCTL"
 out=$(clean_env "'$GFCTL' detect --image '$SRC/test/data/perception/astronaut.png' --out '$T/a.png' --csv '$T/a.csv'" 2>&1)
-echo "$out" | grep -q "models $PREFIX/share/gesture_formation/third_party_models)" \
+echo "$out" | matches "models $PREFIX/share/gesture_formation/third_party_models)" \
   || fail "the installed gfctl does not use the installed models: $(echo "$out" | tail -2)"
 # the installed tools (rosrun finds them in the package's lib directory)
 for tool in gf_command.py plot_timeline.py plot_corridors.py plot_search.py bag_latency.py summarize_estimate.py; do

@@ -20,22 +20,22 @@ done
 params=$(timeout 30 roslaunch --dump-params "$SRC/launch/onboard.launch" key_file:=/dev/null scenario_file:=/dev/null \
   world_frame:=map 2>&1) || fail "onboard.launch --dump-params failed: $(echo "$params" | tail -3)"
 for node in formation_planner lcm_bridge view_observer worker_estimator; do
-  echo "$params" | grep -q "^/$node/world_frame: map$" || fail "onboard.launch world_frame:=map not given to $node"
+  echo "$params" | matches "^/$node/world_frame: map$" || fail "onboard.launch world_frame:=map not given to $node"
 done
 echo "$params" | grep -E "/world_frame: " | grep -vq ": map$" && fail "a world_frame other than map remains: $(echo "$params" | grep world_frame)"
 # flight_stack:=mavros adds the OdometryAdapter and the SetpointRelay (world_frame given to both); the default adds neither.
 args=(key_file:=/dev/null scenario_file:=/dev/null world_frame:=map)
 nodes=$(timeout 30 roslaunch --nodes "$SRC/launch/onboard.launch" "${args[@]}" flight_stack:=mavros 2>&1)
 for node in odometry_adapter setpoint_relay; do
-  echo "$nodes" | grep -q "^/$node$" || fail "onboard.launch flight_stack:=mavros does not start $node"
+  echo "$nodes" | matches "^/$node$" || fail "onboard.launch flight_stack:=mavros does not start $node"
 done
-timeout 30 roslaunch --nodes "$SRC/launch/onboard.launch" "${args[@]}" 2>&1 | grep -qE "^/(odometry_adapter|setpoint_relay)$" \
+timeout 30 roslaunch --nodes "$SRC/launch/onboard.launch" "${args[@]}" 2>&1 | matches -E "^/(odometry_adapter|setpoint_relay)$" \
   && fail "onboard.launch without flight_stack starts the flight-stack relay"
 params=$(timeout 30 roslaunch --dump-params "$SRC/launch/onboard.launch" "${args[@]}" flight_stack:=mavros 2>&1)
 for key in odometry_adapter/world_frame setpoint_relay/world_frame; do
-  echo "$params" | grep -q "^/$key: map$" || fail "onboard.launch flight_stack:=mavros: $key is not map"
+  echo "$params" | matches "^/$key: map$" || fail "onboard.launch flight_stack:=mavros: $key is not map"
 done
-echo "$params" | grep -q "^/odometry_adapter/body_frame: base_link$" || fail "flight_stack:=mavros: body_frame is not base_link"
+echo "$params" | matches "^/odometry_adapter/body_frame: base_link$" || fail "flight_stack:=mavros: body_frame is not base_link"
 [ "$fails" -eq 0 ] && echo "launch_args: $n launch files, all arguments documented, world_frame reaches every nodelet" \
   || echo "launch_args: $fails failures"
 exit $((fails > 0))

@@ -8,7 +8,7 @@ make_key "$T/keys"
 MAP=$SRC/config/scenarios/power_towers.yaml
 roslaunch -p "$PORT" gesture_formation onboard.launch uav_index:=0 key_file:="$T/keys" lcm_url:=memq:// \
   scenario_file:="$MAP" odometry_topic:=odom trajectory_topic:=flight/trajectory > "$T/launch.log" 2>&1 & pids+=($!)
-for _ in $(seq 100); do rostopic list 2>/dev/null | grep -q "^/plan$" && break; sleep 0.3; done
+for _ in $(seq 100); do rostopic list 2>/dev/null | matches "^/plan$" && break; sleep 0.3; done
 # The leader 10 m north of a worker standing at (0, 10, 2)... camera looking south (heading -90°).
 rostopic pub -s -r 20 /odom nav_msgs/Odometry \
   "{header: {stamp: now, frame_id: world}, child_frame_id: world, pose: {pose: {position: {x: 10, y: 10, z: 4}, orientation: {w: 0.7071068, z: -0.7071068}}}}" \
@@ -28,8 +28,8 @@ rostopic pub -s -r 20 /worker_state gesture_formation/WorkerState \
   > /dev/null 2>&1 & pids+=($!)
 sleep 1.5
 plan=$(timeout 5 rostopic echo -n1 /plan 2>/dev/null | grep -E "^(mode|mode_reason|fallback):")
-echo "$plan" | grep -q "^mode: \"hold\"\|^mode: hold" && echo "$plan" | grep -q "^fallback: True" \
-  && echo "$plan" | grep -q "worker not seen for more than max_worker_age_s" \
+echo "$plan" | matches "^mode: \"hold\"\|^mode: hold" && echo "$plan" | matches "^fallback: True" \
+  && echo "$plan" | matches "worker not seen for more than max_worker_age_s" \
   && echo "PASS: an estimate not fused for longer than max_worker_age_s: the leader holds (flagged)" \
   || fail "stale estimate: expected mode hold, fallback True, the reason; got: $plan"
 n=$(timeout 5 rostopic echo -n1 /flight/trajectory 2>/dev/null | grep -c "translation")

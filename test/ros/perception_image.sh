@@ -18,7 +18,7 @@ timeout 8 rosrun nodelet nodelet standalone gesture_formation/Perception __name:
   _models_root:="$T/no_models" _gesture_model:="$MODELS/gesture_lstm/gesture_lstm.onnx" _detector:=yolo \
   _skeleton:=movenet_lightning _detect_every_k:=0 _min_depth_m:=0.2 _max_depth_m:=20.0 _depth_scale_m:=0.001 _image_transport:=theora \
   detection_out:=/perception_bad/worker_detection > "$T/perception_bad.log" 2>&1 & bad=$!
-for _ in $(seq 100); do rostopic list 2>/dev/null | grep -q "^/perception/worker_detection$" && break; sleep 0.3; done
+for _ in $(seq 100); do rostopic list 2>/dev/null | matches "^/perception/worker_detection$" && break; sleep 0.3; done
 timeout 70 python3 "$SRC/test/ros/perception_check.py" "$SRC/test/data/perception/astronaut.png" || fails=$((fails + $?))
 # The same camera compressed: image_transport's `compressed` topic (decoded by the nodelet when the
 # compressed_image_transport plugin is not installed, as on Debian).
@@ -29,10 +29,10 @@ timeout 60 rosrun nodelet nodelet standalone gesture_formation/Perception __name
   _min_depth_m:=0.2 _max_depth_m:=20.0 _depth_scale_m:=0.001 _max_depth_dt_s:=0.05 _image_transport:=compressed \
   image_in:=/cam/image depth_in:=/cam/depth camera_info_in:=/cam/camera_info \
   detection_out:=/perception/worker_detection gesture_out:=/perception/gesture > "$T/perception_compressed.log" 2>&1 & pids+=($!)
-for _ in $(seq 100); do rostopic info /cam/image/compressed 2>/dev/null | grep -q "/perception" && break; sleep 0.3; done
+for _ in $(seq 100); do rostopic info /cam/image/compressed 2>/dev/null | matches "/perception" && break; sleep 0.3; done
 timeout 70 python3 "$SRC/test/ros/perception_check.py" "$SRC/test/data/perception/astronaut.png" --compressed || fails=$((fails + $?))
 grep -q "refuses to start" "$T/perception_compressed.log" && fail "Perception (compressed) refused to start: $(grep -A5 refuses "$T/perception_compressed.log")"
-rostopic list 2>/dev/null | grep -q "^/perception_bad/" && fail "Perception advertised its output although it refused to start"
+rostopic list 2>/dev/null | matches "^/perception_bad/" && fail "Perception advertised its output although it refused to start"
 wait $bad
 for pattern in "refuses to start" "detector: " "detect_every_k: value 0 out of range" "max_depth_dt_s: missing" \
   "image_transport 'theora': no such image_transport plugin installed"; do
