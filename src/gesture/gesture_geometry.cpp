@@ -32,6 +32,7 @@ ArmMeasures measureArm(const Skeleton3D& s, const BodyFrame& f, bool left, const
   const double outward = upper.y() * (left ? 1.0 : -1.0);
   a.horizontal_abduction_deg = common::radToDeg(std::atan2(outward, std::abs(upper.x())));
   a.elbow_deg = angleDeg(s.p_world[sh] - s.p_world[el], s.p_world[wr] - s.p_world[el]);
+  a.shoulder_wrist_elevation_deg = angleDeg(upper + fore, -Eigen::Vector3d::UnitZ());
   a.forearm_from_horizontal_deg = std::abs(common::radToDeg(std::asin(std::clamp(fore.normalized().z(), -1.0, 1.0))));
   a.wrist_height_H = height_H(s.p_world[wr]);
   a.wrist_body = R_body_world * (s.p_world[wr] - f.p_world_origin);
@@ -64,6 +65,40 @@ Test crossArms(const PoseMeasures& m, const GestureGeometryNumbers& n) {
   return Test::kBand;
 }
 
+/// Both wrists within max_midline_offset_H of the body's midline (either naming of the wrists).
+bool wristsNearMidline(const PoseMeasures& m, const TolerantGeometryNumbers& t) {
+  const double max_m = t.max_midline_offset_H * m.height_m;
+  return std::abs(m.left.wrist_body.y()) <= max_m && std::abs(m.right.wrist_body.y()) <= max_m;
+}
+
+/// Palms together as the networks see it (GeometryRules::kNetworkTolerant): hands a hand-width apart.
+Test palmsTolerant(const PoseMeasures& m, const GestureGeometryNumbers& n) {
+  const TolerantGeometryNumbers& t = n.tolerant;
+  if (!m.left.valid || !m.right.valid || m.wrist_separation_H > t.palms_max_separation_H || !wristsNearMidline(m, t)) {
+    return Test::kOut;
+  }
+  const double mean = 0.5 * (m.left.wrist_height_H + m.right.wrist_height_H);
+  if (mean <= t.tool_max_height_H) return Test::kNearMiss;  // a tool held in both hands, low
+  if (mean < t.palms_min_height_H) return Test::kBand;
+  const bool in_front = m.left.wrist_body.x() > 0.0 && m.right.wrist_body.x() > 0.0;
+  const bool level = m.left.forearm_from_horizontal_deg <= n.palms_forearm_max_from_horizontal_deg &&
+                     m.right.forearm_from_horizontal_deg <= n.palms_forearm_max_from_horizontal_deg;
+  return mean <= t.palms_max_height_H && in_front && level ? Test::kInside : Test::kOut;
+}
+
+/// Cross arms without trusting which wrist the network names: both wrists high near the midline,
+/// or the design's crossed wrists.
+Test crossTolerant(const PoseMeasures& m, const GestureGeometryNumbers& n) {
+  if (crossArms(m, n) == Test::kInside) return Test::kInside;
+  const TolerantGeometryNumbers& t = n.tolerant;
+  if (!m.left.valid || !m.right.valid || !wristsNearMidline(m, t)) return Test::kOut;
+  const double lo = std::min(m.left.wrist_height_H, m.right.wrist_height_H);
+  const double hi = std::max(m.left.wrist_height_H, m.right.wrist_height_H);
+  if (lo >= t.cross_min_height_H) return Test::kInside;
+  if (hi <= t.folded_max_height_H) return Test::kNearMiss;  // arms folded low
+  return Test::kBand;
+}
+
 Test extendArm(const ArmMeasures& a, const GestureGeometryNumbers& n) {
   if (!a.valid || a.elevation_deg <= n.hanging_max_elevation_deg) return Test::kOut;
   const double el = a.elevation_deg, side = a.horizontal_abduction_deg;
@@ -85,7 +120,25 @@ Test raiseArm(const ArmMeasures& a, const GestureGeometryNumbers& n) {
   return Test::kOut;
 }
 
+/// Raise an arm read on the line shoulder → wrist (the elbow of a straight arm reads bent).
+Test raiseTolerant(const ArmMeasures& a, const TolerantGeometryNumbers& t) {
+  if (!a.valid) return Test::kOut;
+  const double line = a.shoulder_wrist_elevation_deg;
+  if (line >= t.raise_min_shoulder_wrist_deg && a.elbow_deg >= t.raise_min_elbow_deg) return Test::kInside;
+  if (line > t.reach_max_shoulder_wrist_deg && a.elbow_deg >= t.reach_max_elbow_deg) return Test::kBand;
+  if (a.elevation_deg > 90.0 || line > 90.0) return Test::kNearMiss;  // above the shoulder, but part-way or bent
+  return Test::kOut;
+}
+
 }  // namespace
+
+const char* toString(GeometryRules r) {
+  switch (r) {
+    case GeometryRules::kDesign: return "design";
+    case GeometryRules::kNetworkTolerant: return "network_tolerant";
+  }
+  return "?";
+}
 
 const char* toString(PoseRegion r) {
   switch (r) {
@@ -127,9 +180,12 @@ PoseMeasures measurePose(const Skeleton3D& s, const GestureGeometryNumbers& n) {
 PoseVerdict classifyPose(const PoseMeasures& m, const GestureGeometryNumbers& n) {
   PoseVerdict v;
   if (!m.valid) return v;
-  const Test palms = palmsTogether(m, n), cross = crossArms(m, n);
+  const bool tolerant = n.rules == GeometryRules::kNetworkTolerant;
+  const Test palms = tolerant ? palmsTolerant(m, n) : palmsTogether(m, n);
+  const Test cross = tolerant ? crossTolerant(m, n) : crossArms(m, n);
   const Test extend[2] = {extendArm(m.left, n), extendArm(m.right, n)};
-  const Test raise[2] = {raiseArm(m.left, n), raiseArm(m.right, n)};
+  const Test raise[2] = {tolerant ? raiseTolerant(m.left, n.tolerant) : raiseArm(m.left, n),
+                         tolerant ? raiseTolerant(m.right, n.tolerant) : raiseArm(m.right, n)};
   // Gesture regions: each (gesture, arm) inside counts once; a one-arm gesture needs exactly one arm.
   std::multiset<int> inside;
   if (palms == Test::kInside) inside.insert(kPalmsTogether);

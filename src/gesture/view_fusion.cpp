@@ -33,6 +33,21 @@ const common::FieldTable<ViewFusionConfig>& fields() {
       {"view_fusion.require_3d_min_frames", Range::closed(1, 1000), [](C& c) { return &c.require_3d_min_frames; }},
       {"view_fusion.require_3d_median_frames", Range::closed(1, 31), [](C& c) { return &c.require_3d_median_frames; }},
       {"view_fusion.fusion_lag_s", Range::closed(0.0, 2.0), [](C& c) { return &c.fusion_lag_s; }},
+      {"view_fusion.tolerant_3d.palms_max_separation_H", Range::openClosed(0.0, 0.5),
+       [](C& c) { return &c.geometry.tolerant.palms_max_separation_H; }},
+      {"view_fusion.tolerant_3d.palms_min_height_H", Range::closed(0.0, 1.2), [](C& c) { return &c.geometry.tolerant.palms_min_height_H; }},
+      {"view_fusion.tolerant_3d.palms_max_height_H", Range::closed(0.0, 1.2), [](C& c) { return &c.geometry.tolerant.palms_max_height_H; }},
+      {"view_fusion.tolerant_3d.tool_max_height_H", Range::closed(0.0, 1.2), [](C& c) { return &c.geometry.tolerant.tool_max_height_H; }},
+      {"view_fusion.tolerant_3d.max_midline_offset_H", Range::openClosed(0.0, 0.5),
+       [](C& c) { return &c.geometry.tolerant.max_midline_offset_H; }},
+      {"view_fusion.tolerant_3d.cross_min_height_H", Range::closed(0.0, 1.2), [](C& c) { return &c.geometry.tolerant.cross_min_height_H; }},
+      {"view_fusion.tolerant_3d.folded_max_height_H", Range::closed(0.0, 1.2), [](C& c) { return &c.geometry.tolerant.folded_max_height_H; }},
+      {"view_fusion.tolerant_3d.raise_min_shoulder_wrist_deg", Range::closed(90.0, 180.0),
+       [](C& c) { return &c.geometry.tolerant.raise_min_shoulder_wrist_deg; }},
+      {"view_fusion.tolerant_3d.raise_min_elbow_deg", Range::closed(90.0, 180.0), [](C& c) { return &c.geometry.tolerant.raise_min_elbow_deg; }},
+      {"view_fusion.tolerant_3d.reach_max_shoulder_wrist_deg", Range::closed(90.0, 180.0),
+       [](C& c) { return &c.geometry.tolerant.reach_max_shoulder_wrist_deg; }},
+      {"view_fusion.tolerant_3d.reach_max_elbow_deg", Range::closed(90.0, 180.0), [](C& c) { return &c.geometry.tolerant.reach_max_elbow_deg; }},
   }};
   return t;
 }
@@ -44,6 +59,19 @@ std::vector<common::ConfigError> problems(const ViewFusionConfig& c) {
                     "must exceed view_fusion.distance_min_m " + common::formatDouble(c.distance_min_m));
   common::checkRule(e, c.elevation_max_deg > c.elevation_min_deg, "view_fusion.elevation_max_deg", c.elevation_max_deg,
                     "must exceed view_fusion.elevation_min_deg " + common::formatDouble(c.elevation_min_deg));
+  const TolerantGeometryNumbers& t = c.geometry.tolerant;
+  const std::string k = "view_fusion.tolerant_3d.";
+  common::checkRule(e, t.palms_max_height_H > t.palms_min_height_H, k + "palms_max_height_H", t.palms_max_height_H,
+                    "must exceed " + k + "palms_min_height_H " + common::formatDouble(t.palms_min_height_H));
+  common::checkRule(e, t.tool_max_height_H <= t.palms_min_height_H, k + "tool_max_height_H", t.tool_max_height_H,
+                    "must not exceed " + k + "palms_min_height_H " + common::formatDouble(t.palms_min_height_H));
+  common::checkRule(e, t.folded_max_height_H <= t.cross_min_height_H, k + "folded_max_height_H", t.folded_max_height_H,
+                    "must not exceed " + k + "cross_min_height_H " + common::formatDouble(t.cross_min_height_H));
+  common::checkRule(e, t.reach_max_shoulder_wrist_deg <= t.raise_min_shoulder_wrist_deg, k + "reach_max_shoulder_wrist_deg",
+                    t.reach_max_shoulder_wrist_deg,
+                    "must not exceed " + k + "raise_min_shoulder_wrist_deg " + common::formatDouble(t.raise_min_shoulder_wrist_deg));
+  common::checkRule(e, t.reach_max_elbow_deg <= t.raise_min_elbow_deg, k + "reach_max_elbow_deg", t.reach_max_elbow_deg,
+                    "must not exceed " + k + "raise_min_elbow_deg " + common::formatDouble(t.raise_min_elbow_deg));
   common::checkRule(e, c.require_3d_median_frames % 2 == 1, "view_fusion.require_3d_median_frames",
                     c.require_3d_median_frames, "must be odd (frames centred on the one read)");
   fields().sortByTableOrder(e);
@@ -60,6 +88,9 @@ ViewFusionConfig readViewFusionConfig(ConfigReader& r) {
   r.readBool(k + "gate_envelope", c.gate_envelope);
   r.readBool(k + "confirm_3d", c.confirm_3d);
   r.readBool(k + "require_3d", c.require_3d);
+  std::string rules = toString(c.geometry.rules);
+  r.readString(k + "geometry_3d", rules, {toString(GeometryRules::kDesign), toString(GeometryRules::kNetworkTolerant)});
+  c.geometry.rules = rules == toString(GeometryRules::kNetworkTolerant) ? GeometryRules::kNetworkTolerant : GeometryRules::kDesign;
   fields().readFields(r, "", c);
   // The rules between fields, always (a key outside its range kept its default while reading).
   common::addProblems(r, "", problems(c));
@@ -231,7 +262,7 @@ bool ViewFusion::holdsIn3D(int g, const std::vector<Skeleton3D>& frames) const {
   std::size_t holds = 0;
   for (std::size_t k = 0; k < frames.size(); ++k) {
     const Skeleton3D s = half == 0 ? frames[k] : medianSkeleton(frames, k >= half ? k - half : 0, k + half);
-    if (classifyPose3D(s).gesture_id == g) ++holds;
+    if (classifyPose3D(s, config_.geometry).gesture_id == g) ++holds;
   }
   return static_cast<double>(holds) >= config_.require_3d_min_fraction * static_cast<double>(frames.size());
 }

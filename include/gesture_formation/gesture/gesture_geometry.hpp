@@ -31,6 +31,20 @@
 ///    near-miss "reaching": elevation ≤ 130° or elbow < 120°; band: elevation 130–150° or elbow 120–150°.
 /// A one-arm gesture needs exactly one arm in its region; two arms in gesture regions of different
 /// gestures (or a one-arm and a two-arm gesture at once) are ambiguous: none.
+///
+/// GeometryRules::kNetworkTolerant (docs/gestures.md §6, "3-D rules as the networks see them") keeps
+/// extend as above and replaces palms, cross and raise by regions that allow for the skeleton
+/// network's measured systematic errors (§9: MoveNet names the hands by their image side, so crossed
+/// wrists triangulate uncrossed; palms' wrists a hand-width apart; a raised arm's elbow reads bent),
+/// with their numbers in TolerantGeometryNumbers, chosen on the rendered TUNING set only:
+///  - palms together: wrists ≤ 0.13 H apart, each ≤ 0.10 H from the midline, their mean height
+///    0.65–0.78 H, both in front of the body, forearms within the design's 30° of horizontal;
+///    near-miss "tool held in both hands": the same hands together at a mean ≤ 0.61 H; band 0.61–0.65 H;
+///  - cross arms, not depending on which wrist the network names: both wrists ≤ 0.10 H from the
+///    midline and both ≥ 0.76 H (or the design's region: crossed, both ≥ 0.80 H); near-miss "arms
+///    folded low": near the midline with the higher wrist ≤ 0.70 H; band between;
+///  - raise an arm up: read on the line shoulder → wrist, ≥ 145° from hanging with the elbow ≥ 130°;
+///    near-miss "reaching": that line ≤ 130° or the elbow < 120°; band between.
 /// Thread safety: free functions without state.
 
 #include <cstddef>
@@ -44,6 +58,26 @@
 #include "gesture_formation/gesture/view_triangulation.hpp"
 
 namespace gesture_formation::gesture {
+
+/// \brief Which regions classifyPose() tests (file comment).
+enum class GeometryRules : int {
+  kDesign = 0,         ///< design.md §2's regions as written
+  kNetworkTolerant,    ///< palms, cross and raise allowing for the skeleton network's systematic errors
+};
+const char* toString(GeometryRules r);
+
+/// \brief The numbers of GeometryRules::kNetworkTolerant (fractions of H, degrees), chosen on the rendered
+/// tuning set (seed 3701; tools/gesture/geometry_rules.py; docs/gestures.md §6): not design.md's.
+struct TolerantGeometryNumbers {
+  double palms_max_separation_H = 0.13;   ///< MoveNet's palms: median 0.10 H, p90 0.12 H apart
+  double palms_min_height_H = 0.65, palms_max_height_H = 0.78;  ///< the wrists' mean height
+  double tool_max_height_H = 0.61;        ///< band: tool_max .. palms_min
+  double max_midline_offset_H = 0.10;     ///< palms and label-free cross: each wrist this near the midline
+  double cross_min_height_H = 0.76;       ///< label-free cross: both wrists at least this high
+  double folded_max_height_H = 0.70;      ///< band: folded_max .. cross_min
+  double raise_min_shoulder_wrist_deg = 145.0, raise_min_elbow_deg = 130.0;
+  double reach_max_shoulder_wrist_deg = 130.0, reach_max_elbow_deg = 120.0;  ///< band between
+};
 
 /// \brief design.md §2's numbers (fractions of the standing height H, angles in degrees). The
 /// defaults ARE the design; they are not tuning parameters (tests pin them).
@@ -63,6 +97,9 @@ struct GestureGeometryNumbers {
   /// Reporting aid, not in design.md (it changes no gesture decision): an arm whose upper arm is
   /// within this of hanging down is "at rest", not the near-miss "part-way or pointing".
   double hanging_max_elevation_deg = 20.0;
+  /// Which regions to test; kNetworkTolerant reads `tolerant` for palms, cross and raise.
+  GeometryRules rules = GeometryRules::kDesign;
+  TolerantGeometryNumbers tolerant;
 };
 
 /// \brief One arm measured in the body frame (angles [deg], heights in H, positions [m]).
@@ -72,6 +109,7 @@ struct ArmMeasures {
   double horizontal_abduction_deg = 0.0;  ///< upper arm's horizontal direction from forward/back towards its own side:
                                          ///< 90 sideways, 0 forward or back, < 0 across the body (file comment)
   double elbow_deg = 180.0;           ///< inner elbow angle (180: straight)
+  double shoulder_wrist_elevation_deg = 0.0;  ///< the line shoulder → wrist from hanging down (as elevation_deg)
   double forearm_from_horizontal_deg = 90.0;  ///< |angle| of elbow → wrist to the body's horizontal plane
   double wrist_height_H = 0.0;        ///< h(wrist)
   Eigen::Vector3d wrist_body = Eigen::Vector3d::Zero();  ///< wrist in the body frame [m] (x fwd, y left, z up)
@@ -115,7 +153,7 @@ struct PoseVerdict {
   int nearest_gesture = kNone;
 };
 
-/// \brief Classifies measured geometry by design.md §2's regions (file comment). `numbers` must be
+/// \brief Classifies measured geometry by the regions of `numbers.rules` (file comment). `numbers` must be
 /// consistent (each band's lower edge ≤ its upper edge); the defaults are.
 PoseVerdict classifyPose(const PoseMeasures& m, const GestureGeometryNumbers& numbers = {});
 /// \brief measurePose() then classifyPose().

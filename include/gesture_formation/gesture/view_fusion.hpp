@@ -58,6 +58,7 @@
 #include <vector>
 
 #include "gesture_formation/common/config_reader.hpp"
+#include "gesture_formation/gesture/gesture_geometry.hpp"
 #include "gesture_formation/gesture/view_triangulation.hpp"
 
 namespace gesture_formation::gesture {
@@ -91,6 +92,10 @@ struct ViewFusionConfig {
   /// (this many frames centred on it; gesture::medianSkeleton): a held gesture's single frames are
   /// noisy (the elbow of a triangulated arm moves by centimetres), its median is not. 1: frame by frame.
   int require_3d_median_frames = 5;
+  /// The regions require_3d tests (YAML `view_fusion.geometry_3d`: design | network_tolerant) and, for
+  /// network_tolerant, their numbers (`view_fusion.tolerant_3d.*`, gesture_geometry.hpp); the other
+  /// numbers are design.md's and not configurable.
+  GestureGeometryNumbers geometry;
   /// [0, 2] s: callers fuse at t_now − fusion_lag_s (the links' delay budget); observations may
   /// arrive this much out of order and the history is kept this much longer. 0: no lag.
   /// Default 0.4 s (since 2026-12-03): the fault matrix's delay budget (0.1 s + up to 0.3 s).
@@ -109,7 +114,7 @@ struct ViewFusionConfig {
 /// \brief Reads `view_fusion.{min_agreeing_views, max_age_s, gate_envelope, distance_min_m,
 /// distance_max_m, elevation_min_deg, elevation_max_deg, vote_window_s, vote_min_fraction, confirm_3d,
 /// confirm_3d_min_fraction, confirm_3d_min_frames, confirm_3d_max_dt_s, require_3d, require_3d_min_fraction,
-/// require_3d_min_frames, require_3d_median_frames, fusion_lag_s}` (missing keys: the defaults above
+/// require_3d_min_frames, require_3d_median_frames, geometry_3d, tolerant_3d.*, fusion_lag_s}` (missing keys: the defaults above
 /// unless the reader requires every key).
 ViewFusionConfig readViewFusionConfig(common::ConfigReader& reader);
 

@@ -408,3 +408,134 @@ TEST(GestureGeometryTest, TheMedianSkeletonRemovesSingleFrameNoiseAndKeepsMissin
   EXPECT_NEAR(gf::gesture::medianSkeleton(two, 0, 1).p_world[gf::gesture::kLeftHip].z(),
               w.at(gf::gesture::kLeftHip).z() + 0.05, 1e-12);
 }
+
+// ---------------------------------------------------------------------------------------
+// GeometryRules::kNetworkTolerant (docs/gestures.md §6): palms, cross and raise as the skeleton
+// network reports them (hands a hand-width apart, wrists named by their image side, a straight arm's
+// elbow bent), and the near-misses of each still outside.
+namespace {
+
+gf::gesture::GestureGeometryNumbers tolerant() {
+  gf::gesture::GestureGeometryNumbers n;
+  n.rules = gf::gesture::GeometryRules::kNetworkTolerant;
+  return n;
+}
+
+PoseVerdict tolerantVerdict(const Worker& w) { return classifyPose3D(w.s, tolerant()); }
+
+/// The two wrists (and elbows) placed independently, in fractions of H (x forward, y left, z up).
+void twoHands(Worker& w, const Vector3d& l_elbow, const Vector3d& l_wrist, const Vector3d& r_elbow, const Vector3d& r_wrist) {
+  w.set(gf::gesture::kLeftElbow, w.H * l_elbow);
+  w.set(gf::gesture::kLeftWrist, w.H * l_wrist);
+  w.set(gf::gesture::kRightElbow, w.H * r_elbow);
+  w.set(gf::gesture::kRightWrist, w.H * r_wrist);
+}
+
+}  // namespace
+
+TEST(GestureGeometryTolerantTest, TheDefaultsAreTheDesignsAndTheTolerantNumbersAreTheTuningSetsChoice) {
+  EXPECT_EQ(gf::gesture::GestureGeometryNumbers{}.rules, gf::gesture::GeometryRules::kDesign);
+  const gf::gesture::TolerantGeometryNumbers t;
+  EXPECT_EQ(t.palms_max_separation_H, 0.13);
+  EXPECT_EQ(t.palms_min_height_H, 0.65);
+  EXPECT_EQ(t.palms_max_height_H, 0.78);
+  EXPECT_EQ(t.tool_max_height_H, 0.61);
+  EXPECT_EQ(t.max_midline_offset_H, 0.10);
+  EXPECT_EQ(t.cross_min_height_H, 0.76);
+  EXPECT_EQ(t.folded_max_height_H, 0.70);
+  EXPECT_EQ(t.raise_min_shoulder_wrist_deg, 145.0);
+  EXPECT_EQ(t.raise_min_elbow_deg, 130.0);
+  EXPECT_EQ(t.reach_max_shoulder_wrist_deg, 130.0);
+  EXPECT_EQ(t.reach_max_elbow_deg, 120.0);
+}
+
+TEST(GestureGeometryTolerantTest, PalmsAHandWidthApartAtMidChestArePalmsTogether) {
+  Worker w;
+  w.hands({0.06, 0.15, 0.71}, {0.22, 0.05, 0.73});  // wrists 0.10 H apart, as MoveNet reports palms
+  EXPECT_EQ(classifyPose3D(w.s).gesture_id, gf::gesture::kNone);  // the design's region: ≤ 0.06 H
+  const PoseVerdict v = tolerantVerdict(w);
+  EXPECT_EQ(v.gesture_id, gf::gesture::kPalmsTogether) << gf::gesture::toString(v.region);
+  w.hands({0.06, 0.15, 0.71}, {0.22, 0.01, 0.73});  // the design's palms stay palms
+  EXPECT_EQ(tolerantVerdict(w).gesture_id, gf::gesture::kPalmsTogether);
+}
+
+TEST(GestureGeometryTolerantTest, ObjectsToolsAndTiltedForearmsAreNotPalmsTogether) {
+  Worker w;
+  w.hands({0.06, 0.15, 0.71}, {0.22, 0.08, 0.73});  // wrists 0.16 H apart: an object held at the chest
+  EXPECT_EQ(tolerantVerdict(w).gesture_id, gf::gesture::kNone);
+  // hands 0.10 H apart at the chest but off to one side (the object held beside the body)
+  twoHands(w, {0.06, 0.20, 0.71}, {0.22, 0.20, 0.73}, {0.06, -0.02, 0.71}, {0.22, 0.10, 0.73});
+  EXPECT_EQ(tolerantVerdict(w).gesture_id, gf::gesture::kNone);
+  w.hands({0.10, 0.15, 0.56}, {0.20, 0.05, 0.72});  // forearms ~45° up
+  EXPECT_EQ(tolerantVerdict(w).gesture_id, gf::gesture::kNone);
+  w.hands({-0.10, 0.15, 0.71}, {-0.04, 0.05, 0.73});  // behind the back
+  EXPECT_EQ(tolerantVerdict(w).gesture_id, gf::gesture::kNone);
+  w.hands({0.02, 0.14, 0.60}, {0.18, 0.05, 0.58});  // a tool held at the waist, hands 0.10 H apart
+  const PoseVerdict tool = tolerantVerdict(w);
+  EXPECT_EQ(tool.gesture_id, gf::gesture::kNone);
+  EXPECT_EQ(tool.region, PoseRegion::kToolAtWaist);
+  w.hands({0.02, 0.14, 0.62}, {0.18, 0.05, 0.63});  // between the waist and mid-chest: the band
+  const PoseVerdict band = tolerantVerdict(w);
+  EXPECT_EQ(band.gesture_id, gf::gesture::kNone);
+  EXPECT_EQ(band.region, PoseRegion::kBand);
+  EXPECT_EQ(band.nearest_gesture, gf::gesture::kPalmsTogether);
+}
+
+TEST(GestureGeometryTolerantTest, HighWristsNearTheMidlineAreCrossArmsWhicheverWristIsNamedLeft) {
+  Worker w;
+  w.hands({0.10, 0.16, 0.70}, {0.17, 0.04, 0.84});  // not crossed as named (the network's sides)
+  EXPECT_EQ(classifyPose3D(w.s).gesture_id, gf::gesture::kNone);
+  EXPECT_EQ(tolerantVerdict(w).gesture_id, gf::gesture::kCrossArms);
+  w.hands({0.10, 0.16, 0.70}, {0.17, -0.04, 0.84});  // crossed: the design's cross stays cross
+  EXPECT_EQ(tolerantVerdict(w).gesture_id, gf::gesture::kCrossArms);
+}
+
+TEST(GestureGeometryTolerantTest, LadderRungsFoldedArmsAndTheBandAreNotCrossArms) {
+  Worker w;
+  w.hands({0.15, 0.17, 0.80}, {0.20, 0.14, 0.94});  // hands on a ladder's rungs: 0.14 H off the midline
+  EXPECT_EQ(tolerantVerdict(w).gesture_id, gf::gesture::kNone);
+  w.hands({0.06, 0.15, 0.58}, {0.12, 0.08, 0.62});  // arms folded low, wrists uncrossed as named
+  const PoseVerdict folded = tolerantVerdict(w);
+  EXPECT_EQ(folded.gesture_id, gf::gesture::kNone);
+  EXPECT_EQ(folded.region, PoseRegion::kArmsFoldedLow);
+  w.hands({0.08, 0.16, 0.64}, {0.15, 0.05, 0.73});  // near the midline at 0.73 H, forearms tilted: the band
+  const PoseVerdict band = tolerantVerdict(w);
+  EXPECT_EQ(band.gesture_id, gf::gesture::kNone);
+  EXPECT_EQ(band.region, PoseRegion::kBand);
+  EXPECT_EQ(band.nearest_gesture, gf::gesture::kCrossArms);
+}
+
+TEST(GestureGeometryTolerantTest, ARaisedArmWithABentReadElbowIsRaiseAReachIsNot) {
+  Worker w;
+  // upper arm 140° from hanging, forearm 170° (beside the head): the elbow reads 150°, the line
+  // shoulder → wrist ~154° — MoveNet's raised arm (§9: upper arm 140°, elbow 152°)
+  const auto dir = [](double deg) { return Vector3d(0.0, std::sin(degToRad(deg)), -std::cos(degToRad(deg))); };
+  w.armDir(true, dir(140.0), dir(170.0));
+  const auto m = gf::gesture::measurePose(w.s);
+  ASSERT_TRUE(m.left.valid);
+  EXPECT_GT(m.left.shoulder_wrist_elevation_deg, 150.0);
+  EXPECT_LT(m.left.shoulder_wrist_elevation_deg, 156.0);
+  EXPECT_EQ(classifyPose3D(w.s).gesture_id, gf::gesture::kNone);  // the design's upper arm ≥ 150°
+  EXPECT_EQ(tolerantVerdict(w).gesture_id, gf::gesture::kRaiseArmUp);
+  // reaching up to a bolt: upper arm 100°, elbow ~117° (§9) -> the line ~125°
+  w.armDir(true, dir(100.0), dir(163.0));
+  const PoseVerdict reach = tolerantVerdict(w);
+  EXPECT_EQ(reach.gesture_id, gf::gesture::kNone);
+  EXPECT_EQ(reach.region, PoseRegion::kReachingUp);
+  // the line at ~138°, elbow ~160°: the band
+  w.armDir(true, dir(130.0), dir(150.0));
+  const PoseVerdict band = tolerantVerdict(w);
+  EXPECT_EQ(band.gesture_id, gf::gesture::kNone);
+  EXPECT_EQ(band.region, PoseRegion::kBand);
+  EXPECT_EQ(band.nearest_gesture, gf::gesture::kRaiseArmUp);
+}
+
+TEST(GestureGeometryTolerantTest, ExtendAndItsNearMissesAreTheDesigns) {
+  Worker w;
+  w.straightArm(true, 90.0, 0.0);
+  EXPECT_EQ(tolerantVerdict(w).gesture_id, gf::gesture::kExtendArmSide);
+  w.straightArm(true, 90.0, 90.0);  // pointing forward
+  EXPECT_EQ(tolerantVerdict(w).gesture_id, gf::gesture::kNone);
+  w.straightArm(true, 40.0, 0.0);  // part-way
+  EXPECT_EQ(tolerantVerdict(w).region, PoseRegion::kArmPartwayOrPointing);
+}

@@ -492,3 +492,58 @@ TEST(ViewFusionRequire3DTest, RequireKeysAreValidatedAndRead) {
   EXPECT_TRUE(gf::gesture::readViewFusionConfig(shipped).require_3d);
   EXPECT_TRUE(shipped.ok()) << shipped.errorReport();
 }
+
+TEST(ViewFusionRequire3DTest, TheNetworkTolerantRulesAreWhatTheCheckTests) {
+  // The generator's palms together with the wrists pulled 0.10 H apart (how MoveNet reports them,
+  // docs/gestures.md §9): refused by the design's region, passed by geometry_3d network_tolerant.
+  SkeletonSynthesizer synth(SynthConfig{}, 12);
+  auto body = synth.pose(Motion::kPalmsTogether, 1.0, 0.0, true);
+  const Eigen::Vector3d ls = body.p[gf::gesture::kLeftShoulder], rs = body.p[gf::gesture::kRightShoulder];
+  const Eigen::Vector3d hips = 0.5 * (body.p[gf::gesture::kLeftHip] + body.p[gf::gesture::kRightHip]);
+  const double H = (0.5 * (ls + rs) - hips).norm() / 0.30;
+  const Eigen::Vector3d y = (ls - rs).normalized();
+  const Eigen::Vector3d mid = 0.5 * (body.p[gf::gesture::kLeftWrist] + body.p[gf::gesture::kRightWrist]);
+  body.p[gf::gesture::kLeftWrist] = mid + 0.05 * H * y;
+  body.p[gf::gesture::kRightWrist] = mid - 0.05 * H * y;
+  gf::gesture::ViewFusionConfig c = require3d(true);
+  const auto design = fuseTwoViews(body, 3, 3, c);
+  EXPECT_EQ(design.gesture_id, 0);
+  EXPECT_TRUE(design.rejected_3d);
+  c.geometry.rules = gf::gesture::GeometryRules::kNetworkTolerant;
+  const auto tolerant = fuseTwoViews(body, 3, 3, c);
+  EXPECT_EQ(tolerant.gesture_id, 3);
+  EXPECT_TRUE(tolerant.checked_3d);
+  EXPECT_FALSE(tolerant.rejected_3d);
+  // A tool at the waist both views misread as palms stays refused under the tolerant rules.
+  const auto tool = fuseTwoViews(synth.pose(Motion::kToolAtWaist, 1.0, 0.0, true), 3, 3, c);
+  EXPECT_EQ(tool.gesture_id, 0);
+  EXPECT_TRUE(tool.rejected_3d);
+}
+
+TEST(ViewFusionRequire3DTest, GeometryKeysAreValidatedAndRead) {
+  gf::gesture::ViewFusionConfig c;
+  EXPECT_EQ(c.geometry.rules, gf::gesture::GeometryRules::kDesign);
+  c.geometry.tolerant.palms_max_separation_H = 0.0;
+  c.geometry.tolerant.folded_max_height_H = 0.8;  // above cross_min_height_H 0.76: no band
+  const auto e = c.validate();
+  ASSERT_EQ(e.size(), 2u);
+  EXPECT_NE(e[0].find("view_fusion.tolerant_3d.palms_max_separation_H"), std::string::npos) << e[0];
+  EXPECT_NE(e[1].find("view_fusion.tolerant_3d.folded_max_height_H"), std::string::npos) << e[1];
+  EXPECT_NE(e[1].find("cross_min_height_H"), std::string::npos) << e[1];
+  using gf::common::ConfigReader;
+  ConfigReader ok = ConfigReader::fromString("view_fusion: {geometry_3d: network_tolerant, tolerant_3d: "
+                                             "{palms_max_separation_H: 0.12, raise_min_shoulder_wrist_deg: 150}}\n",
+                                             "ok.yaml", ConfigReader::MissingKeys::kUseDefaults);
+  const auto read = gf::gesture::readViewFusionConfig(ok);
+  EXPECT_TRUE(ok.ok()) << ok.errorReport();
+  EXPECT_EQ(read.geometry.rules, gf::gesture::GeometryRules::kNetworkTolerant);
+  EXPECT_DOUBLE_EQ(read.geometry.tolerant.palms_max_separation_H, 0.12);
+  EXPECT_DOUBLE_EQ(read.geometry.tolerant.raise_min_shoulder_wrist_deg, 150.0);
+  ConfigReader bad = ConfigReader::fromString("view_fusion: {geometry_3d: lenient, tolerant_3d: {cross_min_height_H: 2}}\n",
+                                              "bad.yaml", ConfigReader::MissingKeys::kUseDefaults);
+  (void)gf::gesture::readViewFusionConfig(bad);
+  EXPECT_FALSE(bad.ok());
+  for (const char* key : {"view_fusion.geometry_3d", "lenient", "view_fusion.tolerant_3d.cross_min_height_H"}) {
+    EXPECT_NE(bad.errorReport().find(key), std::string::npos) << key << " missing in:\n" << bad.errorReport();
+  }
+}
