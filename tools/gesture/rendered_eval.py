@@ -472,8 +472,24 @@ def training_lines(trained):
     return lines
 
 
-def report(protocol, protocol_path, tuning_errors, tuning_eval, heldout_eval, out, load_start, v1_runs=(), trained=()):
-    lines = ["# Gestures on rendered frames through the real networks (protocol version 2)", "",
+def rules_lines(rules):
+    """tools/gesture/geometry_rules.py's JSON: every candidate 3-D rule's share of frames per motion (tuning set)."""
+    motions = sorted(rules["share_of_frames"])
+    names = list(rules["share_of_frames"][motions[0]].keys())
+    lines = [f"Set {rules['set']} (seed {rules['seed']}): the three views' network keypoints triangulated per frame, each frame "
+             f"read on the per-keypoint median of {rules['median_frames']} frames around it, measured in the body frame "
+             "(`tools/gesture/geometry_rules.py`); share of each motion's frames (start to end of the motion) in which the rule "
+             "holds. H = torso / 0.30; heights from the feet (shoulders 0.82 H); \"off\": the wrists' largest distance from the "
+             "body's midline; \"whole\": the line shoulder → wrist from hanging down.", "",
+             "| rule | " + " | ".join(motions) + " |", "|---|" + "---|" * len(motions)]
+    for n in names:
+        lines.append(f"| {n} | " + " | ".join(f"{rules['share_of_frames'][m][n]:.3f}" for m in motions) + " |")
+    return lines
+
+
+def report(protocol, protocol_path, tuning_errors, tuning_eval, heldout_eval, out, load_start, v1_runs=(), trained=(),
+           rules=None, title=None):
+    lines = [f"# {title or 'Gestures on rendered frames through the real networks (protocol version 2)'}", "",
              f"Written by `tools/gesture/rendered_eval.py report` on "
              f"{datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC, commit {he.git('rev-parse', '--short', 'HEAD')}"
              f"{'' if he.git('status', '--porcelain', '--untracked-files=no') == '' else ' (with uncommitted changes)'}; protocol "
@@ -501,6 +517,8 @@ def report(protocol, protocol_path, tuning_errors, tuning_eval, heldout_eval, ou
                   "(least squares, confidence-weighted, as view_triangulation.hpp) and measured as gesture_geometry.hpp "
                   "does (H = torso / 0.30); in brackets the same from the truth keypoints.", ""]
         lines += error_table(tuning_errors) + [""]
+    if rules:
+        lines += ["## Tuning set: candidate 3-D rules, share of frames per motion", ""] + rules_lines(rules) + [""]
     for r in tuning_eval:
         lines += [f"## Tuning set through the chain: {r.get('label', '')}", ""] + eval_lines(r, protocol) + [""]
     for r in heldout_eval:
@@ -532,6 +550,8 @@ def main():
     ap.add_argument("--v1", default=None, help="report: protocol version 1 JSONs (heldout_eval.py) of the same models, "
                     "comma-separated, each as LABEL=PATH")
     ap.add_argument("--trained", default=None, help="report: candidate models' training.json, comma-separated, each as LABEL=PATH")
+    ap.add_argument("--rules", default=None, help="report: tools/gesture/geometry_rules.py's JSON (tuning set)")
+    ap.add_argument("--title", default=None, help="report: the page's title")
     ap.add_argument("--label", default="", help="evaluate: what this run is (model / rule), written into its JSON")
     ap.add_argument("--gfctl")
     ap.add_argument("--set", default=None)
@@ -564,7 +584,7 @@ def main():
                 ap.error(f"--trained {item}: expected LABEL=PATH")
             trained.append((label, path))
         report(protocol, a.protocol, load(a.tuning_errors), loads(a.tuning_eval), loads(a.heldout_eval), out, os.getloadavg(),
-               v1, trained)
+               v1, trained, load(a.rules), a.title)
         print(f"wrote {out}")
         return
     if not a.set:
