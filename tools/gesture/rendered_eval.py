@@ -413,7 +413,9 @@ def eval_lines(r, protocol):
     tg = protocol["targets"]["three_cameras"]
     ok_f = (t["fired_share"] or 0) >= tg["gestures_fired_min"]
     ok_a = t["false_adaptations"] <= tg["false_adaptations_max"]
-    lines = [f"Set {r['set']} (seed {r['seed']}, {r['sequences']} performances × 3 views); model `{r['model']}` sha256 "
+    run = (f"Run {r['date_utc']} UTC at commit {r.get('commit', '?')}, load average "
+           f"{', '.join(f'{x:.2f}' for x in r['load_average'])}. " if r.get("date_utc") and r.get("load_average") else "")
+    lines = [run + f"Set {r['set']} (seed {r['seed']}, {r['sequences']} performances × 3 views); model `{r['model']}` sha256 "
              f"{r['model_sha256'][:16]}…; filter and vote `{r['config']}` sha256 {r['config_sha256'][:16]}…. Worker found "
              "(share of rendered frames, per view): " + ", ".join(f"{k.strip('_')} {pct(v)}" for k, v in r["worker_found_share"].items()) + ".",
              "",
