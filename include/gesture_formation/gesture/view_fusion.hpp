@@ -33,8 +33,9 @@
 ///  - with require_3d (default on), every gesture the vote (or the confirmation) passes is checked in
 ///    3-D whenever two or more calibrated views see the worker in the vote window (an instant at
 ///    which two or more views' skeletons, at most confirm_3d_max_dt_s apart, triangulate): it goes
-///    to the filter only when there are at least require_3d_min_frames such frames and design.md
-///    §2's geometry of that gesture (gesture/gesture_geometry.hpp: palms together at mid-chest with
+///    to the filter only when there are at least require_3d_min_frames such frames and the geometry
+///    of that gesture (gesture/gesture_geometry.hpp, the regions of config.geometry.rules: design.md
+///    §2's, or the network-tolerant ones; for the design's: palms together at mid-chest with
 ///    forearms near horizontal, wrists crossed at or above the shoulders, an arm abducted to the
 ///    side near horizontal, an arm straight up) holds in at least require_3d_min_fraction of them,
 ///    each read on the median of require_3d_median_frames frames around it; otherwise none
