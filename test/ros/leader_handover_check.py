@@ -1,13 +1,17 @@
 #!/usr/bin/env python3
 """Checks the leader hand-over in a running simulation.launch leadership:=true (test/ros/leader_handover.sh).
-usage: leader_handover_check.py
+usage: leader_handover_check.py SOURCE_DIR
 Watches every UAV's latched leadership_state (gesture_formation/LeadershipState). Until SILENCE_AT_S
 UAV 0 must be the only one acting (term 1). Then it unloads /uav0/lcm_bridge (SIGINT to its loader: UAV 0 neither sends
 nor receives on the link) and checks: UAV 0 stops acting within lease_s (+ one tick) of the silence; a
 follower acts within HANDOVER_LIMIT_S; at no instant do two UAVs act (each UAV's acting intervals run
 from the stamp of an acting state to the stamp of its next state, or to the end; a lapsed lease is
 stamped with its end by the nodelet); the new leader's term is newer than 1 and the other follower
-names it as leader. Prints one line per check; exit code = number of failures."""
+names it as leader. Then an operator request (`tools/gf_command.py followers distance_m 1`, through the
+ground station and LCM) is applied by the new leader — acknowledged as applied, its parameters
+published with a newer version than it took over — and reaches the other follower over LCM; UAV 0,
+which no longer acts, publishes no parameters after its lease. Prints one line per check; exit code =
+number of failures."""
 import os
 import re
 import signal
@@ -16,7 +20,7 @@ import sys
 import time
 
 import rospy
-from gesture_formation.msg import LeadershipState
+from gesture_formation.msg import FormationParams, LeadershipState
 
 UAVS = 3
 SILENCE_AT_S = 8.0
@@ -46,9 +50,47 @@ def intervals(states, t_end):
     return out
 
 
+def same_views(a, b):
+    """Two FormationParams with the same views (LCM carries parameters without their version)."""
+    return len(a.uavs) == len(b.uavs) and all(
+        abs(x.beta_deg - y.beta_deg) < 1e-9 and abs(x.gamma_deg - y.gamma_deg) < 1e-9 and abs(x.distance_m - y.distance_m) < 1e-9
+        for x, y in zip(a.uavs, b.uavs))
+
+
+def check_request(src, new, other, published, received, t_silence):
+    """The operator's request after the hand-over: applied by the new leader, on to the other follower."""
+    taken = [m for m in published[new]]
+    check(bool(taken), f"UAV {new} publishes the parameters it took over (version {taken[-1].version if taken else None})")
+    before = taken[-1].version if taken else 0
+    cli = subprocess.run([sys.executable, os.path.join(src, "tools/gf_command.py"), "followers", "distance_m", "1"],
+                         capture_output=True, text=True, timeout=30)
+    out = (cli.stdout + cli.stderr).strip().replace("\n", " | ")
+    check(cli.returncode == 0 and "applied" in cli.stdout, f"tools/gf_command.py: the request acknowledged as applied ('{out[:200]}')")
+    t1 = time.time()
+    while time.time() - t1 < 10:
+        done = [m for m in published[new] if m.version > before and m.last_command_status == "applied"]
+        if done and any(same_views(m, done[0]) for m in received[other]):
+            break
+        time.sleep(0.05)
+    applied = [m for m in published[new] if m.version > before and m.last_command_status == "applied"]
+    check(bool(applied), f"UAV {new} applied it: version {applied[0].version if applied else None} > {before}, "
+          f"'{applied[0].last_command if applied else ''}'")
+    check(bool(applied) and not same_views(applied[0], taken[-1]) and any(same_views(m, applied[0]) for m in received[other]),
+          f"UAV {other} received the new parameters over LCM (followers' distances "
+          f"{[round(u.distance_m, 2) for u in received[other][-1].uavs] if received[other] else None})")
+    late = [m for m in published[0] if m.header.stamp.to_sec() > t_silence + LEASE_S + 0.5]
+    check(not late, f"UAV 0 published no parameters after its lease ({len(late)} did)")
+
+
 def main():
+    src = sys.argv[1]
     rospy.init_node("leader_handover_check", anonymous=True)
     states = {i: [] for i in range(UAVS)}
+    published = {i: [] for i in range(UAVS)}  # each planner's own parameters (formation_params)
+    received = {i: [] for i in range(UAVS)}   # the parameters each LcmBridge received (lcm/formation_params)
+    for i in range(UAVS):
+        rospy.Subscriber(f"/uav{i}/formation_params", FormationParams, lambda m, i=i: published[i].append(m))
+        rospy.Subscriber(f"/uav{i}/lcm/formation_params", FormationParams, lambda m, i=i: received[i].append(m))
     for i in range(UAVS):
         rospy.Subscriber(f"/uav{i}/leadership_state", LeadershipState, lambda m, i=i: states[i].append(m))
     t0 = time.time()
@@ -100,6 +142,8 @@ def main():
         check(bool(states[other]) and states[other][-1].leader == new and states[other][-1].term == term,
               f"UAV {other} follows UAV {new} in term {term} (its last state: leader "
               f"{states[other][-1].leader if states[other] else None}, term {states[other][-1].term if states[other] else None})")
+    if new is not None:
+        check_request(src, new, [i for i in range(1, UAVS) if i != new][0], published, received, t_silence)
     print(f"acting intervals: {iv}", flush=True)
     return fails
 
