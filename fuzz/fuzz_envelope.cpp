@@ -111,6 +111,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         decoder.decode(r.envelope, m);
         break;
       }
+      case MessageType::kLeadership: {
+        formation::LeadershipMessage m;
+        decoder.decode(r.envelope, m);
+        break;
+      }
     }
   }
   GF_FUZZ_ASSERT(verifier.counters().accepted() == accepted.size());

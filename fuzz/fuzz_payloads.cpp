@@ -45,6 +45,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     roundTrip<AssistanceMessage>(payload, n);
     return 0;
   }
+  if (data[0] == 251) {  // (before the leadership payload a worker state, as 251 % 5)
+    roundTrip<formation::LeadershipMessage>(payload, n);
+    return 0;
+  }
   if (data[0] == 253) {  // (before the acknowledgement payload a formation params, as 253 % 5)
     roundTrip<CommandAckMessage>(payload, n);
     return 0;

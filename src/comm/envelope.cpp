@@ -18,6 +18,7 @@ const char* toString(MessageType type) {
     case MessageType::kAbortCommand: return "abort_command";
     case MessageType::kCommandAck: return "command_ack";
     case MessageType::kAssistance: return "assistance";
+    case MessageType::kLeadership: return "leadership";
   }
   return "unknown";
 }

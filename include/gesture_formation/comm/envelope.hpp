@@ -63,11 +63,12 @@ enum class MessageType : std::uint8_t {
   kAbortCommand = 7,
   kCommandAck = 8,
   kAssistance = 9,
+  kLeadership = 10,
 };
 constexpr std::uint8_t kMinMessageType = 1;
-constexpr std::uint8_t kMaxMessageType = 9;
+constexpr std::uint8_t kMaxMessageType = 10;
 /// \brief "heartbeat", "worker_state", "planned_trajectory", "formation_params", "formation_command",
-/// "gesture_observation", "abort_command".
+/// "gesture_observation", "abort_command", "command_ack", "assistance", "leadership".
 const char* toString(MessageType type);
 bool isKnownMessageType(std::uint8_t value);
 
