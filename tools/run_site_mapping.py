@@ -15,7 +15,13 @@ the sections of earlier calls below it, unchanged.
 Evaluation hygiene: seeds 1-5 of both scenarios are the development seeds (they have been looked
 at and the safety rules were worked out on them). Seeds 101-105 of both scenarios (mapping on, and
 no prior map for the construction site) are HELD OUT: they are run once, with the final code, and
-reported beside seeds 1-5; nothing is changed after looking at them.
+reported beside seeds 1-5; nothing is changed after looking at them. They were run once (session 23,
+before map sharing) and have been looked at since: from then on they are development seeds too.
+
+Seeds 106-110 of both scenarios (mapping on, with and without map sharing, and the construction site
+without a prior map) are the NEW held-out set, declared before the map sharing between UAVs
+(mapping.share) was written: they are run once, at the end, with the final code, and reported beside
+the development seeds 1-5 and 101-105; nothing is tuned on them.
 """
 import argparse
 import concurrent.futures
