@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "fuzz_common.hpp"
+#include "gesture_formation/comm/map_update.hpp"
 #include "gesture_formation/comm/payloads.hpp"
 
 using namespace gesture_formation;
@@ -43,6 +44,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   if (data[0] == 252) {  // (before the assistance payload a planned trajectory, as 252 % 5)
     roundTrip<AssistanceMessage>(payload, n);
+    return 0;
+  }
+  if (data[0] == 251) {  // (before the map-update payload a formation command, as 251 % 5)
+    roundTrip<MapUpdate>(payload, n);
     return 0;
   }
   if (data[0] == 253) {  // (before the acknowledgement payload a formation params, as 253 % 5)

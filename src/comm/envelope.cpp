@@ -18,11 +18,14 @@ const char* toString(MessageType type) {
     case MessageType::kAbortCommand: return "abort_command";
     case MessageType::kCommandAck: return "command_ack";
     case MessageType::kAssistance: return "assistance";
+    case MessageType::kMapUpdate: return "map_update";
   }
   return "unknown";
 }
 
-bool isKnownMessageType(std::uint8_t value) { return value >= kMinMessageType && value <= kMaxMessageType; }
+bool isKnownMessageType(std::uint8_t value) {
+  return value >= kMinMessageType && value <= kMaxMessageType && value != 10;  // 10: not on this branch
+}
 
 const char* toString(EnvelopeError e) {
   switch (e) {

@@ -84,6 +84,8 @@ InboxItem LinkInbox::decodeOne(const Envelope& e) {
       if (decoder_.decode(e, a)) return a;  // every copy: the state is idempotent
       return {};
     }
+    case MessageType::kMapUpdate:
+      return {};  // not an inbox item: map updates go to the live map (docs/mapping.md §8)
   }
   return {};
 }
