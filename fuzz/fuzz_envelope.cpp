@@ -112,6 +112,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         decoder.decode(r.envelope, m);
         break;
       }
+      case MessageType::kLeadership: {
+        formation::LeadershipMessage m;
+        decoder.decode(r.envelope, m);
+        break;
+      }
       case MessageType::kMapUpdate: {
         MapUpdate m;
         decoder.decode(r.envelope, m);

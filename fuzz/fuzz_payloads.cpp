@@ -46,7 +46,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     roundTrip<AssistanceMessage>(payload, n);
     return 0;
   }
-  if (data[0] == 251) {  // (before the map-update payload a formation command, as 251 % 5)
+  if (data[0] == 251) {  // (before the leadership payload a worker state, as 251 % 5)
+    roundTrip<formation::LeadershipMessage>(payload, n);
+    return 0;
+  }
+  if (data[0] == 250) {  // (before the map-update payload a heartbeat, as 250 % 5)
     roundTrip<MapUpdate>(payload, n);
     return 0;
   }

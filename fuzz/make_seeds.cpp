@@ -2,6 +2,7 @@
 // (fuzz/corpus/<target>/seed_*). Run by tools/fuzz/run_fuzzers.sh --seeds.
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -77,7 +78,7 @@ int main(int argc, char** argv) {
   map_update.delta.resolution_m = 0.2;
   map_update.delta.occupied = {{{32800, 32790, 32770}}, {{32801, 32790, 32770}}};
   map_update.delta.free = {{{32760, 32770, 32771}}};
-  write(dir + "/payloads/seed_map_update", withPrefix(251, encodePayload(map_update).value()));
+  write(dir + "/payloads/seed_map_update", withPrefix(250, encodePayload(map_update).value()));
   KeyEntry k;
   k.id = 2;
   k.key = gf_fuzz::fuzzKey(2);
@@ -89,6 +90,27 @@ int main(int argc, char** argv) {
     std::vector<std::uint8_t> script{0x00, 0x00, 0x00};
     script.insert(script.end(), sealed.begin(), sealed.end());
     write(dir + "/envelope/seed_" + std::to_string(i), script);
+  }
+  // The leadership payload (prefix 251): a vote request with its estimate age, and a granted reply.
+  formation::LeadershipMessage vote;
+  vote.kind = formation::LeadershipMessageKind::kVoteRequest;
+  vote.term = 2;
+  vote.from = 1;
+  vote.sent_s = 61.5;
+  vote.estimate_age_s = 0.2;
+  formation::LeadershipMessage reply = vote;
+  reply.kind = formation::LeadershipMessageKind::kVoteReply;
+  reply.from = 2;
+  reply.to = 1;
+  reply.echo_s = 61.5;
+  reply.granted = true;
+  reply.estimate_age_s = std::numeric_limits<double>::infinity();
+  int k_lead = 0;
+  for (const auto& m : {vote, reply}) {
+    const auto b = encodePayload(m).value();
+    write(dir + "/payloads/seed_leadership_" + std::to_string(k_lead), withPrefix(251, b));
+    const auto sealed = signer.seal(MessageType::kLeadership, b, 100.0).value();
+    write(dir + "/lcm_envelope/seed_leadership_" + std::to_string(k_lead++), lcm_bridge::encodeLcmEnvelope(sealed));
   }
   return 0;
 }

@@ -5,7 +5,13 @@
 // received plans (planning::buildPlanRequest) and the verified plan or its fallback (flagged
 // `fallback`: every other UAV plans around it). The leader's instance also owns the formation's
 // parameters (onboard::FormationParamsRole): commands arrive on formation_command_in (gestures,
-// operator over LCM), the parameters go out on formation_params_out.
+// operator over LCM), the parameters go out on formation_params_out. With ~leadership true (optional,
+// default false) the parameter role follows this UAV's own leadership_state_in (LeadershipState, the
+// Leadership nodelet; docs/safety.md §1.2) instead of its index: every UAV subscribes to commands and
+// parameters; while it acts it applies commands sent since it took over and publishes parameters,
+// acknowledgements and the assistance state; when it starts acting it takes over the parameters and
+// their version from the last ones it received; while it does not act it drops commands and takes
+// the parameters it receives.
 //
 // Topics: odometry_in (nav_msgs/Odometry, orientation = camera axis, docs/ros.md),
 //   worker_state_in (WorkerState: the leader's estimator, or the leader's share over LCM),
@@ -37,6 +43,7 @@
 #include "config_sources.hpp"
 #include "conversions.hpp"
 #include "diagnostics.hpp"
+#include "gesture_formation/LeadershipState.h"
 #include "gesture_formation/onboard/formation_params_role.hpp"
 #include "gesture_formation/onboard/frame_check.hpp"
 #include "gesture_formation/planning/replan_health.hpp"
@@ -59,6 +66,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     params.load("max_wind_estimate_age_s", max_wind_age_s_, 0.1, 60.0);
     double params_rate_hz = 0.0;
     params.load("params_rate_hz", params_rate_hz, 0.1, 50.0);
+    getPrivateNodeHandle().param("leadership", leadership_, false);  // optional: see the file comment
     PlannerSettings settings;  // from ~mission_file (simulation) or the parameters (config_sources.hpp)
     loadPlannerSettings(getPrivateNodeHandle(), params, mission_file, settings);
     const formation::FormationConfig& fcfg = settings.formation;
@@ -77,6 +85,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     }
     NODELET_INFO_STREAM("FormationPlanner (UAV " << uav_index_ << ") loaded:\n" << params.loaded());
     role_.emplace(fcfg, uav_index_);  // the config was validated by its loader
+    fcfg_ = fcfg;
     rc.uav_index = uav_index_;
     rc.uav_count = uav_count_;
     rc.worker_heading = fcfg.worker_heading;
@@ -95,24 +104,61 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     abort_sub_ = nh.subscribe("abort_in", 20, &FormationPlannerNodelet::onAbort, this);
     abort_pub_ = nh.advertise<gesture_formation::AbortState>("abort_state_out", 5, true);
     abort_pub_.publish(toAbortState(step_->abort(), uav_index_, ros::Time::now().toSec(), "", -1, world_frame_));
-    if (uav_index_ == formation::kLeader) {
-      params_pub_ = nh.advertise<gesture_formation::FormationParams>("formation_params_out", 5, true);
-      command_sub_ = nh.subscribe("formation_command_in", 20, &FormationPlannerNodelet::onCommand, this);
-      ack_pub_ = nh.advertise<gesture_formation::CommandAck>("command_ack_out", 20);
-      assistance_pub_ = nh.advertise<gesture_formation::AssistanceState>("assistance_state_out", 5, true);
-      assistance_pub_.publish(toMsg(role_->assistance().state(), ros::Time::now()));
-      assistance_sub_ = nh.subscribe("assistance_in", 20, &FormationPlannerNodelet::onAssistance, this);
-      params_timer_ = nh.createTimer(ros::Duration(1.0 / params_rate_hz), [this](const ros::TimerEvent&) {
-        std::lock_guard<std::mutex> lock(mutex_);
-        publishParams();
-      });
-    } else {
-      params_sub_ = nh.subscribe("formation_params_in", 5, &FormationPlannerNodelet::onParams, this);
-    }
+    setUpParamsRole(nh, params_rate_hz);
     // Staggered replanning: UAV i plans at k·period + i·period/n (as in gfctl simulate).
     offset_s_ = period_s_ * uav_index_ / uav_count_;
     timer_ = nh.createTimer(ros::Duration(period_s_ / 8.0), &FormationPlannerNodelet::onTimer, this);
     diagnostics_.start(nh, 1.0, [this](double since_s) { return health(since_s); });
+  }
+
+  /// The parameter role's topics: the leader by index, or (~leadership) every UAV, its role following
+  /// its leadership_state_in.
+  void setUpParamsRole(ros::NodeHandle& nh, double params_rate_hz) {
+    if (uav_index_ == formation::kLeader || leadership_) {
+      params_pub_ = nh.advertise<gesture_formation::FormationParams>("formation_params_out", 5, true);
+      command_sub_ = nh.subscribe("formation_command_in", 20, &FormationPlannerNodelet::onCommand, this);
+      ack_pub_ = nh.advertise<gesture_formation::CommandAck>("command_ack_out", 20);
+      assistance_pub_ = nh.advertise<gesture_formation::AssistanceState>("assistance_state_out", 5, true);
+      if (owns()) assistance_pub_.publish(toMsg(role_->assistance().state(), ros::Time::now()));
+      assistance_sub_ = nh.subscribe("assistance_in", 20, &FormationPlannerNodelet::onAssistance, this);
+      params_timer_ = nh.createTimer(ros::Duration(1.0 / params_rate_hz), [this](const ros::TimerEvent&) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (owns()) publishParams();
+      });
+    }
+    if (uav_index_ != formation::kLeader || leadership_) {
+      params_sub_ = nh.subscribe("formation_params_in", 5, &FormationPlannerNodelet::onParams, this);
+    }
+    if (leadership_) {
+      leadership_sub_ = nh.subscribe("leadership_state_in", 5, &FormationPlannerNodelet::onLeadership, this);
+    }
+  }
+  /// The parameter owner: the leader by index, or with ~leadership the UAV while it acts.
+  bool owns() const { return leadership_ ? acting_ : uav_index_ == formation::kLeader; }
+
+  // This UAV's leadership view (~leadership): starting to act, it takes the parameters over.
+  void onLeadership(const gesture_formation::LeadershipState::ConstPtr& msg) {
+    if (msg->uav_index != uav_index_) return;
+    std::lock_guard<std::mutex> lock(mutex_);
+    const bool was = acting_;
+    acting_ = msg->acting;
+    if (acting_ == was) return;
+    if (!acting_) {
+      NODELET_WARN_STREAM("FormationPlanner UAV " << uav_index_ << ": no longer acts as leader (term " << msg->term
+                                                  << "): parameters from the leader from now on");
+      return;
+    }
+    // The parameters and their version as last received (or held); commands from now on.
+    formation::FormationConfig cfg = fcfg_;
+    cfg.params = role_->params();
+    base_version_ = version();
+    role_.emplace(cfg, formation::kLeader);
+    took_over_s_ = msg->header.stamp.toSec();
+    NODELET_WARN_STREAM("FormationPlanner UAV " << uav_index_ << ": acts as leader (term " << msg->term << ") from t = "
+                                                << took_over_s_ << " s: parameters version " << base_version_
+                                                << " taken over; commands sent from now on applied");
+    publishParams();
+    assistance_pub_.publish(toMsg(role_->assistance().state(), ros::Time::now()));
   }
 
   void onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
@@ -156,20 +202,26 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   void onParams(const gesture_formation::FormationParams::ConstPtr& msg) {
     auto p = fromMsg(*msg);
     std::lock_guard<std::mutex> lock(mutex_);
+    if (owns()) return;  // ~leadership: the acting UAV's own parameters are the formation's
+    base_version_ = 0;   // the received version is the formation's
     const auto r = p ? role_->receive(*p, msg->version) : common::Result<bool>::fail(p.reason());
     if (!r) NODELET_WARN_STREAM_THROTTLE(1.0, "FormationPlanner: formation parameters dropped: " << r.reason());
   }
   void onCommand(const gesture_formation::FormationCommand::ConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
+    // ~leadership: only the acting UAV applies, and only what was sent since it took over (older
+    // ones were its predecessor's: the parameters it took over carry those it applied).
+    if (!owns() || (leadership_ && msg->header.stamp.toSec() < took_over_s_)) return;
     const auto& r = role_->apply(fromMsg(*msg), describe(*msg), msg->source, msg->header.stamp.toSec());
     NODELET_INFO_STREAM("FormationPlanner: command " << r.text << " → " << r.outcome);
     publishParams();
-    ack_pub_.publish(toAck(*msg, r.status, r.outcome, role_->version(), ros::Time::now()));  // to the operator
+    ack_pub_.publish(toAck(*msg, r.status, r.outcome, version(), ros::Time::now()));  // to the operator
   }
   // The worker's request (GestureCommander) or the operator's acknowledgement (over LCM) → the latch.
   void onAssistance(const gesture_formation::AssistanceState::ConstPtr& m) {
     auto state = fromMsg(*m);
     std::lock_guard<std::mutex> lock(mutex_);
+    if (!owns()) return;  // ~leadership: the acting UAV's latch
     auto& latch = role_->assistance();
     if (!state || !latch.receive(*state)) return;
     NODELET_WARN_STREAM("FormationPlanner: assistance " << formation::toString(latch.state().phase) << " (requested at "
@@ -177,7 +229,13 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
                                                         << "; the worker's gestures are refused while requested)");
     assistance_pub_.publish(toMsg(latch.state(), ros::Time::now()));
   }
-  void publishParams() { params_pub_.publish(toMsg(*role_, ros::Time::now(), world_frame_)); }
+  void publishParams() {
+    auto m = toMsg(*role_, ros::Time::now(), world_frame_);
+    m.version = version();
+    params_pub_.publish(m);
+  }
+  /// The parameters' version: the role's, after a take-over counted on from the version taken over.
+  std::uint64_t version() const { return base_version_ + role_->version(); }
 
   // Every copy of an abort (operator over LCM, the leader's relay, the gesture commander): the
   // ReplanStep accepts the first that is fresh enough (planning::AbortPlanner::receive).
@@ -250,7 +308,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
                                                    << " QP solve(s) stopped (deadline qp.solve_timeout_s, or ProxQP's "
                                                    << "sparse solver broke an invariant: dense backend; docs/safety.md 4.5)");
     }
-    const auto msg = toMsg(out, uav_index_, t, role_->params(), role_->version(), world_frame_);
+    const auto msg = toMsg(out, uav_index_, t, role_->params(), version(), world_frame_);
     plan_pub_.publish(msg);
     traj_pub_.publish(toMultiDof(msg, "uav" + std::to_string(uav_index_)));
   }
@@ -282,6 +340,10 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   std::optional<Eigen::Vector3d> wind_;
   std::uint64_t wind_rejected_ = 0;
   std::optional<onboard::FormationParamsRole> role_;  ///< the leader's parameters and commands, or the received ones
+  formation::FormationConfig fcfg_;  ///< ~leadership: a take-over's role starts from it (with the parameters held)
+  bool leadership_ = false, acting_ = false;  ///< ~leadership; this UAV acts (its leadership_state)
+  std::uint64_t base_version_ = 0;  ///< ~leadership: the version taken over (0: the role's own)
+  double took_over_s_ = 0.0;        ///< ~leadership: when this UAV last started acting
   std::string mode_ = "track";             ///< track | hold | search | abort (logged on change)
   WorldMap world_;  ///< the map and field the planner and the abort's goal search use
   std::unique_ptr<planning::ReplanStep> step_;  ///< planner, hold / search, listening (shared with gfctl simulate)
@@ -290,7 +352,8 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   std::vector<std::optional<planning::ReceivedPlan>> received_;  ///< by sender; [0] the leader's plan
   int abort_link_sender_ = -1;  ///< who delivered the accepted abort (LCM sender id; -1: ROS)
   ros::Publisher plan_pub_, traj_pub_, params_pub_, abort_pub_, ack_pub_, assistance_pub_;
-  ros::Subscriber odom_sub_, worker_sub_, plans_sub_, params_sub_, command_sub_, wind_sub_, abort_sub_, assistance_sub_;
+  ros::Subscriber odom_sub_, worker_sub_, plans_sub_, params_sub_, command_sub_, wind_sub_, abort_sub_, assistance_sub_,
+      leadership_sub_;
   ros::Timer timer_, params_timer_;
 };
 

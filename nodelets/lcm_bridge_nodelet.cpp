@@ -4,7 +4,9 @@
 // fallback flag in a heartbeat sent just before), parameters, gesture observations, aborts (as they
 // come; the leader's accepted abort after every share), and single events repeated like a command
 // (~command_repeats copies, comm::OutgoingRepeats): commands, the leader's acknowledgements and
-// assistance state (also with every share while requested), the ground's acknowledgement of it.
+// assistance state (also with every share while requested), the ground's acknowledgement of it;
+// leadership messages as they come (leadership_in → LCM, LCM → leadership_out: every one from a
+// UAV speaking for itself; docs/safety.md §1.2).
 // LCM → ROS: what each envelope yields (comm::LinkInbox: first copy of each command / ack id, every
 // abort and assistance copy). Start-up (keys, boot counter, high-water marks, verifier):
 // lcm_bridge::startLink; stamps use ROS time (sim time in simulation). Diagnostics: /diagnostics at
@@ -21,6 +23,7 @@
 
 #include "conversions.hpp"
 #include "diagnostics.hpp"
+#include "leadership_conversions.hpp"
 #include "gesture_formation/comm/link_inbox.hpp"
 #include "gesture_formation/comm/outgoing_repeats.hpp"
 #include "gesture_formation/comm/sequence_store.hpp"
@@ -95,6 +98,11 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     abort_pub_ = nh.advertise<gesture_formation::AbortCommand>("abort_out", 100);
     abort_sub_ = nh.subscribe("abort_in", 100, &LcmBridgeNodelet::onAbort, this);
     relay_sub_ = nh.subscribe("abort_relay_in", 5, &LcmBridgeNodelet::onAbortState, this);
+    leadership_pub_ = nh.advertise<gesture_formation::LeadershipMessage>("leadership_out", 100);
+    leadership_sub_ = nh.subscribe<gesture_formation::LeadershipMessage>(
+        "leadership_in", 100, [this](const gesture_formation::LeadershipMessage::ConstPtr& m) {
+          sendChecked(fromMsg(*m), "leadership message");
+        });
     // Single events, sent now and repeated like a command: the operator's and gestures' commands,
     // the leader's acknowledgements, the leader's assistance state (also re-sent with every worker
     // state while requested) and the ground station's acknowledgement of it.
@@ -230,6 +238,8 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
       abort_pub_.publish(toMsg(*a, e.sender_id));  // every copy: the UAV acts on the first it accepts
     } else if (const auto* s = std::get_if<comm::AssistanceMessage>(&item)) {
       assistance_pub_.publish(toMsg(s->state, ros::Time(e.stamp_s)));
+    } else if (const auto* l = std::get_if<formation::LeadershipMessage>(&item)) {
+      leadership_pub_.publish(toMsg(*l));
     } else if (const auto* k = std::get_if<comm::CommandAckMessage>(&item)) {
       auto m = fromWire(*k);
       m.header.stamp = ros::Time(e.stamp_s);
@@ -279,8 +289,10 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
   static constexpr int kMaxDrainPerTick = 2000;
   lcm_bridge::HighWaterMarkSaver marks_;  ///< high_water_file, saved when the marks changed
   std::optional<comm::RejectionReport> report_;  ///< /diagnostics: counts and refusals since the last report
-  ros::Publisher worker_pub_, plans_pub_, params_pub_, command_pub_, observations_pub_, abort_pub_, ack_pub_, assistance_pub_;
-  ros::Subscriber worker_sub_, plan_sub_, params_sub_, command_sub_, observation_sub_, abort_sub_, relay_sub_, ack_sub_, assistance_sub_;
+  ros::Publisher worker_pub_, plans_pub_, params_pub_, command_pub_, observations_pub_, abort_pub_, ack_pub_, assistance_pub_,
+      leadership_pub_;
+  ros::Subscriber worker_sub_, plan_sub_, params_sub_, command_sub_, observation_sub_, abort_sub_, relay_sub_, ack_sub_, assistance_sub_,
+      leadership_sub_;
   ros::WallTimer drain_timer_;
   DiagnosticsPublisher diagnostics_;  ///< /diagnostics every wall second (also saves the high-water marks)
   ros::Timer heartbeat_timer_, repeat_timer_;

@@ -11,11 +11,15 @@
 //   gesture_out (Gesture, one per image with a full skeleton window: this UAV's classifier output,
 //   the ViewObserver's input; with the image's skeleton and camera info once camera_info_in has
 //   delivered, for the formation's 3-D confirmation).
+//   candidates_out (WorkerCandidates, each detection round: the people the operator can choose from).
+// Service ~select_worker (SelectWorker): the operator chooses the worker by an image point or a
+//   candidate index; the tracker then keeps that person (appearance + geometry) and never takes
+//   another one by itself until ~select_worker unlock (docs/perception.md "Choosing the worker").
 // Parameters (required): ~models_root (third_party_models), ~gesture_model (the LSTM's .onnx),
 //   ~detector (movenet_multipose | blazepose), ~skeleton (movenet_lightning | blazepose_landmark),
-//   ~detect_every_k, ~min_depth_m, ~max_depth_m, ~depth_scale_m, ~max_depth_dt_s
+//   ~detect_every_k, ~appearance (true: identity kept by the worker's colours too), ~min_depth_m, ~max_depth_m, ~depth_scale_m, ~max_depth_dt_s
 //   (a depth image further than this from the colour image's stamp is not used; the nodelet keeps the
-//   last kDepthBuffer depth images and uses the one nearest the colour image's stamp — the two
+//   last DepthBuffer::kSize depth images and uses the one nearest the colour image's stamp — the two
 //   topics are not delivered in order, and a colour image processed late must still find its depth).
 // Optional: ~dnn_device (cpu): where the networks run — cpu, opencl, opencl_fp16, cuda, cuda_fp16
 //   (refused at start, naming what this OpenCV can use, when it cannot run there).
@@ -26,10 +30,7 @@
 //   plugin is not installed is refused at start, naming the ones that are).
 // /diagnostics: `Perception`: images per second, found, gestures, images refused, the last image's age.
 #include <algorithm>
-#include <chrono>
 #include <cmath>
-#include <condition_variable>
-#include <deque>
 #include <mutex>
 #include <optional>
 
@@ -47,7 +48,9 @@
 #include "gesture_formation/gesture/gesture_classifier.hpp"
 #include "gesture_formation/perception/perception_pipeline.hpp"
 #include "gesture_formation/perception/worker_tracker.hpp"
+#include "depth_buffer.hpp"
 #include "param_loader.hpp"
+#include "worker_choice.hpp"
 
 namespace gesture_formation::nodelets {
 
@@ -65,11 +68,14 @@ class PerceptionNodelet : public nodelet::Nodelet {
     // One range per setting: the core's tables.
     params.load("detect_every_k", cfg.tracker.detect_every_k,
                 *perception::workerTrackerFields().rangeOf("tracker.detect_every_k"));
+    bool appearance = true;
+    params.load("appearance", appearance);
+    cfg.tracker.appearance.enabled = appearance ? 1 : 0;
     const auto& stereo = estimation::stereoDistanceFields();
     params.load("min_depth_m", stereo_.min_depth_m, *stereo.rangeOf("min_depth_m"));
     params.load("max_depth_m", stereo_.max_depth_m, *stereo.rangeOf("max_depth_m"));
     params.load("depth_scale_m", stereo_.depth_scale_m, *stereo.rangeOf("depth_scale_m"));
-    params.load("max_depth_dt_s", max_depth_dt_s_, 0.0, 1.0);
+    params.load("max_depth_dt_s", depths_.max_dt_s, 0.0, 1.0);
     std::string dnn_device;
     params.loadOptional("dnn_device", dnn_device, "cpu");
     if (const auto d = perception::parseDnnDevice(dnn_device)) cfg.dnn_device = *d;
@@ -102,6 +108,8 @@ class PerceptionNodelet : public nodelet::Nodelet {
     NODELET_INFO_STREAM("Perception loaded:\n" << params.loaded());
     detection_pub_ = nh.advertise<gesture_formation::WorkerDetection>("detection_out", 10);
     gesture_pub_ = nh.advertise<gesture_formation::Gesture>("gesture_out", 10);
+    candidates_pub_ = nh.advertise<gesture_formation::WorkerCandidates>("candidates_out", 2);
+    select_srv_ = getPrivateNodeHandle().advertiseService("select_worker", &PerceptionNodelet::onSelectWorker, this);
     info_sub_ = nh.subscribe<sensor_msgs::CameraInfo>("camera_info_in", 2, [this](const sensor_msgs::CameraInfo::ConstPtr& m) {
       auto k = toIntrinsics(*m);
       std::lock_guard<std::mutex> lock(mutex_);
@@ -153,10 +161,7 @@ class PerceptionNodelet : public nodelet::Nodelet {
   }
 
   void onDepth(const sensor_msgs::Image::ConstPtr& m) {
-    std::lock_guard<std::mutex> lock(depth_mutex_);
-    depths_.push_back(m);
-    while (depths_.size() > kDepthBuffer) depths_.pop_front();
-    depth_arrived_.notify_all();
+    depths_.add(m);
   }
 
   /// A colour image, raw (sensor_msgs/Image) or compressed (sensor_msgs/CompressedImage).
@@ -197,6 +202,9 @@ class PerceptionNodelet : public nodelet::Nodelet {
       NODELET_WARN_STREAM_THROTTLE(5.0, "Perception: " << frame.reason());
       return;
     }
+    if (frame->track.detector_ran) {
+      candidates_pub_.publish(toCandidates(header, ++candidate_round_, frame->track, pipeline_->tracker().locked()));
+    }
     gesture_formation::WorkerDetection d;
     d.header = header;
     d.detected = frame->track.found;
@@ -212,7 +220,7 @@ class PerceptionNodelet : public nodelet::Nodelet {
       if (t.identity_changed) last_score_ = 0.0f;
       if (t.worker_detection >= 0) last_score_ = t.detections[static_cast<std::size_t>(t.worker_detection)].score;
       d.confidence = last_score_;
-      const sensor_msgs::Image::ConstPtr depth_msg = nearestDepth(header.stamp);
+      const sensor_msgs::Image::ConstPtr depth_msg = depths_.nearest(header.stamp);
       if (depth_msg && camera_) {
         auto depth = toDepth(*depth_msg);
         const estimation::Box box{d.u, d.v, d.w, d.h};
@@ -244,49 +252,31 @@ class PerceptionNodelet : public nodelet::Nodelet {
     ++gestures_since_report_;
   }
 
+  bool onSelectWorker(gesture_formation::SelectWorker::Request& req, gesture_formation::SelectWorker::Response& res) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (pipeline_) res = selectWorker(pipeline_->tracker(), req, candidate_round_);
+    else res.message = "perception is not running";
+    if (res.accepted) NODELET_INFO_STREAM("Perception: " << res.message);
+    return true;
+  }
+
   std::mutex mutex_;
   std::unique_ptr<perception::PerceptionPipeline> pipeline_;
   std::optional<gesture::GestureClassifier> classifier_;
   estimation::StereoDistanceConfig stereo_;
-  /// The stored depth image nearest `stamp`, if within max_depth_dt_s (else null). When none is
-  /// stored and no depth image newer than `stamp` has arrived yet, its depth image may still be in
-  /// flight (the topics are not ordered): wait for it, at most max_depth_dt_s of wall time.
-  sensor_msgs::Image::ConstPtr nearestDepth(const ros::Time& stamp) {
-    std::unique_lock<std::mutex> lock(depth_mutex_);
-    const auto nearest = [&]() {
-      sensor_msgs::Image::ConstPtr best;
-      double best_dt = max_depth_dt_s_;
-      for (const auto& d : depths_) {
-        const double dt = std::abs((d->header.stamp - stamp).toSec());
-        if (dt <= best_dt) {
-          best_dt = dt;
-          best = d;
-        }
-      }
-      return best;
-    };
-    const auto settled = [&]() { return nearest() || (!depths_.empty() && depths_.back()->header.stamp > stamp); };
-    if (!depths_.empty()) {  // no depth stream at all: do not wait
-      depth_arrived_.wait_for(lock, std::chrono::duration<double>(max_depth_dt_s_), settled);
-    }
-    return nearest();
-  }
-
-  static constexpr std::size_t kDepthBuffer = 10;  ///< depth images kept (≥ 0.3 s at 30 Hz)
-  double max_depth_dt_s_ = 0.0;
+  DepthBuffer depths_;  ///< the last depth images (depth_in)
   float last_score_ = 0.0f;
   std::optional<estimation::CameraModel> camera_;
   std::optional<sensor_msgs::CameraInfo> camera_info_;  ///< the last usable one (its intrinsics are camera_'s)
-  std::mutex depth_mutex_;                         ///< guards depths_ only
-  std::condition_variable depth_arrived_;
-  std::deque<sensor_msgs::Image::ConstPtr> depths_;  ///< the last kDepthBuffer depth images
   std::string image_transport_, depth_transport_;
   bool decode_compressed_ = false;  ///< image_transport compressed without its plugin: decoded here
   int images_since_report_ = 0, found_since_report_ = 0, gestures_since_report_ = 0, refused_since_report_ = 0;
   ros::Time last_image_;
   DiagnosticsPublisher diagnostics_;
   std::optional<image_transport::ImageTransport> image_it_, depth_it_;
-  ros::Publisher detection_pub_, gesture_pub_;
+  std::uint32_t candidate_round_ = 0;  ///< detection rounds published on candidates_out
+  ros::ServiceServer select_srv_;
+  ros::Publisher detection_pub_, gesture_pub_, candidates_pub_;
   ros::Subscriber info_sub_, compressed_sub_;
   image_transport::Subscriber depth_sub_, image_sub_;
 };

@@ -80,6 +80,21 @@ inline sim::PlanReport toPlanReport(int uav, const gesture_formation::PlannedTra
   return r;
 }
 /// The leader's published parameters for the world's record.
+/// One UAV's abort state as the world's record takes it (phase nullopt: PHASE_NONE or unknown).
+inline sim::AbortReport toAbortReport(int uav, const gesture_formation::AbortState& m) {
+  sim::AbortReport r;
+  r.uav = uav;
+  r.t_s = m.header.stamp.toSec();
+  r.accepted_s = m.accepted_at.toSec();
+  r.source = m.command.source == gesture_formation::AbortCommand::SOURCE_GESTURE ? planning::AbortSource::kGesture
+                                                                                : planning::AbortSource::kOperator;
+  using P = planning::AbortPhase;
+  for (P p : {P::kRetreat, P::kAtRetreat, P::kReturnHome, P::kAtHome, P::kLanding, P::kLanded, P::kNoGoal}) {
+    if (toMsgPhase(p) == m.phase) r.phase = p;
+  }
+  return r;
+}
+
 inline sim::ParamsReport toParamsReport(const gesture_formation::FormationParams& m) {
   sim::ParamsReport r;
   if (auto p = fromMsg(m)) r.params = std::move(*p);

@@ -2,8 +2,10 @@
 // parameters: docs/ros.md "SimWorld"): sim time (/clock, started when every UAV's planner is up), the
 // worker (sim::WorkerModel), the cameras (sim::LeaderCamera: box, stereo and UWB with the mission's
 // sensor faults; each UAV's classification from its actual viewpoint, as its Perception nodelet
-// would publish it), the scheduled operator requests, and the record (sim::WorldRecord: metrics
-// of docs/simulation.md §4, plans, modes, command outcomes, the files at the end). ~camera rendered:
+// would publish it), the scheduled operator requests, faults.abort (asked of the ground station's
+// OperatorInterface at its time, send_abort, as an operator does), and the record (sim::WorldRecord:
+// metrics of docs/simulation.md §4, plans, modes, command outcomes, every UAV's abort_state, the
+// files at the end). ~camera rendered:
 // SimCamera nodelets render the worker's body (worker_body_out) for the Perception nodelets, no
 // detection or classification comes from here; the leader's detections (detection_in) feed the metrics.
 #include <algorithm>
@@ -20,6 +22,7 @@
 #include "sim_config_sources.hpp"
 #include "sim_conversions.hpp"
 #include "gesture_formation/GestureStatus.h"
+#include "gesture_formation/SendAbort.h"
 #include "gesture_formation/formation/worker_heading.hpp"
 #include "gesture_formation/sim/leader_camera.hpp"
 #include "gesture_formation/sim/random.hpp"
@@ -99,7 +102,14 @@ class SimWorldNodelet : public nodelet::Nodelet {
             }
             record_->plan(toPlanReport(i, *m, *status));
           }));
+      abort_subs_.push_back(nh.subscribe<gesture_formation::AbortState>(
+          "uav" + std::to_string(i) + "/abort_state", 10, [this, i](const gesture_formation::AbortState::ConstPtr& m) {
+            std::lock_guard<std::mutex> lock(mutex_);
+            if (!finished_) record_->abortState(toAbortReport(i, *m));
+          }));
     }
+    // faults.abort: asked of the ground station's OperatorInterface as an operator does.
+    abort_client_ = nh.serviceClient<gesture_formation::SendAbort>("send_abort");
     params_sub_ = nh.subscribe("leader_params_in", 20, &SimWorldNodelet::onParams, this);
     estimate_sub_ = nh.subscribe<gesture_formation::WorkerState>(
         "worker_estimate_in", 10, [this](const gesture_formation::WorkerState::ConstPtr& m) {
@@ -149,8 +159,26 @@ class SimWorldNodelet : public nodelet::Nodelet {
   }
 
   void onClock(const ros::WallTimerEvent&) {
+    if (tick()) requestAbort();  // outside the lock: the service call waits for the OperatorInterface
+  }
+
+  /// faults.abort at its time: the operator's abort through the OperatorInterface's send_abort (it
+  /// numbers the command and has the ground station's LcmBridge send its copies to every UAV).
+  void requestAbort() {
+    gesture_formation::SendAbort srv;
+    if (!abort_client_.call(srv) || !srv.response.accepted) {
+      NODELET_ERROR_STREAM("SimWorld: faults.abort: send_abort failed" << (abort_client_.exists() ? ": " : " (no service)")
+                                                                    << srv.response.message);
+      return;
+    }
+    NODELET_WARN_STREAM("SimWorld: faults.abort: the operator's abort #" << srv.response.sequence << " sent at t = " << t_
+                                                                         << " s (" << srv.response.copies << " copies)");
+  }
+
+  /// One clock step; true when faults.abort falls due in it.
+  bool tick() {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (finished_) return;
+    if (finished_) return false;
     if (!started_) {
       // Sim time starts once every UAV's planner is up (it advertises its plan after loading the
       // map), so that no UAV misses the mission's start; after 120 s wall it starts anyway.
@@ -159,7 +187,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
       const double waited = (ros::WallTime::now() - wall0_).toSec();
       if (!all && waited < 120.0) {
         publishClock();
-        return;
+        return false;
       }
       if (!all) NODELET_WARN("SimWorld: not every UAV planner is up after 120 s; starting anyway");
       NODELET_INFO_STREAM("SimWorld: every UAV is up after " << waited << " s wall; sim time starts");
@@ -182,7 +210,9 @@ class SimWorldNodelet : public nodelet::Nodelet {
     // number of followers at every call); SimWorld starts when every planner is up.
     if (camera_frames_->due(k_) && (follower_views_ ? all : truth_[0].has_value())) cameraFrame(ws);
     if (timeline_samples_->due(k_)) sample(ws, all);
+    const bool abort_due = record_->abortDue(t_);
     if (t_ >= set_.duration_s - 1e-9) finish();
+    return abort_due;
   }
 
   /// The leader's estimate predicted to t_s (nullopt before the first one).
@@ -289,7 +319,8 @@ class SimWorldNodelet : public nodelet::Nodelet {
   sensor_msgs::CameraInfo info_;  ///< synthetic camera: the leader camera's intrinsics (the estimator's camera model)
   tf2_ros::TransformBroadcaster tf_;  ///< the gesture cameras (3-D confirmation)
   std::vector<ros::Publisher> gesture_pubs_;  ///< per UAV (only the leader's without follower views)
-  std::vector<ros::Subscriber> truth_subs_, plan_subs_;
+  std::vector<ros::Subscriber> truth_subs_, plan_subs_, abort_subs_;
+  ros::ServiceClient abort_client_;
   ros::Subscriber params_sub_, estimate_sub_, status_sub_, detection_sub_;
   ros::WallTimer clock_timer_;
 };

@@ -18,14 +18,13 @@ const char* toString(MessageType type) {
     case MessageType::kAbortCommand: return "abort_command";
     case MessageType::kCommandAck: return "command_ack";
     case MessageType::kAssistance: return "assistance";
+    case MessageType::kLeadership: return "leadership";
     case MessageType::kMapUpdate: return "map_update";
   }
   return "unknown";
 }
 
-bool isKnownMessageType(std::uint8_t value) {
-  return value >= kMinMessageType && value <= kMaxMessageType && value != 10;  // 10: not on this branch
-}
+bool isKnownMessageType(std::uint8_t value) { return value >= kMinMessageType && value <= kMaxMessageType; }
 
 const char* toString(EnvelopeError e) {
   switch (e) {

@@ -84,6 +84,18 @@ InboxItem LinkInbox::decodeOne(const Envelope& e) {
       if (decoder_.decode(e, a)) return a;  // every copy: the state is idempotent
       return {};
     }
+    case MessageType::kLeadership: {
+      formation::LeadershipMessage m;
+      if (!decoder_.decode(e, m)) return {};
+      // A UAV speaks for itself only: a captured key cannot vote or beat for another member.
+      if (m.from != e.sender_id) {
+        ++leadership_refused_;
+        last_refusal_ = "leadership message refused (" + std::to_string(leadership_refused_) + " so far): sender " +
+                        std::to_string(e.sender_id) + ", from " + std::to_string(m.from);
+        return {};
+      }
+      return m;
+    }
     case MessageType::kMapUpdate:
       return {};  // not an inbox item: map updates go to the live map (docs/mapping.md §8)
   }

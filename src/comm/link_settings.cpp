@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "gesture_formation/comm/payloads.hpp"
 #include "gesture_formation/common/config_fields.hpp"
 
 namespace gesture_formation::comm {
@@ -57,6 +58,12 @@ VerifierConfig verifierConfigOf(const LinkSettings& s, std::vector<common::Confi
       both.erase(std::unique(both.begin(), both.end()), both.end());
       c.senders_by_type[MessageType::kAssistance] = both;
     }
+  }
+  // Leadership messages (docs/safety.md §1.2) come from the UAVs only — the known senders with a UAV
+  // index (0..kMaxUavIndex), never a ground station.
+  auto& members = c.senders_by_type[MessageType::kLeadership];
+  for (const std::uint16_t id : c.known_senders) {
+    if (id <= kMaxUavIndex) members.push_back(id);
   }
   c.own_sender_id = static_cast<std::uint16_t>(std::clamp(s.sender_id, 0, 65535));
   c.max_age_s = age.contains(s.max_age_s) ? s.max_age_s : defaults.max_age_s;

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <initializer_list>
+#include <limits>
 #include <set>
 
 #include <Eigen/Geometry>
@@ -725,6 +726,85 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, Assistanc
   if (d.finish()) {
     a.phase = static_cast<formation::AssistancePhase>(phase);
     out = std::move(m);
+  }
+  return d.report(reason);
+}
+
+// ---- leadership (42 B): u8 kind, u32 term, u16 from, u16 to (0xffff broadcast), f64 sent_s,
+// f64 echo_s, u8 flags (bit 0 granted, bit 1 estimate known), f64 lease_age_s, f64 estimate_age_s
+// (0 when not known) -------------------------------------------------------------------------------
+
+namespace {
+
+constexpr std::uint16_t kWireBroadcast = 0xffff;
+constexpr std::uint8_t kLeadershipGranted = 0x01, kLeadershipEstimateKnown = 0x02;
+constexpr std::uint8_t kMaxLeadershipKind = static_cast<std::uint8_t>(formation::LeadershipMessageKind::kVoteReply);
+
+}  // namespace
+
+EncodeResult encodePayload(const formation::LeadershipMessage& m) {
+  if (static_cast<std::uint8_t>(m.kind) > kMaxLeadershipKind) return EncodeResult::fail("leadership.kind out of range");
+  if (m.from < 0 || m.from > kMaxUavIndex) {
+    return EncodeResult::fail("leadership.from must be 0.." + std::to_string(kMaxUavIndex) + ", got " + std::to_string(m.from));
+  }
+  if (m.to != formation::LeadershipMessage::kBroadcast && (m.to < 0 || m.to > kMaxUavIndex)) {
+    return EncodeResult::fail("leadership.to must be -1 (broadcast) or 0.." + std::to_string(kMaxUavIndex) + ", got " +
+                              std::to_string(m.to));
+  }
+  if (!allFinite({m.sent_s, m.echo_s, m.lease_age_s}) || m.lease_age_s < 0.0) {
+    return EncodeResult::fail("leadership.sent_s / echo_s must be finite and lease_age_s finite and >= 0");
+  }
+  const bool known = std::isfinite(m.estimate_age_s);
+  if (std::isnan(m.estimate_age_s) || m.estimate_age_s < 0.0) {
+    return EncodeResult::fail("leadership.estimate_age_s must be >= 0 or +inf (none)");
+  }
+  ByteWriter w;
+  w.u8(static_cast<std::uint8_t>(m.kind));
+  w.u32(m.term);
+  w.u16(static_cast<std::uint16_t>(m.from));
+  w.u16(m.to == formation::LeadershipMessage::kBroadcast ? kWireBroadcast : static_cast<std::uint16_t>(m.to));
+  w.f64(m.sent_s);
+  w.f64(m.echo_s);
+  w.u8(static_cast<std::uint8_t>((m.granted ? kLeadershipGranted : 0) | (known ? kLeadershipEstimateKnown : 0)));
+  w.f64(m.lease_age_s);
+  w.f64(known ? m.estimate_age_s : 0.0);
+  return EncodeResult::ok(w.release());
+}
+
+PayloadError decodePayload(const std::uint8_t* data, std::size_t size, formation::LeadershipMessage& out,
+                           std::string* reason) {
+  Decoder d(data, size);
+  formation::LeadershipMessage m;
+  std::uint8_t kind = 0, flags = 0;
+  std::uint16_t from = 0, to = 0;
+  double estimate_age_s = 0.0;
+  if (d.u8(kind, "leadership.kind") && kind > kMaxLeadershipKind) d.fail(PayloadError::kOutOfRange, "leadership.kind");
+  d.u32(m.term, "leadership.term");
+  if (d.u16(from, "leadership.from") && from > kMaxUavIndex) d.fail(PayloadError::kOutOfRange, "leadership.from");
+  if (d.u16(to, "leadership.to") && to != kWireBroadcast && to > kMaxUavIndex) {
+    d.fail(PayloadError::kOutOfRange, "leadership.to");
+  }
+  d.f64(m.sent_s, "leadership.sent_s");
+  d.f64(m.echo_s, "leadership.echo_s");
+  if (d.u8(flags, "leadership.flags") && (flags & ~(kLeadershipGranted | kLeadershipEstimateKnown)) != 0) {
+    d.fail(PayloadError::kOutOfRange, "leadership.flags");
+  }
+  if (d.f64(m.lease_age_s, "leadership.lease_age_s") && m.lease_age_s < 0.0) {
+    d.fail(PayloadError::kOutOfRange, "leadership.lease_age_s");
+  }
+  // Without bit 1 the age must be 0 (one encoding per message: what decodes re-encodes the same).
+  if (d.f64(estimate_age_s, "leadership.estimate_age_s") &&
+      (estimate_age_s < 0.0 || (!(flags & kLeadershipEstimateKnown) && estimate_age_s != 0.0) ||
+       (estimate_age_s == 0.0 && std::signbit(estimate_age_s)))) {
+    d.fail(PayloadError::kOutOfRange, "leadership.estimate_age_s");
+  }
+  if (d.finish()) {
+    m.kind = static_cast<formation::LeadershipMessageKind>(kind);
+    m.from = from;
+    m.to = to == kWireBroadcast ? formation::LeadershipMessage::kBroadcast : to;
+    m.granted = (flags & kLeadershipGranted) != 0;
+    m.estimate_age_s = (flags & kLeadershipEstimateKnown) ? estimate_age_s : std::numeric_limits<double>::infinity();
+    out = m;
   }
   return d.report(reason);
 }

@@ -35,6 +35,7 @@ constexpr ChannelSuffix kChannels[] = {
     {comm::MessageType::kAbortCommand, "ABORT_COMMAND"},
     {comm::MessageType::kCommandAck, "COMMAND_ACK"},
     {comm::MessageType::kAssistance, "ASSISTANCE"},
+    {comm::MessageType::kLeadership, "LEADERSHIP"},
     {comm::MessageType::kMapUpdate, "MAP_UPDATE"},
 };
 

@@ -14,12 +14,15 @@ double msSince(int64_t t0) { return static_cast<double>(cv::getTickCount() - t0)
 
 cv::Point2f centre(const cv::Rect2f& r) { return {r.x + r.width / 2, r.y + r.height / 2}; }
 
-/// Index of the detection nearest (centre distance) to `ref` within gate · max(w, h), or −1.
-int nearestWithin(const cv::Rect2f& ref, const std::vector<Detection>& dets, float gate) {
+/// Index of the detection nearest (centre distance) to `ref` within gate · max(w, h), or −1;
+/// only detections with allowed[i] (all when `allowed` is empty).
+int nearestWithin(const cv::Rect2f& ref, const std::vector<Detection>& dets, float gate,
+                  const std::vector<char>& allowed = {}) {
   const float limit = gate * std::max(ref.width, ref.height);
   int best = -1;
   float best_d = limit;
   for (std::size_t i = 0; i < dets.size(); ++i) {
+    if (!allowed.empty() && !allowed[i]) continue;
     const float d = static_cast<float>(cv::norm(centre(dets[i].box_px) - centre(ref)));
     if (d <= best_d) {
       best_d = d;
@@ -29,11 +32,14 @@ int nearestWithin(const cv::Rect2f& ref, const std::vector<Detection>& dets, flo
   return best;
 }
 
-/// Index of the detection overlapping `ref` most (IoU in best_iou), -1 when none overlaps.
-int bestOverlap(const cv::Rect2f& ref, const std::vector<Detection>& dets, float& best_iou) {
+/// Index of the detection overlapping `ref` most (IoU in best_iou), -1 when none overlaps; only
+/// detections with allowed[i] (all when `allowed` is empty).
+int bestOverlap(const cv::Rect2f& ref, const std::vector<Detection>& dets, float& best_iou,
+                const std::vector<char>& allowed = {}) {
   int idx = -1;
   best_iou = 0.0f;
   for (std::size_t i = 0; i < dets.size(); ++i) {
+    if (!allowed.empty() && !allowed[i]) continue;
     const float o = iou(ref, dets[i].box_px);
     if (o > best_iou) {
       best_iou = o;
@@ -53,6 +59,14 @@ cv::Rect detectionWindow(const cv::Rect2f& ref, const cv::Size& frame, const Wor
   const int x = std::clamp(static_cast<int>(std::lround(c.x - side / 2.0f)), 0, frame.width - side);
   const int y = std::clamp(static_cast<int>(std::lround(c.y - side / 2.0f)), 0, frame.height - side);
   return cv::Rect(x, y, side, side);
+}
+
+/// True when detection `idx` overlaps no other detection of the round (its colours are its own).
+bool clearOfOthers(const std::vector<Detection>& dets, int idx) {
+  for (std::size_t i = 0; i < dets.size(); ++i) {
+    if (static_cast<int>(i) != idx && iou(dets[i].box_px, dets[static_cast<std::size_t>(idx)].box_px) > 0.0f) return false;
+  }
+  return true;
 }
 
 }  // namespace
@@ -94,7 +108,9 @@ const common::FieldTable<WorkerTrackerConfig>& workerTrackerFields() {
 }
 
 std::vector<std::string> WorkerTrackerConfig::validate() const {
-  return common::problemLines(workerTrackerFields().rangeProblems(*this));
+  auto lines = common::problemLines(workerTrackerFields().rangeProblems(*this));
+  for (auto& line : appearance.validate()) lines.push_back(std::move(line));
+  return lines;
 }
 
 common::Result<std::unique_ptr<WorkerTracker>> WorkerTracker::create(const WorkerTrackerConfig& config,
@@ -107,7 +123,7 @@ common::Result<std::unique_ptr<WorkerTracker>> WorkerTracker::create(const Worke
 }
 
 WorkerTracker::WorkerTracker(WorkerTrackerConfig config, std::unique_ptr<PersonDetector> detector)
-    : config_(std::move(config)), detector_(std::move(detector)) {}
+    : config_(std::move(config)), detector_(std::move(detector)), appearance_(config_.appearance) {}
 
 void WorkerTracker::reset() {
   tracker_.reset();
@@ -117,6 +133,9 @@ void WorkerTracker::reset() {
   missed_detections_ = 0;
   frames_since_lost_ = -1;
   hint_pending_ = false;
+  locked_ = false;
+  announce_new_id_ = false;
+  appearance_.reset();
 }
 
 void WorkerTracker::setWorkerHint(const cv::Rect2f& box_px) {
@@ -125,6 +144,43 @@ void WorkerTracker::setWorkerHint(const cv::Rect2f& box_px) {
   box_ = box_px;
   hint_pending_ = true;
   frames_since_lost_ = 0;
+}
+
+common::Result<cv::Rect2f> WorkerTracker::selectWorker(const cv::Point2f& point_px) {
+  int best = -1;
+  for (std::size_t i = 0; i < last_detections_.size(); ++i) {
+    const cv::Rect2f& b = last_detections_[i].box_px;
+    if (!b.contains(point_px)) continue;
+    if (best < 0 || b.area() < last_detections_[static_cast<std::size_t>(best)].box_px.area()) best = static_cast<int>(i);
+  }
+  if (best < 0) {
+    return common::Result<cv::Rect2f>::fail("select worker: no person of the last detection round contains the point (" +
+                                            std::to_string(point_px.x) + ", " + std::to_string(point_px.y) + ") px; " +
+                                            std::to_string(last_detections_.size()) + " candidate(s)");
+  }
+  return selectCandidate(best);
+}
+
+common::Result<cv::Rect2f> WorkerTracker::selectCandidate(int index) {
+  if (index < 0 || index >= static_cast<int>(last_detections_.size())) {
+    return common::Result<cv::Rect2f>::fail("select worker: candidate " + std::to_string(index) + " out of range [0, " +
+                                            std::to_string(last_detections_.size()) + ")");
+  }
+  // The chosen person becomes the track at once, on the frame of its detection round — never
+  // "whoever is nearest next time", which could be someone else if the chosen one is missed then.
+  const cv::Rect2f box = last_detections_[static_cast<std::size_t>(index)].box_px;
+  const std::vector<Detection> round = last_detections_;
+  const cv::Mat frame = last_detection_frame_;
+  reset();
+  id_ = next_id_++;
+  ++counters_.identities;
+  announce_new_id_ = true;
+  locked_ = true;
+  box_ = box;
+  tracking_ = initTracker(frame, box);
+  frames_since_detection_ = 0;
+  if (clearOfOthers(round, index)) appearance_.update(appearance_.describe(frame, box));
+  return common::Result<cv::Rect2f>::ok(box);
 }
 
 cv::Ptr<cv::Tracker> WorkerTracker::makeTracker() const {
@@ -162,6 +218,114 @@ common::Result<std::vector<Detection>> WorkerTracker::detectIn(const cv::Mat& fr
   return dets;
 }
 
+std::vector<char> WorkerTracker::lookAlikes(const cv::Mat& frame, const std::vector<Detection>& dets) const {
+  std::vector<char> alike(dets.size(), 1);
+  if (!appearance_.established()) return alike;
+  for (std::size_t i = 0; i < dets.size(); ++i) {
+    alike[i] = appearance_.accepts(appearance_.describe(frame, dets[i].box_px), config_.appearance.min_similarity) ? 1 : 0;
+  }
+  return alike;
+}
+
+void WorkerTracker::take(const cv::Mat& frame, int idx, TrackStep& out) {
+  const cv::Rect2f det = out.detections[static_cast<std::size_t>(idx)].box_px;
+  const int64_t t1 = cv::getTickCount();
+  tracking_ = initTracker(frame, det);  // on failure: re-detect next frame; this frame's box stands
+  out.track_ms += msSince(t1);
+  missed_detections_ = 0;
+  box_ = det;
+  out.found = true;
+  out.source = BoxSource::kDetector;
+  out.worker_detection = idx;
+  const cv::Mat d = appearance_.describe(frame, det);
+  out.similarity = appearance_.established() ? appearance_.similarity(d) : -1.0;
+  if (clearOfOthers(out.detections, idx)) appearance_.update(d);
+}
+
+bool WorkerTracker::associate(const cv::Mat& frame, const cv::Rect2f& predicted, bool have_pred, TrackStep& out) {
+  const cv::Rect2f ref = have_pred ? predicted : box_;
+  const std::vector<char> alike = lookAlikes(frame, out.detections);
+  float best_iou = 0.0f;
+  int idx = bestOverlap(ref, out.detections, best_iou, alike);
+  if (best_iou < config_.associate_min_iou) idx = nearestWithin(ref, out.detections, config_.associate_gate, alike);
+  // Detections the geometry alone would have taken but that do not look like the worker.
+  float geo_iou = 0.0f;
+  int geo = bestOverlap(ref, out.detections, geo_iou);
+  if (geo_iou < config_.associate_min_iou) geo = nearestWithin(ref, out.detections, config_.associate_gate);
+  if (geo >= 0 && geo != idx && !alike[static_cast<std::size_t>(geo)]) {
+    ++out.appearance_rejected;
+    ++counters_.appearance_rejections;
+  }
+  if (idx >= 0) {
+    out.drift = have_pred && iou(predicted, out.detections[static_cast<std::size_t>(idx)].box_px) < config_.drift_iou;
+    if (out.drift) ++counters_.drifts;
+    take(frame, idx, out);
+    return false;
+  }
+  ++missed_detections_;
+  if (have_pred && missed_detections_ <= config_.max_missed_detections) {
+    box_ = predicted;
+    out.found = true;
+    out.source = BoxSource::kTracker;
+    return false;
+  }
+  tracking_ = false;
+  tracker_.reset();
+  frames_since_lost_ = 0;
+  ++counters_.lost;
+  return true;
+}
+
+void WorkerTracker::acquire(const cv::Mat& frame, bool lost_now, TrackStep& out) {
+  // Never in the frame where the track was just lost, so the identity cannot hop to a neighbour
+  // that the association rejected. While a hint or a recently lost worker is remembered, only a
+  // detection near it (and looking like it) is taken, or one looking like it anywhere; a new
+  // person only after that, and never while the operator's choice holds.
+  if (tracking_ || out.found || lost_now || out.detections.empty()) {
+    if (!tracking_ && !out.found && frames_since_lost_ >= 0) {
+      ++frames_since_lost_;
+      if (frames_since_lost_ > config_.reacquire_frames) hint_pending_ = false;
+    }
+    return;
+  }
+  const bool remembering = (id_ >= 0 || hint_pending_) && frames_since_lost_ >= 0 &&
+                           frames_since_lost_ <= config_.reacquire_frames;
+  const std::vector<char> alike = lookAlikes(frame, out.detections);
+  int idx = remembering ? nearestWithin(box_, out.detections, config_.reacquire_gate, alike) : -1;
+  if (idx >= 0 && hint_pending_) {
+    id_ = next_id_++;
+    out.identity_changed = true;
+    ++counters_.identities;
+  } else if (idx < 0 && !hint_pending_ && id_ >= 0 && appearance_.established()) {
+    double best = config_.appearance.min_similarity;
+    for (std::size_t i = 0; i < out.detections.size(); ++i) {
+      const double s = appearance_.similarity(appearance_.describe(frame, out.detections[i].box_px));
+      if (s >= best) {
+        best = s;
+        idx = static_cast<int>(i);
+      }
+    }
+    if (idx >= 0) {
+      out.reidentified = true;
+      ++counters_.reidentifications;
+    }
+  }
+  if (idx < 0 && !hint_pending_ && !locked_ && !remembering) {
+    idx = 0;  // best score first: a new worker (never while the lost one is remembered)
+    id_ = next_id_++;
+    out.identity_changed = true;
+    ++counters_.identities;
+    appearance_.reset();
+  }
+  if (idx < 0) {
+    if (frames_since_lost_ >= 0 && ++frames_since_lost_ > config_.reacquire_frames) hint_pending_ = false;
+    return;
+  }
+  take(frame, idx, out);
+  frames_since_lost_ = -1;
+  hint_pending_ = false;
+}
+
 common::Result<TrackStep> WorkerTracker::step(const cv::Mat& frame) {
   using R = common::Result<TrackStep>;
   const std::string bad = checkBgrImage(frame, "frame");
@@ -173,8 +337,10 @@ common::Result<TrackStep> WorkerTracker::step(const cv::Mat& frame) {
   ++counters_.frames;
   const cv::Rect2f image_rect(0.0f, 0.0f, static_cast<float>(frame.cols), static_cast<float>(frame.rows));
   TrackStep out;
+  out.identity_changed = announce_new_id_;  // the operator chose a person since the last frame
+  announce_new_id_ = false;
 
-  // 1. visual tracker prediction
+  // 1. visual tracker prediction; a box that stopped looking like the worker is a failure
   cv::Rect2f predicted;
   bool have_pred = false;
   if (tracking_ && tracker_) {
@@ -186,9 +352,16 @@ common::Result<TrackStep> WorkerTracker::step(const cv::Mat& frame) {
     } catch (const cv::Exception&) {
       ok = false;
     }
-    out.track_ms += msSince(t0);
     predicted = cv::Rect2f(r) & image_rect;
     have_pred = ok && predicted.width >= config_.min_box_px && predicted.height >= config_.min_box_px;
+    if (have_pred && appearance_.established()) {
+      out.similarity = appearance_.similarity(appearance_.describe(frame, predicted));
+      if (out.similarity < config_.appearance.tracker_min_similarity) {
+        have_pred = false;
+        ++counters_.appearance_tracker_failures;
+      }
+    }
+    out.track_ms += msSince(t0);
     if (!have_pred) {
       out.tracker_failed = true;
       ++counters_.tracker_failures;
@@ -214,7 +387,12 @@ common::Result<TrackStep> WorkerTracker::step(const cv::Mat& frame) {
       if (d.score >= config_.min_detection_score && d.box_px.width > 0 && d.box_px.height > 0) out.detections.push_back(d);
     }
   };
-  if (tracking_ && config_.roi_detection) {
+  // The window around the worker while tracking, and around its last box while it is remembered
+  // after a loss or the operator's choice holds: a small, distant worker is found at ~full
+  // resolution there, where the whole-frame search would shrink it below what the network sees.
+  const bool remembered = box_.area() > 0.0f && (locked_ || ((id_ >= 0 || hint_pending_) && frames_since_lost_ >= 0 &&
+                                                             frames_since_lost_ <= config_.reacquire_frames));
+  if ((tracking_ || remembered) && config_.roi_detection) {
     out.roi_px = detectionWindow(have_pred ? predicted : box_, frame.size(), config_);
     out.roi_used = true;
     auto dets = detectIn(frame, out.roi_px);
@@ -230,77 +408,12 @@ common::Result<TrackStep> WorkerTracker::step(const cv::Mat& frame) {
   out.detector_ran = true;
   ++counters_.detections_run;
   frames_since_detection_ = 0;
+  last_detections_ = out.detections;
+  last_detection_frame_ = frame.clone();  // selectCandidate starts the chosen person's track on it
 
-  bool lost_now = false;
-  if (tracking_) {
-    const cv::Rect2f ref = have_pred ? predicted : box_;
-    float best_iou = 0.0f;
-    int idx = bestOverlap(ref, out.detections, best_iou);
-    if (best_iou < config_.associate_min_iou) idx = nearestWithin(ref, out.detections, config_.associate_gate);
-    if (idx >= 0) {
-      const cv::Rect2f det = out.detections[static_cast<std::size_t>(idx)].box_px;
-      out.drift = have_pred && iou(predicted, det) < config_.drift_iou;
-      if (out.drift) ++counters_.drifts;
-      const int64_t t1 = cv::getTickCount();
-      const bool ok = initTracker(frame, det);
-      out.track_ms += msSince(t1);
-      missed_detections_ = 0;
-      box_ = det;
-      out.found = true;
-      out.source = BoxSource::kDetector;
-      out.worker_detection = idx;
-      if (!ok) tracking_ = false;  // re-detect next frame; the box of this frame stands
-    } else {
-      ++missed_detections_;
-      if (have_pred && missed_detections_ <= config_.max_missed_detections) {
-        box_ = predicted;
-        out.found = true;
-        out.source = BoxSource::kTracker;
-      } else {
-        tracking_ = false;
-        tracker_.reset();
-        frames_since_lost_ = 0;
-        ++counters_.lost;
-        lost_now = true;
-      }
-    }
-  }
-
-  // 3. (re)acquisition — never in the frame where the track was just lost, so the identity
-  // cannot hop to a neighbour that the association above rejected. While a hint or a
-  // recently lost worker is remembered, only a detection near it is taken.
-  const bool remembering = (id_ >= 0 || hint_pending_) && frames_since_lost_ >= 0 &&
-                           frames_since_lost_ <= config_.reacquire_frames;
-  int idx = -1;
-  if (!tracking_ && !out.found && !lost_now && !out.detections.empty()) {
-    if (remembering) idx = nearestWithin(box_, out.detections, config_.reacquire_gate);
-    if (idx < 0 && !hint_pending_) {
-      idx = 0;  // best score first: a new worker
-      id_ = next_id_++;
-      out.identity_changed = true;
-      ++counters_.identities;
-    } else if (idx >= 0 && hint_pending_) {
-      id_ = next_id_++;
-      out.identity_changed = true;
-      ++counters_.identities;
-    }
-  }
-  if (idx >= 0) {
-    const cv::Rect2f det = out.detections[static_cast<std::size_t>(idx)].box_px;
-    const int64_t t1 = cv::getTickCount();
-    tracking_ = initTracker(frame, det);
-    out.track_ms += msSince(t1);
-    missed_detections_ = 0;
-    frames_since_lost_ = -1;
-    hint_pending_ = false;
-    box_ = det;
-    out.found = true;
-    out.source = BoxSource::kDetector;
-    out.worker_detection = idx;
-  } else if (!tracking_ && !out.found && frames_since_lost_ >= 0) {
-    ++frames_since_lost_;
-    if (frames_since_lost_ > config_.reacquire_frames) hint_pending_ = false;
-  }
+  // 3. association with the live track, else (re)acquisition
+  const bool lost_now = tracking_ && associate(frame, predicted, have_pred, out);
+  acquire(frame, lost_now, out);
   if (out.found) {
     out.id = id_;
     out.box_px = box_;

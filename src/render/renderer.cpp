@@ -248,6 +248,9 @@ struct Renderer::Impl {
   GpuMesh world, ground, uav, worker;
   std::shared_ptr<WorkerMesh> worker_mesh;
   bool worker_set = false;
+  PosedKeypoints worker_keypoints;   ///< the worker's, kept apart from the bystanders' posing
+  std::vector<GpuMesh> bystanders;   ///< allocated as needed, released with the renderer
+  std::size_t bystander_count = 0;   ///< of the last setBystanders
   cv::Mat rgba;  ///< read-back buffer, reused
   std::vector<Eigen::Isometry3d, Eigen::aligned_allocator<Eigen::Isometry3d>> uavs;
 
@@ -264,6 +267,7 @@ struct Renderer::Impl {
     if (display == EGL_NO_DISPLAY) return;
     if (context != EGL_NO_CONTEXT && makeCurrent()) {
       for (GpuMesh* m : {&world, &ground, &uav, &worker}) m->release();
+      for (GpuMesh& m : bystanders) m.release();
       if (fbo != 0) {
         glDeleteFramebuffers(1, &fbo);
         GLuint rbs[4] = {rb_colour, rb_depth_m, rb_class, rb_z};
@@ -420,18 +424,44 @@ common::Result<bool> Renderer::setWorker(const WorkerJoints& joints, double heig
   if (!posed) return posed;
   if (!impl_->makeCurrent()) return R::fail("eglMakeCurrent failed: " + eglErrorText());
   impl_->worker.upload(impl_->worker_mesh->mesh(), GL_DYNAMIC_DRAW);
+  impl_->worker_keypoints = impl_->worker_mesh->keypoints();
   impl_->worker_set = true;
   return R::ok(true);
 }
 
 void Renderer::clearWorker() { impl_->worker_set = false; }
 
+common::Result<bool> Renderer::setBystanders(const std::vector<Bystander>& people) {
+  using R = common::Result<bool>;
+  if (people.size() > kMaxBystanders) {
+    return R::fail("bystanders: at most " + std::to_string(kMaxBystanders) + ", got " + std::to_string(people.size()));
+  }
+  if (!people.empty() && !impl_->worker_mesh) return R::fail("no worker asset: RendererConfig.worker_asset_path is empty");
+  for (std::size_t i = 0; i < people.size(); ++i) {
+    const auto problems = people[i].appearance.validate();
+    if (!problems.empty()) return R::fail("bystander " + std::to_string(i) + ": " + problems.front());
+  }
+  if (!impl_->makeCurrent()) return R::fail("eglMakeCurrent failed: " + eglErrorText());
+  if (impl_->bystanders.size() < people.size()) impl_->bystanders.resize(people.size());
+  for (std::size_t i = 0; i < people.size(); ++i) {
+    impl_->worker_mesh->dress(people[i].appearance);
+    const auto posed = impl_->worker_mesh->pose(people[i].joints, people[i].height_m);
+    if (!posed) {
+      impl_->bystander_count = 0;
+      return R::fail("bystander " + std::to_string(i) + ": " + posed.reason());
+    }
+    impl_->bystanders[i].upload(impl_->worker_mesh->mesh(), GL_DYNAMIC_DRAW);
+  }
+  impl_->bystander_count = people.size();
+  return R::ok(true);
+}
+
 void Renderer::setUavs(const std::vector<Eigen::Isometry3d, Eigen::aligned_allocator<Eigen::Isometry3d>>& T_world_body) {
   impl_->uavs = T_world_body;
 }
 
 const std::string& Renderer::glRenderer() const { return impl_->gl_renderer; }
-const WorkerMesh* Renderer::worker() const { return impl_->worker_set ? impl_->worker_mesh.get() : nullptr; }
+const PosedKeypoints* Renderer::workerKeypoints() const { return impl_->worker_set ? &impl_->worker_keypoints : nullptr; }
 
 WorkerTruth Renderer::Impl::truth(const CameraView& cam, const RenderedFrame& f) const {
   WorkerTruth t;
@@ -439,7 +469,7 @@ WorkerTruth Renderer::Impl::truth(const CameraView& cam, const RenderedFrame& f)
   t.drawn = true;
   const estimation::CameraModel model(cam.intrinsics);
   const Eigen::Isometry3d T_camera_world = cam.T_world_camera.inverse();
-  const PosedKeypoints& kp = worker_mesh->keypoints();
+  const PosedKeypoints& kp = worker_keypoints;
   for (int k = 0; k < gesture::kNumKeypoints; ++k) {
     auto& out = t.keypoints[static_cast<std::size_t>(k)];
     const Vector3d p_cam = T_camera_world * kp.p_world[static_cast<std::size_t>(k)];
@@ -492,6 +522,10 @@ void Renderer::Impl::drawScene(const CameraView& cam, std::optional<std::size_t>
     setUniforms(program, I, view, proj, 0, PixelClass::kWorker, eye);
     worker.draw();
   }
+  for (std::size_t i = 0; i < bystander_count; ++i) {
+    setUniforms(program, I, view, proj, 0, static_cast<PixelClass>(static_cast<int>(PixelClass::kBystander) + static_cast<int>(i)), eye);
+    bystanders[i].draw();
+  }
   glUseProgram(sky_program);
   Eigen::Matrix3d Kinv = Eigen::Matrix3d::Identity();
   Kinv(0, 0) = 1.0 / k.fx, Kinv(1, 1) = 1.0 / k.fy, Kinv(0, 2) = -k.cx / k.fx, Kinv(1, 2) = -k.cy / k.fy;
@@ -538,6 +572,13 @@ common::Result<RenderedFrame> Renderer::render(const CameraView& cam, std::optio
     return R::fail(s.str());
   }
   f.worker = m.truth(cam, f);
+  for (std::size_t i = 0; i < m.bystander_count; ++i) {
+    const cv::Mat mask = f.classes == static_cast<int>(PixelClass::kBystander) + static_cast<int>(i);
+    BystanderTruth b;
+    b.visible_pixels = cv::countNonZero(mask);
+    if (b.visible_pixels > 0) b.visible_box_px = cv::boundingRect(mask);
+    f.bystanders.push_back(b);
+  }
   return R::ok(std::move(f));
 }
 

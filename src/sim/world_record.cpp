@@ -11,7 +11,8 @@ WorldRecord::WorldRecord(const MissionConfig& config, const ObstacleDistance& ob
       versions_(config.formation.params),
       params_(config.formation.params),
       plan_mode_(static_cast<std::size_t>(n_)),
-      config_(config) {}
+      config_(config),
+      obstacles_(obstacles) {}
 
 std::uint64_t WorldRecord::planVersion(const PlanReport& p) const {
   if (p.uav == formation::kLeader || p.params_version > 0 || !p.formation || p.formation->uavCount() != n_) {
@@ -60,6 +61,21 @@ std::vector<formation::FormationCommand> WorldRecord::dueRequests(double t_s) {
   return out;
 }
 
+bool WorldRecord::abortDue(double t_s) {
+  const std::optional<AbortEvent>& e = config_.faults.abort;
+  if (!e || abort_requested_ || e->source != planning::AbortSource::kOperator || t_s < e->t_s) return false;
+  abort_requested_ = true;
+  if (!abort_) abort_.emplace(*e, n_, obstacles_);
+  return true;
+}
+
+void WorldRecord::abortState(const AbortReport& r) {
+  if (r.uav < 0 || r.uav >= n_ || !r.phase) return;
+  if (!abort_) abort_.emplace(AbortEvent{r.accepted_s, r.source}, n_, obstacles_);
+  abort_->accepted(r.uav, r.accepted_s);
+  abort_->phase(r.uav, r.t_s, *r.phase);
+}
+
 void WorldRecord::gestureFired(double t_s, int gesture_id, const gesture::GestureMapping& mapping) {
   metrics_.addRequest(firedGestureRecord(t_s, gesture_id, mapping));
   metrics_.resolveOutcomes(kStampToleranceS);
@@ -83,6 +99,7 @@ bool WorldRecord::sampleSafety(double t_s, const std::vector<std::optional<Multi
   }
   metrics_.sampleSafety(t_s, p_world, worker);
   if (approach_) approach_->sample(t_s, p_world, worker.p_world);
+  if (abort_) abort_->sample(t_s, p_world, worker.p_world);
   return true;
 }
 
@@ -95,6 +112,7 @@ bool WorldRecord::finish(const std::vector<GestureEpisode>& gestures, double sim
                                       "qp_sparse_timeouts"};
   MissionOutput out = metrics_.finish(gestures, sim_time_s, wall_time_s);
   if (approach_) out.metrics.worker_approach = approach_->summary();
+  if (abort_) out.metrics.abort = abort_->summary();
   out.modes = modes_;  // from the plans' mode fields (the planners' hold decisions)
   const bool ok = writeMissionFiles(dir, out, n_, true, error);
   if (const auto& left = metrics_.unmatchedOutcomes(); !left.empty() && warning != nullptr) {

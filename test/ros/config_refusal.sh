@@ -4,7 +4,8 @@
 # ROS parameter + a missing one), GestureCommander (a gestures.yaml with an out-of-range ratio; one
 # with an out-of-range view_fusion.min_agreeing_views and a missing view_fusion key), ViewObserver
 # (no parameters),
-# LcmBridge (a key file readable by others), SimWorld/SimUav (no mission).
+# LcmBridge (a key file readable by others), SimWorld/SimUav (no mission), Leadership (an
+# out-of-range leadership.clock_drift and a missing estimate_tolerance_s).
 set -o pipefail
 source "$(dirname "$0")/common.bash"
 start_master
@@ -32,24 +33,29 @@ make_key "$T/keys"; chmod 644 "$T/keys"
 run lb_bad LcmBridge _sender_id:=1 _known_senders:="[0,1,2]" _lcm_url:="memq://" _channel_prefix:=GF_ \
   _key_file:="$T/keys" _max_age_s:=1.0 _heartbeat_rate_hz:=5.0 _world_frame:=world
 run sw_bad SimWorld
+run ld_bad Leadership _uav_index:=0 _uav_count:=3 _heartbeat_period_s:=0.2 _lease_s:=1.0 _silence_limit_s:=2.0 \
+  _candidacy_stagger_s:=0.5 _election_timeout_s:=1.0 _clock_drift:=0.5 leadership_state:=ld_bad_state
 # Wait until every nodelet has printed its refusal (a loaded machine takes several seconds to load
 # six nodelet processes), at most 80 s, then give the rest of their messages a second.
 for _ in $(seq 160); do
   n=0
-  for f in fp_bad gc_bad gc_vf vo_bad lb_bad sw_bad; do grep -q "refuses to start" "$T/$f.log" 2>/dev/null && n=$((n + 1)); done
-  [ $n -eq 6 ] && break
+  for f in fp_bad gc_bad gc_vf vo_bad lb_bad sw_bad ld_bad; do grep -q "refuses to start" "$T/$f.log" 2>/dev/null && n=$((n + 1)); done
+  [ $n -eq 7 ] && break
   sleep 0.5
 done
 sleep 1
 rostopic list 2>/dev/null | matches fp_bad_plan && fail "FormationPlanner advertised its output although it refused to start"
 rostopic list 2>/dev/null | matches gc_vf_status && fail "GestureCommander advertised its output although it refused to start"
 rostopic list 2>/dev/null | matches vo_bad_observation && fail "ViewObserver advertised its output although it refused to start"
+rostopic list 2>/dev/null | matches ld_bad_state && fail "Leadership advertised its state although it refused to start"
 kill "${runs[@]}" 2>/dev/null
 wait "${runs[@]}"
 check() {  # log, pattern, what
   grep -q -- "$2" "$T/$1.log" || { fail "$1: $3 not reported"; sed 's/^/    /' "$T/$1.log" | head -20; }
 }
-for f in fp_bad gc_bad gc_vf vo_bad lb_bad sw_bad; do check $f "refuses to start" "refusal"; done
+for f in fp_bad gc_bad gc_vf vo_bad lb_bad sw_bad ld_bad; do check $f "refuses to start" "refusal"; done
+check ld_bad "ld_bad/clock_drift: value 0.5 out of range" "out-of-range clock_drift (leadership.clock_drift's core range)"
+check ld_bad "ld_bad/estimate_tolerance_s: missing" "missing estimate_tolerance_s"
 check fp_bad "fp_bad/replanning_period_s: value 99 out of range" "out-of-range replanning_period_s"
 check fp_bad "fp_bad/max_share_age_s: missing" "missing max_share_age_s"
 check fp_bad "fp_bad/max_wind_estimate_age_s: missing" "missing max_wind_estimate_age_s"

@@ -33,7 +33,7 @@ out=$(clean_env "'$GFCTL' detect --image '$SRC/test/data/perception/astronaut.pn
 echo "$out" | matches "models $PREFIX/share/gesture_formation/third_party_models)" \
   || fail "the installed gfctl does not use the installed models: $(echo "$out" | tail -2)"
 # the installed tools (rosrun finds them in the package's lib directory)
-for tool in gf_command.py plot_timeline.py plot_corridors.py plot_search.py bag_latency.py summarize_estimate.py; do
+for tool in gf_command.py gf_worker.py plot_timeline.py plot_corridors.py plot_search.py bag_latency.py summarize_estimate.py; do
   [ -x "$PREFIX/lib/gesture_formation/$tool" ] || { fail "not installed: lib/gesture_formation/$tool"; continue; }
   [ "$tool" = bag_latency.py ] && continue  # no --help: it reads a bag given as its argument
   clean_env "rosrun gesture_formation $tool --help" > "$T/$tool.help" 2>&1 || fail "rosrun gesture_formation $tool --help: $(tail -2 "$T/$tool.help")"

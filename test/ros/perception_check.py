@@ -9,7 +9,9 @@ With --compressed the colour image goes out as the PNG file's bytes in a sensor_
 (format "png") on /cam/image/compressed, image_transport's `compressed` topic, and no raw image.
 Usage: perception_check.py IMAGE.png [--compressed]; exit code = number of failures."""
 import math
+import os
 import struct
+import subprocess
 import sys
 import time
 import zlib
@@ -17,7 +19,8 @@ import zlib
 import numpy as np
 import rospy
 from diagnostic_msgs.msg import DiagnosticArray
-from gesture_formation.msg import Gesture, WorkerDetection
+from gesture_formation.msg import Gesture, WorkerCandidates, WorkerDetection
+from gesture_formation.srv import SelectWorker
 from sensor_msgs.msg import CameraInfo, CompressedImage, Image
 
 DEPTH_M = 4.0
@@ -69,6 +72,54 @@ def read_png(path):
     return np.ascontiguousarray(rgb[:, :, ::-1])  # BGR
 
 
+def check_worker_choice(candidates, send):
+    """The candidates of each detection round, and ~select_worker: a point on nobody and a stale
+    candidate index are refused; a point on the person chooses it (locked in later rounds); unlock."""
+    fails = 0
+    ok = bool(candidates) and len(candidates[-1].u) >= 1 and candidates[-1].worker == 0 and candidates[-1].worker_id >= 0 \
+        and not candidates[-1].locked
+    print("%s: WorkerCandidates each detection round: %d rounds, last with %d candidate(s), worker %s, locked %s" % (
+        "PASS" if ok else "FAIL", len(candidates), len(candidates[-1].u) if candidates else 0,
+        candidates[-1].worker if candidates else None, candidates[-1].locked if candidates else None))
+    fails += 0 if ok else 1
+    if not candidates:
+        return fails + 1
+    rospy.wait_for_service("/perception/select_worker", timeout=10)
+    select = rospy.ServiceProxy("/perception/select_worker", SelectWorker)
+    last = candidates[-1]
+    nobody = select(u=1.0, v=1.0, candidate=-1, candidates_seq=0, unlock=False)
+    stale = select(u=0.0, v=0.0, candidate=0, candidates_seq=last.header.seq + 1000, unlock=False)
+    cu, cv = last.u[0] + last.w[0] / 2, last.v[0] + last.h[0] / 2
+    chosen = select(u=cu, v=cv, candidate=-1, candidates_seq=0, unlock=False)
+    ok = not nobody.accepted and "no person" in nobody.message and not stale.accepted and "candidates_seq" in stale.message \
+        and chosen.accepted and abs(chosen.u - last.u[0]) < 1e-3 and abs(chosen.w - last.w[0]) < 1e-3
+    print("%s: select_worker: point on nobody refused (%s); stale candidate refused (%s); point on the person chosen (%s)" % (
+        "PASS" if ok else "FAIL", nobody.message, stale.message, chosen.message))
+    fails += 0 if ok else 1
+    n = len(candidates)
+    t0 = time.time()
+    while time.time() - t0 < 20 and not any(c.locked and c.worker >= 0 for c in candidates[n:]):
+        send()
+        time.sleep(0.1)
+    later = [c for c in candidates[n:] if c.locked and c.worker >= 0]
+    # The ground station's tool lists the candidates of the next round (frames keep coming meanwhile).
+    tool = subprocess.Popen([sys.executable, os.path.join(os.path.dirname(__file__), "..", "..", "tools", "gf_worker.py"),
+                             "list", "--ns", "/perception", "--timeout", "15"], stdout=subprocess.PIPE, text=True)
+    while tool.poll() is None:
+        send()
+        time.sleep(0.1)
+    listed = tool.stdout.read()
+    ok = tool.returncode == 0 and "1 person(s)" in listed and "locked by the operator" in listed and "<- worker" in listed
+    print("%s: tools/gf_worker.py list: exit %d: %s" % ("PASS" if ok else "FAIL", tool.returncode, listed.strip()))
+    fails += 0 if ok else 1
+    unlock = select(u=0.0, v=0.0, candidate=-1, candidates_seq=0, unlock=True)
+    ok = bool(later) and later[0].worker_id != last.worker_id and unlock.accepted
+    fails += 0 if ok else 1
+    print("%s: after the choice the tracker is locked to the chosen person with a new id (%s -> %s); unlock accepted" % (
+        "PASS" if ok else "FAIL", last.worker_id, later[0].worker_id if later else None))
+    return fails
+
+
 def main():
     bgr = read_png(sys.argv[1])
     compressed = "--compressed" in sys.argv[2:]
@@ -82,6 +133,8 @@ def main():
     detections, gestures = [], []
     rospy.Subscriber("/perception/worker_detection", WorkerDetection, detections.append)
     rospy.Subscriber("/perception/gesture", Gesture, gestures.append)
+    candidates = []
+    rospy.Subscriber("/perception/candidates", WorkerCandidates, candidates.append)
     health = []
     rospy.Subscriber("/diagnostics", DiagnosticArray, lambda a: health.extend(x for x in a.status if x.name == "Perception"))
     info = CameraInfo(width=w, height=h, distortion_model="plumb_bob", D=[0.0] * 5,
@@ -90,7 +143,7 @@ def main():
     info_pub.publish(info)
     depth = np.full((h, w), DEPTH_M, dtype=np.float32)
     wall0 = time.time()
-    while time.time() - wall0 < 50 and not rospy.is_shutdown():
+    def send():  # one depth image and its colour image
         stamp = rospy.Time.now()
         m = CompressedImage(format="png", data=png_bytes) if compressed \
             else Image(height=h, width=w, encoding="bgr8", step=3 * w, data=bgr.tobytes())
@@ -100,6 +153,9 @@ def main():
         depth_pub.publish(d)
         time.sleep(0.03)  # depth first (a RealSense driver publishes both at once; order is not guaranteed)
         img_pub.publish(m)
+
+    while time.time() - wall0 < 50 and not rospy.is_shutdown():
+        send()
         if gestures and len(detections) >= 10:
             break
         time.sleep(0.1)
@@ -139,6 +195,8 @@ def main():
         "PASS" if ok else "FAIL", "id %d, p(none) %.3f" % (gestures[0].gesture_id, gestures[0].probabilities[0])
         if gestures else "none published"))
     fails += 0 if ok else 1
+    if not compressed:
+        fails += check_worker_choice(candidates, send)
     time.sleep(1.2)  # one more /diagnostics report (1 s of wall time)
     values = [{kv.key: kv.value for kv in x.values} for x in health]
     busy = [v for v in values if float(v.get("images_per_s", 0)) > 0 and float(v.get("found_per_s", 0)) > 0]

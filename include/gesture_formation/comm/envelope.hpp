@@ -63,12 +63,13 @@ enum class MessageType : std::uint8_t {
   kAbortCommand = 7,
   kCommandAck = 8,
   kAssistance = 9,
-  kMapUpdate = 11,  ///< comm/map_update.hpp (10: leadership messages, another branch)
+  kLeadership = 10,
+  kMapUpdate = 11,  ///< comm/map_update.hpp
 };
 constexpr std::uint8_t kMinMessageType = 1;
 constexpr std::uint8_t kMaxMessageType = 11;
 /// \brief "heartbeat", "worker_state", "planned_trajectory", "formation_params", "formation_command",
-/// "gesture_observation", "abort_command".
+/// "gesture_observation", "abort_command", "command_ack", "assistance", "leadership", "map_update".
 const char* toString(MessageType type);
 bool isKnownMessageType(std::uint8_t value);
 

@@ -8,7 +8,9 @@
 /// observations refused when the observing UAV is not the envelope's sender or the frame time is
 /// not a valid time, abort commands handed on at every copy with sent_s = the envelope's stamp (the
 /// UAV's ReplanStep acts on the first it accepts; docs/safety.md §2.8), command acknowledgements
-/// handed on once per command id (the leader repeats them like commands; docs/safety.md §2.9).
+/// handed on once per command id (the leader repeats them like commands; docs/safety.md §2.9),
+/// leadership messages handed on at every copy when their `from` is the envelope's sender
+/// (formation::Leadership tolerates duplicates; docs/safety.md §1.2).
 /// Thread safety: none (the caller's lock).
 
 #include <cstdint>
@@ -34,7 +36,7 @@ struct ReceivedPlanMessage {
 /// a refusal).
 using InboxItem = std::variant<std::monostate, WorkerStateMessage, ReceivedPlanMessage, formation::FormationParams,
                                formation::FormationCommand, GestureObservationMessage, planning::AbortCommand,
-                               CommandAckMessage, AssistanceMessage>;
+                               CommandAckMessage, AssistanceMessage, formation::LeadershipMessage>;
 
 class LinkInbox {
  public:
@@ -48,6 +50,8 @@ class LinkInbox {
 
   std::uint64_t commandCopiesDropped() const { return intake_.copiesDropped(); }
   std::uint64_t observationsRefused() const { return observations_refused_; }
+  /// \brief Leadership messages whose `from` was not the envelope's sender.
+  std::uint64_t leadershipRefused() const { return leadership_refused_; }
   const PayloadCounters& payloadCounters() const { return decoder_.counters(); }
 
  private:
@@ -61,6 +65,7 @@ class LinkInbox {
   std::set<std::pair<std::string, std::uint64_t>> acks_seen_;
   std::deque<std::pair<std::string, std::uint64_t>> acks_order_;
   std::uint64_t observations_refused_ = 0;
+  std::uint64_t leadership_refused_ = 0;
   std::string last_refusal_;
   bool last_decode_failure_ = false;
 };

@@ -25,6 +25,7 @@
 #include "gesture_formation/formation/assistance.hpp"
 #include "gesture_formation/formation/formation_commands.hpp"
 #include "gesture_formation/formation/formation_params.hpp"
+#include "gesture_formation/formation/leadership.hpp"
 #include "gesture_formation/gesture/view_triangulation.hpp"
 #include "gesture_formation/planning/abort_mode.hpp"
 #include "gesture_formation/planning/planned_trajectory.hpp"
@@ -160,6 +161,9 @@ common::Result<std::vector<std::uint8_t>> encodePayload(const GestureObservation
 common::Result<std::vector<std::uint8_t>> encodePayload(const AbortMessage& m);
 common::Result<std::vector<std::uint8_t>> encodePayload(const CommandAckMessage& m);
 common::Result<std::vector<std::uint8_t>> encodePayload(const AssistanceMessage& m);
+/// A leadership message (docs/safety.md §1.2): `to` −1 (broadcast) or 0..kMaxUavIndex, `from`
+/// 0..kMaxUavIndex, times finite, lease_age_s ≥ 0, estimate_age_s ≥ 0 or +inf (none).
+common::Result<std::vector<std::uint8_t>> encodePayload(const formation::LeadershipMessage& m);
 
 /// \brief The envelope type of each payload.
 inline MessageType messageTypeOf(const Heartbeat&) { return MessageType::kHeartbeat; }
@@ -171,6 +175,7 @@ inline MessageType messageTypeOf(const GestureObservationMessage&) { return Mess
 inline MessageType messageTypeOf(const AbortMessage&) { return MessageType::kAbortCommand; }
 inline MessageType messageTypeOf(const CommandAckMessage&) { return MessageType::kCommandAck; }
 inline MessageType messageTypeOf(const AssistanceMessage&) { return MessageType::kAssistance; }
+inline MessageType messageTypeOf(const formation::LeadershipMessage&) { return MessageType::kLeadership; }
 
 // ---- decoders: `out` written only on kNone; `reason` (optional) names the field ---------
 PayloadError decodePayload(const std::uint8_t* data, std::size_t size, Heartbeat& out, std::string* reason = nullptr);
@@ -188,6 +193,8 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, AbortMess
 PayloadError decodePayload(const std::uint8_t* data, std::size_t size, CommandAckMessage& out,
                            std::string* reason = nullptr);
 PayloadError decodePayload(const std::uint8_t* data, std::size_t size, AssistanceMessage& out,
+                           std::string* reason = nullptr);
+PayloadError decodePayload(const std::uint8_t* data, std::size_t size, formation::LeadershipMessage& out,
                            std::string* reason = nullptr);
 
 /// \brief One counter per PayloadError (kNone counts successful decodes).

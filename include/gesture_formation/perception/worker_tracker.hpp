@@ -14,13 +14,22 @@
 /// current one is associated. If no detection is associated the tracker box is kept for up
 /// to `max_missed_detections` detection rounds, then the track is lost; after a loss the
 /// nearest detection within `reacquire_gate` · max(w, h) of the last box keeps the id during
-/// `reacquire_frames` frames, otherwise the best-scoring person starts a new id.
+/// `reacquire_frames` frames; after that the best-scoring person starts a new id (unless the
+/// operator's choice holds, below).
 ///
 /// While a track exists, the detector runs on a square window around the worker
 /// (`roi_scale` · max(w, h), at least `roi_min_side_px`, shifted inside the frame) instead
 /// of the whole frame: a 60–120 px worker then reaches the network at ~full resolution
 /// rather than shrunk 2.5× by letterboxing a 640×480 frame into 256×256. If that window
 /// holds nobody, the whole frame is searched in the same step.
+///
+/// Identity by appearance (`appearance`, perception/appearance.hpp): once the worker's colour model
+/// is established, a detection that does not look like the worker is never associated with it nor
+/// re-acquired as it, and a tracker box that stops looking like the worker counts as a tracker
+/// failure (the tracker slid onto someone crossing in front). After a loss the worker is found
+/// again by appearance anywhere in the frame (same id). When the operator chose the worker
+/// (`selectWorker`), the tracker never starts a new identity by itself: without the chosen person
+/// it reports nobody, so a stranger's arms never reach the gesture classifier.
 
 #include <memory>
 #include <string>
@@ -30,6 +39,7 @@
 #include <opencv2/tracking.hpp>
 
 #include "gesture_formation/common/result.hpp"
+#include "gesture_formation/perception/appearance.hpp"
 #include "gesture_formation/perception/person_detector.hpp"
 
 namespace gesture_formation::common {
@@ -59,6 +69,7 @@ struct WorkerTrackerConfig {
   bool roi_detection = true;          ///< detect in a window around the worker while tracking
   float roi_scale = 2.5f;             ///< window side / max(w, h) of the worker box, ≥ 1
   float roi_min_side_px = 256.0f;     ///< smallest window side [px], ≥ 32 (256 = multipose input)
+  AppearanceConfig appearance;        ///< keys tracker.appearance.*
 
   /// \brief Every problem, each naming the key (`tracker.*`); empty when valid.
   std::vector<std::string> validate() const;
@@ -86,6 +97,9 @@ struct TrackStep {
   bool identity_changed = false; ///< a new id was started this frame
   std::vector<Detection> detections;  ///< all detections of this frame (empty if none ran)
   int worker_detection = -1;     ///< index in `detections` of the worker, −1 none
+  double similarity = -1.0;      ///< appearance similarity of the worker's box, −1 not computed
+  int appearance_rejected = 0;   ///< detections near the worker refused for their appearance this frame
+  bool reidentified = false;     ///< the lost worker was found again by appearance (same id)
   double detect_ms = 0.0;        ///< detector wall time this frame [ms]
   double track_ms = 0.0;         ///< tracker update + init wall time this frame [ms]
 };
@@ -93,6 +107,9 @@ struct TrackStep {
 /// \brief Running counters (for logs and tests).
 struct TrackCounters {
   int frames = 0, detections_run = 0, tracker_failures = 0, drifts = 0, identities = 0, lost = 0;
+  int appearance_rejections = 0;  ///< detections refused for their appearance
+  int appearance_tracker_failures = 0;  ///< tracker boxes refused for their appearance
+  int reidentifications = 0;      ///< losses ended by finding the worker again by appearance
 };
 
 /// \brief Detector–tracker alternation. Thread safety: not reentrant.
@@ -114,6 +131,22 @@ class WorkerTracker {
   /// (within `reacquire_gate` · max(w, h)) becomes the worker with a new id.
   void setWorkerHint(const cv::Rect2f& box_px);
 
+  /// \brief The operator's choice: the person of the last detection round whose box contains
+  /// `point_px` (the smallest such box) becomes the worker with a new id — its track starts at once
+  /// on that round's frame — and the tracker is locked to that person (it never picks another one
+  /// by itself; `unlock()` ends that). Fails, changing nothing, when no detection of the last round
+  /// contains the point.
+  common::Result<cv::Rect2f> selectWorker(const cv::Point2f& point_px);
+  /// \brief The operator's choice by candidate index (into `lastDetections()`); fails, changing
+  /// nothing, when out of range.
+  common::Result<cv::Rect2f> selectCandidate(int index);
+  /// \brief Ends the operator's lock: after a loss the best-scoring person may become the worker.
+  void unlock() { locked_ = false; }
+  bool locked() const { return locked_; }
+  /// The people of the last detection round (the candidates the operator can choose from).
+  const std::vector<Detection>& lastDetections() const { return last_detections_; }
+  const AppearanceModel& appearance() const { return appearance_; }
+
   const TrackCounters& counters() const { return counters_; }
   const WorkerTrackerConfig& config() const { return config_; }
   PersonDetector& detector() { return *detector_; }
@@ -124,6 +157,14 @@ class WorkerTracker {
   bool initTracker(const cv::Mat& frame, const cv::Rect2f& box);
   /// Detections in `window` of `frame`, boxes in frame pixels.
   common::Result<std::vector<Detection>> detectIn(const cv::Mat& frame, const cv::Rect& window);
+  /// Which of `dets` may be the worker by appearance (1) — all when the model is not established.
+  std::vector<char> lookAlikes(const cv::Mat& frame, const std::vector<Detection>& dets) const;
+  /// Associates this round's detections with the live track; true when the track was lost now.
+  bool associate(const cv::Mat& frame, const cv::Rect2f& predicted, bool have_pred, TrackStep& out);
+  /// Starts or resumes a track from this round's detections when none is live.
+  void acquire(const cv::Mat& frame, bool lost_now, TrackStep& out);
+  /// Takes detection `idx` as the worker's box (tracker re-initialised).
+  void take(const cv::Mat& frame, int idx, TrackStep& out);
 
   WorkerTrackerConfig config_;
   std::unique_ptr<PersonDetector> detector_;
@@ -136,6 +177,11 @@ class WorkerTracker {
   int missed_detections_ = 0;
   int frames_since_lost_ = -1;   ///< −1: never lost / no previous box
   bool hint_pending_ = false;    ///< setWorkerHint was called and not yet resolved
+  bool locked_ = false;          ///< the operator chose the worker: never a new person by itself
+  bool announce_new_id_ = false; ///< selectCandidate started a new id: the next step says so
+  cv::Mat last_detection_frame_; ///< the frame of last_detections_
+  AppearanceModel appearance_;
+  std::vector<Detection> last_detections_;
   cv::Size frame_size_;
   TrackCounters counters_;
 };

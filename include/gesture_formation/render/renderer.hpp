@@ -45,7 +45,10 @@
 namespace gesture_formation::render {
 
 /// \brief What each pixel sees (the class image, CV_8UC1).
-enum class PixelClass : std::uint8_t { kSky = 0, kGround = 1, kObstacle = 2, kUav = 3, kWorker = 4 };
+/// Bystander i (Renderer::setBystanders) is drawn as kBystander + i.
+enum class PixelClass : std::uint8_t { kSky = 0, kGround = 1, kObstacle = 2, kUav = 3, kWorker = 4, kBystander = 5 };
+/// At most this many bystanders (their classes 5 .. 5 + kMaxBystanders - 1).
+constexpr std::size_t kMaxBystanders = 8;
 
 struct RendererConfig {
   /// The worker mesh (tools/models/convert_mannequin.py). Empty: no worker can be drawn.
@@ -89,12 +92,28 @@ struct WorkerTruth {
   int visible_pixels = 0;
 };
 
+/// \brief Another person in the scene (a second crew member, a passer-by): the same mannequin, its
+/// own pose and clothes.
+struct Bystander {
+  WorkerJoints joints;
+  double height_m = 1.75;
+  Appearance appearance;
+  EIGEN_MAKE_ALIGNED_OPERATOR_NEW
+};
+
+/// \brief A bystander's truth in one frame: its visible pixels (class kBystander + i).
+struct BystanderTruth {
+  cv::Rect visible_box_px;  ///< empty when none is seen
+  int visible_pixels = 0;
+};
+
 /// \brief One rendered frame.
 struct RenderedFrame {
   cv::Mat rgb;       ///< CV_8UC3 in **RGB** order (sensor_msgs "rgb8"; cv::imwrite wants BGR)
   cv::Mat depth_m;   ///< CV_32FC1, metres along the optical axis, NaN where nothing
   cv::Mat classes;   ///< CV_8UC1, PixelClass per pixel
   WorkerTruth worker;
+  std::vector<BystanderTruth> bystanders;  ///< one per bystander of setBystanders, in its order
 };
 
 class Renderer {
@@ -116,6 +135,9 @@ class Renderer {
   common::Result<bool> setWorker(const WorkerJoints& joints, double height_m, const Appearance& appearance);
   /// \brief No worker in the next frames.
   void clearWorker();
+  /// \brief Poses, dresses and uploads the other people of the next frames (at most
+  /// kMaxBystanders; empty: none). The worker's truth is unaffected.
+  common::Result<bool> setBystanders(const std::vector<Bystander>& people);
   /// \brief Body poses (FLU) of the UAVs drawn in the next frames.
   void setUavs(const std::vector<Eigen::Isometry3d, Eigen::aligned_allocator<Eigen::Isometry3d>>& T_world_body);
 
@@ -124,8 +146,9 @@ class Renderer {
 
   /// \brief The GL renderer string (e.g. "llvmpipe (LLVM 15.0.6, 256 bits)").
   const std::string& glRenderer() const;
-  /// \brief The posed worker mesh (after setWorker), e.g. for tests.
-  const WorkerMesh* worker() const;
+  /// \brief The worker's posed truth keypoints (after setWorker; null without a worker), e.g. for
+  /// tests — the worker's own, whatever bystanders were posed after it.
+  const PosedKeypoints* workerKeypoints() const;
 
   struct Impl;
 

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "gesture_formation/sim/abort_drill.hpp"
 #include "gesture_formation/sim/mission_metrics.hpp"
 #include "gesture_formation/sim/multirotor.hpp"
 #include "gesture_formation/sim/worker_approach.hpp"
@@ -45,6 +46,16 @@ struct ParamsReport {
   std::vector<int> last_uavs;
 };
 
+/// \brief One UAV's abort state as its planner published it (AbortState): its phase (nullopt: not
+/// aborting), when it accepted the command and from whom.
+struct AbortReport {
+  int uav = 0;
+  double t_s = 0.0;  ///< when the state was decided
+  std::optional<planning::AbortPhase> phase;
+  double accepted_s = 0.0;
+  planning::AbortSource source = planning::AbortSource::kOperator;
+};
+
 class WorldRecord {
  public:
   /// A command outcome goes to the earliest pending request of its source issued at the command's
@@ -68,6 +79,14 @@ class WorldRecord {
   /// \brief The mission's operator requests due at t_s (in order, each once), recorded as pending
   /// ("lost" until the leader says what it did with them) and resolved with the outcomes known.
   std::vector<formation::FormationCommand> dueRequests(double t_s);
+  /// \brief faults.abort by the operator: true once, at the first t_s ≥ its time — the world then asks
+  /// the ground station's OperatorInterface for it (as an operator does: send_abort), and the abort
+  /// is recorded from its time on (metrics.json `abort`, as `gfctl simulate`). A gesture-source
+  /// faults.abort is not injected here (the worker's gesture takes the gesture path): false.
+  bool abortDue(double t_s);
+  /// \brief A UAV's abort state: its acceptance and phases into the abort record (an abort accepted
+  /// without faults.abort, e.g. a recognised gesture, is recorded from its acceptance on).
+  void abortState(const AbortReport& r);
   /// \brief A gesture the leader's filter fired at t_s (dominant id `gesture_id`), recorded and
   /// resolved like a request.
   void gestureFired(double t_s, int gesture_id, const gesture::GestureMapping& mapping);
@@ -105,6 +124,9 @@ class WorldRecord {
   std::string last_outcome_key_;        ///< the last (command, status) counted
   const MissionConfig& config_;
   std::optional<ApproachRecorder> approach_;  ///< faults.worker_approach, once the worker turned
+  ObstacleDistance obstacles_;                ///< the obstacle-distance metric (the abort's)
+  bool abort_requested_ = false;              ///< faults.abort asked for
+  std::optional<AbortRecorder> abort_;        ///< the abort, from its issue
 };
 
 }  // namespace gesture_formation::sim

@@ -99,6 +99,26 @@ TEST(LinkInboxTest, EveryAbortCopyIsHandedOnStampedWithItsEnvelope) {
   }
 }
 
+// A leadership message speaks for its sender only: `from` must be the envelope's sender; every
+// copy is handed on (the election tolerates duplicates).
+TEST(LinkInboxTest, ALeadershipMessageIsHandedOnOnlyFromItsOwnSender) {
+  LinkInbox inbox;
+  formation::LeadershipMessage m;
+  m.kind = formation::LeadershipMessageKind::kHeartbeat;
+  m.term = 2;
+  m.from = 1;
+  m.sent_s = 5.0;
+  for (int copy = 0; copy < 2; ++copy) {
+    const auto item = inbox.take(envelopeOf(m, 1));
+    ASSERT_TRUE(std::holds_alternative<formation::LeadershipMessage>(item));
+    EXPECT_EQ(std::get<formation::LeadershipMessage>(item).term, 2u);
+  }
+  const auto forged = inbox.take(envelopeOf(m, 2));  // UAV 2's key speaking for UAV 1
+  EXPECT_TRUE(std::holds_alternative<std::monostate>(forged));
+  EXPECT_EQ(inbox.leadershipRefused(), 1u);
+  EXPECT_NE(inbox.lastRefusal().find("leadership message refused"), std::string::npos) << inbox.lastRefusal();
+}
+
 TEST(LinkInboxTest, AnAcknowledgementIsHandedOnOncePerCommandId) {
   LinkInbox inbox;
   CommandAckMessage a;

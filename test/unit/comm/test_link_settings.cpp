@@ -64,6 +64,18 @@ TEST(LinkSettingsTest, AcknowledgementsComeFromTheParamsSenders) {
   EXPECT_EQ(verifierConfigOf(s, problems).senders_by_type.count(MessageType::kCommandAck), 0u);  // any known sender
 }
 
+// Leadership messages come from the UAVs only: the known senders with a UAV index, never the ground
+// station (own id dropped as for every list).
+TEST(LinkSettingsTest, LeadershipMessagesComeFromTheKnownUavsOnly) {
+  LinkSettings s;
+  s.sender_id = 1;
+  s.known_senders = {0, 1, 2, 100};
+  std::vector<ConfigError> problems;
+  const VerifierConfig c = verifierConfigOf(s, problems);
+  EXPECT_TRUE(problems.empty());
+  EXPECT_EQ(c.senders_by_type.at(MessageType::kLeadership), (std::vector<std::uint16_t>{0, 2}));
+}
+
 // Aborts come from the ground station and the leader's relay: their own sender list.
 TEST(LinkSettingsTest, AbortSendersAreTheirOwnList) {
   LinkSettings s;

@@ -687,3 +687,95 @@ TEST(CommPayloadsTest, RandomBytesDecodeOrRoundTripExactly) {
   }
   EXPECT_GT(decoded, 0);
 }
+
+// The leadership message (docs/security.md §3.2): 42 bytes, broadcast as 0xffff, an unknown
+// estimate age as flag bit 1 clear and 0; one encoding per message.
+TEST(CommPayloadsTest, LeadershipRoundTripAndRefusals) {
+  formation::LeadershipMessage m;
+  m.kind = formation::LeadershipMessageKind::kVoteRequest;
+  m.term = 3;
+  m.from = 2;
+  m.sent_s = 2.0;
+  m.estimate_age_s = 0.5;
+  const auto b = encoded(m);
+  ASSERT_EQ(b.size(), 42u);
+  const std::vector<std::uint8_t> head{4, 0, 0, 0, 3, 0, 2, 0xff, 0xff, 0x40, 0, 0, 0, 0, 0, 0, 0};
+  EXPECT_TRUE(std::equal(head.begin(), head.end(), b.begin()));
+  EXPECT_EQ(b[25], 0x02) << "flags: estimate known, not granted";
+  formation::LeadershipMessage d;
+  ASSERT_EQ(decode(b, d), PayloadError::kNone);
+  EXPECT_EQ(d.kind, formation::LeadershipMessageKind::kVoteRequest);
+  EXPECT_EQ(d.term, 3u);
+  EXPECT_EQ(d.from, 2);
+  EXPECT_EQ(d.to, formation::LeadershipMessage::kBroadcast);
+  EXPECT_EQ(d.sent_s, 2.0);
+  EXPECT_EQ(d.estimate_age_s, 0.5);
+  EXPECT_FALSE(d.granted);
+  // A reply to UAV 1, granted, no estimate: +inf survives as "not known".
+  m.kind = formation::LeadershipMessageKind::kVoteReply;
+  m.to = 1;
+  m.granted = true;
+  m.echo_s = 1.5;
+  m.estimate_age_s = std::numeric_limits<double>::infinity();
+  const auto r = encoded(m);
+  EXPECT_EQ(r[25], 0x01);
+  ASSERT_EQ(decode(r, d), PayloadError::kNone);
+  EXPECT_EQ(d.to, 1);
+  EXPECT_TRUE(d.granted);
+  EXPECT_EQ(d.echo_s, 1.5);
+  EXPECT_TRUE(std::isinf(d.estimate_age_s));
+  // Encoder refusals name the field.
+  auto bad_m = m;
+  bad_m.from = kMaxUavIndex + 1;
+  EXPECT_FALSE(encodePayload(bad_m));
+  bad_m = m;
+  bad_m.to = -2;
+  EXPECT_FALSE(encodePayload(bad_m));
+  bad_m = m;
+  bad_m.sent_s = std::nan("");
+  EXPECT_FALSE(encodePayload(bad_m));
+  bad_m = m;
+  bad_m.lease_age_s = -1.0;
+  EXPECT_FALSE(encodePayload(bad_m));
+  bad_m = m;
+  bad_m.estimate_age_s = -0.1;
+  EXPECT_FALSE(encodePayload(bad_m));
+  // Decoder refusals.
+  std::string reason;
+  auto bad = b;
+  bad[0] = 6;
+  EXPECT_EQ(decodePayload(bad.data(), bad.size(), d, &reason), PayloadError::kOutOfRange);
+  EXPECT_NE(reason.find("leadership.kind"), std::string::npos) << reason;
+  bad = b;
+  bad[6] = kMaxUavIndex + 1;
+  EXPECT_EQ(decodePayload(bad.data(), bad.size(), d, &reason), PayloadError::kOutOfRange);
+  EXPECT_NE(reason.find("leadership.from"), std::string::npos) << reason;
+  bad = b;
+  bad[7] = 0;
+  bad[8] = kMaxUavIndex + 1;
+  EXPECT_EQ(decodePayload(bad.data(), bad.size(), d, &reason), PayloadError::kOutOfRange);
+  EXPECT_NE(reason.find("leadership.to"), std::string::npos) << reason;
+  bad = b;
+  bad[25] = 0x04;
+  EXPECT_EQ(decodePayload(bad.data(), bad.size(), d, &reason), PayloadError::kOutOfRange);
+  EXPECT_NE(reason.find("leadership.flags"), std::string::npos) << reason;
+  bad = b;
+  bad[25] = 0x00;  // "not known" with an age of 0.5: two encodings of one message are refused
+  EXPECT_EQ(decodePayload(bad.data(), bad.size(), d, &reason), PayloadError::kOutOfRange);
+  EXPECT_NE(reason.find("leadership.estimate_age_s"), std::string::npos) << reason;
+  bad = b;
+  bad[26] = 0x80;  // a negative lease age
+  bad[27] = 0xf0;
+  EXPECT_EQ(decodePayload(bad.data(), bad.size(), d, &reason), PayloadError::kOutOfRange);
+  EXPECT_NE(reason.find("leadership.lease_age_s"), std::string::npos) << reason;
+  bad = b;
+  bad[9] = 0x7f;  // sent_s +inf
+  bad[10] = 0xf0;
+  EXPECT_EQ(decode(bad, d), PayloadError::kNonFinite);
+  bad = b;
+  bad.pop_back();
+  EXPECT_EQ(decode(bad, d), PayloadError::kTruncated);
+  bad = b;
+  bad.push_back(0);
+  EXPECT_EQ(decode(bad, d), PayloadError::kTrailingBytes);
+}

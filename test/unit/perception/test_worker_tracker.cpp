@@ -209,5 +209,147 @@ TEST(WorkerTrackerTest, ValidateAndTheNodeletParameterAgreeOnBoundaries) {
   EXPECT_FALSE(range.contains(1001));
 }
 
+// ---- identity by appearance (perception/appearance.hpp) -------------------------------------
+
+TEST(AppearanceModelTest, TheSamePersonLooksAlikeAnotherDoesNot) {
+  cv::setRNGSeed(7);
+  AppearanceModel model;
+  const cv::Rect2f a(100, 60, 20, 60), b(200, 60, 20, 60);
+  EXPECT_FALSE(model.established());
+  const cv::Mat first = model.describe(scene(100, 200), b);
+  EXPECT_DOUBLE_EQ(model.similarity(first), 1.0) << "a model not yet established rejects nothing";
+  for (int i = 0; i < 3; ++i) model.update(model.describe(scene(100, 200), a));
+  ASSERT_TRUE(model.established());
+  const double same = model.similarity(model.describe(scene(100, 200), a));
+  const double other = model.similarity(model.describe(scene(100, 200), b));
+  EXPECT_GT(same, 0.9);
+  EXPECT_LT(other, 0.3);
+  EXPECT_TRUE(model.accepts(model.describe(scene(100, 200), a), 0.55));
+  EXPECT_FALSE(model.accepts(model.describe(scene(100, 200), b), 0.55));
+  EXPECT_TRUE(model.describe(scene(100, 200), cv::Rect2f(-50, -50, 10, 10)).empty()) << "outside the frame";
+  AppearanceConfig off;
+  off.enabled = 0;
+  AppearanceModel geometry_only(off);
+  for (int i = 0; i < 5; ++i) geometry_only.update(geometry_only.describe(scene(100, 200), a));
+  EXPECT_FALSE(geometry_only.established());
+  EXPECT_DOUBLE_EQ(geometry_only.similarity(geometry_only.describe(scene(100, 200), b)), 1.0);
+}
+
+TEST(AppearanceModelTest, ValidateNamesEveryBadKey) {
+  WorkerTrackerConfig cfg;
+  cfg.appearance.enabled = 2;
+  cfg.appearance.min_similarity = 1.5f;
+  cfg.appearance.update_rate = 0.0f;
+  const auto e = cfg.validate();
+  ASSERT_EQ(e.size(), 3u);
+  EXPECT_NE(e[0].find("tracker.appearance.enabled"), std::string::npos) << e[0];
+  EXPECT_NE(e[1].find("tracker.appearance.min_similarity"), std::string::npos) << e[1];
+  EXPECT_NE(e[2].find("tracker.appearance.update_rate"), std::string::npos) << e[2];
+}
+
+/// Two people cross: A (the worker, dark) walks right, B (red) walks left and passes in front of
+/// A; while they overlap the detector sees only B. Returns the worker's box x per frame (−1 when
+/// not found) and the ids.
+struct Crossing {
+  std::vector<float> x;
+  std::vector<int> id;
+};
+Crossing crossing(const WorkerTrackerConfig& cfg, int frames = 40) {
+  cv::setRNGSeed(11);
+  const auto xa = [](int i) { return 80 + 4 * i; };
+  const auto xb = [](int i) { return 236 - 4 * i; };
+  std::vector<std::vector<Detection>> script;
+  for (int i = 0; i < frames; ++i) {
+    const bool overlap = std::abs(xa(i) - xb(i)) < 20;
+    if (i < 4) script.push_back({det(static_cast<float>(xa(i)), 60, 20, 60, 0.5f)});
+    else if (overlap) script.push_back({det(static_cast<float>(xb(i)), 60, 20, 60, 0.9f)});
+    else script.push_back({det(static_cast<float>(xb(i)), 60, 20, 60, 0.9f), det(static_cast<float>(xa(i)), 60, 20, 60, 0.5f)});
+  }
+  auto t = WorkerTracker::create(cfg, std::make_unique<ScriptedDetector>(script));
+  EXPECT_TRUE(t) << t.reason();
+  Crossing out;
+  for (int i = 0; i < frames; ++i) {
+    cv::Mat img(240, 320, CV_8UC3);
+    cv::randu(img, cv::Scalar::all(90), cv::Scalar::all(160));
+    cv::rectangle(img, cv::Rect(xa(i), 60, 20, 60), cv::Scalar(20, 20, 20), -1);
+    if (i >= 4) cv::rectangle(img, cv::Rect(xb(i), 60, 20, 60), cv::Scalar(30, 30, 200), -1);  // B in front
+    auto r = (*t)->step(img);
+    EXPECT_TRUE(r) << r.reason();
+    out.x.push_back(r->found ? r->box_px.x : -1.0f);
+    out.id.push_back(r->found ? r->id : -1);
+  }
+  return out;
+}
+
+TEST(WorkerTrackerTest, APersonCrossingInFrontDoesNotTakeTheWorkersIdentity) {
+  WorkerTrackerConfig cfg;
+  cfg.detect_every_k = 1;
+  cfg.roi_detection = false;
+  const Crossing c = crossing(cfg);
+  const int id0 = c.id[0];
+  ASSERT_GE(id0, 0);
+  for (std::size_t i = 0; i < c.x.size(); ++i) {
+    if (c.id[i] < 0) continue;
+    EXPECT_EQ(c.id[i], id0) << "frame " << i;
+    // Wherever the worker is reported, the box is A's (never B's, which is 4(2i) px away after the crossing).
+    EXPECT_NEAR(c.x[i], 80 + 4 * static_cast<float>(i), 12.0f) << "frame " << i;
+  }
+  // After the crossing A is found again with its id.
+  EXPECT_EQ(c.id.back(), id0);
+  EXPECT_NEAR(c.x.back(), 80 + 4 * 39, 1.0f);
+
+  // The control: geometry alone follows B through the crossing (the rule above is what keeps A).
+  cfg.appearance.enabled = 0;
+  const Crossing g = crossing(cfg);
+  EXPECT_GT(std::abs(g.x.back() - (80 + 4 * 39)), 40.0f) << "geometry alone was expected to swap to B";
+}
+
+TEST(WorkerTrackerTest, TheOperatorsChoiceIsKeptAndNoStrangerIsTaken) {
+  cv::setRNGSeed(7);
+  WorkerTrackerConfig cfg;
+  cfg.detect_every_k = 1;
+  cfg.roi_detection = false;
+  cfg.reacquire_frames = 2;
+  // Frames 0-1: A (best score) and B; the operator picks B; B then leaves for 5 frames (only A).
+  std::vector<std::vector<Detection>> script = {{det(100, 60, 20, 60, 0.9f), det(200, 60, 20, 60, 0.5f)},
+                                                {det(100, 60, 20, 60, 0.9f), det(200, 60, 20, 60, 0.5f)}};
+  for (int i = 0; i < 4; ++i) script.push_back({det(100, 60, 20, 60, 0.9f), det(200, 60, 20, 60, 0.5f)});
+  for (int i = 0; i < 5; ++i) script.push_back({det(100, 60, 20, 60, 0.9f)});
+  script.push_back({det(100, 60, 20, 60, 0.9f), det(260, 60, 20, 60, 0.5f)});  // B back, elsewhere
+  auto t = WorkerTracker::create(cfg, std::make_unique<ScriptedDetector>(script));
+  ASSERT_TRUE(t);
+  auto r0 = (*t)->step(scene(100, 200));
+  ASSERT_TRUE(r0 && r0->found);
+  EXPECT_NEAR(r0->box_px.x, 100.0f, 0.5f) << "the best-scoring person first";
+  ASSERT_EQ((*t)->lastDetections().size(), 2u);
+  EXPECT_FALSE((*t)->selectWorker({50.0f, 50.0f})) << "a point on nobody is refused";
+  EXPECT_FALSE((*t)->selectCandidate(2));
+  auto chosen = (*t)->selectWorker({210.0f, 90.0f});
+  ASSERT_TRUE(chosen) << chosen.reason();
+  EXPECT_TRUE((*t)->locked());
+  int id_b = -1;
+  for (int i = 1; i < 6; ++i) {
+    auto r = (*t)->step(scene(100, 200));
+    ASSERT_TRUE(r && r->found) << i;
+    EXPECT_NEAR(r->box_px.x, 200.0f, 0.5f) << i;
+    if (id_b < 0) id_b = r->id;
+    EXPECT_EQ(r->id, id_b);
+  }
+  EXPECT_NE(id_b, r0->id);
+  for (int i = 0; i < 5; ++i) {  // B gone: nobody (A is never taken while the choice holds)
+    cv::Mat img(240, 320, CV_8UC3);
+    cv::randu(img, cv::Scalar::all(90), cv::Scalar::all(160));
+    cv::rectangle(img, cv::Rect(100, 60, 20, 60), cv::Scalar(20, 20, 20), -1);
+    auto r = (*t)->step(img);
+    ASSERT_TRUE(r);
+    EXPECT_FALSE(r->found && r->box_px.x < 150.0f) << "took the stranger at step " << i;
+  }
+  auto back = (*t)->step(scene(100, 260));  // B back far from its last box: found by appearance
+  ASSERT_TRUE(back && back->found);
+  EXPECT_NEAR(back->box_px.x, 260.0f, 0.5f);
+  EXPECT_EQ(back->id, id_b);
+  EXPECT_TRUE(back->reidentified);
+}
+
 }  // namespace
 }  // namespace gesture_formation::perception

@@ -142,7 +142,7 @@ TEST_F(RendererTest, JointProjectionLandsOnItsPixel) {
   auto with_worker = renderer_->render(cam);
   ASSERT_TRUE(with_worker) << with_worker.reason();
   const ge::CameraModel model(k_);
-  const auto& kp = renderer_->worker()->keypoints();
+  const auto kp = *renderer_->workerKeypoints();
   renderer_->clearWorker();
   for (int j = 0; j < gg::kNumKeypoints; ++j) {
     const auto& truth = with_worker->worker.keypoints[static_cast<std::size_t>(j)];
@@ -207,6 +207,46 @@ TEST_F(RendererTest, ColourImageShowsTheWorkerWhereTheTruthBoxSays) {
   EXPECT_TRUE(f->worker.keypoints[gg::kNose].visible);
   EXPECT_TRUE(f->worker.keypoints[gg::kLeftShoulder].visible);
   EXPECT_TRUE(f->worker.keypoints[gg::kRightShoulder].visible);
+}
+
+// Other people (Renderer::setBystanders): each drawn with its own class and truth box; the
+// worker's truth (keypoints, box) is the worker's whatever is posed after it; too many refused.
+TEST_F(RendererTest, BystandersHaveTheirOwnClassAndLeaveTheWorkersTruthAlone) {
+  ASSERT_OK(renderer_->setWorldMesh(gr::TriangleMesh(), 0.0, Vector3d::Zero()));
+  double height = 0.0;
+  const auto joints = worker(gg::Motion::kIdle, Vector3d(8.0, 1.0, 0.0), M_PI, &height);
+  ASSERT_OK(renderer_->setWorker(joints, height, gr::Appearance::fromSeed(3)));
+  gr::CameraView cam;
+  cam.intrinsics = k_;
+  cam.T_world_camera = gr::cameraPoseFromHeadingPitch(Vector3d(0.0, 0.0, 1.5), 0.0, 0.0);
+  auto alone = renderer_->render(cam);
+  ASSERT_TRUE(alone) << alone.reason();
+  EXPECT_TRUE(alone->bystanders.empty());
+  gr::Bystander b;
+  b.joints = worker(gg::Motion::kWalking, Vector3d(8.0, -1.5, 0.0), M_PI / 2, &b.height_m);
+  b.appearance = gr::Appearance::fromSeed(4);
+  ASSERT_OK(renderer_->setBystanders({b}));
+  auto both = renderer_->render(cam);
+  ASSERT_TRUE(both) << both.reason();
+  ASSERT_EQ(both->bystanders.size(), 1u);
+  const cv::Rect bb = both->bystanders[0].visible_box_px;
+  EXPECT_GT(both->bystanders[0].visible_pixels, 500);
+  EXPECT_EQ(bb & alone->worker.visible_box_px, cv::Rect()) << "1.5 m and 1 m to either side: the boxes do not overlap";
+  EXPECT_GT(bb.x + bb.width / 2, alone->worker.visible_box_px.x + alone->worker.visible_box_px.width / 2)
+      << "the bystander (world -y) is right of the worker in the image";
+  EXPECT_EQ(both->worker.visible_box_px, alone->worker.visible_box_px);
+  for (int j = 0; j < gg::kNumKeypoints; ++j) {
+    const auto& a = alone->worker.keypoints[static_cast<std::size_t>(j)];
+    const auto& c = both->worker.keypoints[static_cast<std::size_t>(j)];
+    EXPECT_LT((a.uv_px - c.uv_px).norm(), 1e-9) << "keypoint " << j;
+  }
+  EXPECT_EQ(cv::countNonZero(both->classes == static_cast<int>(gr::PixelClass::kBystander)), both->bystanders[0].visible_pixels);
+  EXPECT_FALSE(renderer_->setBystanders(std::vector<gr::Bystander>(gr::kMaxBystanders + 1, b)));
+  ASSERT_OK(renderer_->setBystanders({}));
+  auto none = renderer_->render(cam);
+  ASSERT_TRUE(none);
+  EXPECT_TRUE(none->bystanders.empty());
+  EXPECT_EQ(cv::countNonZero(none->classes == static_cast<int>(gr::PixelClass::kBystander)), 0);
 }
 
 TEST_F(RendererTest, ObstaclePixelsLieOnThePlannersSolids) {

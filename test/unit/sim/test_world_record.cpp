@@ -202,3 +202,69 @@ TEST(WorldRecordTest, TheWorkerApproachTurnsTheWorkerTowardsTheUavAndIsRecorded)
   const std::string metrics = readFile(dir + "/metrics.json");
   EXPECT_NE(metrics.find("\"worker_approach\""), std::string::npos);
 }
+
+// faults.abort in the ROS world: the operator's abort is due once, at its time; every UAV's
+// published abort states go into metrics.json's `abort` (accepted, retreat reached, settled, the
+// least distances from the issue on), as gfctl simulate's AbortRecorder writes it.
+TEST(WorldRecordTest, TheAbortIsDueOnceAtItsTimeAndEveryUavsStatesAreRecorded) {
+  Fixture fx;
+  fx.cfg.faults.abort = gf::sim::AbortEvent{10.0, gf::planning::AbortSource::kOperator};
+  WorldRecord r(fx.cfg, fx.obstacles(), 1);
+  EXPECT_FALSE(r.abortDue(9.9));
+  EXPECT_TRUE(r.abortDue(10.05));
+  EXPECT_FALSE(r.abortDue(10.1)) << "requested once";
+  using P = gf::planning::AbortPhase;
+  for (int i = 0; i < 3; ++i) {
+    r.abortState({i, 10.2, P::kRetreat, 10.15, gf::planning::AbortSource::kOperator});
+    r.abortState({i, 11.0, P::kRetreat, 10.15, gf::planning::AbortSource::kOperator});  // every replanning
+  }
+  r.abortState({0, 14.0, P::kAtRetreat, 10.15, gf::planning::AbortSource::kOperator});
+  r.abortState({1, 15.0, P::kAtRetreat, 10.15, gf::planning::AbortSource::kOperator});
+  r.abortState({1, 16.0, P::kAtRetreat, 10.15, gf::planning::AbortSource::kOperator});
+  r.abortState({2, 12.0, std::nullopt, 0.0, gf::planning::AbortSource::kOperator});  // not aborting: ignored
+  std::vector<std::optional<gf::sim::MultirotorState>> truths(3);
+  for (int i = 0; i < 3; ++i) {
+    truths[static_cast<std::size_t>(i)] = gf::sim::MultirotorState{};
+    truths[static_cast<std::size_t>(i)]->p_world = Eigen::Vector3d(5.0 * i, 8.0, 4.0);
+  }
+  gf::sim::WorkerState w;
+  w.p_world = Eigen::Vector3d(0, 0, 0.9);
+  ASSERT_TRUE(r.sampleSafety(9.0, truths, w));  // before the issue: not the abort's
+  truths[0]->p_world = Eigen::Vector3d(0, 12.0, 0.9);
+  ASSERT_TRUE(r.sampleSafety(12.0, truths, w));
+  const std::string dir = ::testing::TempDir() + "/world_record_abort";
+  std::filesystem::create_directories(dir);
+  std::string error, warning;
+  ASSERT_TRUE(r.finish({}, 20.0, 1.0, dir, &error, &warning)) << error;
+  const std::string metrics = readFile(dir + "/metrics.json");
+  EXPECT_NE(metrics.find("\"issued_s\": 10"), std::string::npos) << metrics;
+  EXPECT_NE(metrics.find("{\"uav\": 0, \"accepted_s\": 10.15, \"retreat_reached_s\": 14, \"settled_s\": 14, "
+                         "\"phase\": \"at_retreat\""),
+            std::string::npos)
+      << metrics;
+  EXPECT_NE(metrics.find("{\"uav\": 1, \"accepted_s\": 10.15, \"retreat_reached_s\": 15, \"settled_s\": 15"),
+            std::string::npos)
+      << metrics;
+  EXPECT_NE(metrics.find("{\"uav\": 2, \"accepted_s\": 10.15, \"retreat_reached_s\": null, \"settled_s\": null, "
+                         "\"phase\": \"retreat\""),
+            std::string::npos)
+      << metrics;
+  // UAV 0's least worker distance is the sample after the issue (12 m), not the one before (8.6 m).
+  EXPECT_NE(metrics.find("\"phase\": \"at_retreat\", \"min_worker_distance_m\": 12,"), std::string::npos) << metrics;
+  EXPECT_NE(metrics.find("\"time_to_settle_max_s\": null"), std::string::npos) << metrics;
+}
+
+// An abort accepted without faults.abort (the worker's gesture) is recorded from its acceptance.
+TEST(WorldRecordTest, AnAbortAcceptedWithoutTheFaultIsRecordedFromItsAcceptance) {
+  Fixture fx;
+  WorldRecord r(fx.cfg, fx.obstacles(), 1);
+  EXPECT_FALSE(r.abortDue(100.0)) << "no faults.abort";
+  r.abortState({0, 30.0, gf::planning::AbortPhase::kRetreat, 29.9, gf::planning::AbortSource::kGesture});
+  const std::string dir = ::testing::TempDir() + "/world_record_abort_gesture";
+  std::filesystem::create_directories(dir);
+  std::string error, warning;
+  ASSERT_TRUE(r.finish({}, 40.0, 1.0, dir, &error, &warning)) << error;
+  const std::string metrics = readFile(dir + "/metrics.json");
+  EXPECT_NE(metrics.find("\"issued_s\": 29.9"), std::string::npos) << metrics;
+  EXPECT_NE(metrics.find("\"source\": \"gesture\""), std::string::npos) << metrics;
+}

@@ -31,7 +31,6 @@ std::unique_ptr<LcmTransport> memq() {
 
 TEST(CommLcmTransportTest, ChannelNamesRoundTrip) {
   for (std::uint8_t k = comm::kMinMessageType; k <= comm::kMaxMessageType; ++k) {
-    if (!comm::isKnownMessageType(k)) continue;  // a gap in the numbering (10 is another branch's)
     const auto type = static_cast<comm::MessageType>(k);
     const std::string name = channelName(type, "GF_");
     EXPECT_EQ(channelType(name, "GF_"), type) << name;

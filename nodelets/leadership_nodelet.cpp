@@ -1,0 +1,121 @@
+// Leadership nodelet: this UAV's formation::Leadership (docs/safety.md §1.2) — the election and
+// leases of gfctl simulate's hand-over, over the real link: its messages go to the LcmBridge
+// (leadership_out → LCM, signed, to every UAV) and come back from it (leadership_in: every UAV's,
+// from its own sender only). Every heartbeat_period_s / 4 it ticks (heartbeats, candidacy, timeouts)
+// and publishes leadership_state (LeadershipState, latched) whenever its view changes — term, leader,
+// role, acting; a lapsed lease is published stamped with the lease's end. The UAV that acts does
+// the leader's work (docs/ros.md "Leader hand-over").
+//
+// Topics: leadership_in (LeadershipMessage), worker_state_in (WorkerState: the estimate age it
+//   stands with, now − last_fused; none: +inf) → leadership_out (LeadershipMessage),
+//   leadership_state (LeadershipState, latched).
+// Parameters (all required): ~uav_index, and formation::leadershipFields() by their last key
+//   segment: ~uav_count, ~heartbeat_period_s, ~lease_s, ~silence_limit_s, ~candidacy_stagger_s,
+//   ~election_timeout_s, ~clock_drift, ~estimate_tolerance_s (config/ros/nodelets.yaml `leadership`).
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <optional>
+
+#include <nodelet/nodelet.h>
+#include <pluginlib/class_list_macros.hpp>
+#include <ros/ros.h>
+
+#include "gesture_formation/WorkerState.h"
+#include "leadership_conversions.hpp"
+#include "param_loader.hpp"
+
+namespace gesture_formation::nodelets {
+
+class LeadershipNodelet : public nodelet::Nodelet {
+ private:
+  void onInit() override {
+    ros::NodeHandle& nh = getNodeHandle();
+    ParamLoader params(getPrivateNodeHandle());
+    formation::LeadershipConfig cfg;
+    params.loadFields(formation::leadershipFields(), cfg);
+    params.load("uav_index", uav_index_, 0, comm::kMaxUavIndex);
+    if (params.ok()) {
+      for (const auto& e : cfg.validate()) params.addError(e);  // the cross-field rules, naming the key
+      if (uav_index_ >= cfg.uav_count) params.addError("uav_index: must be < uav_count (" + std::to_string(cfg.uav_count) + ")");
+    }
+    if (!params.ok()) {
+      NODELET_ERROR_STREAM("Leadership refuses to start; fix these parameters:\n" << params.report());
+      return;
+    }
+    NODELET_INFO_STREAM("Leadership (UAV " << uav_index_ << ") loaded:\n" << params.loaded());
+    lead_.emplace(cfg, uav_index_, formation::Leadership::Start::kMissionStart, now());
+    out_pub_ = nh.advertise<gesture_formation::LeadershipMessage>("leadership_out", 50);
+    state_pub_ = nh.advertise<gesture_formation::LeadershipState>("leadership_state", 5, true);
+    publishState(now());
+    in_sub_ = nh.subscribe("leadership_in", 100, &LeadershipNodelet::onMessage, this);
+    worker_sub_ = nh.subscribe<gesture_formation::WorkerState>(
+        "worker_state_in", 5, [this](const gesture_formation::WorkerState::ConstPtr& m) {
+          std::lock_guard<std::mutex> lock(mutex_);
+          last_fused_s_ = m->last_fused.toSec();
+        });
+    timer_ = nh.createTimer(ros::Duration(cfg.heartbeat_period_s / 4.0), [this](const ros::TimerEvent&) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      const double t = now();
+      send(lead_->tick(t, estimateAge(t)));
+      update(t);
+    });
+  }
+
+  static double now() { return ros::Time::now().toSec(); }
+  double estimateAge(double t) const {
+    return last_fused_s_ ? std::max(0.0, t - *last_fused_s_) : std::numeric_limits<double>::infinity();
+  }
+
+  void onMessage(const gesture_formation::LeadershipMessage::ConstPtr& msg) {
+    auto m = fromMsg(*msg);
+    if (!m) {
+      NODELET_WARN_STREAM_THROTTLE(1.0, "Leadership: message dropped: " << m.reason());
+      return;
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (m->from == uav_index_) return;  // its own, echoed
+    const double t = now();
+    send(lead_->receive(t, *m, estimateAge(t)));
+    update(t);
+  }
+
+  void send(const std::vector<formation::LeadershipMessage>& out) {
+    for (const auto& m : out) out_pub_.publish(toMsg(m));
+  }
+
+  /// Publishes the state when the view changed; a lapsed lease is stamped with its end.
+  void update(double t) {
+    const bool acting = lead_->acting(t);
+    if (acting == acting_ && lead_->term() == term_ && lead_->leader() == leader_ && lead_->role() == role_) return;
+    const double stamp = (acting_ && !acting && lead_->leaseUntil() <= t) ? lead_->leaseUntil() : t;
+    if (acting != acting_) {
+      NODELET_WARN_STREAM("Leadership UAV " << uav_index_ << ": " << (acting ? "acts as leader" : "no longer acts")
+                                            << " (term " << lead_->term() << ", t = " << stamp << " s)");
+    }
+    publishState(stamp);
+  }
+  void publishState(double stamp) {
+    acting_ = lead_->acting(stamp);
+    term_ = lead_->term();
+    leader_ = lead_->leader();
+    role_ = lead_->role();
+    state_pub_.publish(toStateMsg(*lead_, acting_, ros::Time(std::max(stamp, 0.0))));
+  }
+
+  std::mutex mutex_;
+  int uav_index_ = 0;
+  std::optional<formation::Leadership> lead_;
+  std::optional<double> last_fused_s_;  ///< the last worker state's last fusion (none: no estimate)
+  bool acting_ = false;
+  std::uint32_t term_ = 0;
+  int leader_ = -2;
+  formation::LeadershipRole role_ = formation::LeadershipRole::kFollower;
+  ros::Publisher out_pub_, state_pub_;
+  ros::Subscriber in_sub_, worker_sub_;
+  ros::Timer timer_;
+};
+
+}  // namespace gesture_formation::nodelets
+
+PLUGINLIB_EXPORT_CLASS(gesture_formation::nodelets::LeadershipNodelet, nodelet::Nodelet)
