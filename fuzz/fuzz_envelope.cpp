@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "fuzz_common.hpp"
+#include "gesture_formation/comm/map_update.hpp"
 #include "gesture_formation/comm/payloads.hpp"
 #include "gesture_formation/comm/signer.hpp"
 
@@ -113,6 +114,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       }
       case MessageType::kLeadership: {
         formation::LeadershipMessage m;
+        decoder.decode(r.envelope, m);
+        break;
+      }
+      case MessageType::kMapUpdate: {
+        MapUpdate m;
         decoder.decode(r.envelope, m);
         break;
       }

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "fuzz_common.hpp"
+#include "gesture_formation/comm/map_update.hpp"
 #include "gesture_formation/comm/payloads.hpp"
 
 using namespace gesture_formation;
@@ -47,6 +48,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   if (data[0] == 251) {  // (before the leadership payload a worker state, as 251 % 5)
     roundTrip<formation::LeadershipMessage>(payload, n);
+    return 0;
+  }
+  if (data[0] == 250) {  // (before the map-update payload a heartbeat, as 250 % 5)
+    roundTrip<MapUpdate>(payload, n);
     return 0;
   }
   if (data[0] == 253) {  // (before the acknowledgement payload a formation params, as 253 % 5)

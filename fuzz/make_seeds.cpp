@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "fuzz_common.hpp"
+#include "gesture_formation/comm/map_update.hpp"
 #include "gesture_formation/comm/payloads.hpp"
 #include "gesture_formation/comm/signer.hpp"
 #include "gesture_formation/lcm_bridge/lcm_transport.hpp"
@@ -70,6 +71,14 @@ int main(int argc, char** argv) {
   for (std::size_t i = 0; i < payloads.size(); ++i) {
     write(dir + "/payloads/seed_" + std::to_string(i), withPrefix(static_cast<std::uint8_t>(i < 5 ? i : 255), payloads[i]));
   }
+  MapUpdate map_update;
+  map_update.uav_index = 1;
+  map_update.sequence = 7;
+  map_update.delta.stamp_s = 12.5;
+  map_update.delta.resolution_m = 0.2;
+  map_update.delta.occupied = {{{32800, 32790, 32770}}, {{32801, 32790, 32770}}};
+  map_update.delta.free = {{{32760, 32770, 32771}}};
+  write(dir + "/payloads/seed_map_update", withPrefix(250, encodePayload(map_update).value()));
   KeyEntry k;
   k.id = 2;
   k.key = gf_fuzz::fuzzKey(2);

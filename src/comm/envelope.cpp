@@ -19,6 +19,7 @@ const char* toString(MessageType type) {
     case MessageType::kCommandAck: return "command_ack";
     case MessageType::kAssistance: return "assistance";
     case MessageType::kLeadership: return "leadership";
+    case MessageType::kMapUpdate: return "map_update";
   }
   return "unknown";
 }

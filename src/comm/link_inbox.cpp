@@ -96,6 +96,8 @@ InboxItem LinkInbox::decodeOne(const Envelope& e) {
       }
       return m;
     }
+    case MessageType::kMapUpdate:
+      return {};  // not an inbox item: map updates go to the live map (docs/mapping.md §8)
   }
   return {};
 }

@@ -40,7 +40,7 @@ const Registrar kRegistrar{
     "simulate",
     "--scenario FILE --out DIR [--seed N | --seeds A..B] [--duration S] [--model ONNX] [--no-plot] "
     "[--faults FILE | --fault-profile NAME] [--threads N] [--camera synthetic|rendered] [--camera-rate HZ] "
-    "[--camera-video DIR] [--models DIR] [--mapping on|off] [--no-prior-map]   closed-loop mission: metrics.json, timeline.csv, events.csv, modes.csv, "
+    "[--camera-video DIR] [--models DIR] [--mapping on|off] [--no-prior-map] [--map-share on|off]   closed-loop mission: metrics.json, timeline.csv, events.csv, modes.csv, "
     "timeline.png (docs/design.md §8.4); --faults replaces mission.faults with FILE's faults: section, --fault-profile NAME "
     "uses <scenario dir>/../faults/NAME.yaml (config/faults/; docs/safety.md); --threads N classifies the UAVs' "
     "camera views of a frame on N threads, with --camera rendered also runs their perception pipelines on them (default: "
@@ -49,7 +49,8 @@ const Registrar kRegistrar{
     "docs/simulation.md §8): perception.csv and a metrics.json perception section; --camera-rate lowers its frame "
     "rate, --camera-video writes each UAV's annotated stream (MJPG .avi); --mapping on|off overrides mission.mapping.enabled "
     "(every UAV maps the site from its depth frames and plans on its live map; docs/mapping.md §7), --no-prior-map starts "
-    "the live maps empty (mission.mapping.prior_map false); a scenario's unmapped_obstacles are in the world, not in the "
+    "the live maps empty (mission.mapping.prior_map false), --map-share on|off overrides mission.mapping.share.enabled "
+    "(every UAV sends its map changes to the others and merges theirs; docs/mapping.md §8); a scenario's unmapped_obstacles are in the world, not in the "
     "prior map (docs/simulation.md)",
     cmdSimulate};
 
@@ -211,6 +212,13 @@ void printSiteMapping(const sim::SiteMappingSummary& s) {
               << o.avoided_s << " s (sight to avoidance " << o.sight_to_avoidance_s << " s), min distance "
               << o.min_distance_m << " m (UAV " << o.min_distance_uav << " at " << o.min_distance_t_s << " s)\n";
   }
+  const sim::MapShareSummary& m = s.share;
+  if (!m.enabled) return;
+  std::cout << "    map sharing: " << m.updates_sent << " updates sent (" << m.voxels_sent << " voxels), " << m.updates_merged
+            << " merged, " << m.updates_lost << " lost, " << m.updates_refused << " refused; changes deferred "
+            << m.changes_deferred << ", dropped " << m.changes_dropped << "; bytes/s per UAV p50 " << m.bytes_per_s_p50
+            << " max " << m.bytes_per_s_max << "; age of received changes p50 " << m.age_s_p50 << " s max " << m.age_s_max
+            << " s; merge median " << m.merge_ms_median << " ms p99 " << m.merge_ms_p99 << " ms\n";
 }
 
 int runOne(const Args& args, Loaded& L, std::uint64_t seed, double duration, const std::string& dir, bool plot,
@@ -305,6 +313,12 @@ std::string applyMappingOptions(const Args& args, Loaded& L) {
     if (!L.mission.mapping.enabled) return "--no-prior-map needs mapping (mission.mapping.enabled or --mapping on)";
     L.mission.mapping.prior_map = false;
   }
+  if (args.has("map-share")) {
+    const std::string v = args.get("map-share");
+    if (v != "on" && v != "off") return "--map-share: expected on or off, got '" + v + "'";
+    if (v == "on" && !L.mission.mapping.enabled) return "--map-share on needs mapping (mission.mapping.enabled or --mapping on)";
+    L.mission.mapping.live.share.enabled = v == "on";
+  }
   return "";
 }
 
@@ -345,7 +359,7 @@ std::string setUpRendered(const Args& args, Loaded& L) {
 
 int cmdSimulate(const Args& args) {
   if (!checkOptions(args, {"scenario", "out"}, {"seed", "seeds", "duration", "model", "no-plot", "faults", "fault-profile", "threads",
-                                                 "camera", "camera-rate", "camera-video", "models", "mapping",
+                                                 "camera", "camera-rate", "camera-video", "models", "mapping", "map-share",
                                                  "no-prior-map"})) {
     return kExitBadInput;
   }

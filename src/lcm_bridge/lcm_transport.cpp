@@ -36,6 +36,7 @@ constexpr ChannelSuffix kChannels[] = {
     {comm::MessageType::kCommandAck, "COMMAND_ACK"},
     {comm::MessageType::kAssistance, "ASSISTANCE"},
     {comm::MessageType::kLeadership, "LEADERSHIP"},
+    {comm::MessageType::kMapUpdate, "MAP_UPDATE"},
 };
 
 /// LCM's fixed part of gf_lcm::envelope_t: 8-byte fingerprint + int32 length.

@@ -20,6 +20,7 @@ std::string frameProblem(const DepthFrame& frame) {
   if (!out.str().empty()) return out.str();
   const Eigen::Matrix4d& T = frame.T_world_camera.matrix();
   if (!T.allFinite()) return "T_world_camera must be finite";
+  if (!std::isfinite(frame.stamp_s)) return "stamp_s must be finite, got " + std::to_string(frame.stamp_s);
   const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
   const double orthogonality = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   if (orthogonality > 1e-6 || R.determinant() < 0.0) {

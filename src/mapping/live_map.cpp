@@ -1,6 +1,8 @@
 #include "gesture_formation/mapping/live_map.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <limits>
 #include <mutex>
 
 #include <octomap/OcTree.h>
@@ -67,6 +69,12 @@ LiveMap::LiveMap(const MappingConfig& config, std::shared_ptr<planning::Occupanc
   key_origin_ = map_->gridOrigin() + planning::VoxelIndex::Constant(kKeyOrigin);
   grid_size_ = map_->gridSize();
   saturated_.assign(voxels, 0);
+  own_s_.assign(voxels, -std::numeric_limits<double>::infinity());
+  received_.assign(voxels, kReceivedNone);
+  received_s_.assign(voxels, 0.0);
+  announced_.assign(voxels, 0);
+  pending_mark_.assign(voxels, 0);
+  pending_s_.assign(voxels, 0.0);
 }
 
 LiveMap::~LiveMap() = default;
@@ -160,8 +168,59 @@ int LiveMap::castRays(const DepthPoints& points) {
   return static_cast<int>(ends.size());
 }
 
-std::vector<planning::VoxelChange> LiveMap::fusedChanges(int& observed_changes) {
+planning::VoxelIndex LiveMap::voxelOfIndex(std::size_t index) const {
+  const auto nx = static_cast<std::size_t>(grid_size_.x()), ny = static_cast<std::size_t>(grid_size_.y());
+  return map_->gridOrigin() + planning::VoxelIndex(static_cast<int>(index % nx), static_cast<int>((index / nx) % ny),
+                                                   static_cast<int>(index / (nx * ny)));
+}
+
+octomap::OcTreeKey LiveMap::keyOfIndex(std::size_t index) const {
+  const planning::VoxelIndex k = voxelOfIndex(index) + planning::VoxelIndex::Constant(kKeyOrigin);
+  return octomap::OcTreeKey(static_cast<octomap::key_type>(k.x()), static_cast<octomap::key_type>(k.y()),
+                            static_cast<octomap::key_type>(k.z()));
+}
+
+bool LiveMap::ownOccupied(std::size_t index) const {
+  const octomap::OcTreeNode* node = tree_->search(keyOfIndex(index));
+  return node != nullptr && tree_->isNodeOccupied(node);
+}
+
+bool LiveMap::fusedOccupied(std::size_t index, const planning::VoxelIndex& voxel, bool own_occupied) const {
+  if (prior_ && prior_->isOccupied(voxel)) return true;
+  if (received_[index] != kReceivedNone) return received_[index] == kReceivedOccupied;
+  return own_occupied;
+}
+
+void LiveMap::notePending(std::size_t index, const planning::VoxelIndex& voxel, bool own_occupied, double stamp_s) {
+  if (prior_ && prior_->isOccupied(voxel)) return;  // every UAV holds the prior: nothing to tell
+  if ((own_occupied ? 1 : 0) == announced_[index] && pending_mark_[index] == 0) return;
+  pending_s_[index] = stamp_s;
+  if (pending_mark_[index] == 0) {
+    pending_mark_[index] = 1;
+    pending_.push_back(index);
+  }
+}
+
+std::vector<std::size_t> LiveMap::stampOwnCells(double stamp_s) {
+  std::vector<std::size_t> recheck;
+  auto stamp = [&](const std::vector<std::pair<octomap::OcTreeKey, std::ptrdiff_t>>& cells) {
+    for (const auto& cell : cells) {
+      const auto index = static_cast<std::size_t>(cell.second);
+      own_s_[index] = std::max(own_s_[index], stamp_s);
+      if (received_[index] != kReceivedNone && received_s_[index] <= stamp_s) {  // own word is newer
+        received_[index] = kReceivedNone;
+        recheck.push_back(index);
+      }
+    }
+  };
+  stamp(free_cells_);
+  stamp(occupied_cells_);
+  return recheck;
+}
+
+std::vector<planning::VoxelChange> LiveMap::fusedChanges(int& observed_changes, const std::vector<std::size_t>& recheck) {
   std::vector<planning::VoxelChange> changes;
+  std::vector<std::size_t> marked;
   observed_changes = 0;
   for (auto it = tree_->changedKeysBegin(), end = tree_->changedKeysEnd(); it != end; ++it) {
     ++observed_changes;
@@ -169,10 +228,25 @@ std::vector<planning::VoxelChange> LiveMap::fusedChanges(int& observed_changes) 
         Eigen::Vector3d(tree_->keyToCoord(it->first[0]), tree_->keyToCoord(it->first[1]), tree_->keyToCoord(it->first[2])));
     const octomap::OcTreeNode* node = tree_->search(it->first);
     const bool seen_occupied = node != nullptr && tree_->isNodeOccupied(node);
-    const bool occupied = seen_occupied || (prior_ && prior_->isOccupied(voxel));
+    const std::ptrdiff_t index = gridIndex(it->first);
+    bool occupied = seen_occupied || (prior_ && prior_->isOccupied(voxel));
+    if (index >= 0) {
+      const auto u = static_cast<std::size_t>(index);
+      notePending(u, voxel, seen_occupied, map_stamp_s_);
+      occupied = fusedOccupied(u, voxel, seen_occupied);
+      mark_[u] = 3;
+      marked.push_back(u);
+    }
     if (occupied != map_->isOccupied(voxel)) changes.push_back({voxel, occupied});
   }
   tree_->resetChangeDetection();
+  for (const std::size_t index : recheck) {  // a received class replaced by an unchanged own observation
+    if (mark_[index] == 3) continue;
+    const planning::VoxelIndex voxel = voxelOfIndex(index);
+    const bool occupied = fusedOccupied(index, voxel, ownOccupied(index));
+    if (occupied != map_->isOccupied(voxel)) changes.push_back({voxel, occupied});
+  }
+  for (const std::size_t index : marked) mark_[index] = 0;
   return changes;
 }
 
@@ -193,7 +267,9 @@ common::Result<FrameUpdate> LiveMap::integrate(const DepthFrame& frame) {
   out.raycast_ms = msSince(t1);
 
   const auto t2 = std::chrono::steady_clock::now();
-  const std::vector<planning::VoxelChange> changes = fusedChanges(out.observed_changes);
+  map_stamp_s_ = std::max(map_stamp_s_, frame.stamp_s);
+  const std::vector<std::size_t> recheck = stampOwnCells(frame.stamp_s);
+  const std::vector<planning::VoxelChange> changes = fusedChanges(out.observed_changes, recheck);
   std::unique_lock<std::shared_mutex> lock(mutex_);
   const std::vector<planning::VoxelIndex> changed = map_->setOccupancy(changes);
   for (const auto& cell : free_cells_) seen_->markLinear(static_cast<std::size_t>(cell.second));  // castRays' cells
@@ -208,6 +284,100 @@ common::Result<FrameUpdate> LiveMap::integrate(const DepthFrame& frame) {
   out.field_ms = msSince(t3);
   out.total_ms = msSince(t0);
   return R::ok(out);
+}
+
+KeyGrid LiveMap::keyGrid() const {
+  KeyGrid g;
+  g.resolution_m = map_->resolution();
+  for (int a = 0; a < 3; ++a) {
+    g.min_key[static_cast<std::size_t>(a)] = static_cast<std::uint16_t>(key_origin_[a]);
+    g.max_key[static_cast<std::size_t>(a)] = static_cast<std::uint16_t>(key_origin_[a] + grid_size_[a] - 1);
+  }
+  return g;
+}
+
+common::Result<MergeResult> LiveMap::merge(const MapDelta& delta) {
+  using R = common::Result<MergeResult>;
+  const auto t0 = std::chrono::steady_clock::now();
+  if (const std::string problem = deltaProblem(delta, keyGrid()); !problem.empty()) return R::fail(problem);
+  MergeResult out;
+  out.voxels = static_cast<int>(delta.size());
+  std::vector<planning::VoxelChange> changes;
+  std::vector<std::size_t> marked;
+  auto take = [&](const std::vector<VoxelKey>& keys, bool occupied) {
+    for (const VoxelKey& k : keys) {
+      const std::ptrdiff_t i = gridIndex(octomap::OcTreeKey(k[0], k[1], k[2]));
+      const auto index = static_cast<std::size_t>(i);  // ≥ 0: deltaProblem checked the keys
+      if (own_s_[index] >= delta.stamp_s || (received_[index] != kReceivedNone && received_s_[index] > delta.stamp_s) ||
+          mark_[index] != 0) {
+        ++out.superseded;  // seen here since, a newer received class, or listed twice
+        continue;
+      }
+      received_[index] = occupied ? kReceivedOccupied : kReceivedFree;
+      received_s_[index] = delta.stamp_s;
+      mark_[index] = 1;
+      marked.push_back(index);
+      const planning::VoxelIndex voxel = voxelOfIndex(index);
+      const bool fused = fusedOccupied(index, voxel, occupied);
+      if (fused != map_->isOccupied(voxel)) changes.push_back({voxel, fused});
+    }
+  };
+  take(delta.occupied, true);
+  take(delta.free, false);
+  for (const std::size_t index : marked) mark_[index] = 0;
+  std::unique_lock<std::shared_mutex> lock(mutex_);
+  const std::vector<planning::VoxelIndex> changed = map_->setOccupancy(changes);
+  out.map_changes = static_cast<int>(changed.size());
+  const auto field_stats = field_->update(*map_, changed);
+  if (!field_stats) return R::fail(field_stats.reason());  // cannot happen: same grid by construction
+  out.field = *field_stats;
+  out.total_ms = msSince(t0);
+  return R::ok(out);
+}
+
+MapDelta LiveMap::takeChanges(const Eigen::Vector3d& p_sender_world, double now_s, std::size_t max_voxels, double max_age_s,
+                              OutgoingStats* stats) {
+  MapDelta delta;
+  delta.stamp_s = map_stamp_s_;
+  delta.resolution_m = map_->resolution();
+  OutgoingStats s;
+  struct Candidate {
+    double distance_m, stamp_s;
+    std::size_t index;
+    bool occupied;
+  };
+  std::vector<Candidate> candidates;
+  for (const std::size_t index : pending_) {
+    const bool occupied = ownOccupied(index);
+    if ((occupied ? 1 : 0) == announced_[index]) {
+      pending_mark_[index] = 0;  // changed back: receivers hold the right class
+    } else if (now_s - pending_s_[index] > max_age_s) {
+      pending_mark_[index] = 0;
+      ++s.dropped;
+    } else {
+      const Eigen::Vector3d c = map_->centerOf(voxelOfIndex(index));
+      candidates.push_back({(c - p_sender_world).norm(), pending_s_[index], index, occupied});
+    }
+  }
+  std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
+    return a.distance_m != b.distance_m ? a.distance_m < b.distance_m : a.stamp_s > b.stamp_s;
+  });
+  pending_.clear();
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    const Candidate& c = candidates[i];
+    if (i >= max_voxels) {
+      pending_.push_back(c.index);
+      ++s.deferred;
+      continue;
+    }
+    pending_mark_[c.index] = 0;
+    announced_[c.index] = c.occupied ? 1 : 0;
+    const octomap::OcTreeKey k = keyOfIndex(c.index);
+    (c.occupied ? delta.occupied : delta.free).push_back(VoxelKey{{k[0], k[1], k[2]}});
+  }
+  s.sent = static_cast<int>(delta.size());
+  if (stats != nullptr) *stats = s;
+  return delta;
 }
 
 Observed LiveMap::observed(const Eigen::Vector3d& p_world) const {

@@ -259,6 +259,8 @@ std::string MissionRun::addUavs() {
 
 void MissionRun::openLinks() {
   const auto n = static_cast<std::size_t>(n_);
+  // The map-update links (mission.mapping.share; own random streams: the others' are unchanged).
+  if (world_.site != nullptr) world_.site->openShareLinks(cfg_.link, seed_);
   plan_links_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     share_links_.push_back(std::make_unique<Link<LeaderShare>>(cfg_.link, makeRng(seed_, Stream::kLink, link_index_++)));
@@ -408,8 +410,12 @@ MissionOutput MissionRun::run(double duration_s, std::chrono::steady_clock::time
     for (auto& u : uavs_) u->est = u->odo.measure(u->plant.state(), dt);
     if (world_.site != nullptr) {  // the unmapped obstacles' clock and the UAVs' depth frames (site_mapping.hpp)
       std::vector<MultirotorState> truth;
-      for (const auto& u : uavs_) truth.push_back(u->plant.state());
-      world_.site->step(t, truth);
+      std::vector<bool> offline;
+      for (const auto& u : uavs_) {
+        truth.push_back(u->plant.state());
+        offline.push_back(u->offline);
+      }
+      world_.site->step(t, truth, offline);
     }
     if (camera_frames.due(k)) cameraFrame(t, ws);
     replanDue(t);

@@ -5,8 +5,10 @@
 #include <cmath>
 #include <sstream>
 
+#include "gesture_formation/comm/map_update.hpp"
 #include "gesture_formation/common/csv.hpp"
 #include "gesture_formation/planning/uav_planner.hpp"
+#include "gesture_formation/sim/random.hpp"
 
 namespace gesture_formation::sim {
 
@@ -58,6 +60,19 @@ std::vector<Eigen::Vector3d> surfaceOf(const UnmappedObstacle& o, const planning
   return out;
 }
 
+std::string shareJson(const MapShareSummary& s) {
+  std::ostringstream os;
+  os << "{\"enabled\": " << (s.enabled ? "true" : "false") << ", \"updates_sent\": " << s.updates_sent
+     << ", \"updates_merged\": " << s.updates_merged << ", \"updates_lost\": " << s.updates_lost
+     << ", \"updates_refused\": " << s.updates_refused << ", \"voxels_sent\": " << s.voxels_sent
+     << ", \"changes_deferred\": " << s.changes_deferred << ", \"changes_dropped\": " << s.changes_dropped
+     << ", \"voxels_superseded\": " << s.voxels_superseded << ", \"bytes_per_s_p50\": " << num(s.bytes_per_s_p50)
+     << ", \"bytes_per_s_max\": " << num(s.bytes_per_s_max) << ", \"age_s_p50\": " << num(s.age_s_p50)
+     << ", \"age_s_max\": " << num(s.age_s_max) << ", \"merge_ms_median\": " << num(s.merge_ms_median)
+     << ", \"merge_ms_p99\": " << num(s.merge_ms_p99) << "}";
+  return os.str();
+}
+
 }  // namespace
 
 std::string siteMappingJson(const SiteMappingSummary& s, int indent) {
@@ -73,6 +88,7 @@ std::string siteMappingJson(const SiteMappingSummary& s, int indent) {
      << in << "\"depth_ms_median\": " << num(s.depth_ms_median) << ",\n"
      << in << "\"integrate_ms_median\": " << num(s.integrate_ms_median) << ",\n"
      << in << "\"integrate_ms_p99\": " << num(s.integrate_ms_p99) << ",\n"
+     << in << "\"share\": " << shareJson(s.share) << ",\n"
      << in << "\"obstacles\": [";
   for (std::size_t i = 0; i < s.obstacles.size(); ++i) {
     const UnmappedObstacleRecord& r = s.obstacles[i];
@@ -168,8 +184,83 @@ ObstacleDistance SiteMapping::withUnmapped(ObstacleDistance base) const {
   return base;
 }
 
-void SiteMapping::step(double t_s, const std::vector<MultirotorState>& uavs) {
+void SiteMapping::openShareLinks(const LinkConfig& link, std::uint64_t seed) {
+  if (live_.empty() || !config_.live.share.enabled || !share_links_.empty()) return;
+  const auto n = static_cast<std::size_t>(n_);
+  std::uint64_t index = 0;
+  share_links_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    share_links_[i].resize(n);
+    for (std::size_t j = 0; j < n; ++j) {
+      if (i != j) share_links_[i][j] = std::make_unique<ShareLink>(link, makeRng(seed, Stream::kMapShare, index++));
+    }
+    // Staggered like the frames, half a frame period after them.
+    next_share_s_.push_back((static_cast<double>(i) + 0.5) / (static_cast<double>(n) * config_.live.share.rate_hz));
+  }
+  share_sequence_.assign(n, 0);
+  bytes_by_second_.assign(n, {});
+  share_.enabled = true;
+}
+
+void SiteMapping::sendUpdate(int uav, double t_s, const Eigen::Vector3d& p_world) {
+  const auto u = static_cast<std::size_t>(uav);
+  mapping::OutgoingStats stats;
+  comm::MapUpdate m;
+  m.delta = live_[u]->takeChanges(p_world, t_s, mapping::shareVoxelBudget(config_.live.share), config_.live.share.max_age_s,
+                                  &stats);
+  share_.changes_deferred += stats.deferred;
+  share_.changes_dropped += stats.dropped;
+  if (m.delta.size() == 0) return;  // nothing to tell
+  m.uav_index = static_cast<std::uint16_t>(uav);
+  m.sequence = ++share_sequence_[u];
+  const auto bytes = comm::encodePayload(m);
+  if (!bytes) {  // cannot happen: the budget keeps the count within the limit, the keys are the grid's
+    ++share_.updates_refused;
+    return;
+  }
+  ++share_.updates_sent;
+  share_.voxels_sent += static_cast<long>(m.delta.size());
+  const auto second = static_cast<std::size_t>(std::max(0.0, std::floor(t_s)));
+  if (bytes_by_second_[u].size() <= second) bytes_by_second_[u].resize(second + 1, 0.0);
+  bytes_by_second_[u][second] += static_cast<double>(bytes->size() + mapping::kMapUpdateEnvelopeBytes);
+  for (std::size_t j = 0; j < share_links_[u].size(); ++j) {
+    if (share_links_[u][j]) share_links_[u][j]->send(t_s, *bytes);
+  }
+}
+
+void SiteMapping::receiveUpdates(int uav, double t_s, bool offline) {
+  const auto u = static_cast<std::size_t>(uav);
+  for (std::size_t from = 0; from < share_links_.size(); ++from) {
+    if (!share_links_[from][u]) continue;
+    for (const std::vector<std::uint8_t>& bytes : share_links_[from][u]->receive(t_s)) {
+      if (offline) {  // the radio is down: what arrives is lost
+        ++share_.updates_lost;
+        continue;
+      }
+      comm::MapUpdate m;
+      if (comm::decodePayload(bytes.data(), bytes.size(), m) != comm::PayloadError::kNone ||
+          comm::checkMapUpdate(m, live_[u]->keyGrid()) != comm::PayloadError::kNone) {
+        ++share_.updates_refused;
+        continue;
+      }
+      const auto t0 = std::chrono::steady_clock::now();
+      const auto merged = live_[u]->merge(m.delta);
+      merge_ms_.push_back(msSince(t0));
+      if (!merged) {
+        ++share_.updates_refused;
+        continue;
+      }
+      ++share_.updates_merged;
+      share_.voxels_superseded += merged->superseded;
+      share_age_s_.push_back(t_s - m.delta.stamp_s);
+    }
+  }
+}
+
+void SiteMapping::step(double t_s, const std::vector<MultirotorState>& uavs, const std::vector<bool>& offline) {
   clock_s_ = t_s;
+  const auto isOffline = [&](int i) { return static_cast<std::size_t>(i) < offline.size() && offline[static_cast<std::size_t>(i)]; };
+  for (int i = 0; i < n_ && !share_links_.empty(); ++i) receiveUpdates(i, t_s, isOffline(i));
   for (int i = 0; i < n_ && i < static_cast<int>(uavs.size()); ++i) {
     const MultirotorState& s = uavs[static_cast<std::size_t>(i)];
     for (std::size_t j = 0; j < unmapped_.size(); ++j) {
@@ -180,6 +271,10 @@ void SiteMapping::step(double t_s, const std::vector<MultirotorState>& uavs) {
         r.min_distance_uav = i;
         r.min_distance_t_s = t_s;
       }
+    }
+    if (!share_links_.empty() && t_s + 1e-9 >= next_share_s_[static_cast<std::size_t>(i)]) {
+      next_share_s_[static_cast<std::size_t>(i)] += 1.0 / config_.live.share.rate_hz;
+      if (!isOffline(i)) sendUpdate(i, t_s, s.p_world);
     }
     if (live_.empty() || t_s + 1e-9 < next_frame_s_[static_cast<std::size_t>(i)]) continue;
     next_frame_s_[static_cast<std::size_t>(i)] += 1.0 / config_.rate_hz;
@@ -203,6 +298,7 @@ void SiteMapping::integrateFrame(int uav, double t_s, const Eigen::Isometry3d& T
   mapping::DepthFrame frame;
   frame.T_world_camera = T_world_camera;
   frame.intrinsics = mapping::PinholeIntrinsics{intrinsics.fx, intrinsics.fy, intrinsics.cx, intrinsics.cy};
+  frame.stamp_s = t_s;
   const auto t0 = std::chrono::steady_clock::now();
   frame.depth_m = raycaster_.render(intrinsics, frame.T_world_camera, config_.live.pixel_stride, config_.camera_range_m, now);
   depth_ms_.push_back(msSince(t0));
@@ -266,6 +362,30 @@ void SiteMapping::planned(int uav, double t_s, const planning::PlanResult& resul
   }
 }
 
+MapShareSummary SiteMapping::shareSummary() const {
+  MapShareSummary s = share_;
+  std::vector<double> per_second;
+  for (const auto& row : bytes_by_second_) {
+    // every whole second of the mission so far (silent seconds count as 0 bytes)
+    const auto seconds = static_cast<std::size_t>(std::max(1.0, std::floor(clock_s_)));
+    for (std::size_t k = 0; k < seconds; ++k) per_second.push_back(k < row.size() ? row[k] : 0.0);
+  }
+  if (s.enabled) {
+    s.bytes_per_s_p50 = quantile(per_second, 0.5);
+    s.bytes_per_s_max = quantile(per_second, 1.0);
+    for (const auto& row : share_links_) {
+      for (const auto& l : row) {
+        if (l) s.updates_lost += static_cast<long>(l->counters().lost);
+      }
+    }
+  }
+  s.age_s_p50 = quantile(share_age_s_, 0.5);
+  s.age_s_max = quantile(share_age_s_, 1.0);
+  s.merge_ms_median = quantile(merge_ms_, 0.5);
+  s.merge_ms_p99 = quantile(merge_ms_, 0.99);
+  return s;
+}
+
 SiteMappingSummary SiteMapping::summary() const {
   SiteMappingSummary s;
   s.mapping = mapping();
@@ -298,6 +418,7 @@ SiteMappingSummary SiteMapping::summary() const {
     s.obstacles.push_back(r);
   }
   s.coverage = surface > 0 ? static_cast<double>(seen) / surface : 0.0;
+  s.share = shareSummary();
   return s;
 }
 

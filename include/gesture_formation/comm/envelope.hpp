@@ -7,7 +7,7 @@
 /// offset size field
 ///      0    2 magic 'G' 'F' (0x47 0x46)
 ///      2    1 version: 1 = group HMAC tag (32 B), 2 = per-sender Ed25519 signature (64 B)
-///      3    1 message type (MessageType, 1..9)
+///      3    1 message type (MessageType, 1..11)
 ///      4    2 sender id
 ///      6    1 key id (which pre-shared key made the tag)
 ///      7    1 flags (reserved, must be 0)
@@ -64,11 +64,12 @@ enum class MessageType : std::uint8_t {
   kCommandAck = 8,
   kAssistance = 9,
   kLeadership = 10,
+  kMapUpdate = 11,  ///< comm/map_update.hpp
 };
 constexpr std::uint8_t kMinMessageType = 1;
-constexpr std::uint8_t kMaxMessageType = 10;
+constexpr std::uint8_t kMaxMessageType = 11;
 /// \brief "heartbeat", "worker_state", "planned_trajectory", "formation_params", "formation_command",
-/// "gesture_observation", "abort_command", "command_ack", "assistance", "leadership".
+/// "gesture_observation", "abort_command", "command_ack", "assistance", "leadership", "map_update".
 const char* toString(MessageType type);
 bool isKnownMessageType(std::uint8_t value);
 

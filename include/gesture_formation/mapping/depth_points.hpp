@@ -37,6 +37,9 @@ struct DepthFrame {
   PinholeIntrinsics intrinsics;  ///< of depth_m's pixels
   /// The optical frame's pose in the world at the frame's time (camera → world).
   Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity();
+  /// The frame's time [s] (finite): what the live map stamps its own observations with, compared
+  /// with the stamps of map changes received from other UAVs (LiveMap::merge, docs/mapping.md §8).
+  double stamp_s = 0.0;
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
 

@@ -35,6 +35,7 @@
 
 #include "gesture_formation/common/result.hpp"
 #include "gesture_formation/mapping/depth_points.hpp"
+#include "gesture_formation/mapping/map_delta.hpp"
 #include "gesture_formation/mapping/mapping_config.hpp"
 #include "gesture_formation/planning/distance_field.hpp"
 #include "gesture_formation/planning/occupancy_map.hpp"
@@ -59,6 +60,22 @@ struct FrameUpdate {
   double map_ms = 0.0;      ///< fusion and OccupancyMap::setOccupancy
   double field_ms = 0.0;    ///< DistanceField::update
   double total_ms = 0.0;
+};
+
+/// \brief What one merge() of another UAV's changes did.
+struct MergeResult {
+  int voxels = 0;       ///< voxels in the delta
+  int superseded = 0;   ///< ignored: seen by this UAV (or received) at or after the delta's stamp
+  int map_changes = 0;  ///< voxels of the planner's map that changed
+  planning::FieldUpdateStats field;
+  double total_ms = 0.0;
+};
+
+/// \brief What one takeChanges() did.
+struct OutgoingStats {
+  int sent = 0;      ///< voxels in the returned delta
+  int deferred = 0;  ///< changes left for a later update (over the voxel budget)
+  int dropped = 0;   ///< changes older than max_age_s when their turn came: never sent
 };
 
 /// \brief The observed state of a voxel in the live OctoMap (not fused with the prior).
@@ -89,6 +106,26 @@ class LiveMap {
   /// \brief A shared lock on the map and field: hold it while planning on another thread.
   std::shared_lock<std::shared_mutex> readLock() const { return std::shared_lock<std::shared_mutex>(mutex_); }
 
+  /// \brief Merges another UAV's map changes (docs/mapping.md §8). Per voxel, the newer word wins:
+  /// a received class is ignored where this UAV's own rays crossed or ended in the voxel at or after
+  /// `delta.stamp_s` (or a newer received class is held), and a later own frame through the voxel
+  /// replaces it. Received occupied voxels enter the map and the field like observed ones; prior
+  /// voxels stay occupied. Received voxels do NOT count as seen for the seen-space rule (§8 why).
+  /// Fails, changing nothing, on a delta that does not fit keyGrid() (naming the field).
+  /// Same thread rules as integrate() (never concurrently with it or itself).
+  common::Result<MergeResult> merge(const MapDelta& delta);
+  /// \brief This UAV's own observed changes not yet sent (docs/mapping.md §8): voxels whose observed
+  /// class became occupied, or free after being sent occupied (prior voxels are never sent). At most
+  /// `max_voxels` of them, the nearest to `p_sender_world` first (ties: the newest); changes older
+  /// than `max_age_s` at `now_s` are dropped, the rest wait for the next call. Stamped with the
+  /// newest integrated frame's time. Not concurrently with integrate().
+  MapDelta takeChanges(const Eigen::Vector3d& p_sender_world, double now_s, std::size_t max_voxels, double max_age_s,
+                       OutgoingStats* stats = nullptr);
+  /// \brief Own changes waiting to be sent.
+  std::size_t pendingChanges() const { return pending_.size(); }
+  /// \brief The keys this map holds (resolution and grid), what merge() accepts.
+  KeyGrid keyGrid() const;
+
   /// \brief The observed state of the voxel containing p (world, m): the OctoMap alone.
   Observed observed(const Eigen::Vector3d& p_world) const;
   /// \brief The observed OctoMap (log-odds, pruned); not to be read while integrate() runs.
@@ -110,8 +147,18 @@ class LiveMap {
   }
   /// One hit or miss of a voxel (index −1: outside the grid), skipped when OctoMap would abort it.
   void updateVoxel(const octomap::OcTreeKey& key, std::ptrdiff_t index, bool hit);
-  /// The changed OctoMap voxels as planner-map changes (fused with the prior); clears the record.
-  std::vector<planning::VoxelChange> fusedChanges(int& observed_changes);
+  /// The changed OctoMap voxels, and the voxels of this frame that held a received class, as
+  /// planner-map changes (fused with the prior and the received classes); clears the record.
+  std::vector<planning::VoxelChange> fusedChanges(int& observed_changes, const std::vector<std::size_t>& recheck);
+  /// This frame's own observations: stamps, received classes they replace (returned: to re-fuse).
+  std::vector<std::size_t> stampOwnCells(double stamp_s);
+  /// The planner's voxel (fused): prior, else a received class, else the own observation.
+  bool fusedOccupied(std::size_t index, const planning::VoxelIndex& voxel, bool own_occupied) const;
+  bool ownOccupied(std::size_t index) const;
+  planning::VoxelIndex voxelOfIndex(std::size_t index) const;
+  octomap::OcTreeKey keyOfIndex(std::size_t index) const;
+  /// Queues an own change of the voxel for sharing when its class differs from what was sent.
+  void notePending(std::size_t index, const planning::VoxelIndex& voxel, bool own_occupied, double stamp_s);
 
   MappingConfig config_;
   std::shared_ptr<planning::OccupancyMap> map_;
@@ -126,7 +173,19 @@ class LiveMap {
   planning::VoxelIndex grid_size_ = planning::VoxelIndex::Zero();
   std::vector<std::uint8_t> mark_;       ///< per grid voxel, this frame: 1 free cell, 2 occupied cell
   std::vector<std::uint8_t> saturated_;  ///< per grid voxel: kSaturatedFree / kSaturatedOccupied / 0
+  // Sharing (docs/mapping.md §8), per grid voxel:
+  std::vector<double> own_s_;             ///< the last own frame whose ray crossed or ended in it (−inf: none)
+  std::vector<std::uint8_t> received_;    ///< kReceivedNone / kReceivedOccupied / kReceivedFree
+  std::vector<double> received_s_;        ///< the received class's stamp
+  std::vector<std::uint8_t> announced_;   ///< 1: sent as occupied (receivers hold it occupied)
+  std::vector<std::uint8_t> pending_mark_;
+  std::vector<double> pending_s_;         ///< when the pending change was observed
+  std::vector<std::size_t> pending_;      ///< grid voxels with an unsent own change
+  double map_stamp_s_ = 0.0;              ///< the newest integrated frame's stamp
   mutable std::shared_mutex mutex_;
+  static constexpr std::uint8_t kReceivedNone = 0;
+  static constexpr std::uint8_t kReceivedOccupied = 1;
+  static constexpr std::uint8_t kReceivedFree = 2;
   static constexpr int kKeyOrigin = 32768;  ///< OctoMap's key of voxel index 0 (tree depth 16)
   static constexpr std::uint8_t kSaturatedFree = 1;
   static constexpr std::uint8_t kSaturatedOccupied = 2;

@@ -5,6 +5,7 @@
 /// number's range is written once, in mappingConfigFields(), which validate() and the YAML
 /// reader share. Thread safety: value types and pure functions.
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,24 @@ struct FieldTable;
 }  // namespace gesture_formation::common
 
 namespace gesture_formation::mapping {
+
+/// \brief Sharing map changes with the other UAVs (docs/mapping.md §8): keys `share.*`.
+struct ShareConfig {
+  /// `share.enabled` [false]: every UAV sends its own map changes and merges the others'.
+  bool enabled = false;
+  /// `share.rate_hz` [2, in (0, 10]]: updates per second and UAV (an update only when something changed).
+  double rate_hz = 2.0;
+  /// `share.max_bytes_per_s` [50 000, in [1 000, 10 000 000]]: each UAV's sending budget, envelope
+  /// included; an update carries at most (max_bytes_per_s / rate_hz − 118) / 6 voxels (and at most
+  /// mapping::kMaxMapUpdateVoxels), the nearest to the sender first; must allow one voxel per update.
+  double max_bytes_per_s = 50000.0;
+  /// `share.max_age_s` [5, in (0, 60]]: a change still unsent this long after it was observed is
+  /// dropped (counted), not sent stale.
+  double max_age_s = 5.0;
+};
+
+/// \brief Voxels one update may carry under `share`'s budget (0: not even one).
+std::size_t shareVoxelBudget(const ShareConfig& share);
 
 /// \brief Online mapping settings (keys as in mappingConfigFields()).
 struct MappingConfig {
@@ -48,6 +67,8 @@ struct MappingConfig {
   /// The seen-space rule the planners on this live map verify (planning/seen_space.hpp):
   /// `seen.margin_m` (> 0, default 0.3) and `seen.horizon_s` (> 0, default 1.0).
   planning::SeenRule seen;
+  /// Sharing with the other UAVs (`share.*`).
+  ShareConfig share;
 
   /// \brief Every problem, each "<prefix><key> must be ..., got v"; empty when valid.
   std::vector<std::string> validate(const std::string& prefix = "") const;
@@ -55,7 +76,8 @@ struct MappingConfig {
 
 /// \brief MappingConfig's numbers with their ranges (keys `depth.pixel_stride`,
 /// `depth.min_range_m`, `depth.max_range_m`, `octomap.prob_hit`, `octomap.prob_miss`,
-/// `octomap.clamping_min`, `octomap.clamping_max`, `field.range_m`, `seen.margin_m`, `seen.horizon_s`).
+/// `octomap.clamping_min`, `octomap.clamping_max`, `field.range_m`, `seen.margin_m`, `seen.horizon_s`,
+/// `share.rate_hz`, `share.max_bytes_per_s`, `share.max_age_s`; `share.enabled` is a bool read by readMappingConfig).
 const common::FieldTable<MappingConfig>& mappingConfigFields();
 
 /// \brief Reads a MappingConfig under `prefix` (missing keys per the reader's mode); every

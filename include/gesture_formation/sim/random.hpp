@@ -31,6 +31,7 @@ enum class Stream : std::uint64_t {
   kFault = 40,       ///< injected sensor faults (range outliers)
   kFollowerCamera = 50,  ///< + follower index: the followers' cameras (gesture views)
   kHandover = 60,        ///< + link index: the leadership's links and the links a new leader needs
+  kMapShare = 70,        ///< + link index: the map-update links between UAVs (site_mapping.hpp)
 };
 
 /// \brief The RNG of stream `stream` (+ `index`) of a mission with seed `seed`.

@@ -12,6 +12,11 @@
 ///     least distance of each UAV to each unmapped obstacle;
 ///   - planned(i, t, result) after every replanning: the time from first sight to avoidance;
 ///   - summary() at the end (metrics.json `site_mapping`).
+///   - openShareLinks(link, seed) once before the first step: with `mission.mapping.share.enabled`
+///     every UAV sends its own map changes (comm::MapUpdate, encoded as on the wire) to every other
+///     UAV over a Link with the inter-UAV fault model, `share.rate_hz` times a second (staggered),
+///     within `share.max_bytes_per_s`; each receiver decodes, checks and merges them
+///     (mapping::LiveMap::merge). A UAV offline (dropout) neither sends nor receives.
 /// The planners come from plannerFactory() (UavPlanner over UAV i's live map and field).
 ///
 /// Depth frames: `--camera synthetic` (default) renders them analytically (DepthRaycaster) from
@@ -37,6 +42,7 @@
 #include "gesture_formation/planning/occupancy_map.hpp"
 #include "gesture_formation/planning/scenario.hpp"
 #include "gesture_formation/sim/depth_raycaster.hpp"
+#include "gesture_formation/sim/link.hpp"
 #include "gesture_formation/sim/mission_config.hpp"
 #include "gesture_formation/sim/mission_metrics.hpp"
 #include "gesture_formation/sim/mission_runner.hpp"
@@ -63,19 +69,30 @@ class SiteMapping {
   bool mapping() const { return !live_.empty(); }
   /// \brief UAV i's planning field (live, updated in place), null without mapping.
   const planning::DistanceField* field(int uav) const;
+  /// \brief UAV i's live map, null without mapping.
+  const mapping::LiveMap* liveMap(int uav) const {
+    return uav >= 0 && uav < static_cast<int>(live_.size()) ? live_[static_cast<std::size_t>(uav)].get() : nullptr;
+  }
   /// \brief UavPlanner over UAV i's live map (mapping), else over `prior_map`/`prior_field`.
   PlannerFactory plannerFactory(const planning::PlannerConfig& config, std::shared_ptr<const planning::OccupancyMap> prior_map,
                                 std::shared_ptr<const planning::DistanceField> prior_field) const;
   /// \brief `base` (the mapped world) plus the unmapped obstacles at this object's clock.
   ObstacleDistance withUnmapped(ObstacleDistance base) const;
 
-  /// \brief Every plant step, before the safety sample: the clock, due depth frames, distances.
-  void step(double t_s, const std::vector<MultirotorState>& uavs);
+  /// \brief The map-update links (share enabled; no-op otherwise): UAV i → j for every i ≠ j, each
+  /// with `link`'s faults and its own random stream (Stream::kMapShare of `seed`: the mission's
+  /// other streams are untouched).
+  void openShareLinks(const LinkConfig& link, std::uint64_t seed);
+  /// \brief Every plant step, before the safety sample: the clock, due depth frames, distances,
+  /// and map updates sent and received; `offline[i]` (optional): UAV i's radio is down.
+  void step(double t_s, const std::vector<MultirotorState>& uavs, const std::vector<bool>& offline = {});
   /// \brief After UAV i's replanning at t_s; `reference` (stage 1, steps of `reference_dt_s` from
   /// t_s) gives the travel camera its direction.
   void planned(int uav, double t_s, const planning::PlanResult& result, const formation::ReferenceTrajectory& reference = {},
                double reference_dt_s = 0.0);
   SiteMappingSummary summary() const;
+  /// \brief The sharing part of summary().
+  MapShareSummary shareSummary() const;
 
   /// \brief Distance (m) from p to the nearest unmapped obstacle at the clock (+inf: none).
   double unmappedDistanceNow(const Eigen::Vector3d& p_world) const { return unmappedDistance(unmapped_, p_world, clock_s_); }
@@ -92,6 +109,10 @@ class SiteMapping {
   /// Marks what UAV i's live map now holds of the obstacles near `p_world`.
   void recordSightings(int uav, double t_s, const Eigen::Vector3d& p_world);
   void surfaceVoxels(const planning::MapConfig& grid);
+  /// UAV i's due map update: its pending changes within the budget, encoded, to every other UAV.
+  void sendUpdate(int uav, double t_s, const Eigen::Vector3d& p_world);
+  /// Every update that reached UAV i by t_s: decoded, checked and merged (dropped when offline).
+  void receiveUpdates(int uav, double t_s, bool offline);
 
   SiteMappingConfig config_;
   estimation::CameraIntrinsics intrinsics_;
@@ -111,6 +132,14 @@ class SiteMapping {
   std::vector<std::vector<double>> seen_s_, avoided_s_;  ///< [uav][obstacle]
   std::vector<UnmappedObstacleRecord> records_;
   std::vector<double> depth_ms_, integrate_ms_;
+  // Sharing (openShareLinks):
+  using ShareLink = Link<std::vector<std::uint8_t>>;
+  std::vector<std::vector<std::unique_ptr<ShareLink>>> share_links_;  ///< [from][to]
+  std::vector<double> next_share_s_;
+  std::vector<std::uint32_t> share_sequence_;
+  std::vector<std::vector<double>> bytes_by_second_;  ///< [uav][whole mission second]
+  std::vector<double> share_age_s_, merge_ms_;
+  MapShareSummary share_;
 };
 
 }  // namespace gesture_formation::sim

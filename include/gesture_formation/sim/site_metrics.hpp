@@ -33,6 +33,28 @@ struct UnmappedObstacleRecord {
 };
 
 /// \brief The mission's site-mapping summary.
+/// \brief What the UAVs' map sharing did over a mission.
+struct MapShareSummary {
+  bool enabled = false;
+  long updates_sent = 0;        ///< map updates sent (each to every other UAV)
+  long updates_merged = 0;      ///< received, decoded, checked and merged
+  long updates_lost = 0;        ///< lost on the links (the link model) or sent to / from an offline UAV
+  long updates_refused = 0;     ///< refused by the decoder or the receiver's check (none expected)
+  long voxels_sent = 0;
+  long changes_deferred = 0;    ///< summed over updates: changes left for a later update (budget)
+  long changes_dropped = 0;     ///< changes older than share.max_age_s before their turn: never sent
+  long voxels_superseded = 0;   ///< received voxels the receiver had seen itself since (or held newer)
+  /// Bytes each UAV sent per mission second (envelope included), over every UAV and second.
+  double bytes_per_s_p50 = std::numeric_limits<double>::quiet_NaN();
+  double bytes_per_s_max = std::numeric_limits<double>::quiet_NaN();
+  /// The age (receiver's time − the sender's map stamp) of each merged update: median and largest.
+  double age_s_p50 = std::numeric_limits<double>::quiet_NaN();
+  double age_s_max = std::numeric_limits<double>::quiet_NaN();
+  /// LiveMap::merge wall time per update (ms).
+  double merge_ms_median = std::numeric_limits<double>::quiet_NaN();
+  double merge_ms_p99 = std::numeric_limits<double>::quiet_NaN();
+};
+
 struct SiteMappingSummary {
   bool mapping = false;        ///< the UAVs kept live maps (mission.mapping.enabled)
   bool prior_map = true;       ///< the live maps started from the prior map
@@ -48,6 +70,8 @@ struct SiteMappingSummary {
   double integrate_ms_median = std::numeric_limits<double>::quiet_NaN();
   double integrate_ms_p99 = std::numeric_limits<double>::quiet_NaN();
   std::vector<UnmappedObstacleRecord> obstacles;
+  /// Map sharing (mission.mapping.share; docs/mapping.md §8); all zero / NaN when off.
+  MapShareSummary share;
 };
 
 /// \brief The summary as a JSON object (non-finite numbers as null), `indent` spaces deep.

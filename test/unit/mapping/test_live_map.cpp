@@ -420,3 +420,165 @@ TEST(MappingConfigTest, SeenRuleKeysAreRangeChecked) {
   EXPECT_NE(problems[0].find("seen.margin_m must be > 0, got 0"), std::string::npos) << problems[0];
   EXPECT_NE(problems[1].find("seen.horizon_s must be > 0, got -1"), std::string::npos) << problems[1];
 }
+
+// ---- Sharing (docs/mapping.md §8): one UAV's changes into another's live map ----------------
+
+namespace {
+
+DepthFrame boxFrame(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double stamp_s) {
+  DepthFrame f = cameraAt(kCamera);
+  renderBox(f, lo, hi);
+  f.stamp_s = stamp_s;
+  return f;
+}
+
+DepthFrame emptyFrame(double stamp_s) {  // nothing in view: every ray free up to the maximum range
+  DepthFrame f = cameraAt(kCamera);
+  f.depth_m.setTo(std::numeric_limits<float>::infinity());
+  f.stamp_s = stamp_s;
+  return f;
+}
+
+std::set<Key> keysToVoxels(const std::vector<mapping::VoxelKey>& keys) {
+  std::set<Key> out;
+  for (const auto& k : keys) out.insert({int(k[0]) - 32768, int(k[1]) - 32768, int(k[2]) - 32768});
+  return out;
+}
+
+}  // namespace
+
+TEST(MapShareTest, OneUavsBoxEntersTheOtherMapAndFieldButNotItsSeenSpace) {
+  auto a = makeLiveMap(), b = makeLiveMap();
+  ASSERT_TRUE(a && b);
+  ASSERT_TRUE(a->integrate(boxFrame(kBoxALo, kBoxAHi, 1.0)));
+  const std::set<Key> face = faceVoxels(4.7, -0.9, 0.9, 0.9, 2.1);
+  EXPECT_EQ(a->pendingChanges(), face.size());  // created-free voxels are not changes to tell
+  mapping::OutgoingStats stats;
+  const mapping::MapDelta delta = a->takeChanges(kCamera, 1.0, 10000, 5.0, &stats);
+  EXPECT_EQ(stats.sent, 70);
+  EXPECT_EQ(stats.deferred + stats.dropped, 0);
+  EXPECT_DOUBLE_EQ(delta.stamp_s, 1.0);
+  EXPECT_DOUBLE_EQ(delta.resolution_m, kRes);
+  EXPECT_EQ(keysToVoxels(delta.occupied), face);
+  EXPECT_TRUE(delta.free.empty());
+  EXPECT_EQ(a->pendingChanges(), 0u);
+  EXPECT_EQ(a->takeChanges(kCamera, 1.1, 10000, 5.0).size(), 0u);  // sent once
+
+  const std::size_t seen_before = b->seen()->seenCount();
+  const auto merged = b->merge(delta);
+  ASSERT_TRUE(merged) << merged.reason();
+  EXPECT_EQ(merged->map_changes, 70);
+  EXPECT_EQ(occupiedVoxels(*b->map()), face);
+  expectFieldIsFullRebuild(*b);
+  EXPECT_LT(b->field()->clearance(Eigen::Vector3d(4.5, 0.1, 1.5)), 0.3);
+  EXPECT_EQ(b->seen()->seenCount(), seen_before);  // received voxels do not count as seen
+  EXPECT_EQ(b->observed(centre(*face.begin())), mapping::Observed::kUnknown);  // nor as its own observation
+  EXPECT_EQ(b->pendingChanges(), 0u);  // and are never passed on
+}
+
+TEST(MapShareTest, TheNewerWordWinsPerVoxel) {
+  auto a = makeLiveMap(), b = makeLiveMap();
+  ASSERT_TRUE(a && b);
+  ASSERT_TRUE(a->integrate(boxFrame(kBoxALo, kBoxAHi, 2.0)));
+  const mapping::MapDelta delta = a->takeChanges(kCamera, 2.0, 10000, 5.0);
+  // B looked at the same place at 3 s and saw nothing there: its own, newer observation wins.
+  ASSERT_TRUE(b->integrate(emptyFrame(3.0)));
+  auto merged = b->merge(delta);
+  ASSERT_TRUE(merged) << merged.reason();
+  EXPECT_EQ(merged->superseded, 70);
+  EXPECT_TRUE(occupiedVoxels(*b->map()).empty());
+  // A fresh B receives the box (stamp 2 s), then sees the place empty at 3 s: the box is cleared.
+  auto c = makeLiveMap();
+  ASSERT_TRUE(c->merge(delta));
+  ASSERT_EQ(occupiedVoxels(*c->map()).size(), 70u);
+  ASSERT_TRUE(c->integrate(emptyFrame(3.0)));
+  EXPECT_TRUE(occupiedVoxels(*c->map()).empty());
+  expectFieldIsFullRebuild(*c);
+  // An older update of the same voxels (stamp 1 s) changes nothing now.
+  mapping::MapDelta old = delta;
+  old.stamp_s = 1.0;
+  merged = c->merge(old);
+  ASSERT_TRUE(merged);
+  EXPECT_EQ(merged->superseded, 70);
+  EXPECT_TRUE(occupiedVoxels(*c->map()).empty());
+}
+
+TEST(MapShareTest, AMovedBoxIsClearedOnTheReceiverToo) {
+  auto a = makeLiveMap(), b = makeLiveMap();
+  ASSERT_TRUE(a && b);
+  for (int i = 0; i < 10; ++i) ASSERT_TRUE(a->integrate(boxFrame(kBoxALo, kBoxAHi, 0.1 * i)));
+  ASSERT_TRUE(b->merge(a->takeChanges(kCamera, 1.0, 10000, 5.0)));
+  const std::set<Key> old_face = faceVoxels(4.7, -0.9, 0.9, 0.9, 2.1);
+  ASSERT_EQ(occupiedVoxels(*b->map()), old_face);
+  for (int i = 0; i < 10; ++i) ASSERT_TRUE(a->integrate(boxFrame(kBoxBLo, kBoxBHi, 2.0 + 0.1 * i)));
+  const mapping::MapDelta moved = a->takeChanges(kCamera, 3.0, 10000, 5.0);
+  EXPECT_EQ(keysToVoxels(moved.free), old_face);  // the old face, sent free
+  ASSERT_TRUE(b->merge(moved));
+  EXPECT_EQ(occupiedVoxels(*b->map()), occupiedVoxels(*a->map()));
+  expectFieldIsFullRebuild(*b);
+}
+
+TEST(MapShareTest, TheBudgetSendsTheNearestFirstAndDropsWhatWaitedTooLong) {
+  auto a = makeLiveMap();
+  ASSERT_TRUE(a);
+  ASSERT_TRUE(a->integrate(boxFrame(kBoxALo, kBoxAHi, 1.0)));
+  const Eigen::Vector3d sender(4.0, -3.0, 1.5);  // nearest to the box's −y edge
+  mapping::OutgoingStats stats;
+  const mapping::MapDelta first = a->takeChanges(sender, 1.0, 20, 5.0, &stats);
+  EXPECT_EQ(stats.sent, 20);
+  EXPECT_EQ(stats.deferred, 50);
+  double farthest_sent = 0.0;
+  for (const auto& k : keysToVoxels(first.occupied)) farthest_sent = std::max(farthest_sent, (centre(k) - sender).norm());
+  const mapping::MapDelta second = a->takeChanges(sender, 1.2, 20, 5.0, &stats);
+  EXPECT_EQ(stats.sent, 20);
+  for (const auto& k : keysToVoxels(second.occupied)) EXPECT_GE((centre(k) - sender).norm(), farthest_sent - 1e-9);
+  // 30 left; 10 s later they are older than max_age_s: dropped, counted, never sent.
+  const mapping::MapDelta late = a->takeChanges(sender, 11.0, 20, 5.0, &stats);
+  EXPECT_EQ(late.size(), 0u);
+  EXPECT_EQ(stats.dropped, 30);
+  EXPECT_EQ(a->pendingChanges(), 0u);
+}
+
+TEST(MapShareTest, ADeltaThatDoesNotFitIsRefusedNamingTheFieldAndChangesNothing) {
+  auto a = makeLiveMap(), b = makeLiveMap();
+  ASSERT_TRUE(a && b);
+  ASSERT_TRUE(a->integrate(boxFrame(kBoxALo, kBoxAHi, 1.0)));
+  mapping::MapDelta delta = a->takeChanges(kCamera, 1.0, 10000, 5.0);
+  mapping::MapDelta bad = delta;
+  bad.resolution_m = 0.4;
+  auto r = b->merge(bad);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.reason().find("resolution_m"), std::string::npos) << r.reason();
+  bad = delta;
+  bad.occupied.back()[0] = 1;  // far outside the grid
+  r = b->merge(bad);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.reason().find("occupied[69] key (1, "), std::string::npos) << r.reason();
+  EXPECT_TRUE(occupiedVoxels(*b->map()).empty());
+  const mapping::KeyGrid g = b->keyGrid();
+  EXPECT_EQ(g.min_key[0], 32768 - 5);  // x from −1 m at 0.2 m
+  EXPECT_DOUBLE_EQ(g.resolution_m, kRes);
+}
+
+TEST(MappingConfigTest, ShareKeysAndTheBudgetRuleAreChecked) {
+  MappingConfig c;
+  EXPECT_EQ(mapping::shareVoxelBudget(c.share), (25000u - 118u) / 6u);  // 50 000 B/s at 2 Hz
+  c.share.rate_hz = 0.0;
+  c.share.max_bytes_per_s = 500.0;
+  c.share.max_age_s = 61.0;
+  auto problems = c.validate();
+  ASSERT_EQ(problems.size(), 3u) << ::testing::PrintToString(problems);
+  EXPECT_NE(problems[0].find("share.rate_hz"), std::string::npos) << problems[0];
+  EXPECT_NE(problems[1].find("share.max_bytes_per_s"), std::string::npos) << problems[1];
+  EXPECT_NE(problems[2].find("share.max_age_s"), std::string::npos) << problems[2];
+  // In range each, but 1 000 B/s at 10 updates a second leaves 100 B an update: not one voxel.
+  c = MappingConfig{};
+  c.share.rate_hz = 10.0;
+  c.share.max_bytes_per_s = 1000.0;
+  problems = c.validate();
+  ASSERT_EQ(problems.size(), 1u) << ::testing::PrintToString(problems);
+  EXPECT_NE(problems[0].find("share.max_bytes_per_s must allow one voxel per update"), std::string::npos) << problems[0];
+  EXPECT_EQ(mapping::shareVoxelBudget(c.share), 0u);
+  c.share.max_bytes_per_s = 1e7;  // capped by the payload limit
+  EXPECT_EQ(mapping::shareVoxelBudget(c.share), mapping::kMaxMapUpdateVoxels);
+}

@@ -4,7 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
+#include "gesture_formation/planning/trajectory_verifier.hpp"
+#include "gesture_formation/planning/uav_planner.hpp"
 #include "gesture_formation/sim/site_mapping.hpp"
 #include "sim_test_support.hpp"
 
@@ -160,4 +163,113 @@ TEST(SiteMappingTest, TravelCameraLooksWhereTheReferenceLeads) {
   const auto refused = gf::sim::SiteMapping::create(bad, grid(), prior, gf::planning::PrimitiveSet{}, 0.0, wallAhead());
   ASSERT_FALSE(static_cast<bool>(refused));
   EXPECT_NE(refused.reason().find("mission.mapping.travel_camera_hfov_deg"), std::string::npos) << refused.reason();
+}
+
+// Map sharing (mission.mapping.share; docs/mapping.md §8). Only UAV 1 sees the wall (UAVs 0 and 2
+// look east from y = ∓10, the wall outside their view). UAV 0's planner, asked to fly through the
+// wall's place, plans through it without sharing — the control, which must fail — and around it,
+// clear of the real wall, with sharing, on a budget the updates respect.
+namespace {
+
+struct ShareRun {
+  gf::planning::PlanResult plan;
+  double least_wall_distance_m = 0.0;  // the plan (dense in time) to the real wall
+  gf::sim::MapShareSummary share;
+  double b_field_at_wall = 0.0;
+};
+
+ShareRun flyUav0ThroughTheWall(bool share, const gf::sim::LinkConfig& link, double max_bytes_per_s = 50000.0,
+                              bool uav0_offline = false) {
+  const gf::sim::test::EmptyWorld w;
+  gf::sim::MissionConfig cfg = gf::sim::test::openFieldWithoutRequests();
+  cfg.mapping.enabled = true;
+  cfg.mapping.live.share.enabled = share;
+  cfg.mapping.live.share.max_bytes_per_s = max_bytes_per_s;
+  auto prior = std::make_shared<const gf::planning::OccupancyMap>(w.map);
+  auto site = gf::sim::SiteMapping::create(cfg, grid(), prior, gf::planning::PrimitiveSet{}, 0.0, wallAhead());
+  EXPECT_TRUE(static_cast<bool>(site)) << site.reason();
+  gf::sim::SiteMapping& s = **site;
+  s.openShareLinks(link, 11);
+  const int n = static_cast<int>(cfg.uavs.size());
+  std::vector<bool> offline(static_cast<std::size_t>(n), false);
+  offline[0] = uav0_offline;
+  for (int k = 0; k <= 200; ++k) s.step(k * 0.01, uavsLookingEast(n), offline);  // 2 s
+  ShareRun out;
+  out.share = s.summary().share;
+  const gf::mapping::LiveMap& b = *s.liveMap(0);
+  out.b_field_at_wall = b.field()->clearance(Eigen::Vector3d(5.4, 0.0, 3.0));
+  gf::planning::PlannerConfig pc = cfg.planner;
+  pc.time_budget_ms = 0.0;  // deterministic under load
+  gf::planning::UavPlanner planner(pc, b.map(), b.field());  // the map's content is what is tested here
+  gf::planning::PlanRequest r;
+  r.t_now_s = 2.0;
+  r.state.t_s = 2.0;
+  r.state.p_world = Eigen::Vector3d(1.0, 0.0, 3.0);
+  r.dt_s = 0.2;
+  const int steps = 41;
+  r.reference.resize(steps);
+  r.worker.p_world.resize(3, steps);
+  r.worker.heading_rad.resize(1, steps);
+  for (int k = 0; k < steps; ++k) {
+    r.reference.p_world.col(k) = Eigen::Vector3d(std::min(1.0 + 0.6 * k, 11.0), 0.0, 3.0);  // through x = 6
+    r.reference.heading_rad(k) = 0.0;
+    r.reference.pitch_rad(k) = 0.0;
+    r.worker.p_world.col(k) = Eigen::Vector3d(-4.0, 8.0, 0.0);
+    r.worker.heading_rad(k) = 0.0;
+  }
+  out.plan = planner.plan(r);
+  out.least_wall_distance_m = std::numeric_limits<double>::infinity();
+  if (out.plan.verified && !out.plan.trajectory.empty()) {
+    const gf::planning::PlannedTrajectory& t = out.plan.trajectory;
+    for (double ts = t.t0_s; ts <= t.tEnd() + 1e-9; ts += t.dt_s / 8) {
+      out.least_wall_distance_m = std::min(out.least_wall_distance_m, s.unmappedDistanceNow(gf::planning::evaluateTrajectory(t, ts).p));
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST(SiteMappingShareTest, AUavAvoidsAWallOnlyAnotherSawBecauseOfTheShare) {
+  const gf::sim::LinkConfig clean;
+  const ShareRun without = flyUav0ThroughTheWall(false, clean);
+  ASSERT_TRUE(without.plan.verified) << without.plan.reason;
+  EXPECT_GT(without.b_field_at_wall, 2.0) << "UAV 0 must not see the wall itself";
+  EXPECT_LT(without.least_wall_distance_m, 0.2) << "the control: without sharing UAV 0 plans into the wall";
+  EXPECT_FALSE(without.share.enabled);
+  EXPECT_EQ(without.share.updates_sent, 0);
+
+  const ShareRun with = flyUav0ThroughTheWall(true, clean);
+  ASSERT_TRUE(with.plan.verified) << with.plan.reason;
+  EXPECT_LT(with.b_field_at_wall, 0.5) << "UAV 1's wall is in UAV 0's field";
+  EXPECT_GT(with.least_wall_distance_m, 0.5) << "with sharing UAV 0 plans around the wall";
+  EXPECT_TRUE(with.share.enabled);
+  EXPECT_GT(with.share.updates_sent, 0);
+  EXPECT_EQ(with.share.updates_merged, with.share.updates_sent * 2);  // each to the 2 others, clean link
+  EXPECT_EQ(with.share.updates_lost + with.share.updates_refused, 0);
+  EXPECT_LE(with.share.age_s_max, 0.5 + 0.02 + 1e-9);  // at most one share period (2 Hz) + the link delay
+  EXPECT_GT(with.share.bytes_per_s_max, 0.0);
+}
+
+TEST(SiteMappingShareTest, UpdatesKeepTheByteBudgetAndSufferTheLinkAndDropouts) {
+  // A budget of 1 000 B/s at 2 Hz: 500 B per update, 63 voxels; the wall's face (15 × 10 voxels of
+  // 0.4 m) takes UAV 1 three updates, nearest first — all within the 2 s.
+  const ShareRun tight = flyUav0ThroughTheWall(true, gf::sim::LinkConfig{}, 1000.0);
+  EXPECT_LE(tight.share.bytes_per_s_max, 1000.0);
+  EXPECT_GT(tight.share.changes_deferred, 0);
+  EXPECT_GE(tight.share.updates_sent, 3);
+  EXPECT_EQ(tight.share.changes_dropped, 0);
+  EXPECT_LT(tight.b_field_at_wall, 0.5) << "the wall arrives, later";
+  // A link that loses everything: sent, never merged; UAV 0 plans into the wall as without sharing.
+  gf::sim::LinkConfig lossy;
+  lossy.loss_probability = 1.0;
+  const ShareRun lost = flyUav0ThroughTheWall(true, lossy);
+  EXPECT_GT(lost.share.updates_sent, 0);
+  EXPECT_EQ(lost.share.updates_merged, 0);
+  EXPECT_EQ(lost.share.updates_lost, lost.share.updates_sent * 2);
+  EXPECT_GT(lost.b_field_at_wall, 2.0);
+  // UAV 0 offline (a dropout): what reaches it is lost, nothing merged into its map.
+  const ShareRun dropout = flyUav0ThroughTheWall(true, gf::sim::LinkConfig{}, 50000.0, true);
+  EXPECT_GT(dropout.b_field_at_wall, 2.0);
+  EXPECT_GT(dropout.share.updates_lost, 0);
 }
