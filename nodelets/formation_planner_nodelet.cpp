@@ -4,14 +4,10 @@
 // (§2.4), the stage-1 reference on the worker's prediction, the request around the other UAVs'
 // received plans (planning::buildPlanRequest) and the verified plan or its fallback (flagged
 // `fallback`: every other UAV plans around it). The leader's instance also owns the formation's
-// parameters (onboard::FormationParamsRole): commands arrive on formation_command_in (gestures,
+// parameters (onboard::ParamsOwnership): commands arrive on formation_command_in (gestures,
 // operator over LCM), the parameters go out on formation_params_out. With ~leadership true (optional,
-// default false) the parameter role follows this UAV's own leadership_state_in (LeadershipState, the
-// Leadership nodelet; docs/safety.md §1.2) instead of its index: every UAV subscribes to commands and
-// parameters; while it acts it applies commands sent since it took over and publishes parameters,
-// acknowledgements and the assistance state; when it starts acting it takes over the parameters and
-// their version from the last ones it received; while it does not act it drops commands and takes
-// the parameters it receives.
+// default false) that role follows this UAV's own leadership_state_in (LeadershipState; docs/safety.md
+// §1.2): every UAV subscribes, the acting one owns the parameters (onboard::ParamsOwnership says how).
 //
 // Topics: odometry_in (nav_msgs/Odometry, orientation = camera axis, docs/ros.md),
 //   worker_state_in (WorkerState: the leader's estimator, or the leader's share over LCM),
@@ -25,12 +21,11 @@
 //   command_ack_out (leader: CommandAck per command handled, to the operator; docs/safety.md §2.9);
 //   leader: assistance_in (AssistanceState: the worker's request, the operator's acknowledgement) →
 //   assistance_state_out (latched; while requested the worker's gesture commands are refused, §2.10).
-// Parameters (all required unless noted): ~uav_index, ~uav_count, ~world_frame, ~scenario_file
-//   (the map), ~params_rate_hz, ~max_wind_estimate_age_s, and the settings of
-//   loadPlannerSettings (config_sources.hpp): ~mission_file (optional; simulation: the mission's
-//   settings, with the optional ~faults_file merged) or ~replanning_period_s, ~horizon_dt_s,
-//   ~horizon_steps, ~max_share_age_s, ~max_worker_age_s, ~max_plan_age_s, ~avoid_all_plans,
-//   ~brake_accel_mps2, ~search_*, ~abort (a map), ~formation_config, ~planner_config.
+// Parameters (all required unless noted): ~uav_index, ~uav_count, ~world_frame, ~scenario_file (the
+//   map), ~params_rate_hz, ~max_wind_estimate_age_s, and loadPlannerSettings' (config_sources.hpp):
+//   ~mission_file (optional; simulation: the mission's settings, with the optional ~faults_file merged)
+//   or ~replanning_period_s, ~horizon_dt_s, ~horizon_steps, ~max_share_age_s, ~max_worker_age_s,
+//   ~max_plan_age_s, ~avoid_all_plans, ~brake_accel_mps2, ~search_*, ~abort (a map), ~formation_config, ~planner_config.
 #include <cmath>
 #include <mutex>
 #include <optional>
@@ -43,9 +38,11 @@
 #include "config_sources.hpp"
 #include "conversions.hpp"
 #include "diagnostics.hpp"
+#include "planner_health.hpp"
 #include "gesture_formation/LeadershipState.h"
 #include "gesture_formation/onboard/formation_params_role.hpp"
 #include "gesture_formation/onboard/frame_check.hpp"
+#include "gesture_formation/onboard/wind_input.hpp"
 #include "gesture_formation/planning/replan_health.hpp"
 #include "gesture_formation/planning/replan_step.hpp"
 #include "param_loader.hpp"
@@ -63,7 +60,9 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     std::string scenario_file, mission_file;
     params.load("scenario_file", scenario_file);
     params.loadOptional("mission_file", mission_file, "");
-    params.load("max_wind_estimate_age_s", max_wind_age_s_, 0.1, 60.0);
+    double max_wind_age_s = 0.0;
+    params.load("max_wind_estimate_age_s", max_wind_age_s, 0.1, 60.0);
+    wind_ = onboard::WindInput(max_wind_age_s);
     double params_rate_hz = 0.0;
     params.load("params_rate_hz", params_rate_hz, 0.1, 50.0);
     getPrivateNodeHandle().param("leadership", leadership_, false);  // optional: see the file comment
@@ -74,8 +73,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     period_s_ = settings.replanning_period_s;
     // Every source is checked before refusing (cross-field checks whenever both fields loaded).
     if (settings.formation_loaded && fcfg.params.uavCount() != uav_count_) {
-      params.addError("uav_count: " + std::to_string(uav_count_) + " but the formation config has " +
-                      std::to_string(fcfg.params.uavCount()) + " UAVs");
+      params.addError("uav_count: " + std::to_string(uav_count_) + " but the formation config has " + std::to_string(fcfg.params.uavCount()) + " UAVs");
     }
     if (uav_index_ >= uav_count_) params.addError("uav_index: must be < uav_count");
     loadWorldMap(scenario_file, params, world_);
@@ -84,8 +82,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
       return;
     }
     NODELET_INFO_STREAM("FormationPlanner (UAV " << uav_index_ << ") loaded:\n" << params.loaded());
-    role_.emplace(fcfg, uav_index_);  // the config was validated by its loader
-    fcfg_ = fcfg;
+    own_.emplace(fcfg, uav_index_, leadership_);  // the config was validated by its loader
     rc.uav_index = uav_index_;
     rc.uav_count = uav_count_;
     rc.worker_heading = fcfg.worker_heading;
@@ -94,7 +91,6 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
                                                        settings.planner, world_.map, world_.field)),
                                                    retreatSpace(world_));
     received_.resize(static_cast<std::size_t>(uav_count_));
-
     plan_pub_ = nh.advertise<gesture_formation::PlannedTrajectory>("plan_out", 5);
     traj_pub_ = nh.advertise<trajectory_msgs::MultiDOFJointTrajectory>("trajectory_out", 5);
     odom_sub_ = nh.subscribe("odometry_in", 5, &FormationPlannerNodelet::onOdometry, this);
@@ -111,54 +107,38 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     diagnostics_.start(nh, 1.0, [this](double since_s) { return health(since_s); });
   }
 
-  /// The parameter role's topics: the leader by index, or (~leadership) every UAV, its role following
-  /// its leadership_state_in.
+  /// The parameter role's topics: the leader by index, or (~leadership) every UAV.
   void setUpParamsRole(ros::NodeHandle& nh, double params_rate_hz) {
     if (uav_index_ == formation::kLeader || leadership_) {
       params_pub_ = nh.advertise<gesture_formation::FormationParams>("formation_params_out", 5, true);
       command_sub_ = nh.subscribe("formation_command_in", 20, &FormationPlannerNodelet::onCommand, this);
       ack_pub_ = nh.advertise<gesture_formation::CommandAck>("command_ack_out", 20);
       assistance_pub_ = nh.advertise<gesture_formation::AssistanceState>("assistance_state_out", 5, true);
-      if (owns()) assistance_pub_.publish(toMsg(role_->assistance().state(), ros::Time::now()));
+      if (own_->owns()) assistance_pub_.publish(toMsg(own_->role().assistance().state(), ros::Time::now()));
       assistance_sub_ = nh.subscribe("assistance_in", 20, &FormationPlannerNodelet::onAssistance, this);
       params_timer_ = nh.createTimer(ros::Duration(1.0 / params_rate_hz), [this](const ros::TimerEvent&) {
         std::lock_guard<std::mutex> lock(mutex_);
-        if (owns()) publishParams();
+        if (own_->owns()) publishParams();
       });
     }
-    if (uav_index_ != formation::kLeader || leadership_) {
-      params_sub_ = nh.subscribe("formation_params_in", 5, &FormationPlannerNodelet::onParams, this);
-    }
-    if (leadership_) {
-      leadership_sub_ = nh.subscribe("leadership_state_in", 5, &FormationPlannerNodelet::onLeadership, this);
-    }
+    if (uav_index_ != formation::kLeader || leadership_) params_sub_ = nh.subscribe("formation_params_in", 5, &FormationPlannerNodelet::onParams, this);
+    if (leadership_) leadership_sub_ = nh.subscribe("leadership_state_in", 5, &FormationPlannerNodelet::onLeadership, this);
   }
-  /// The parameter owner: the leader by index, or with ~leadership the UAV while it acts.
-  bool owns() const { return leadership_ ? acting_ : uav_index_ == formation::kLeader; }
 
   // This UAV's leadership view (~leadership): starting to act, it takes the parameters over.
   void onLeadership(const gesture_formation::LeadershipState::ConstPtr& msg) {
     if (msg->uav_index != uav_index_) return;
     std::lock_guard<std::mutex> lock(mutex_);
-    const bool was = acting_;
-    acting_ = msg->acting;
-    if (acting_ == was) return;
-    if (!acting_) {
-      NODELET_WARN_STREAM("FormationPlanner UAV " << uav_index_ << ": no longer acts as leader (term " << msg->term
-                                                  << "): parameters from the leader from now on");
-      return;
-    }
-    // The parameters and their version as last received (or held); commands from now on.
-    formation::FormationConfig cfg = fcfg_;
-    cfg.params = role_->params();
-    base_version_ = version();
-    role_.emplace(cfg, formation::kLeader);
-    took_over_s_ = msg->header.stamp.toSec();
-    NODELET_WARN_STREAM("FormationPlanner UAV " << uav_index_ << ": acts as leader (term " << msg->term << ") from t = "
-                                                << took_over_s_ << " s: parameters version " << base_version_
-                                                << " taken over; commands sent from now on applied");
+    const auto change = own_->setActing(msg->acting, msg->header.stamp.toSec());
+    if (change == onboard::ParamsOwnership::Change::kNone) return;
+    const bool started = change == onboard::ParamsOwnership::Change::kStarted;
+    NODELET_WARN_STREAM("FormationPlanner UAV " << uav_index_ << (started ? ": acts as leader (term " : ": no longer acts as leader (term ")
+                        << msg->term << (started ? ") from t = " + std::to_string(own_->tookOverS()) + " s: parameters version " +
+                                                       std::to_string(own_->version()) + " taken over; commands sent from now on applied"
+                                                 : "): parameters from the leader from now on"));
+    if (!started) return;
     publishParams();
-    assistance_pub_.publish(toMsg(role_->assistance().state(), ros::Time::now()));
+    assistance_pub_.publish(toMsg(own_->role().assistance().state(), ros::Time::now()));
   }
 
   void onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
@@ -171,18 +151,11 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     odom_ = toKinematicState(*msg);
   }
   void onWind(const geometry_msgs::TwistWithCovarianceStamped::ConstPtr& msg) {
-    const Eigen::Vector3d w = toEigen(msg->twist.twist.linear);
     std::lock_guard<std::mutex> lock(mutex_);
-    if (msg->header.frame_id != world_frame_ || !w.allFinite() || w.norm() > kMaxWindMps) {
-      ++wind_rejected_;
-      NODELET_WARN_STREAM_THROTTLE(2.0, "FormationPlanner: wind estimate rejected (frame_id '"
-                                            << msg->header.frame_id << "', expected '" << world_frame_
-                                            << "'; wind " << w.transpose() << " m/s, at most " << kMaxWindMps
-                                            << "); " << wind_rejected_ << " rejected so far");
-      return;
-    }
-    wind_ = w;
-    wind_stamp_s_ = msg->header.stamp.toSec();
+    const std::string why = wind_.receive(msg->header.frame_id, world_frame_, toEigen(msg->twist.twist.linear), msg->header.stamp.toSec());
+    if (why.empty()) return;
+    NODELET_WARN_STREAM_THROTTLE(2.0, "FormationPlanner: wind estimate rejected (" << why << "); " << wind_.rejected()
+                                                                               << " rejected so far");
   }
   void onWorker(const gesture_formation::WorkerState::ConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -202,27 +175,23 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   void onParams(const gesture_formation::FormationParams::ConstPtr& msg) {
     auto p = fromMsg(*msg);
     std::lock_guard<std::mutex> lock(mutex_);
-    if (owns()) return;  // ~leadership: the acting UAV's own parameters are the formation's
-    base_version_ = 0;   // the received version is the formation's
-    const auto r = p ? role_->receive(*p, msg->version) : common::Result<bool>::fail(p.reason());
+    const auto r = p ? own_->receive(*p, msg->version) : common::Result<bool>::fail(p.reason());
     if (!r) NODELET_WARN_STREAM_THROTTLE(1.0, "FormationPlanner: formation parameters dropped: " << r.reason());
   }
   void onCommand(const gesture_formation::FormationCommand::ConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
-    // ~leadership: only the acting UAV applies, and only what was sent since it took over (older
-    // ones were its predecessor's: the parameters it took over carry those it applied).
-    if (!owns() || (leadership_ && msg->header.stamp.toSec() < took_over_s_)) return;
-    const auto& r = role_->apply(fromMsg(*msg), describe(*msg), msg->source, msg->header.stamp.toSec());
+    if (!own_->takesCommand(msg->header.stamp.toSec())) return;
+    const auto& r = own_->role().apply(fromMsg(*msg), describe(*msg), msg->source, msg->header.stamp.toSec());
     NODELET_INFO_STREAM("FormationPlanner: command " << r.text << " → " << r.outcome);
     publishParams();
-    ack_pub_.publish(toAck(*msg, r.status, r.outcome, version(), ros::Time::now()));  // to the operator
+    ack_pub_.publish(toAck(*msg, r.status, r.outcome, own_->version(), ros::Time::now()));  // to the operator
   }
   // The worker's request (GestureCommander) or the operator's acknowledgement (over LCM) → the latch.
   void onAssistance(const gesture_formation::AssistanceState::ConstPtr& m) {
     auto state = fromMsg(*m);
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!owns()) return;  // ~leadership: the acting UAV's latch
-    auto& latch = role_->assistance();
+    if (!own_->owns()) return;  // ~leadership: the acting UAV's latch
+    auto& latch = own_->role().assistance();
     if (!state || !latch.receive(*state)) return;
     NODELET_WARN_STREAM("FormationPlanner: assistance " << formation::toString(latch.state().phase) << " (requested at "
                                                         << latch.state().requested_s << " s by " << latch.state().requested_by
@@ -230,12 +199,10 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     assistance_pub_.publish(toMsg(latch.state(), ros::Time::now()));
   }
   void publishParams() {
-    auto m = toMsg(*role_, ros::Time::now(), world_frame_);
-    m.version = version();
+    auto m = toMsg(own_->role(), ros::Time::now(), world_frame_);
+    m.version = own_->version();
     params_pub_.publish(m);
   }
-  /// The parameters' version: the role's, after a take-over counted on from the version taken over.
-  std::uint64_t version() const { return base_version_ + role_->version(); }
 
   // Every copy of an abort (operator over LCM, the leader's relay, the gesture commander): the
   // ReplanStep accepts the first that is fresh enough (planning::AbortPlanner::receive).
@@ -251,9 +218,8 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
       return;
     }
     abort_link_sender_ = msg->link_sender;
-    NODELET_WARN_STREAM("FormationPlanner UAV " << uav_index_ << ": abort accepted: " << msg->sender << "#"
-                                                << msg->sequence << " (" << planning::toString(c->source) << ", via "
-                                                << (msg->link_sender < 0 ? std::string("ROS") : "LCM sender " + std::to_string(msg->link_sender)) << ")");
+    NODELET_WARN_STREAM("FormationPlanner UAV " << uav_index_ << ": abort accepted: " << msg->sender << "#" << msg->sequence << " ("
+                        << planning::toString(c->source) << ", via " << (msg->link_sender < 0 ? std::string("ROS") : "LCM sender " + std::to_string(msg->link_sender)) << ")");
     abort_pub_.publish(toAbortState(step_->abort(), uav_index_, t, "accepted", abort_link_sender_, world_frame_));
   }
 
@@ -276,9 +242,9 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     planning::ReplanInputs in;
     in.t_s = t;
     in.state = *odom_;
-    if (wind_ && t - wind_stamp_s_ <= max_wind_age_s_) in.wind_estimate_mps = *wind_;
+    if (const auto w = wind_.at(t)) in.wind_estimate_mps = *w;
     in.worker = worker ? &*worker : nullptr;
-    in.params = &role_->params();
+    in.params = &own_->role().params();
     in.leader_plan = received_[0] ? &received_[0]->plan : nullptr;
     in.received = &received_;
     const planning::ReplanOutcome out = step_->step(in);
@@ -290,25 +256,13 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
       abort_pub_.publish(toAbortState(step_->abort(), uav_index_, t, out.reason, abort_link_sender_, world_frame_));
     }
     if (mode != mode_) {
-      if (out.holding() || out.aborting()) {
-        NODELET_WARN_STREAM("FormationPlanner UAV " << uav_index_ << ": " << mode << ": " << out.reason);
-      } else {
-        NODELET_INFO_STREAM("FormationPlanner UAV " << uav_index_ << ": track: fresh data");
-      }
+      if (out.holding() || out.aborting()) NODELET_WARN_STREAM("FormationPlanner UAV " << uav_index_ << ": " << mode << ": " << out.reason);
+      else NODELET_INFO_STREAM("FormationPlanner UAV " << uav_index_ << ": track: fresh data");
       mode_ = mode;
     }
-    const planning::PlanResult& res = out.result;
     health_.record(out, t);
-    if (res.status != planning::PlanStatus::kOptimized) {
-      NODELET_WARN_STREAM_THROTTLE(2.0, "FormationPlanner UAV " << uav_index_ << ": " << planning::toString(res.status)
-                                                                << ": " << res.reason);
-    }
-    if (res.qp_sparse_timeouts > 0) {
-      NODELET_ERROR_STREAM("FormationPlanner UAV " << uav_index_ << ": " << res.qp_sparse_timeouts
-                                                   << " QP solve(s) stopped (deadline qp.solve_timeout_s, or ProxQP's "
-                                                   << "sparse solver broke an invariant: dense backend; docs/safety.md 4.5)");
-    }
-    const auto msg = toMsg(out, uav_index_, t, role_->params(), version(), world_frame_);
+    logPlanProblems(out.result, uav_index_);
+    const auto msg = toMsg(out, uav_index_, t, own_->role().params(), own_->version(), world_frame_);
     plan_pub_.publish(msg);
     traj_pub_.publish(toMultiDof(msg, "uav" + std::to_string(uav_index_)));
   }
@@ -316,17 +270,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   /// This UAV's planner on /diagnostics (planning::ReplanHealth).
   std::vector<diagnostic_msgs::DiagnosticStatus> health(double since_s) {
     std::lock_guard<std::mutex> lock(mutex_);
-    const planning::ReplanHealthReport r = health_.report(ros::Time::now().toSec(), period_s_);  // ROS (sim) time
-    Health h("FormationPlanner uav" + std::to_string(uav_index_), "uav" + std::to_string(uav_index_));
-    h.error(r.level == planning::ReplanHealthReport::Level::kError, r.message)
-        .warn(r.level == planning::ReplanHealthReport::Level::kWarn, r.message)
-        .value("mode", r.mode)
-        .value("plans_per_s", since_s > 0.0 ? r.plans / since_s : 0.0)
-        .value("fallbacks", r.fallbacks)
-        .value("last_status", r.last_status)
-        .value("last_planning_ms", r.last_planning_ms)
-        .value("last_plan_age_s", r.last_plan_age_s);
-    return {h.status()};
+    return {plannerHealth(health_.report(ros::Time::now().toSec(), period_s_), uav_index_, since_s)};  // ROS (sim) time
   }
 
   std::mutex mutex_;
@@ -335,15 +279,9 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   int uav_index_ = 0, uav_count_ = 0;
   std::string world_frame_;
   double period_s_ = 0.0, offset_s_ = 0.0, next_plan_s_ = -1.0;
-  static constexpr double kMaxWindMps = 60.0;  ///< a larger wind estimate is garbage
-  double max_wind_age_s_ = 0.0, wind_stamp_s_ = 0.0;
-  std::optional<Eigen::Vector3d> wind_;
-  std::uint64_t wind_rejected_ = 0;
-  std::optional<onboard::FormationParamsRole> role_;  ///< the leader's parameters and commands, or the received ones
-  formation::FormationConfig fcfg_;  ///< ~leadership: a take-over's role starts from it (with the parameters held)
-  bool leadership_ = false, acting_ = false;  ///< ~leadership; this UAV acts (its leadership_state)
-  std::uint64_t base_version_ = 0;  ///< ~leadership: the version taken over (0: the role's own)
-  double took_over_s_ = 0.0;        ///< ~leadership: when this UAV last started acting
+  onboard::WindInput wind_;  ///< wind_estimate_in, checked and aged (docs/safety.md §4.7)
+  std::optional<onboard::ParamsOwnership> own_;  ///< the parameters' role, following the leadership or the index
+  bool leadership_ = false;  ///< ~leadership: the parameters' role follows this UAV's leadership_state
   std::string mode_ = "track";             ///< track | hold | search | abort (logged on change)
   WorldMap world_;  ///< the map and field the planner and the abort's goal search use
   std::unique_ptr<planning::ReplanStep> step_;  ///< planner, hold / search, listening (shared with gfctl simulate)

@@ -100,9 +100,7 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     relay_sub_ = nh.subscribe("abort_relay_in", 5, &LcmBridgeNodelet::onAbortState, this);
     leadership_pub_ = nh.advertise<gesture_formation::LeadershipMessage>("leadership_out", 100);
     leadership_sub_ = nh.subscribe<gesture_formation::LeadershipMessage>(
-        "leadership_in", 100, [this](const gesture_formation::LeadershipMessage::ConstPtr& m) {
-          sendChecked(fromMsg(*m), "leadership message");
-        });
+        "leadership_in", 100, [this](const gesture_formation::LeadershipMessage::ConstPtr& m) { sendChecked(fromMsg(*m), "leadership message"); });
     // Single events, sent now and repeated like a command: the operator's and gestures' commands,
     // the leader's acknowledgements, the leader's assistance state (also re-sent with every worker
     // state while requested) and the ground station's acknowledgement of it.
@@ -289,10 +287,8 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
   static constexpr int kMaxDrainPerTick = 2000;
   lcm_bridge::HighWaterMarkSaver marks_;  ///< high_water_file, saved when the marks changed
   std::optional<comm::RejectionReport> report_;  ///< /diagnostics: counts and refusals since the last report
-  ros::Publisher worker_pub_, plans_pub_, params_pub_, command_pub_, observations_pub_, abort_pub_, ack_pub_, assistance_pub_,
-      leadership_pub_;
-  ros::Subscriber worker_sub_, plan_sub_, params_sub_, command_sub_, observation_sub_, abort_sub_, relay_sub_, ack_sub_, assistance_sub_,
-      leadership_sub_;
+  ros::Publisher worker_pub_, plans_pub_, params_pub_, command_pub_, observations_pub_, abort_pub_, ack_pub_, assistance_pub_, leadership_pub_;
+  ros::Subscriber worker_sub_, plan_sub_, params_sub_, command_sub_, observation_sub_, abort_sub_, relay_sub_, ack_sub_, assistance_sub_, leadership_sub_;
   ros::WallTimer drain_timer_;
   DiagnosticsPublisher diagnostics_;  ///< /diagnostics every wall second (also saves the high-water marks)
   ros::Timer heartbeat_timer_, repeat_timer_;

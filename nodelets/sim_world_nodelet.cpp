@@ -1,13 +1,10 @@
-// SimWorld nodelet: the simulated mission's world on the sim core of `gfctl simulate` (topics and
-// parameters: docs/ros.md "SimWorld"): sim time (/clock, started when every UAV's planner is up), the
-// worker (sim::WorkerModel), the cameras (sim::LeaderCamera: box, stereo and UWB with the mission's
-// sensor faults; each UAV's classification from its actual viewpoint, as its Perception nodelet
-// would publish it), the scheduled operator requests, faults.abort (asked of the ground station's
-// OperatorInterface at its time, send_abort, as an operator does), and the record (sim::WorldRecord:
-// metrics of docs/simulation.md §4, plans, modes, command outcomes, every UAV's abort_state, the
-// files at the end). ~camera rendered:
-// SimCamera nodelets render the worker's body (worker_body_out) for the Perception nodelets, no
-// detection or classification comes from here; the leader's detections (detection_in) feed the metrics.
+// SimWorld nodelet: the simulated mission's world on the sim core of `gfctl simulate` (docs/ros.md
+// "SimWorld"): sim time (/clock, from when every UAV's planner is up), the worker (sim::WorkerModel),
+// the cameras (sim::LeaderCamera: box, stereo and UWB with the sensor faults; each UAV's classification
+// as its Perception nodelet would publish it), the operator's scheduled requests and faults.abort
+// (through the ground's OperatorInterface, as an operator), the record (sim::WorldRecord: metrics,
+// plans, modes, outcomes, abort states, files). ~camera rendered: SimCamera renders the worker's body
+// (worker_body_out) for the Perception nodelets; the leader's detections (detection_in) feed the metrics.
 #include <algorithm>
 #include <mutex>
 #include <optional>
@@ -21,6 +18,7 @@
 
 #include "sim_config_sources.hpp"
 #include "sim_conversions.hpp"
+#include "sim_start_gate.hpp"
 #include "gesture_formation/GestureStatus.h"
 #include "gesture_formation/SendAbort.h"
 #include "gesture_formation/formation/worker_heading.hpp"
@@ -79,34 +77,21 @@ class SimWorldNodelet : public nodelet::Nodelet {
       info_pub_ = nh.advertise<sensor_msgs::CameraInfo>("camera_info_out", 2);  // the leader camera's, every frame
       info_ = toCameraInfo(cfg_.camera.camera);
       info_.header.frame_id = set_.camera_frame;
-      for (int i = 0; i < (follower_views_ ? n_ : 1); ++i) {
-        gesture_pubs_.push_back(nh.advertise<gesture_formation::Gesture>("uav" + std::to_string(i) + "/gesture_out", 10));
-      }
+      for (int i = 0; i < (follower_views_ ? n_ : 1); ++i) gesture_pubs_.push_back(nh.advertise<gesture_formation::Gesture>("uav" + std::to_string(i) + "/gesture_out", 10));
     }
     command_pub_ = nh.advertise<gesture_formation::FormationCommand>("operator_command_out", 20);
     done_pub_ = nh.advertise<std_msgs::Bool>("done_out", 1, true);
-    for (int i = 0; i < n_; ++i) {
-      truth_subs_.push_back(nh.subscribe<nav_msgs::Odometry>(
-          "uav" + std::to_string(i) + "/ground_truth", 10, [this, i](const nav_msgs::Odometry::ConstPtr& m) {
-            std::lock_guard<std::mutex> lock(mutex_);
-            truth_[static_cast<std::size_t>(i)] = toMultirotorState(*m);
-          }));
-      plan_subs_.push_back(nh.subscribe<gesture_formation::PlannedTrajectory>(
-          "uav" + std::to_string(i) + "/plan", 10, [this, i](const gesture_formation::PlannedTrajectory::ConstPtr& m) {
-            const auto status = planStatusFromName(m->status);
-            std::lock_guard<std::mutex> lock(mutex_);
-            if (finished_) return;
-            if (!status) {
-              NODELET_WARN_STREAM_THROTTLE(5.0, "SimWorld: plan not counted: " << status.reason());
-              return;
-            }
-            record_->plan(toPlanReport(i, *m, *status));
-          }));
-      abort_subs_.push_back(nh.subscribe<gesture_formation::AbortState>(
-          "uav" + std::to_string(i) + "/abort_state", 10, [this, i](const gesture_formation::AbortState::ConstPtr& m) {
-            std::lock_guard<std::mutex> lock(mutex_);
-            if (!finished_) record_->abortState(toAbortReport(i, *m));
-          }));
+    for (int i = 0; i < n_; ++i) {  // each UAV's truth, plans and abort state, recorded until the end
+      truth_subs_.push_back(perUav<nav_msgs::Odometry>(nh, i, "ground_truth", [this](int k, const nav_msgs::Odometry& m) {
+        truth_[static_cast<std::size_t>(k)] = toMultirotorState(m);
+      }));
+      plan_subs_.push_back(perUav<gesture_formation::PlannedTrajectory>(nh, i, "plan", [this](int k, const gesture_formation::PlannedTrajectory& m) {
+        const auto status = planStatusFromName(m.status);
+        if (status) record_->plan(toPlanReport(k, m, *status));
+        else NODELET_WARN_STREAM_THROTTLE(5.0, "SimWorld: plan not counted: " << status.reason());
+      }));
+      abort_subs_.push_back(perUav<gesture_formation::AbortState>(
+          nh, i, "abort_state", [this](int k, const gesture_formation::AbortState& m) { record_->abortState(toAbortReport(k, m)); }));
     }
     // faults.abort: asked of the ground station's OperatorInterface as an operator does.
     abort_client_ = nh.serviceClient<gesture_formation::SendAbort>("send_abort");
@@ -118,9 +103,18 @@ class SimWorldNodelet : public nodelet::Nodelet {
           if (!m->lost) heading_->update(toEigen(m->velocity));  // the leader's ^Hφ follows its estimate
         });
     status_sub_ = nh.subscribe("gesture_status_in", 50, &SimWorldNodelet::onGestureStatus, this);
-    wall0_ = ros::WallTime::now();
+    gate_.arm();
     publishClock();
     clock_timer_ = nh.createWallTimer(ros::WallDuration(set_.clock_step_s / set_.real_time_factor), &SimWorldNodelet::onClock, this);
+  }
+
+  /// uav<i>/<topic>, handed to `f(i, msg)` under the lock until the mission finished.
+  template <class Msg, class F>
+  ros::Subscriber perUav(ros::NodeHandle& nh, int i, const std::string& topic, F f) {
+    return nh.subscribe<Msg>("uav" + std::to_string(i) + "/" + topic, 10, [this, i, f](const typename Msg::ConstPtr& m) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!finished_) f(i, *m);
+    });
   }
 
   void onParams(const gesture_formation::FormationParams::ConstPtr& m) {
@@ -128,16 +122,13 @@ class SimWorldNodelet : public nodelet::Nodelet {
     if (!finished_) record_->params(toParamsReport(*m));
   }
 
-  /// Rendered cameras: the timeline's `visible` holds this long after the leader's Perception last
-  /// found the worker (its frames come at the SimCamera's rate, a few Hz, and late by their
-  /// processing time).
+  /// Rendered cameras: `visible` holds this long after the leader's Perception last found the worker.
   static constexpr double kRenderedVisibleS = 1.0;
 
-  /// Rendered cameras: the leader's Perception output, one per frame it processed (metrics:
-  /// visibility and the estimate's error at that frame).
+  /// Rendered cameras: the leader's Perception output per processed frame (visibility, estimate error).
   void onLeaderDetection(const gesture_formation::WorkerDetection::ConstPtr& m) {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (finished_ || !started_) return;
+    if (finished_ || !gate_.started()) return;
     const double t = m->header.stamp.toSec();
     if (m->detected) last_detected_s_ = t;
     const std::optional<Eigen::Vector3d> est = estimateAt(t);
@@ -159,40 +150,23 @@ class SimWorldNodelet : public nodelet::Nodelet {
   }
 
   void onClock(const ros::WallTimerEvent&) {
-    if (tick()) requestAbort();  // outside the lock: the service call waits for the OperatorInterface
-  }
-
-  /// faults.abort at its time: the operator's abort through the OperatorInterface's send_abort (it
-  /// numbers the command and has the ground station's LcmBridge send its copies to every UAV).
-  void requestAbort() {
+    // faults.abort at its time: the operator's abort through the OperatorInterface's send_abort (it
+    // numbers the command and has the ground station's LcmBridge send its copies to every UAV);
+    // outside the lock: the service call waits for the OperatorInterface.
+    if (!tick()) return;
     gesture_formation::SendAbort srv;
-    if (!abort_client_.call(srv) || !srv.response.accepted) {
-      NODELET_ERROR_STREAM("SimWorld: faults.abort: send_abort failed" << (abort_client_.exists() ? ": " : " (no service)")
-                                                                    << srv.response.message);
-      return;
-    }
-    NODELET_WARN_STREAM("SimWorld: faults.abort: the operator's abort #" << srv.response.sequence << " sent at t = " << t_
-                                                                         << " s (" << srv.response.copies << " copies)");
+    const bool sent = abort_client_.call(srv) && srv.response.accepted;
+    if (!sent) NODELET_ERROR_STREAM("SimWorld: faults.abort: send_abort failed" << (abort_client_.exists() ? ": " : " (no service)") << srv.response.message);
+    else NODELET_WARN_STREAM("SimWorld: faults.abort: the operator's abort #" << srv.response.sequence << " sent (" << srv.response.copies << " copies)");
   }
 
   /// One clock step; true when faults.abort falls due in it.
   bool tick() {
     std::lock_guard<std::mutex> lock(mutex_);
     if (finished_) return false;
-    if (!started_) {
-      // Sim time starts once every UAV's planner is up (it advertises its plan after loading the
-      // map), so that no UAV misses the mission's start; after 120 s wall it starts anyway.
-      bool all = true;
-      for (const auto& sub : plan_subs_) all = all && sub.getNumPublishers() > 0;
-      const double waited = (ros::WallTime::now() - wall0_).toSec();
-      if (!all && waited < 120.0) {
-        publishClock();
-        return false;
-      }
-      if (!all) NODELET_WARN("SimWorld: not every UAV planner is up after 120 s; starting anyway");
-      NODELET_INFO_STREAM("SimWorld: every UAV is up after " << waited << " s wall; sim time starts");
-      started_ = true;
-      wall0_ = ros::WallTime::now();
+    if (!gate_.open(plan_subs_)) {  // sim time starts once every UAV's planner is up
+      publishClock();
+      return false;
     }
     ++k_;
     t_ = static_cast<double>(k_) * set_.clock_step_s;
@@ -206,8 +180,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
       command_pub_.publish(m);
     }
     const bool all = record_->sampleSafety(t_, truth_, ws);  // false until every UAV's truth came
-    // With the followers' cameras, a frame needs every UAV's truth (LeaderCamera wants the same
-    // number of followers at every call); SimWorld starts when every planner is up.
+    // With the followers' cameras a frame needs every UAV's truth (the same number of followers every call).
     if (camera_frames_->due(k_) && (follower_views_ ? all : truth_[0].has_value())) cameraFrame(ws);
     if (timeline_samples_->due(k_)) sample(ws, all);
     const bool abort_due = record_->abortDue(t_);
@@ -254,8 +227,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
     if (set_.rendered) return;  // the Perception nodelets see the rendered images
     info_.header.stamp = stamp;
     info_pub_.publish(info_);
-    // Each UAV's classifier output, as its Perception nodelet would publish it (the followers'
-    // first: the leader's closes the frame at the GestureCommander only when all have reported).
+    // Each UAV's classifier output, the followers' first (the leader's closes the frame at the GestureCommander).
     for (std::size_t i = 0; i < cf.followers.size(); ++i) {
       const auto& f = cf.followers[i];
       if (f.classification) publishGesture(static_cast<int>(i) + 1, *f.classification, stamp,
@@ -286,16 +258,14 @@ class SimWorldNodelet : public nodelet::Nodelet {
 
   void finish() {
     finished_ = true;
-    const double wall = (ros::WallTime::now() - wall0_).toSec();
+    const double wall = gate_.wallSinceStart();
     // metrics.json last: its appearance tells tools/run_ros_mission.sh that the files are complete.
     std::string err, warning;
     if (!record_->finish(worker_->episodes(), t_, wall, set_.output_dir, &err, &warning)) NODELET_ERROR_STREAM("SimWorld: " << err);
     if (!warning.empty()) NODELET_WARN_STREAM("SimWorld: " << warning);
     NODELET_INFO_STREAM("SimWorld: mission done at t = " << t_ << " s (" << wall << " s wall); wrote " << set_.output_dir
                                                          << "/metrics.json");
-    std_msgs::Bool done;
-    done.data = true;
-    done_pub_.publish(done);
+    done_pub_.publish([] { std_msgs::Bool b; b.data = true; return b; }());
   }
 
   std::mutex mutex_;
@@ -311,10 +281,10 @@ class SimWorldNodelet : public nodelet::Nodelet {
   double t_ = 0.0, last_ratio_ = 0.0, last_detected_s_ = -1e9;  ///< last detected: the leader's Perception (rendered)
   long k_ = 0;
   int n_ = 0, last_class_ = -1;
-  bool finished_ = false, started_ = false, follower_views_ = false;
+  bool finished_ = false, follower_views_ = false;
+  SimStartGate gate_;  ///< sim time starts once every UAV's planner is up
   std::vector<std::optional<sim::MultirotorState>> truth_;
   std::optional<gesture_formation::WorkerState> estimate_;
-  ros::WallTime wall0_;
   ros::Publisher clock_pub_, worker_pub_, detection_pub_, uwb_pub_, command_pub_, done_pub_, body_pub_, info_pub_;
   sensor_msgs::CameraInfo info_;  ///< synthetic camera: the leader camera's intrinsics (the estimator's camera model)
   tf2_ros::TransformBroadcaster tf_;  ///< the gesture cameras (3-D confirmation)

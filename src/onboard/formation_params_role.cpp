@@ -46,4 +46,27 @@ common::Result<bool> FormationParamsRole::receive(const formation::FormationPara
   return common::Result<bool>::ok(true);
 }
 
+ParamsOwnership::ParamsOwnership(const formation::FormationConfig& config, int uav_index, bool follow_leadership)
+    : config_(config), uav_index_(uav_index), follow_(follow_leadership) {
+  role_.emplace(config, uav_index);
+}
+
+ParamsOwnership::Change ParamsOwnership::setActing(bool acting, double t_s) {
+  if (!follow_ || acting == acting_) return Change::kNone;
+  acting_ = acting;
+  if (!acting_) return Change::kStopped;
+  formation::FormationConfig cfg = config_;
+  cfg.params = role_->params();
+  base_version_ = version();
+  role_.emplace(cfg, formation::kLeader);
+  took_over_s_ = t_s;
+  return Change::kStarted;
+}
+
+common::Result<bool> ParamsOwnership::receive(const formation::FormationParams& params, std::uint64_t version) {
+  if (owns()) return common::Result<bool>::ok(false);  // the owner's own parameters are the formation's
+  base_version_ = 0;                                    // the received version is the formation's
+  return role_->receive(params, version);
+}
+
 }  // namespace gesture_formation::onboard

@@ -59,4 +59,41 @@ class FormationParamsRole {
   formation::AssistanceLatch assistance_;
 };
 
+/// \brief Who owns the formation's parameters (the FormationPlanner's role): the leader by index,
+/// or — following the leadership (docs/safety.md §1.2, the FormationPlanner's ~leadership) — the UAV
+/// while it acts as leader. A UAV that starts acting takes the parameters it holds (the last ones
+/// received) over with their version and from then on applies only the commands sent since it took
+/// over (older ones were its predecessor's, whose effect the parameters carry); while it does not
+/// act it takes the parameters it receives. Thread safety: none (the caller's lock).
+class ParamsOwnership {
+ public:
+  enum class Change { kNone, kStarted, kStopped };
+
+  /// `config` must be valid (its loader checked it).
+  ParamsOwnership(const formation::FormationConfig& config, int uav_index, bool follow_leadership);
+
+  /// This UAV owns the parameters now.
+  bool owns() const { return follow_ ? acting_ : uav_index_ == formation::kLeader; }
+  /// \brief Following the leadership: this UAV's acting state (its own LeadershipState) at `t_s`.
+  /// Starting to act, the role becomes the leader's from the parameters held, version carried on.
+  Change setActing(bool acting, double t_s);
+  /// \brief A command sent at `stamp_s` is this UAV's to apply.
+  bool takesCommand(double stamp_s) const { return owns() && (!follow_ || stamp_s >= took_over_s_); }
+  /// \brief The owner's parameters as received; ignored (ok(false)) while this UAV owns them.
+  common::Result<bool> receive(const formation::FormationParams& params, std::uint64_t version);
+  /// The parameters' version: the one taken over plus this UAV's own applied commands.
+  std::uint64_t version() const { return base_version_ + role_->version(); }
+  double tookOverS() const { return took_over_s_; }
+  FormationParamsRole& role() { return *role_; }
+  const FormationParamsRole& role() const { return *role_; }
+
+ private:
+  formation::FormationConfig config_;
+  std::optional<FormationParamsRole> role_;
+  int uav_index_ = 0;
+  bool follow_ = false, acting_ = false;
+  std::uint64_t base_version_ = 0;  ///< the version taken over (0: the role's own)
+  double took_over_s_ = 0.0;        ///< when this UAV last started acting
+};
+
 }  // namespace gesture_formation::onboard

@@ -118,3 +118,41 @@ TEST(FormationParamsRoleTest, ReceivedAssistanceStatesDispatchByPhase) {
   EXPECT_DOUBLE_EQ(latch.state().acknowledged_s, 12.0);
   EXPECT_EQ(latch.state().acknowledged_by, "gcs");
 }
+
+// onboard::ParamsOwnership following the leadership (docs/safety.md §1.2): a follower that starts
+// acting takes over the parameters it received with their version, applies only commands sent since,
+// and stops owning (taking received parameters again) when it stops acting. By index it never changes.
+TEST(ParamsOwnershipTest, TheActingUavTakesTheParametersOverWithTheirVersion) {
+  formation::FormationConfig config;
+  onboard::ParamsOwnership own(config, 1, true);
+  EXPECT_FALSE(own.owns());
+  formation::FormationParams p = config.params;
+  p.followers[0].distance_m += 2.0;
+  ASSERT_TRUE(own.receive(p, 7));
+  EXPECT_EQ(own.version(), 7u);
+  EXPECT_FALSE(own.takesCommand(100.0)) << "not acting: no command is this UAV's";
+  EXPECT_EQ(own.setActing(false, 5.0), onboard::ParamsOwnership::Change::kNone);
+  ASSERT_EQ(own.setActing(true, 10.0), onboard::ParamsOwnership::Change::kStarted);
+  EXPECT_TRUE(own.owns());
+  EXPECT_TRUE(own.role().leader());
+  EXPECT_EQ(own.version(), 7u) << "the version taken over";
+  EXPECT_DOUBLE_EQ(own.role().params().uav(1).distance_m, p.followers[0].distance_m) << "the parameters taken over";
+  EXPECT_FALSE(own.takesCommand(9.9)) << "sent before the take-over: the predecessor's";
+  EXPECT_TRUE(own.takesCommand(10.0));
+  own.role().apply(common::Result<formation::FormationCommand>::ok(distancePlusOne(1)), "op #1", "operator", 10.5);
+  EXPECT_EQ(own.version(), 8u) << "counted on from the version taken over";
+  const auto ignored = own.receive(config.params, 99);
+  ASSERT_TRUE(ignored);
+  EXPECT_FALSE(*ignored) << "while owning, received parameters are ignored";
+  EXPECT_EQ(own.version(), 8u);
+  EXPECT_EQ(own.setActing(false, 20.0), onboard::ParamsOwnership::Change::kStopped);
+  EXPECT_FALSE(own.owns());
+  ASSERT_TRUE(own.receive(p, 9));
+  EXPECT_EQ(own.version(), 9u) << "the received version is the formation's";
+
+  onboard::ParamsOwnership by_index(config, 0, false);
+  EXPECT_TRUE(by_index.owns());
+  EXPECT_EQ(by_index.setActing(false, 1.0), onboard::ParamsOwnership::Change::kNone) << "by index the acting state is not used";
+  EXPECT_TRUE(by_index.owns());
+  EXPECT_TRUE(by_index.takesCommand(0.0));
+}
