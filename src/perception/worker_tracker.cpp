@@ -171,6 +171,7 @@ common::Result<cv::Rect2f> WorkerTracker::selectCandidate(int index) {
   const cv::Rect2f box = last_detections_[static_cast<std::size_t>(index)].box_px;
   const std::vector<Detection> round = last_detections_;
   const cv::Mat frame = last_detection_frame_;
+  const std::vector<cv::Mat> descriptors = round_descriptors_;
   reset();
   id_ = next_id_++;
   ++counters_.identities;
@@ -179,7 +180,7 @@ common::Result<cv::Rect2f> WorkerTracker::selectCandidate(int index) {
   box_ = box;
   tracking_ = initTracker(frame, box);
   frames_since_detection_ = 0;
-  if (clearOfOthers(round, index)) appearance_.update(appearance_.describe(frame, box));
+  if (clearOfOthers(round, index)) appearance_.update(descriptors[static_cast<std::size_t>(index)]);
   return common::Result<cv::Rect2f>::ok(box);
 }
 
@@ -218,11 +219,11 @@ common::Result<std::vector<Detection>> WorkerTracker::detectIn(const cv::Mat& fr
   return dets;
 }
 
-std::vector<char> WorkerTracker::lookAlikes(const cv::Mat& frame, const std::vector<Detection>& dets) const {
-  std::vector<char> alike(dets.size(), 1);
+std::vector<char> WorkerTracker::lookAlikes() const {
+  std::vector<char> alike(last_detections_.size(), 1);
   if (!appearance_.established()) return alike;
-  for (std::size_t i = 0; i < dets.size(); ++i) {
-    alike[i] = appearance_.accepts(appearance_.describe(frame, dets[i].box_px), config_.appearance.min_similarity) ? 1 : 0;
+  for (std::size_t i = 0; i < alike.size(); ++i) {
+    alike[i] = appearance_.accepts(descriptor(static_cast<int>(i)), config_.appearance.min_similarity) ? 1 : 0;
   }
   return alike;
 }
@@ -237,14 +238,14 @@ void WorkerTracker::take(const cv::Mat& frame, int idx, TrackStep& out) {
   out.found = true;
   out.source = BoxSource::kDetector;
   out.worker_detection = idx;
-  const cv::Mat d = appearance_.describe(frame, det);
+  const cv::Mat d = descriptor(idx);
   out.similarity = appearance_.established() ? appearance_.similarity(d) : -1.0;
   if (clearOfOthers(out.detections, idx)) appearance_.update(d);
 }
 
 bool WorkerTracker::associate(const cv::Mat& frame, const cv::Rect2f& predicted, bool have_pred, TrackStep& out) {
   const cv::Rect2f ref = have_pred ? predicted : box_;
-  const std::vector<char> alike = lookAlikes(frame, out.detections);
+  const std::vector<char> alike = lookAlikes();
   float best_iou = 0.0f;
   int idx = bestOverlap(ref, out.detections, best_iou, alike);
   if (best_iou < config_.associate_min_iou) idx = nearestWithin(ref, out.detections, config_.associate_gate, alike);
@@ -290,7 +291,7 @@ void WorkerTracker::acquire(const cv::Mat& frame, bool lost_now, TrackStep& out)
   }
   const bool remembering = (id_ >= 0 || hint_pending_) && frames_since_lost_ >= 0 &&
                            frames_since_lost_ <= config_.reacquire_frames;
-  const std::vector<char> alike = lookAlikes(frame, out.detections);
+  const std::vector<char> alike = lookAlikes();
   int idx = remembering ? nearestWithin(box_, out.detections, config_.reacquire_gate, alike) : -1;
   if (idx >= 0 && hint_pending_) {
     id_ = next_id_++;
@@ -299,7 +300,7 @@ void WorkerTracker::acquire(const cv::Mat& frame, bool lost_now, TrackStep& out)
   } else if (idx < 0 && !hint_pending_ && id_ >= 0 && appearance_.established()) {
     double best = config_.appearance.min_similarity;
     for (std::size_t i = 0; i < out.detections.size(); ++i) {
-      const double s = appearance_.similarity(appearance_.describe(frame, out.detections[i].box_px));
+      const double s = appearance_.similarity(descriptor(static_cast<int>(i)));
       if (s >= best) {
         best = s;
         idx = static_cast<int>(i);
@@ -410,6 +411,10 @@ common::Result<TrackStep> WorkerTracker::step(const cv::Mat& frame) {
   frames_since_detection_ = 0;
   last_detections_ = out.detections;
   last_detection_frame_ = frame.clone();  // selectCandidate starts the chosen person's track on it
+  round_descriptors_.clear();            // each person's colours, once per round
+  for (const Detection& d : out.detections) {
+    round_descriptors_.push_back(config_.appearance.enabled != 0 ? appearance_.describe(frame, d.box_px) : cv::Mat());
+  }
 
   // 3. association with the live track, else (re)acquisition
   const bool lost_now = tracking_ && associate(frame, predicted, have_pred, out);

@@ -157,8 +157,11 @@ class WorkerTracker {
   bool initTracker(const cv::Mat& frame, const cv::Rect2f& box);
   /// Detections in `window` of `frame`, boxes in frame pixels.
   common::Result<std::vector<Detection>> detectIn(const cv::Mat& frame, const cv::Rect& window);
-  /// Which of `dets` may be the worker by appearance (1) — all when the model is not established.
-  std::vector<char> lookAlikes(const cv::Mat& frame, const std::vector<Detection>& dets) const;
+  /// Which of the last round's detections may be the worker by appearance (1) — all when the model
+  /// is not established.
+  std::vector<char> lookAlikes() const;
+  /// The appearance descriptor of the last round's detection `i` (empty with appearance off).
+  const cv::Mat& descriptor(int i) const { return round_descriptors_[static_cast<std::size_t>(i)]; }
   /// Associates this round's detections with the live track; true when the track was lost now.
   bool associate(const cv::Mat& frame, const cv::Rect2f& predicted, bool have_pred, TrackStep& out);
   /// Starts or resumes a track from this round's detections when none is live.
@@ -180,6 +183,7 @@ class WorkerTracker {
   bool locked_ = false;          ///< the operator chose the worker: never a new person by itself
   bool announce_new_id_ = false; ///< selectCandidate started a new id: the next step says so
   cv::Mat last_detection_frame_; ///< the frame of last_detections_
+  std::vector<cv::Mat> round_descriptors_;  ///< appearance descriptors of last_detections_, in order
   AppearanceModel appearance_;
   std::vector<Detection> last_detections_;
   cv::Size frame_size_;
