@@ -49,11 +49,12 @@ def max_acting(iv):
 
 
 def requests_after(events_path, t0):
-    """(applied, total) of the requests issued at or after t0 (operator and gestures)."""
+    """(applied, total) of the requests issued at or after t0 (the operator's and the recognised gestures';
+    rows of source worker are performances no camera recognised, not requests)."""
     applied = total = 0
     with open(events_path) as f:
         for row in csv.DictReader(f):
-            if float(row["t"]) >= t0:
+            if float(row["t"]) >= t0 and row["source"] != "worker":
                 total += 1
                 applied += row["status"] == "applied"
     return applied, total
