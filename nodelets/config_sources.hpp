@@ -29,6 +29,7 @@ struct WorldMap {
   std::shared_ptr<const planning::DistanceField> field;
   std::shared_ptr<const planning::PrimitiveSet> solids;
   double ground_height_m = -1e9;  ///< −1e9: the scenario has no ground
+  planning::MapConfig grid;       ///< the map's resolution and bounds (a live map's grid)
 };
 
 inline bool loadWorldMap(const std::string& scenario_file, ParamLoader& params, WorldMap& out) {
@@ -47,6 +48,7 @@ inline bool loadWorldMap(const std::string& scenario_file, ParamLoader& params, 
   out.field = std::make_shared<const planning::DistanceField>(*out.map);
   out.solids = std::make_shared<const planning::PrimitiveSet>(sc->primitives());
   out.ground_height_m = sc->ground.enabled ? sc->ground.height_m : -1e9;
+  out.grid = sc->map;
   return true;
 }
 

@@ -6,25 +6,19 @@
 // `fallback`: every other UAV plans around it). The leader's instance owns the formation's parameters
 // (onboard::ParamsOwnership; commands in on formation_command_in, parameters out on formation_params_out).
 // With ~leadership true (optional, default false) the role, the slot flown and whose plan is the leader's
-// follow this UAV's own leadership_state_in (LeadershipState; docs/safety.md §1.2).
+// follow this UAV's own leadership_state_in (LeadershipState; docs/safety.md §1.2). With ~mapping_config
+// it plans on a live map of its depth camera (planner_live_map.hpp: depth_in, depth_info_in).
 //
-// Topics: odometry_in (nav_msgs/Odometry, orientation = camera axis, docs/ros.md),
-//   worker_state_in (WorkerState: the leader's estimator, or the leader's share over LCM),
-//   plans_in (PlannedTrajectory of other UAVs), formation_params_in (followers),
-//   formation_command_in (leader), wind_estimate_in (geometry_msgs/TwistWithCovarianceStamped in
-//   world_frame, twist.linear = the wind, mavros `wind_estimation`; optional, docs/safety.md §4.7)
-//   abort_in (AbortCommand: every copy, from the LcmBridge and on the leader the GestureCommander)
-//   → plan_out (PlannedTrajectory; mode track | hold | search | abort and its reason), trajectory_out
-//   (trajectory_msgs/MultiDOFJointTrajectory), formation_params_out (leader, latched), abort_state_out
-//   (AbortState, latched: on acceptance and at every replanning while aborting; docs/safety.md §2.8),
-//   command_ack_out (leader: CommandAck per command handled, to the operator; docs/safety.md §2.9);
-//   leader: assistance_in (AssistanceState: the worker's request, the operator's acknowledgement) →
-//   assistance_state_out (latched; while requested the worker's gesture commands are refused, §2.10).
+// Topics (docs/ros.md "FormationPlanner"): odometry_in (nav_msgs/Odometry, orientation = camera axis),
+//   worker_state_in (WorkerState), plans_in (PlannedTrajectory of other UAVs), formation_params_in,
+//   formation_command_in, wind_estimate_in (TwistWithCovarianceStamped, optional, safety.md §4.7),
+//   abort_in (AbortCommand: every copy), assistance_in → plan_out (PlannedTrajectory: mode track | hold
+//   | search | abort and its reason), trajectory_out (MultiDOFJointTrajectory), formation_params_out
+//   (latched), abort_state_out (latched, §2.8), command_ack_out (§2.9), assistance_state_out (§2.10).
 // Parameters (all required unless noted): ~uav_index, ~uav_count, ~world_frame, ~scenario_file (the
-//   map), ~params_rate_hz, ~max_wind_estimate_age_s, and loadPlannerSettings' (config_sources.hpp):
-//   ~mission_file (optional; simulation: the mission's settings, with the optional ~faults_file merged)
-//   or ~replanning_period_s, ~horizon_dt_s, ~horizon_steps, ~max_share_age_s, ~max_worker_age_s,
-//   ~max_plan_age_s, ~avoid_all_plans, ~brake_accel_mps2, ~search_*, ~abort (a map), ~formation_config, ~planner_config.
+//   map), ~params_rate_hz, ~max_wind_estimate_age_s, loadPlannerSettings' (config_sources.hpp:
+//   ~mission_file, or ~replanning_period_s, ~horizon_*, ~max_*_age_s, ~avoid_all_plans, ~brake_accel_mps2,
+//   ~search_*, ~abort, ~formation_config, ~planner_config) and the live map's (~mapping_*).
 #include <cmath>
 #include <mutex>
 #include <optional>
@@ -38,6 +32,7 @@
 #include "conversions.hpp"
 #include "diagnostics.hpp"
 #include "planner_health.hpp"
+#include "planner_live_map.hpp"
 #include "gesture_formation/LeadershipState.h"
 #include "gesture_formation/onboard/formation_params_role.hpp"
 #include "gesture_formation/onboard/frame_check.hpp"
@@ -76,6 +71,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     }
     if (uav_index_ >= uav_count_) params.addError("uav_index: must be < uav_count");
     loadWorldMap(scenario_file, params, world_);
+    live_map_.setUp(nh, getPrivateNodeHandle(), params, world_, world_frame_);  // ~mapping_config: planner_live_map.hpp
     if (!params.ok()) {
       NODELET_ERROR_STREAM("FormationPlanner refuses to start; fix these parameters:\n" << params.report());
       return;
@@ -87,7 +83,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     rc.worker_heading = fcfg.worker_heading;
     step_ = std::make_unique<planning::ReplanStep>(rc,
                                                    std::make_unique<planning::UavPlannerAdapter>(std::make_unique<planning::UavPlanner>(
-                                                       settings.planner, world_.map, world_.field)),
+                                                       settings.planner, world_.map, world_.field, live_map_.seen())),
                                                    retreatSpace(world_));
     received_.resize(static_cast<std::size_t>(uav_count_));
     plan_pub_ = nh.advertise<gesture_formation::PlannedTrajectory>("plan_out", 5);
@@ -234,6 +230,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
 
   void replan(double t) {
     if (!odom_) return;
+    const auto map_lock = live_map_.readLock();  // a live map's updates wait for this replanning
     // The replanning step gfctl simulate's UAVs run too (planning::ReplanStep): freshness and
     // hold, listen before moving, the worker's extrapolation, hold / search, the request.
     std::optional<planning::WorkerKnowledge> worker;
@@ -271,7 +268,9 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   /// This UAV's planner on /diagnostics (planning::ReplanHealth).
   std::vector<diagnostic_msgs::DiagnosticStatus> health(double since_s) {
     std::lock_guard<std::mutex> lock(mutex_);
-    return {plannerHealth(health_.report(ros::Time::now().toSec(), period_s_), uav_index_, since_s)};  // ROS (sim) time
+    auto status = plannerHealth(health_.report(ros::Time::now().toSec(), period_s_), uav_index_, since_s);  // ROS (sim) time
+    live_map_.report(status, since_s);
+    return {status};
   }
 
   std::mutex mutex_;
@@ -284,7 +283,8 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   std::optional<onboard::ParamsOwnership> own_;  ///< the parameters' role, following the leadership or the index
   bool leadership_ = false;  ///< ~leadership: the parameters' role follows this UAV's leadership_state
   std::string mode_ = "track";             ///< track | hold | search | abort (logged on change)
-  WorldMap world_;  ///< the map and field the planner and the abort's goal search use
+  WorldMap world_;  ///< the map and field the planner and the abort's goal search use (live: live_map_'s)
+  PlannerLiveMap live_map_;  ///< ~mapping_config: the depth camera's live map
   std::unique_ptr<planning::ReplanStep> step_;  ///< planner, hold / search, listening (shared with gfctl simulate)
   std::optional<planning::UavKinematicState> odom_;
   std::optional<gesture_formation::WorkerState> worker_;

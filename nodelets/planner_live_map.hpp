@@ -1,0 +1,170 @@
+#pragma once
+// The FormationPlanner's live map (docs/mapping.md "Through ROS"): with ~mapping_config (a YAML of
+// mapping::MappingConfig's keys, config/mapping.yaml) the planner plans on a mapping::LiveMap fed by
+// this UAV's aligned depth images (depth_in: sensor_msgs/Image 32FC1 metres or 16UC1 millimetres,
+// REP 118; depth_info_in: its CameraInfo — the pinhole of the rectified image; the optical frame's
+// pose from tf at the image's stamp), fused with the scenario's map as the prior (~mapping_prior,
+// default true). Frames are integrated at most ~mapping_rate_hz on the depth callback's thread
+// (ROS serialises one subscription's callbacks: never two integrate() at once); the planner holds
+// readLock() for a whole replanning. Without ~mapping_config nothing is subscribed and the planner
+// plans on the scenario's map, as before. Thread safety: the counters under their own mutex.
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+
+#include <diagnostic_msgs/DiagnosticStatus.h>
+#include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+
+#include "config_sources.hpp"
+#include "conversions.hpp"
+#include "gesture_formation/common/config_reader.hpp"
+#include "gesture_formation/mapping/live_map.hpp"
+#include "param_loader.hpp"
+
+namespace gesture_formation::nodelets {
+
+class PlannerLiveMap {
+ public:
+  /// load(), then (when configured and every parameter so far is fine) start(); problems into `params`.
+  void setUp(ros::NodeHandle& nh, ros::NodeHandle& pnh, ParamLoader& params, WorldMap& world, const std::string& world_frame) {
+    if (!load(pnh, params) || !params.ok()) return;
+    if (const auto why = start(nh, world, world_frame); !why.empty()) params.addError(why);
+  }
+
+  /// Reads ~mapping_config (optional), ~mapping_rate_hz, ~mapping_prior, ~tf_timeout_s; every
+  /// problem into `params`. True when a live map is configured.
+  bool load(ros::NodeHandle& pnh, ParamLoader& params) {
+    params.loadOptional("mapping_config", file_, "");
+    if (file_.empty()) return false;
+    params.load("mapping_rate_hz", rate_hz_, 0.1, 30.0);
+    params.loadOptional("mapping_prior", prior_, true);
+    pnh.param("mapping_tf_timeout_s", tf_timeout_s_, 0.1);
+    common::ConfigReader r = common::ConfigReader::fromFile(file_, common::ConfigReader::MissingKeys::kError);
+    config_ = mapping::readMappingConfig(r);
+    for (const auto& e : r.errors()) params.addError("mapping_config: " + file_ + ": " + e);
+    for (const auto& k : r.unusedKeys()) params.addError("mapping_config: " + file_ + ": unknown key " + k);
+    if (config_.share.enabled) params.addError("mapping_config: " + file_ + ": share.enabled true: map sharing is not relayed through ROS yet");
+    return true;
+  }
+
+  /// Creates the live map over `world`'s grid (its map as the prior unless ~mapping_prior false)
+  /// and points `world`'s map and field at the live ones. Empty on success, else the problem.
+  std::string start(ros::NodeHandle& nh, WorldMap& world, const std::string& world_frame) {
+    auto live = mapping::LiveMap::create(config_, world.grid, prior_ ? world.map : nullptr);
+    if (!live) return "mapping_config: " + live.reason();
+    live_ = std::move(*live);
+    world.map = live_->map();
+    world.field = live_->field();
+    world_frame_ = world_frame;
+    tf_listener_ = std::make_unique<tf2_ros::TransformListener>(tf_buffer_);
+    info_sub_ = nh.subscribe<sensor_msgs::CameraInfo>("depth_info_in", 2, [this](const sensor_msgs::CameraInfo::ConstPtr& m) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      info_ = *m;
+    });
+    depth_sub_ = nh.subscribe("depth_in", 2, &PlannerLiveMap::onDepth, this);
+    return "";
+  }
+
+  bool enabled() const { return live_ != nullptr; }
+  const mapping::LiveMap& live() const { return *live_; }
+  std::shared_ptr<const planning::SeenSpace> seen() const { return live_ ? live_->seen() : nullptr; }
+  /// For a whole replanning (no lock without a live map).
+  std::shared_lock<std::shared_mutex> readLock() const {
+    return live_ ? live_->readLock() : std::shared_lock<std::shared_mutex>();
+  }
+
+  /// Adds the live map's counts since the last report to the planner's /diagnostics status (WARN
+  /// when frames were refused); nothing without a live map.
+  void report(diagnostic_msgs::DiagnosticStatus& st, double since_s) {
+    if (!live_) return;
+    Counts c;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      std::swap(c, counts_);
+    }
+    const auto kv = [&st](const std::string& k, const std::string& v) {
+      diagnostic_msgs::KeyValue x;
+      x.key = k;
+      x.value = v;
+      st.values.push_back(x);
+    };
+    kv("live_map_frames_per_s", std::to_string(since_s > 0.0 ? c.frames / since_s : 0.0));
+    kv("live_map_changes", std::to_string(c.map_changes));
+    kv("live_map_frame_ms_mean", std::to_string(c.frames > 0 ? c.total_ms / c.frames : 0.0));
+    kv("live_map_refused", std::to_string(c.refused));
+    if (c.refused == 0) return;
+    st.level = std::max<std::uint8_t>(st.level, diagnostic_msgs::DiagnosticStatus::WARN);
+    st.message += (st.message.empty() ? "" : "; ") + std::to_string(c.refused) + " depth frame(s) refused: " + c.last_refusal;
+  }
+
+ private:
+  void refuse(const std::string& why) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++counts_.refused;
+    counts_.last_refusal = why;
+  }
+
+  void onDepth(const sensor_msgs::Image::ConstPtr& m) {
+    const double t = m->header.stamp.toSec();
+    if (t < next_frame_s_) return;  // at most mapping_rate_hz
+    next_frame_s_ = t + 1.0 / rate_hz_;
+    mapping::DepthFrame frame;
+    frame.stamp_s = t;
+    std::optional<sensor_msgs::CameraInfo> info;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      info = info_;
+    }
+    if (!info) return refuse("no CameraInfo on depth_info_in yet");
+    if (info->width != m->width || info->height != m->height) return refuse("depth image size differs from its CameraInfo");
+    frame.intrinsics = {info->K[0], info->K[4], info->K[2], info->K[5]};
+    auto depth = toDepth(*m);
+    if (!depth) return refuse("depth_in: " + depth.reason());
+    if (depth->type() == CV_16UC1) {  // millimetres; 0: no return (REP 118) -> NaN
+      depth->convertTo(frame.depth_m, CV_32FC1, 1e-3);
+      frame.depth_m.setTo(std::nanf(""), *depth == 0);
+    } else {
+      frame.depth_m = *depth;
+    }
+    try {
+      const auto T = tf_buffer_.lookupTransform(world_frame_, m->header.frame_id, m->header.stamp, ros::Duration(tf_timeout_s_));
+      const auto& q = T.transform.rotation;
+      const auto& p = T.transform.translation;
+      frame.T_world_camera = Eigen::Translation3d(p.x, p.y, p.z) * Eigen::Quaterniond(q.w, q.x, q.y, q.z);
+    } catch (const tf2::TransformException& e) {
+      return refuse(std::string("depth frame not used: ") + e.what());
+    }
+    const auto u = live_->integrate(frame);
+    if (!u) return refuse("depth frame refused: " + u.reason());
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++counts_.frames;
+    counts_.map_changes += u->map_changes;
+    counts_.total_ms += u->total_ms;
+  }
+
+  std::string file_, world_frame_;
+  double rate_hz_ = 5.0, tf_timeout_s_ = 0.1, next_frame_s_ = -1e18;
+  bool prior_ = true;
+  mapping::MappingConfig config_;
+  std::unique_ptr<mapping::LiveMap> live_;
+  std::mutex mutex_;
+  std::optional<sensor_msgs::CameraInfo> info_;
+  struct Counts {
+    int frames = 0, refused = 0, map_changes = 0;
+    double total_ms = 0.0;
+    std::string last_refusal;
+  };
+  Counts counts_;
+  tf2_ros::Buffer tf_buffer_;
+  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+  ros::Subscriber info_sub_, depth_sub_;
+};
+
+}  // namespace gesture_formation::nodelets
