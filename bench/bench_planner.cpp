@@ -11,7 +11,8 @@
 //      replanning's stage timings, the slowest 1 % and what they did (the tails: issue 38).
 //   gf_bench_planner --mission [--seed N] [--fault-profile NAME] [--slowest K] [--qp-instances]
 //   (section 4 only; --qp-instances: the slow replannings' QPs solved again alone, each formulation,
-//   median of 3 solves; --qp-repeats R: of R, e.g. to profile them)
+//   median of 3 solves; --qp-repeats R: of R, e.g. to profile them; --results FILE.md: also a dated
+//   page with the output, e.g. docs/results/planning_tails.md)
 // Figures and decisions: docs/planning.md §10.
 #include <algorithm>
 #include <chrono>
@@ -69,10 +70,12 @@ struct Stats {
   double max() const { return v.empty() ? std::nan("") : *std::max_element(v.begin(), v.end()); }
 };
 
-void row(const char* name, const Stats& s, const char* unit = "ms") {
-  std::printf("  %-34s median %9.3f  p99 %9.3f  max %9.3f %s  (n=%zu)\n", name, s.median(), s.quantile(0.99), s.max(), unit,
-              s.v.size());
+void row(std::FILE* out, const char* name, const Stats& s, const char* unit = "ms") {
+  std::fprintf(out, "  %-34s median %9.3f  p99 %9.3f  max %9.3f %s  (n=%zu)\n", name, s.median(), s.quantile(0.99), s.max(),
+               unit, s.v.size());
 }
+
+void row(const char* name, const Stats& s, const char* unit = "ms") { row(stdout, name, s, unit); }
 
 std::string source(const std::string& rel) {
   const char* src = std::getenv("GF_SOURCE_DIR");
@@ -412,7 +415,7 @@ class RecordingPlanner final : public Planner {
 
 /// The slow replannings' QPs solved again, alone: the product's solve (sparse, warm) beside the
 /// alternatives, CPU time (median of `repeats`).
-void benchQpInstances(const std::vector<QpInstance>& instances, int repeats) {
+void benchQpInstances(std::FILE* out, const std::vector<QpInstance>& instances, int repeats) {
   if (instances.empty()) return;
   struct Variant {
     const char* name;
@@ -422,7 +425,7 @@ void benchQpInstances(const std::vector<QpInstance>& instances, int repeats) {
   const Variant variants[] = {{"sparse, warm (the product)", TrajectoryQpProblem::Formulation::kSparse, true},
                               {"sparse, cold", TrajectoryQpProblem::Formulation::kSparse, false},
                               {"condensed dense, warm", TrajectoryQpProblem::Formulation::kCondensed, true}};
-  std::printf("  the QPs of the %zu replannings over %.0f ms CPU, solved again alone (CPU ms, median of %d):\n",
+  std::fprintf(out, "  the QPs of the %zu replannings over %.0f ms CPU, solved again alone (CPU ms, median of %d):\n",
               instances.size(), RecordingPlanner::kInstanceCpuMs, repeats);
   const TrajectoryQp qp;
   std::vector<double> product_objective(instances.size(), NAN);
@@ -450,10 +453,10 @@ void benchQpInstances(const std::vector<QpInstance>& instances, int repeats) {
         worst_rel = std::max(worst_rel, std::abs(sol.objective - product_objective[i]) / std::max(1.0, std::abs(product_objective[i])));
       }
     }
-    std::printf("    %-28s solved %d/%zu, worst objective difference to the product %.1e (relative)\n", v.name, solved,
+    std::fprintf(out, "    %-28s solved %d/%zu, worst objective difference to the product %.1e (relative)\n", v.name, solved,
                 instances.size(), worst_rel);
-    row("      time", t);
-    row("      iterations", it, "");
+    row(out, "      time", t);
+    row(out, "      iterations", it, "");
   }
 }
 
@@ -504,17 +507,17 @@ std::optional<MissionSetup> loadMission(const std::string& fault_profile) {
   return s;
 }
 
-void printSlowest(const std::vector<ReplanRecord>& recs, int count) {
+void printSlowest(std::FILE* out, const std::vector<ReplanRecord>& recs, int count) {
   std::vector<const ReplanRecord*> by_time;
   for (const auto& r : recs) by_time.push_back(&r);
   std::sort(by_time.begin(), by_time.end(), [](const auto* a, const auto* b) { return a->cpu_ms > b->cpu_ms; });
-  std::printf("  the %d slowest by CPU time (ms; planes: corridor planes, cons: QP rows, it: ProxQP iterations):\n", count);
-  std::printf("    %8s %3s %9s %8s %8s %7s %8s %8s %7s %7s %6s %5s %6s %5s %7s  %s\n", "t_s", "uav", "status", "cpu", "wall", "path",
+  std::fprintf(out, "  the %d slowest by CPU time (ms; planes: corridor planes, cons: QP rows, it: ProxQP iterations):\n", count);
+  std::fprintf(out, "    %8s %3s %9s %8s %8s %7s %8s %8s %7s %7s %6s %5s %6s %5s %7s  %s\n", "t_s", "uav", "status", "cpu", "wall", "path",
               "corridor", "qp", "camera", "verify", "cons", "it", "corr", "A*", "expand", "reason");
   for (int i = 0; i < count && i < static_cast<int>(by_time.size()); ++i) {
     const ReplanRecord& r = *by_time[static_cast<std::size_t>(i)];
     const auto& T = r.timings;
-    std::printf("    %8.2f %3d %9s %8.2f %8.2f %7.2f %8.2f %8.2f %7.3f %7.2f %6d %5d %2d/%-3d %d/%-3d %7d  %.70s\n", r.t_s, r.uav,
+    std::fprintf(out, "    %8.2f %3d %9s %8.2f %8.2f %7.2f %8.2f %8.2f %7.3f %7.2f %6d %5d %2d/%-3d %d/%-3d %7d  %.70s\n", r.t_s, r.uav,
                 r.status == PlanStatus::kOptimized ? "optimized" : (r.status == PlanStatus::kFallbackPrevious ? "previous" : "brake"),
                 r.cpu_ms, T.total_ms, T.path_ms, T.corridor_ms, T.qp_ms, T.heading_ms, T.verify_ms, r.qp_constraints,
                 r.qp_iterations, r.corridors, r.corridor_planes, r.searches_failed, r.path_searches, r.expansions, r.reason.c_str());
@@ -522,7 +525,7 @@ void printSlowest(const std::vector<ReplanRecord>& recs, int count) {
 }
 
 /// The slowest 1 % by CPU time, beside all replannings: where their time goes.
-void printTail(const std::vector<ReplanRecord>& recs) {
+void printTail(std::FILE* out, const std::vector<ReplanRecord>& recs) {
   std::vector<ReplanRecord> sorted = recs;
   std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.cpu_ms > b.cpu_ms; });
   const std::size_t n_tail = std::max<std::size_t>(1, sorted.size() / 100);
@@ -539,46 +542,34 @@ void printTail(const std::vector<ReplanRecord>& recs) {
     planes_tail.add(sorted[i].corridor_planes);
     failed_tail += sorted[i].status == PlanStatus::kOptimized ? 0 : 1;
   }
-  std::printf("  slowest 1 %% (%zu replannings, %d failed): wall-time share path %.1f %%, corridors %.1f %%, QP %.1f %%, "
+  std::fprintf(out, "  slowest 1 %% (%zu replannings, %d failed): wall-time share path %.1f %%, corridors %.1f %%, QP %.1f %%, "
               "camera %.1f %%, verification+fallback %.1f %%\n",
               n_tail, failed_tail, share(sorted, n_tail, &StageTimings::path_ms), share(sorted, n_tail, &StageTimings::corridor_ms),
               share(sorted, n_tail, &StageTimings::qp_ms), share(sorted, n_tail, &StageTimings::heading_ms),
               share(sorted, n_tail, &StageTimings::verify_ms));
-  std::printf("    QP rows median %.0f (all: see below), iterations median %.0f max %.0f, corridor planes median %.0f max %.0f\n",
+  std::fprintf(out, "    QP rows median %.0f (all: see below), iterations median %.0f max %.0f, corridor planes median %.0f max %.0f\n",
               cons_tail.median(), it_tail.median(), it_tail.max(), planes_tail.median(), planes_tail.max());
 }
 
-int benchMission(std::uint64_t seed, const std::string& fault_profile, int slowest, int qp_repeats) {
-  const bool qp_instances = qp_repeats > 0;
-  const std::string load_before = loadAverage();
-  auto setup = loadMission(fault_profile);
-  if (!setup) return 2;
-  MissionSetup& S = *setup;
-  sim::MissionWorld world;
-  world.map = S.map.get();
-  world.field = S.field.get();
-  world.ground_height_m = S.scenario.ground.enabled ? S.scenario.ground.height_m : -1e9;
-  world.solids = &S.solids;
-  std::vector<ReplanRecord> recs;
+struct MissionRecord {
+  sim::MissionMetrics metrics;
+  std::vector<ReplanRecord> replannings;
   std::vector<QpInstance> instances;
-  const sim::PlannerFactory product = sim::uavPlannerFactory(S.mission.planner, S.map, S.field);
-  const sim::PlannerFactory recording = [&](int i) -> std::unique_ptr<sim::MissionPlanner> {
-    return std::make_unique<RecordingPlanner>(product(i), i, &recs, qp_instances ? &instances : nullptr);
-  };
-  const auto out = sim::runMission(S.mission, world, recording, S.classifier.get(), seed);
-  if (!out) {
-    std::fprintf(stderr, "mission: %s\n", out.reason().c_str());
-    return 2;
-  }
-  const auto& m = out->metrics;
-  std::printf("4. power-tower mission, seed %llu%s%s (load average %s before, %s after; the lead's quiet anchor, seed 1 "
-              "nominal, main before issue 38: planning p99 20.5-21.7 ms, max 130-163 ms; target p99 <= 20, max <= 50 ms):\n",
-              static_cast<unsigned long long>(seed), fault_profile.empty() ? "" : ", faults ", fault_profile.c_str(),
-              load_before.c_str(), loadAverage().c_str());
-  std::printf("  mission: collisions %d, min obstacle %.3f m, min mutual %.3f m, requests %d/%d, planning median %.2f p99 %.2f "
-              "max %.2f ms (wall), fallback previous %d, brake %d of %d\n",
-              m.collisions, m.min_obstacle_distance_m, m.min_mutual_distance_m, m.requests_applied, m.requests_total,
-              m.planning_ms_median, m.planning_ms_p99, m.planning_ms_max, m.plans_fallback_previous, m.plans_fallback_brake, m.plans);
+  std::string load_before, load_after;
+};
+
+void printMission(std::FILE* out, const MissionRecord& M, std::uint64_t seed, const std::string& fault_profile, int slowest,
+                  int qp_repeats) {
+  const auto& m = M.metrics;
+  const auto& recs = M.replannings;
+  std::fprintf(out, "4. power-tower mission, seed %llu%s%s (load average %s before, %s after; the lead's quiet anchor, seed 1 "
+               "nominal, main before issue 38: planning p99 20.5-21.7 ms, max 130-163 ms; target p99 <= 20, max <= 50 ms):\n",
+               static_cast<unsigned long long>(seed), fault_profile.empty() ? "" : ", faults ", fault_profile.c_str(),
+               M.load_before.c_str(), M.load_after.c_str());
+  std::fprintf(out, "  mission: collisions %d, min obstacle %.3f m, min mutual %.3f m, requests %d/%d, planning median %.2f p99 "
+               "%.2f max %.2f ms (wall), fallback previous %d, brake %d of %d\n",
+               m.collisions, m.min_obstacle_distance_m, m.min_mutual_distance_m, m.requests_applied, m.requests_total,
+               m.planning_ms_median, m.planning_ms_p99, m.planning_ms_max, m.plans_fallback_previous, m.plans_fallback_brake, m.plans);
   Stats cpu, wall, path, corridor, qp, heading, verify, cons, iters, planes;
   int over[3] = {0, 0, 0};
   for (const auto& r : recs) {
@@ -596,20 +587,74 @@ int benchMission(std::uint64_t seed, const std::string& fault_profile, int slowe
     over[1] += r.cpu_ms > 20.0 ? 1 : 0;
     over[2] += r.cpu_ms > 50.0 ? 1 : 0;
   }
-  row("TOTAL one replanning, CPU time", cpu);
-  row("TOTAL one replanning, wall", wall);
-  row("stage 2 path (projection, A*)", path);
-  row("stage 3 corridors", corridor);
-  row("stage 3 QP (assembly + ProxQP)", qp);
-  row("camera heading/pitch", heading);
-  row("verification (+ fallback)", verify);
-  row("QP constraints (eq + ineq)", cons, "");
-  row("QP iterations", iters, "");
-  row("corridor planes per replanning", planes, "");
-  std::printf("  replannings over 10 / 20 / 50 ms CPU: %d / %d / %d of %zu\n", over[0], over[1], over[2], recs.size());
-  printTail(recs);
-  printSlowest(recs, slowest);
-  benchQpInstances(instances, qp_repeats);
+  row(out, "TOTAL one replanning, CPU time", cpu);
+  row(out, "TOTAL one replanning, wall", wall);
+  row(out, "stage 2 path (projection, A*)", path);
+  row(out, "stage 3 corridors", corridor);
+  row(out, "stage 3 QP (assembly + ProxQP)", qp);
+  row(out, "camera heading/pitch", heading);
+  row(out, "verification (+ fallback)", verify);
+  row(out, "QP constraints (eq + ineq)", cons, "");
+  row(out, "QP iterations", iters, "");
+  row(out, "corridor planes per replanning", planes, "");
+  std::fprintf(out, "  replannings over 10 / 20 / 50 ms CPU: %d / %d / %d of %zu\n", over[0], over[1], over[2], recs.size());
+  printTail(out, recs);
+  printSlowest(out, recs, slowest);
+  if (qp_repeats > 0) benchQpInstances(out, M.instances, qp_repeats);
+}
+
+std::string utcNow() {
+  const std::time_t now = std::time(nullptr);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
+  return buf;
+}
+
+/// A dated results page: the command and its output verbatim (docs/results/, written only by this).
+bool writeResultsPage(const std::string& path, const MissionRecord& M, std::uint64_t seed, const std::string& fault_profile,
+                      int slowest, int qp_repeats, const std::string& command) {
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (f == nullptr) return false;
+  std::fprintf(f, "# Results: replanning tails in the power-tower mission (issue 38 item 1)\n\n"
+                  "Written by `%s` on %s (%u hardware threads; load average %s before, %s after: wall times on a\n"
+                  "loaded machine are inflated, the CPU times per replanning much less). The planner is the product's\n"
+                  "(`sim::uavPlannerFactory`), run in `gfctl simulate`'s closed loop with the same seed and configs;\n"
+                  "CPU time is the planner thread's (`CLOCK_THREAD_CPUTIME_ID`) around each `plan()`. What the\n"
+                  "figures mean: [planning.md](../planning.md) §10.\n\n```\n",
+               command.c_str(), utcNow().c_str(), std::thread::hardware_concurrency(), M.load_before.c_str(), M.load_after.c_str());
+  printMission(f, M, seed, fault_profile, slowest, qp_repeats);
+  std::fprintf(f, "```\n");
+  return std::fclose(f) == 0;
+}
+
+int benchMission(std::uint64_t seed, const std::string& fault_profile, int slowest, int qp_repeats, const std::string& results,
+                 const std::string& command) {
+  MissionRecord M;
+  M.load_before = loadAverage();
+  auto setup = loadMission(fault_profile);
+  if (!setup) return 2;
+  MissionSetup& S = *setup;
+  sim::MissionWorld world;
+  world.map = S.map.get();
+  world.field = S.field.get();
+  world.ground_height_m = S.scenario.ground.enabled ? S.scenario.ground.height_m : -1e9;
+  world.solids = &S.solids;
+  const sim::PlannerFactory product = sim::uavPlannerFactory(S.mission.planner, S.map, S.field);
+  const sim::PlannerFactory recording = [&](int i) -> std::unique_ptr<sim::MissionPlanner> {
+    return std::make_unique<RecordingPlanner>(product(i), i, &M.replannings, qp_repeats > 0 ? &M.instances : nullptr);
+  };
+  const auto out = sim::runMission(S.mission, world, recording, S.classifier.get(), seed);
+  if (!out) {
+    std::fprintf(stderr, "mission: %s\n", out.reason().c_str());
+    return 2;
+  }
+  M.metrics = out->metrics;
+  M.load_after = loadAverage();
+  printMission(stdout, M, seed, fault_profile, slowest, qp_repeats);
+  if (!results.empty() && !writeResultsPage(results, M, seed, fault_profile, slowest, qp_repeats, command)) {
+    std::fprintf(stderr, "gf_bench_planner: cannot write %s\n", results.c_str());
+    return 2;
+  }
   return 0;
 }
 
@@ -619,8 +664,10 @@ int main(int argc, char** argv) {
   int runs = 200, slowest = 20;
   bool mission = false;
   int qp_repeats = 0;
+  std::string results, command = "gf_bench_planner";
   std::uint64_t seed = 1;
   std::string fault_profile;
+  for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
   for (int i = 1; i < argc; ++i) {
     const bool has_value = i + 1 < argc;
     if (std::strcmp(argv[i], "--mission") == 0) {
@@ -635,15 +682,17 @@ int main(int argc, char** argv) {
       seed = std::strtoull(argv[++i], nullptr, 10);
     } else if (std::strcmp(argv[i], "--slowest") == 0 && has_value) {
       slowest = std::max(0, std::atoi(argv[++i]));
+    } else if (std::strcmp(argv[i], "--results") == 0 && has_value) {
+      results = argv[++i];
     } else if (std::strcmp(argv[i], "--fault-profile") == 0 && has_value) {
       fault_profile = argv[++i];
     } else {
       std::fprintf(stderr, "gf_bench_planner: unknown or incomplete option '%s' (--runs N | --mission [--seed N] "
-                           "[--fault-profile NAME] [--slowest K] [--qp-instances | --qp-repeats R])\n", argv[i]);
+                           "[--fault-profile NAME] [--slowest K] [--qp-instances | --qp-repeats R] [--results FILE.md])\n", argv[i]);
       return 2;
     }
   }
-  if (mission) return benchMission(seed, fault_profile, slowest, qp_repeats);
+  if (mission) return benchMission(seed, fault_profile, slowest, qp_repeats, results, command);
   auto scenario = loadScenario(source("config/scenarios/power_towers.yaml"));
   if (!scenario) {
     std::fprintf(stderr, "cannot load the scenario (run from the source tree or set GF_SOURCE_DIR):\n%s", scenario.reason().c_str());
