@@ -661,8 +661,13 @@ void UavPlanner::planPath(PlanContext& c, PlanResult& result) const {
                                         config_.search_max_expansions, &stats, tube);
     result.path_search_expansions += stats.expansions;
     if (!detour) {
+      // The rest of the reference is unreachable for now: the path ends here, and so do the QP's
+      // references — pulled towards points it cannot reach, every sample pressed against the
+      // walls of the corridor left (a formation point inside a tower's lattice: 25–80 ProxQP
+      // iterations a replanning instead of 3, docs/planning.md §10).
       ++result.path_searches_failed;
-      break;  // the rest of the reference is unreachable for now
+      for (int j = k; j <= c.N; ++j) c.ref[static_cast<std::size_t>(j)] = raw.back();
+      break;
     }
     for (std::size_t i = 1; i < detour->size(); ++i) raw.push_back((*detour)[i]);
   }
