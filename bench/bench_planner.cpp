@@ -6,7 +6,13 @@
 //      worker climbing the west tower), per stage, QP size and iterations;
 //   2. stage-2 decision: A* on the distance field vs OMPL RRT-Connect (+ path simplification)
 //      on blocked segments through the towers and conductors;
-//   3. camera: Ceres vs the closed-form rate-limited filter (time and line-of-sight error).
+//   3. camera: Ceres vs the closed-form rate-limited filter (time and line-of-sight error);
+//   4. the power-tower mission (gfctl simulate's closed loop, the same seed and planners): every
+//      replanning's stage timings, the slowest 1 % and what they did (the tails: issue 38).
+//   gf_bench_planner --mission [--seed N] [--fault-profile NAME] [--slowest K] [--qp-instances]
+//   (section 4 only; --qp-instances: the slow replannings' QPs solved again alone, each formulation,
+//   median of 3 solves; --qp-repeats R: of R, e.g. to profile them; --results FILE.md: also a dated
+//   page with the output, e.g. docs/results/planning_tails.md)
 // Figures and decisions: docs/planning.md §10.
 #include <algorithm>
 #include <chrono>
@@ -14,9 +20,12 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
+#include <optional>
 #include <memory>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <ompl/base/SpaceInformation.h>
@@ -35,6 +44,9 @@
 #include "gesture_formation/planning/scenario.hpp"
 #include "gesture_formation/planning/trajectory_verifier.hpp"
 #include "gesture_formation/planning/uav_planner.hpp"
+#include "gesture_formation/sim/leader_camera.hpp"
+#include "gesture_formation/sim/mission_config.hpp"
+#include "gesture_formation/sim/mission_runner.hpp"
 
 using namespace gesture_formation;
 using namespace gesture_formation::planning;
@@ -58,10 +70,12 @@ struct Stats {
   double max() const { return v.empty() ? std::nan("") : *std::max_element(v.begin(), v.end()); }
 };
 
-void row(const char* name, const Stats& s, const char* unit = "ms") {
-  std::printf("  %-34s median %9.3f  p99 %9.3f  max %9.3f %s  (n=%zu)\n", name, s.median(), s.quantile(0.99), s.max(), unit,
-              s.v.size());
+void row(std::FILE* out, const char* name, const Stats& s, const char* unit = "ms") {
+  std::fprintf(out, "  %-34s median %9.3f  p99 %9.3f  max %9.3f %s  (n=%zu)\n", name, s.median(), s.quantile(0.99), s.max(),
+               unit, s.v.size());
 }
+
+void row(const char* name, const Stats& s, const char* unit = "ms") { row(stdout, name, s, unit); }
 
 std::string source(const std::string& rel) {
   const char* src = std::getenv("GF_SOURCE_DIR");
@@ -315,13 +329,370 @@ void benchCamera(int n) {
   row("filter RMS line-of-sight error", filter_err, "deg");
 }
 
+
+// ---- 4. the power-tower mission: every replanning, the slowest 1 % ------------------------------
+
+double threadCpuMs() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return 1e3 * static_cast<double>(ts.tv_sec) + 1e-6 * static_cast<double>(ts.tv_nsec);
+}
+
+std::string loadAverage() {
+  std::FILE* f = std::fopen("/proc/loadavg", "r");
+  if (f == nullptr) return "?";
+  char buf[64] = {0};
+  const bool ok = std::fgets(buf, sizeof buf, f) != nullptr;
+  std::fclose(f);
+  std::string s = ok ? buf : "?";
+  return s.substr(0, s.find(' '));
+}
+
+struct ReplanRecord {
+  int uav = 0;
+  double t_s = 0.0;
+  PlanStatus status = PlanStatus::kOptimized;
+  StageTimings timings;
+  double cpu_ms = 0.0;  ///< the planner thread's CPU time (survives a loaded machine better than wall time)
+  int qp_constraints = 0, qp_iterations = 0, corridors = 0, corridor_planes = 0, path_searches = 0, sparse_stops = 0;
+  int searches_failed = 0, expansions = 0;
+  std::string reason;
+};
+
+/// A slow replanning's QP as the planner handed it to ProxQP (problem and warm start).
+struct QpInstance {
+  double t_s = 0.0;
+  int uav = 0;
+  double replanning_cpu_ms = 0.0;
+  TrajectoryQpProblem problem;
+  TrajectoryQpSolution warm;
+};
+
+/// The product's planner of one UAV, recording what each replanning did (and, with `instances`,
+/// the QPs of the replannings over kInstanceCpuMs).
+class RecordingPlanner final : public Planner {
+ public:
+  static constexpr double kInstanceCpuMs = 10.0;
+  RecordingPlanner(std::unique_ptr<Planner> inner, int uav, std::vector<ReplanRecord>* out, std::vector<QpInstance>* instances)
+      : inner_(std::move(inner)), uav_(uav), out_(out), instances_(instances) {
+    auto* adapter = dynamic_cast<UavPlannerAdapter*>(inner_.get());
+    planner_ = adapter != nullptr ? &adapter->planner() : nullptr;
+    if (planner_ != nullptr && instances_ != nullptr) planner_->keepLastQp(true);
+  }
+  PlanResult plan(const PlanRequest& request) override {
+    const double cpu0 = threadCpuMs();
+    PlanResult r = inner_->plan(request);
+    ReplanRecord rec;
+    rec.cpu_ms = threadCpuMs() - cpu0;
+    rec.uav = uav_;
+    rec.t_s = request.t_now_s;
+    rec.status = r.status;
+    rec.timings = r.timings;
+    rec.qp_constraints = r.qp_constraints;
+    rec.qp_iterations = r.qp_iterations;
+    rec.corridors = r.corridor_count;
+    for (const auto& c : r.corridors) rec.corridor_planes += static_cast<int>(c.polytope.rows());
+    rec.path_searches = r.path_searches;
+    rec.searches_failed = r.path_searches_failed;
+    rec.expansions = r.path_search_expansions;
+    rec.sparse_stops = r.qp_sparse_timeouts;
+    rec.reason = r.reason;
+    if (instances_ != nullptr && planner_ != nullptr && rec.cpu_ms > kInstanceCpuMs && planner_->lastQp() != nullptr &&
+        r.qp_constraints > 0) {
+      instances_->push_back(QpInstance{request.t_now_s, uav_, rec.cpu_ms, *planner_->lastQp(), *planner_->lastQpWarmStart()});
+    }
+    out_->push_back(std::move(rec));
+    return r;
+  }
+
+ private:
+  std::unique_ptr<Planner> inner_;
+  int uav_;
+  std::vector<ReplanRecord>* out_;
+  std::vector<QpInstance>* instances_;
+  UavPlanner* planner_ = nullptr;
+};
+
+/// The slow replannings' QPs solved again, alone: the product's solve (sparse, warm) beside the
+/// alternatives, CPU time (median of `repeats`).
+void benchQpInstances(std::FILE* out, const std::vector<QpInstance>& instances, int repeats) {
+  if (instances.empty()) return;
+  struct Variant {
+    const char* name;
+    TrajectoryQpProblem::Formulation formulation;
+    bool warm;
+  };
+  const Variant variants[] = {{"sparse, warm (the product)", TrajectoryQpProblem::Formulation::kSparse, true},
+                              {"sparse, cold", TrajectoryQpProblem::Formulation::kSparse, false},
+                              {"condensed dense, warm", TrajectoryQpProblem::Formulation::kCondensed, true}};
+  std::fprintf(out, "  the QPs of the %zu replannings over %.0f ms CPU, solved again alone (CPU ms, median of %d):\n",
+              instances.size(), RecordingPlanner::kInstanceCpuMs, repeats);
+  const TrajectoryQp qp;
+  std::vector<double> product_objective(instances.size(), NAN);
+  for (const Variant& v : variants) {
+    Stats t, it;
+    int solved = 0;
+    double worst_rel = 0.0;
+    for (std::size_t i = 0; i < instances.size(); ++i) {
+      TrajectoryQpProblem pr = instances[i].problem;
+      pr.formulation = v.formulation;
+      const bool use_warm = v.warm && !instances[i].warm.p.empty();
+      Stats once;
+      TrajectoryQpSolution sol;
+      for (int r = 0; r < repeats; ++r) {
+        const double c0 = threadCpuMs();
+        sol = qp.solve(pr, use_warm ? &instances[i].warm : nullptr);
+        once.add(threadCpuMs() - c0);
+      }
+      t.add(once.median());
+      it.add(sol.iterations);
+      if (!sol.solved()) continue;
+      ++solved;
+      if (&v == &variants[0]) product_objective[i] = sol.objective;
+      if (std::isfinite(product_objective[i])) {
+        worst_rel = std::max(worst_rel, std::abs(sol.objective - product_objective[i]) / std::max(1.0, std::abs(product_objective[i])));
+      }
+    }
+    std::fprintf(out, "    %-28s solved %d/%zu, worst objective difference to the product %.1e (relative)\n", v.name, solved,
+                instances.size(), worst_rel);
+    row(out, "      time", t);
+    row(out, "      iterations", it, "");
+  }
+}
+
+struct MissionSetup {
+  Scenario scenario;
+  sim::MissionConfig mission;
+  std::shared_ptr<const OccupancyMap> map;
+  std::shared_ptr<const DistanceField> field;
+  std::unique_ptr<sim::MissionClassifier> classifier;
+  PrimitiveSet solids;
+};
+
+/// gfctl simulate's set-up of a power-tower mission (scenario, faults, gesture model, map, field).
+std::optional<MissionSetup> loadMission(const std::string& fault_profile) {
+  const std::string path = source("config/scenarios/power_towers.yaml");
+  auto sc = loadScenario(path);
+  auto mission = fault_profile.empty() ? sim::loadMissionConfig(path)
+                                       : sim::loadMissionConfig(path, source("config/faults/" + fault_profile + ".yaml"));
+  if (!sc || !mission) {
+    std::fprintf(stderr, "mission: %s%s\n", sc ? "" : sc.reason().c_str(), mission ? "" : mission.reason().c_str());
+    return std::nullopt;
+  }
+  if (mission->mapping.enabled) {
+    std::fprintf(stderr, "mission: live mapping is not run by this benchmark (gfctl simulate --mapping)\n");
+    return std::nullopt;
+  }
+  MissionSetup s;
+  s.scenario = std::move(*sc);
+  s.mission = std::move(*mission);
+  s.solids = s.scenario.primitives();
+  if (!s.mission.gesture_model.empty()) {
+    const int threads = std::clamp(s.mission.formation.params.uavCount(), 1,
+                                   std::min(static_cast<int>(std::max(1u, std::thread::hardware_concurrency())), sim::kMaxClassifierThreads));
+    auto c = sim::loadOnnxClassifier(s.mission.gesture_model, threads);
+    if (!c) {
+      std::fprintf(stderr, "mission: %s: %s\n", s.mission.gesture_model.c_str(), c.reason().c_str());
+      return std::nullopt;
+    }
+    s.classifier = std::move(*c);
+  }
+  auto m = OccupancyMap::fromScenario(s.scenario);
+  if (!m) {
+    std::fprintf(stderr, "mission: map: %s\n", m.reason().c_str());
+    return std::nullopt;
+  }
+  s.map = std::make_shared<const OccupancyMap>(std::move(*m));
+  s.field = std::make_shared<const DistanceField>(*s.map);
+  return s;
+}
+
+void printSlowest(std::FILE* out, const std::vector<ReplanRecord>& recs, int count) {
+  std::vector<const ReplanRecord*> by_time;
+  for (const auto& r : recs) by_time.push_back(&r);
+  std::sort(by_time.begin(), by_time.end(), [](const auto* a, const auto* b) { return a->cpu_ms > b->cpu_ms; });
+  std::fprintf(out, "  the %d slowest by CPU time (ms; planes: corridor planes, cons: QP rows, it: ProxQP iterations):\n", count);
+  std::fprintf(out, "    %8s %3s %9s %8s %8s %7s %8s %8s %7s %7s %6s %5s %6s %5s %7s  %s\n", "t_s", "uav", "status", "cpu", "wall", "path",
+              "corridor", "qp", "camera", "verify", "cons", "it", "corr", "A*", "expand", "reason");
+  for (int i = 0; i < count && i < static_cast<int>(by_time.size()); ++i) {
+    const ReplanRecord& r = *by_time[static_cast<std::size_t>(i)];
+    const auto& T = r.timings;
+    std::fprintf(out, "    %8.2f %3d %9s %8.2f %8.2f %7.2f %8.2f %8.2f %7.3f %7.2f %6d %5d %2d/%-3d %d/%-3d %7d  %.70s\n", r.t_s, r.uav,
+                r.status == PlanStatus::kOptimized ? "optimized" : (r.status == PlanStatus::kFallbackPrevious ? "previous" : "brake"),
+                r.cpu_ms, T.total_ms, T.path_ms, T.corridor_ms, T.qp_ms, T.heading_ms, T.verify_ms, r.qp_constraints,
+                r.qp_iterations, r.corridors, r.corridor_planes, r.searches_failed, r.path_searches, r.expansions, r.reason.c_str());
+  }
+}
+
+/// The slowest 1 % by CPU time, beside all replannings: where their time goes.
+void printTail(std::FILE* out, const std::vector<ReplanRecord>& recs) {
+  std::vector<ReplanRecord> sorted = recs;
+  std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.cpu_ms > b.cpu_ms; });
+  const std::size_t n_tail = std::max<std::size_t>(1, sorted.size() / 100);
+  const auto share = [](const std::vector<ReplanRecord>& v, std::size_t n, double StageTimings::*f) {
+    double part = 0.0, whole = 0.0;
+    for (std::size_t i = 0; i < n; ++i) part += v[i].timings.*f, whole += v[i].timings.total_ms;
+    return whole > 0.0 ? 100.0 * part / whole : 0.0;
+  };
+  Stats cons_tail, it_tail, planes_tail;
+  int failed_tail = 0;
+  for (std::size_t i = 0; i < n_tail; ++i) {
+    cons_tail.add(sorted[i].qp_constraints);
+    it_tail.add(sorted[i].qp_iterations);
+    planes_tail.add(sorted[i].corridor_planes);
+    failed_tail += sorted[i].status == PlanStatus::kOptimized ? 0 : 1;
+  }
+  std::fprintf(out, "  slowest 1 %% (%zu replannings, %d failed): wall-time share path %.1f %%, corridors %.1f %%, QP %.1f %%, "
+              "camera %.1f %%, verification+fallback %.1f %%\n",
+              n_tail, failed_tail, share(sorted, n_tail, &StageTimings::path_ms), share(sorted, n_tail, &StageTimings::corridor_ms),
+              share(sorted, n_tail, &StageTimings::qp_ms), share(sorted, n_tail, &StageTimings::heading_ms),
+              share(sorted, n_tail, &StageTimings::verify_ms));
+  std::fprintf(out, "    QP rows median %.0f (all: see below), iterations median %.0f max %.0f, corridor planes median %.0f max %.0f\n",
+              cons_tail.median(), it_tail.median(), it_tail.max(), planes_tail.median(), planes_tail.max());
+}
+
+struct MissionRecord {
+  sim::MissionMetrics metrics;
+  std::vector<ReplanRecord> replannings;
+  std::vector<QpInstance> instances;
+  std::string load_before, load_after;
+};
+
+void printMission(std::FILE* out, const MissionRecord& M, std::uint64_t seed, const std::string& fault_profile, int slowest,
+                  int qp_repeats) {
+  const auto& m = M.metrics;
+  const auto& recs = M.replannings;
+  std::fprintf(out, "4. power-tower mission, seed %llu%s%s (load average %s before, %s after; the lead's quiet anchor, seed 1 "
+               "nominal, main before issue 38: planning p99 20.5-21.7 ms, max 130-163 ms; target p99 <= 20, max <= 50 ms):\n",
+               static_cast<unsigned long long>(seed), fault_profile.empty() ? "" : ", faults ", fault_profile.c_str(),
+               M.load_before.c_str(), M.load_after.c_str());
+  std::fprintf(out, "  mission: collisions %d, min obstacle %.3f m, min mutual %.3f m, requests %d/%d, planning median %.2f p99 "
+               "%.2f max %.2f ms (wall), fallback previous %d, brake %d of %d\n",
+               m.collisions, m.min_obstacle_distance_m, m.min_mutual_distance_m, m.requests_applied, m.requests_total,
+               m.planning_ms_median, m.planning_ms_p99, m.planning_ms_max, m.plans_fallback_previous, m.plans_fallback_brake, m.plans);
+  Stats cpu, wall, path, corridor, qp, heading, verify, cons, iters, planes;
+  int over[3] = {0, 0, 0};
+  for (const auto& r : recs) {
+    cpu.add(r.cpu_ms);
+    wall.add(r.timings.total_ms);
+    path.add(r.timings.path_ms);
+    corridor.add(r.timings.corridor_ms);
+    qp.add(r.timings.qp_ms);
+    heading.add(r.timings.heading_ms);
+    verify.add(r.timings.verify_ms);
+    cons.add(r.qp_constraints);
+    iters.add(r.qp_iterations);
+    planes.add(r.corridor_planes);
+    over[0] += r.cpu_ms > 10.0 ? 1 : 0;
+    over[1] += r.cpu_ms > 20.0 ? 1 : 0;
+    over[2] += r.cpu_ms > 50.0 ? 1 : 0;
+  }
+  row(out, "TOTAL one replanning, CPU time", cpu);
+  row(out, "TOTAL one replanning, wall", wall);
+  row(out, "stage 2 path (projection, A*)", path);
+  row(out, "stage 3 corridors", corridor);
+  row(out, "stage 3 QP (assembly + ProxQP)", qp);
+  row(out, "camera heading/pitch", heading);
+  row(out, "verification (+ fallback)", verify);
+  row(out, "QP constraints (eq + ineq)", cons, "");
+  row(out, "QP iterations", iters, "");
+  row(out, "corridor planes per replanning", planes, "");
+  std::fprintf(out, "  replannings over 10 / 20 / 50 ms CPU: %d / %d / %d of %zu\n", over[0], over[1], over[2], recs.size());
+  printTail(out, recs);
+  printSlowest(out, recs, slowest);
+  if (qp_repeats > 0) benchQpInstances(out, M.instances, qp_repeats);
+}
+
+std::string utcNow() {
+  const std::time_t now = std::time(nullptr);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
+  return buf;
+}
+
+/// A dated results page: the command and its output verbatim (docs/results/, written only by this).
+bool writeResultsPage(const std::string& path, const MissionRecord& M, std::uint64_t seed, const std::string& fault_profile,
+                      int slowest, int qp_repeats, const std::string& command) {
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (f == nullptr) return false;
+  std::fprintf(f, "# Results: replanning tails in the power-tower mission (issue 38 item 1)\n\n"
+                  "Written by `%s` on %s (%u hardware threads; load average %s before, %s after: wall times on a\n"
+                  "loaded machine are inflated, the CPU times per replanning much less). The planner is the product's\n"
+                  "(`sim::uavPlannerFactory`), run in `gfctl simulate`'s closed loop with the same seed and configs;\n"
+                  "CPU time is the planner thread's (`CLOCK_THREAD_CPUTIME_ID`) around each `plan()`. What the\n"
+                  "figures mean: [planning.md](../planning.md) §10.\n\n```\n",
+               command.c_str(), utcNow().c_str(), std::thread::hardware_concurrency(), M.load_before.c_str(), M.load_after.c_str());
+  printMission(f, M, seed, fault_profile, slowest, qp_repeats);
+  std::fprintf(f, "```\n");
+  return std::fclose(f) == 0;
+}
+
+int benchMission(std::uint64_t seed, const std::string& fault_profile, int slowest, int qp_repeats, const std::string& results,
+                 const std::string& command) {
+  MissionRecord M;
+  M.load_before = loadAverage();
+  auto setup = loadMission(fault_profile);
+  if (!setup) return 2;
+  MissionSetup& S = *setup;
+  sim::MissionWorld world;
+  world.map = S.map.get();
+  world.field = S.field.get();
+  world.ground_height_m = S.scenario.ground.enabled ? S.scenario.ground.height_m : -1e9;
+  world.solids = &S.solids;
+  const sim::PlannerFactory product = sim::uavPlannerFactory(S.mission.planner, S.map, S.field);
+  const sim::PlannerFactory recording = [&](int i) -> std::unique_ptr<sim::MissionPlanner> {
+    return std::make_unique<RecordingPlanner>(product(i), i, &M.replannings, qp_repeats > 0 ? &M.instances : nullptr);
+  };
+  const auto out = sim::runMission(S.mission, world, recording, S.classifier.get(), seed);
+  if (!out) {
+    std::fprintf(stderr, "mission: %s\n", out.reason().c_str());
+    return 2;
+  }
+  M.metrics = out->metrics;
+  M.load_after = loadAverage();
+  printMission(stdout, M, seed, fault_profile, slowest, qp_repeats);
+  if (!results.empty() && !writeResultsPage(results, M, seed, fault_profile, slowest, qp_repeats, command)) {
+    std::fprintf(stderr, "gf_bench_planner: cannot write %s\n", results.c_str());
+    return 2;
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  int runs = 200;
-  for (int i = 1; i + 1 < argc; ++i) {
-    if (std::strcmp(argv[i], "--runs") == 0) runs = std::max(1, std::atoi(argv[i + 1]));
+  int runs = 200, slowest = 20;
+  bool mission = false;
+  int qp_repeats = 0;
+  std::string results, command = "gf_bench_planner";
+  std::uint64_t seed = 1;
+  std::string fault_profile;
+  for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
+  for (int i = 1; i < argc; ++i) {
+    const bool has_value = i + 1 < argc;
+    if (std::strcmp(argv[i], "--mission") == 0) {
+      mission = true;
+    } else if (std::strcmp(argv[i], "--qp-instances") == 0) {
+      qp_repeats = 3;
+    } else if (std::strcmp(argv[i], "--qp-repeats") == 0 && has_value) {
+      qp_repeats = std::max(1, std::atoi(argv[++i]));
+    } else if (std::strcmp(argv[i], "--runs") == 0 && has_value) {
+      runs = std::max(1, std::atoi(argv[++i]));
+    } else if (std::strcmp(argv[i], "--seed") == 0 && has_value) {
+      seed = std::strtoull(argv[++i], nullptr, 10);
+    } else if (std::strcmp(argv[i], "--slowest") == 0 && has_value) {
+      slowest = std::max(0, std::atoi(argv[++i]));
+    } else if (std::strcmp(argv[i], "--results") == 0 && has_value) {
+      results = argv[++i];
+    } else if (std::strcmp(argv[i], "--fault-profile") == 0 && has_value) {
+      fault_profile = argv[++i];
+    } else {
+      std::fprintf(stderr, "gf_bench_planner: unknown or incomplete option '%s' (--runs N | --mission [--seed N] "
+                           "[--fault-profile NAME] [--slowest K] [--qp-instances | --qp-repeats R] [--results FILE.md])\n", argv[i]);
+      return 2;
+    }
   }
+  if (mission) return benchMission(seed, fault_profile, slowest, qp_repeats, results, command);
   auto scenario = loadScenario(source("config/scenarios/power_towers.yaml"));
   if (!scenario) {
     std::fprintf(stderr, "cannot load the scenario (run from the source tree or set GF_SOURCE_DIR):\n%s", scenario.reason().c_str());

@@ -218,6 +218,10 @@ common::Result<std::vector<Eigen::Vector3d>> GridPathSearch::search(const Eigen:
     }
     return static_cast<long>(flood_queue_.size());
   };
+  // The last goal lay in a closed pocket (a reference in a lattice stays there): flood first; the
+  // answer does not depend on when the flood runs, only the cost does.
+  const bool pocket_checked = pocket_hint_;
+  if (pocket_checked && (pocket_voxels = goalPocket()) > 0) open = decltype(open)();  // no path
   while (!open.empty()) {
     const std::int32_t cur = open.top().second;
     open.pop();
@@ -228,7 +232,7 @@ common::Result<std::vector<Eigen::Vector3d>> GridPathSearch::search(const Eigen:
       break;
     }
     if (++expansions > max_expansions) break;
-    if (expansions == kPocketCheckAfter && (pocket_voxels = goalPocket()) > 0) break;
+    if (expansions == kPocketCheckAfter && !pocket_checked && (pocket_voxels = goalPocket()) > 0) break;
     const int cx = lx + cur % nx, cy = ly + (cur / nx) % ny, cz = lz + cur / (nx * ny);
     const float gc = g_[static_cast<std::size_t>(cur)];
     for (int dz = -1; dz <= 1; ++dz) {
@@ -252,6 +256,7 @@ common::Result<std::vector<Eigen::Vector3d>> GridPathSearch::search(const Eigen:
     }
   }
   if (stats) stats->expansions = expansions;
+  pocket_hint_ = pocket_voxels > 0;
   if (!found) return R::fail(noPathReason(a, b, clearance_m, margin_m, expansions, pocket_voxels));
   std::vector<Eigen::Vector3d> raw;
   for (std::int32_t i = goal; i != -1; i = parent_[static_cast<std::size_t>(i)]) {

@@ -656,9 +656,19 @@ void UavPlanner::planPath(PlanContext& c, PlanResult& result) const {
     }
     c.path_around_worker = c.path_around_worker || !outside;
     ++result.path_searches;
+    GridPathSearch::Stats stats;
     const auto detour = search_->search(raw.back(), target, c.path_clear, c.seg_clear, config_.search_margin_m,
-                                        config_.search_max_expansions, nullptr, tube);
-    if (!detour) break;  // the rest of the reference is unreachable for now
+                                        config_.search_max_expansions, &stats, tube);
+    result.path_search_expansions += stats.expansions;
+    if (!detour) {
+      // The rest of the reference is unreachable for now: the path ends here, and so do the QP's
+      // references — pulled towards points it cannot reach, every sample pressed against the
+      // walls of the corridor left (a formation point inside a tower's lattice: 25–80 ProxQP
+      // iterations a replanning instead of 3, docs/planning.md §10).
+      ++result.path_searches_failed;
+      for (int j = k; j <= c.N; ++j) c.ref[static_cast<std::size_t>(j)] = raw.back();
+      break;
+    }
     for (std::size_t i = 1; i < detour->size(); ++i) raw.push_back((*detour)[i]);
   }
   c.path = mergeWaypoints(raw, config_.path_merge_tolerance_m,
@@ -962,7 +972,10 @@ std::string UavPlanner::solveQp(PlanContext& c, PlanResult& result) {
       warm.a.push_back(x.a);
     }
   }
-  if (keep_last_qp_) last_qp_ = std::make_unique<TrajectoryQpProblem>(c.qp);
+  if (keep_last_qp_) {
+    last_qp_ = std::make_unique<TrajectoryQpProblem>(c.qp);
+    last_qp_warm_ = std::make_unique<TrajectoryQpSolution>(warm);
+  }
   c.sol = qp_->solve(c.qp, c.have_prev ? &warm : nullptr);
   result.qp_variables = c.sol.variables;
   result.qp_constraints = c.sol.equalities + c.sol.inequalities;

@@ -76,7 +76,9 @@ class GridPathSearch {
   /// the goal (at most kPocketMaxVoxels voxels, same connectivity) checks whether the goal lies
   /// in a closed pocket that does not hold the start — e.g. inside a tower's lattice — and
   /// fails at once if so, instead of spending the whole budget on the start's side: the result
-  /// is the same (no path exists), only cheaper (docs/planning.md §10). With `keep_out`, voxel
+  /// is the same (no path exists), only cheaper (docs/planning.md §10). When the previous
+  /// search's goal lay in a closed pocket, the flood runs before the first expansion (a goal in a
+  /// pocket tends to stay there from one replanning to the next); same result, cheaper again. With `keep_out`, voxel
   /// centres inside the tube are not free either (the goal's voxel still counts as free) and
   /// shortcuts stay outside it; the caller shrinks the tube when a or b lies inside it.
   common::Result<std::vector<Eigen::Vector3d>> search(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double clearance_m,
@@ -94,6 +96,7 @@ class GridPathSearch {
   mutable std::vector<std::uint32_t> flood_stamp_;
   mutable std::uint32_t flood_generation_ = 0;
   mutable std::vector<std::int32_t> flood_queue_;
+  mutable bool pocket_hint_ = false;  ///< the last search ended in a closed pocket
 
  public:
   static constexpr int kPocketCheckAfter = 20'000;

@@ -34,6 +34,7 @@
 #include "gesture_formation/planning/corridor_builder.hpp"
 #include "gesture_formation/planning/planned_trajectory.hpp"
 #include "gesture_formation/planning/planner_config.hpp"
+#include "gesture_formation/planning/trajectory_qp.hpp"
 
 namespace gesture_formation::planning {
 
@@ -108,6 +109,8 @@ struct PlanResult {
   int corridor_count = 0;
   int projected_references = 0;  ///< reference steps moved out of obstacles / the worker zone
   int path_searches = 0;         ///< A* searches run for blocked segments
+  int path_searches_failed = 0;  ///< of them, those that found no path (the path ends before it)
+  int path_search_expansions = 0;  ///< A* expansions of all of them (their cost)
   /// Corridor rows moved out because the UAV's momentum carries it over them (at most the tracking
   /// allowance), and move-away rows lowered to what it can reach (docs/planning.md §6.3).
   int momentum_relaxed_rows = 0;
@@ -164,6 +167,8 @@ class UavPlanner {
   void keepLastQp(bool keep) { keep_last_qp_ = keep; }
   /// \brief The last QP assembled by plan() when keepLastQp(true); nullptr otherwise.
   const TrajectoryQpProblem* lastQp() const { return last_qp_.get(); }
+  /// \brief The warm start plan() gave that QP (p, v, a empty without one); nullptr as lastQp().
+  const TrajectoryQpSolution* lastQpWarmStart() const { return last_qp_warm_.get(); }
 
  private:
   /// One replanning's working state, handed from stage to stage (defined in uav_planner.cpp).
@@ -223,6 +228,7 @@ class UavPlanner {
   std::uint32_t sequence_ = 0;
   bool keep_last_qp_ = false;
   std::unique_ptr<TrajectoryQpProblem> last_qp_;
+  std::unique_ptr<TrajectoryQpSolution> last_qp_warm_;
 };
 
 /// \brief Plans a formation in priority order (docs/design.md §4): planners[0] (the leader) first,

@@ -60,6 +60,29 @@ TEST(GridPathSearchTest, GoalInAClosedPocketFailsAfterThePocketCheck) {
   ASSERT_TRUE(inside.has_value()) << inside.reason();
 }
 
+TEST(GridPathSearchTest, GoalStillInThePocketAtTheNextSearchFailsBeforeExpanding) {
+  const OccupancyMap map = OccupancyMap::fromPrimitives(mapConfig(), closedShell(), GroundSpec{});
+  const DistanceField field(map);
+  const GridPathSearch search(map, field);
+  const Eigen::Vector3d outside(8, 0, 0), in_pocket(0, 0, 0), also_inside(0.8, 0.8, 0.8);
+  GridPathSearch::Stats first, again, from_inside, after;
+  ASSERT_FALSE(search.search(outside, in_pocket, 0.3, 0.3, 9.0, 200'000, &first).has_value());
+  EXPECT_EQ(first.expansions, GridPathSearch::kPocketCheckAfter);
+  // The next search to the pocket: the flood runs first, the same answer without expansions.
+  const auto r = search.search(outside + Eigen::Vector3d(0, 0.4, 0), in_pocket, 0.3, 0.3, 9.0, 200'000, &again);
+  ASSERT_FALSE(r.has_value());
+  EXPECT_NE(r.reason().find("closed pocket"), std::string::npos) << r.reason();
+  EXPECT_EQ(again.expansions, 0);
+  // A reachable goal right after (the start inside the pocket): the early flood reaches the start
+  // and the search runs as usual.
+  const auto inside = search.search(also_inside, in_pocket, 0.3, 0.3, 9.0, 200'000, &from_inside);
+  ASSERT_TRUE(inside.has_value()) << inside.reason();
+  EXPECT_GT(from_inside.expansions, 0);
+  // That success clears the memory: the next pocket search expands until the regular check.
+  ASSERT_FALSE(search.search(outside, in_pocket, 0.3, 0.3, 9.0, 200'000, &after).has_value());
+  EXPECT_EQ(after.expansions, GridPathSearch::kPocketCheckAfter);
+}
+
 TEST(GridPathSearchTest, GoalBehindALargeWallWithAGapIsFoundAfterThePocketCheck) {
   PrimitiveSet s;
   // A 0.4 m wall across x = 0 through the whole map (to ±11 m, past its ±10 m bounds) except a

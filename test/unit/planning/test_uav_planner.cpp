@@ -258,6 +258,38 @@ TEST(UavPlannerTest, ReferenceInsideTowerIsProjectedAndPlanAvoidsIt) {
   expectSafe(r.trajectory, *w.map, planner.config());
 }
 
+TEST(UavPlannerTest, ReferenceInAClosedPocketIsHeldAtThePathsEnd) {
+  // A hollow cube (6.8 m outside, 0.4 m walls, closed) and the reference at its centre: no path
+  // reaches it. The path ends at the start, and so do the QP's references: the UAV holds where it
+  // is instead of pressing every sample against the corridor's wall towards a point it cannot
+  // reach (what made such replannings the slowest of the power-tower mission, planning.md §10).
+  MapConfig mc;
+  mc.resolution_m = 0.2;
+  mc.bounds = Aabb{Eigen::Vector3d(-12, -12, -12), Eigen::Vector3d(12, 12, 12)};
+  PrimitiveSet shell;
+  for (int axis = 0; axis < 3; ++axis) {
+    for (double side : {-3.2, 3.2}) {
+      OrientedBox b;
+      b.center_world = Eigen::Vector3d::Zero();
+      b.center_world(axis) = side;
+      b.size_m = Eigen::Vector3d::Constant(6.8);
+      b.size_m(axis) = 0.4;
+      shell.boxes.push_back(b);
+    }
+  }
+  auto map = std::make_shared<const OccupancyMap>(OccupancyMap::fromPrimitives(mc, shell, GroundSpec{}));
+  auto field = std::make_shared<const DistanceField>(*map);
+  UavPlanner planner(testConfig(), map, field);
+  const Eigen::Vector3d start(9, 0, 0), centre(0, 0, 0);
+  const PlanResult r = planner.plan(straightRequest(0, 0.0, stateAt(start), centre, centre, 1.0, Eigen::Vector3d(9, 9, -9)));
+  ASSERT_EQ(r.status, PlanStatus::kOptimized) << r.reason;
+  EXPECT_EQ(r.path_searches_failed, 1);
+  expectSafe(r.trajectory, *map, planner.config());
+  double farthest = 0.0;
+  for (double t = 0.0; t <= r.trajectory.tEnd(); t += 0.05) farthest = std::max(farthest, (evaluateTrajectory(r.trajectory, t).p - start).norm());
+  EXPECT_LT(farthest, 0.1) << "the UAV moved towards the unreachable reference";
+}
+
 TEST(UavPlannerTest, PassesThroughGapBetweenConductors) {
   // From below the lower conductors (z 16 at the towers, ~13 mid-span) to above them, between
   // the middle phase (y = 0) and the side phase (y = 6.5) at mid-span: a 6.5 m wide gap.
