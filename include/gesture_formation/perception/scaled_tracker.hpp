@@ -6,9 +6,11 @@
 /// KCF and CSRT work on a window of about 2.5× the box around it: their cost grows with the box's
 /// area (KCF ~2 ms on a 35 × 83 px pedestrian, 32–36 ms on a person a third of a 640 × 480 frame
 /// tall). When the box given to `init` is longer than `max_side_px` on either side, every frame is
-/// shrunk (INTER_AREA, the whole frame, so that the tracker's coordinates stay fixed) by
-/// s = max_side_px / max(w, h) before the tracker sees it, and the boxes are mapped back
-/// (box_frame = box_scaled / s). The scale is chosen at `init` and kept until the next `init`.
+/// shrunk (INTER_AREA, the whole frame, so that the tracker's coordinates stay fixed) by the integer
+/// factor n = ⌈max(w, h) / max_side_px⌉ (s = 1/n: the box then measures between max_side_px / 2 and
+/// max_side_px; an integer factor takes INTER_AREA's fast path) before the tracker sees it, and the
+/// boxes are mapped back (box_frame = box_scaled / s). The scale is chosen at `init` and kept until
+/// the next `init`.
 /// Boxes no longer than `max_side_px` are tracked at full resolution, exactly as before.
 /// Cost per update: the tracker on a box of at most `max_side_px` plus one resize of the frame.
 /// Thread safety: not reentrant (one per WorkerTracker).
