@@ -7,9 +7,11 @@
 # multicast route. Root runs it directly; another user needs sudo, used for that namespace only
 # (the launch itself runs as the user, setpriv).
 #   tools/run_ros_mission.sh [--out DIR] [--duration S] [--rtf X] [--seed N] [--mission FILE]
-#                            [--faults FILE] [--rviz]
+#                            [--faults FILE] [--leadership] [--rviz]
 # --faults: a fault profile (e.g. config/faults/worker_lost_5s.yaml) merged into the mission for
 # every nodelet, as gfctl simulate --faults (simulation.launch faults:=).
+# --leadership: simulation.launch leadership:=true (the leader hand-over, docs/ros.md; needed by the
+# leader_dropout_for_good profile); SimWorld then also writes leadership.csv.
 # Defaults: --out results/demo, the whole mission (451 s), --rtf 2 (sim seconds per wall second).
 # Exit code: 0 when the mission finished without a collision; 1 when it did not finish or a UAV
 # collided; 2 for bad arguments or a missing build.
@@ -25,6 +27,7 @@ SEED=1
 MISSION=$SRC/config/scenarios/power_towers.yaml
 RVIZ=false
 FAULTS=
+LEADERSHIP=false
 while [ $# -gt 0 ]; do
   case $1 in
     --out) OUT=$2; shift 2 ;;
@@ -34,7 +37,8 @@ while [ $# -gt 0 ]; do
     --mission) MISSION=$(realpath "$2"); shift 2 ;;
     --faults) FAULTS=$(realpath "$2"); [ -f "$FAULTS" ] || { echo "$0: --faults: no file '$2'" >&2; exit 2; }; shift 2 ;;
     --rviz) RVIZ=true; shift ;;
-    *) echo "usage: $0 [--out DIR] [--duration S] [--rtf X] [--seed N] [--mission FILE] [--faults FILE] [--rviz]" >&2; exit 2 ;;
+    --leadership) LEADERSHIP=true; shift ;;
+    *) echo "usage: $0 [--out DIR] [--duration S] [--rtf X] [--seed N] [--mission FILE] [--faults FILE] [--leadership] [--rviz]" >&2; exit 2 ;;
   esac
 done
 DEVEL=$(gf_devel_dir "$SRC") || exit 2
@@ -71,7 +75,7 @@ export DISPLAY=${DISPLAY:-} XAUTHORITY=${XAUTHORITY:-${HOME:-/root}/.Xauthority}
 source "$DEVEL/setup.bash"
 roslaunch --screen -p 11311 gesture_formation simulation.launch mission:=$MISSION seed:=$SEED \
   real_time_factor:=$RTF duration:=$DURATION output_dir:=$OUT key_dir:=$T/keys record:=true \
-  bag:=$OUT/mission.bag rviz:=$RVIZ faults:=$FAULTS > "$T/launch.log" 2>&1 &
+  bag:=$OUT/mission.bag rviz:=$RVIZ faults:=$FAULTS leadership:=$LEADERSHIP > "$T/launch.log" 2>&1 &
 launch=\$!
 # The world writes metrics.json when the mission ends; then stop everything (rosbag closes the bag).
 while kill -0 \$launch 2>/dev/null && [ ! -f "$OUT/metrics.json" ]; do sleep 1; done
