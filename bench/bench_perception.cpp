@@ -1,7 +1,14 @@
 // Perception stages and the whole pipeline on 640×480 frames of Debian's vtest.avi
 // (opencv-doc), 2 threads (cv::setNumThreads(2)). Every benchmark records the wall time of
 // each iteration and reports its median (median_ms) and 90th percentile (p90_ms); frames/s
-// of the pipeline = 1000 / median_ms. Run: build-perception/gf_bench_perception
+// of the pipeline = 1000 / median_ms.
+//
+// Then workers at 5, 10 and 15 m (bench/perception_distances.cpp): the whole pipeline on real
+// frames (vtest.avi scaled so the walking woman is as tall as a worker at that distance) and on
+// rendered frames (the project's renderer, the worker 5/10/15 m from the camera), the old path
+// (visual tracker at full resolution) beside the new one (tracker on the shrunk frame).
+// Run from anywhere: build/devel/lib/gesture_formation/gf_bench_perception
+//   [--gf_results=docs/results/perception_distances.md]  (writes the distance tables there too)
 #include <algorithm>
 #include <cstdlib>
 #include <memory>
@@ -18,18 +25,27 @@
 
 namespace gp = gesture_formation::perception;
 
+std::string benchModelsRoot();
+/// Google Benchmark's main plus the distance tables (bench/perception_distances.cpp).
+int benchPerceptionMain(int argc, char** argv);
+
 namespace {
 
 constexpr int kFrames = 300;  // consecutive frames of vtest.avi used (30 s at 10 fps)
 
-/// $GF_MODELS_DIR, else <source>/third_party_models (this file is <source>/bench/bench_perception.cpp).
-std::string modelsRoot() {
+}  // namespace
+
+/// $GF_MODELS_DIR, else GF_SOURCE_DIR/third_party_models: the absolute source directory given by
+/// CMake (__FILE__ is relative under ccache's base_dir, so it cannot be used to find the models).
+std::string benchModelsRoot() {
   const char* env = std::getenv("GF_MODELS_DIR");
-  if (env != nullptr) return env;
-  std::string file = __FILE__;
-  const auto bench_dir = file.rfind("/bench/");
-  return bench_dir == std::string::npos ? std::string("third_party_models") : file.substr(0, bench_dir) + "/third_party_models";
+  if (env != nullptr && *env != '\0') return env;
+  return std::string(GF_SOURCE_DIR) + "/third_party_models";
 }
+
+namespace {
+
+std::string modelsRoot() { return benchModelsRoot(); }
 
 const std::vector<cv::Mat>& frames() {
   static const std::vector<cv::Mat> f = [] {
@@ -220,4 +236,4 @@ BENCHMARK(BM_Pipeline)
 
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) { return benchPerceptionMain(argc, argv); }

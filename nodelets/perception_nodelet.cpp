@@ -23,6 +23,8 @@
 //   topics are not delivered in order, and a colour image processed late must still find its depth).
 // Optional: ~dnn_device (cpu): where the networks run — cpu, opencl, opencl_fp16, cuda, cuda_fp16
 //   (refused at start, naming what this OpenCV can use, when it cannot run there).
+//   ~track_max_side_px (96): the visual tracker works on the image shrunk so the worker's box is at
+//   most this [px] (0: full resolution; its cost then grows with a close worker's box).
 //   ~image_transport (raw): how image_in arrives, through image_transport (image_in/<transport>);
 //   `compressed` (sensor_msgs/CompressedImage, JPEG / PNG) is decoded here with OpenCV when the
 //   compressed_image_transport plugin is not installed (Debian ships the raw transport only).
@@ -68,6 +70,11 @@ class PerceptionNodelet : public nodelet::Nodelet {
     // One range per setting: the core's tables.
     params.load("detect_every_k", cfg.tracker.detect_every_k,
                 *perception::workerTrackerFields().rangeOf("tracker.detect_every_k"));
+    if (getPrivateNodeHandle().hasParam("track_max_side_px")) {
+      double side = cfg.tracker.track_max_side_px;
+      params.load("track_max_side_px", side, *perception::workerTrackerFields().rangeOf("tracker.track_max_side_px"));
+      cfg.tracker.track_max_side_px = static_cast<float>(side);
+    }
     bool appearance = true;
     params.load("appearance", appearance);
     cfg.tracker.appearance.enabled = appearance ? 1 : 0;

@@ -103,12 +103,17 @@ const common::FieldTable<WorkerTrackerConfig>& workerTrackerFields() {
       {"tracker.min_box_px", Range::atLeast(1.0), [](C& c) { return &c.min_box_px; }},
       {"tracker.roi_scale", Range::atLeast(1.0), [](C& c) { return &c.roi_scale; }},
       {"tracker.roi_min_side_px", Range::atLeast(32.0), [](C& c) { return &c.roi_min_side_px; }},
+      {"tracker.track_max_side_px", Range::closed(0.0, 4096.0), [](C& c) { return &c.track_max_side_px; }},
   }};
   return t;
 }
 
 std::vector<std::string> WorkerTrackerConfig::validate() const {
   auto lines = common::problemLines(workerTrackerFields().rangeProblems(*this));
+  if (track_max_side_px > 0.0f && track_max_side_px < kMinTrackSidePx) {
+    lines.push_back("tracker.track_max_side_px must be 0 (full resolution) or at least " +
+                    std::to_string(static_cast<int>(kMinTrackSidePx)) + " px, got " + std::to_string(track_max_side_px));
+  }
   for (auto& line : appearance.validate()) lines.push_back(std::move(line));
   return lines;
 }
@@ -123,7 +128,10 @@ common::Result<std::unique_ptr<WorkerTracker>> WorkerTracker::create(const Worke
 }
 
 WorkerTracker::WorkerTracker(WorkerTrackerConfig config, std::unique_ptr<PersonDetector> detector)
-    : config_(std::move(config)), detector_(std::move(detector)), appearance_(config_.appearance) {}
+    : config_(std::move(config)),
+      detector_(std::move(detector)),
+      tracker_(config_.tracker, config_.track_max_side_px),
+      appearance_(config_.appearance) {}
 
 void WorkerTracker::reset() {
   tracker_.reset();
@@ -184,22 +192,10 @@ common::Result<cv::Rect2f> WorkerTracker::selectCandidate(int index) {
   return common::Result<cv::Rect2f>::ok(box);
 }
 
-cv::Ptr<cv::Tracker> WorkerTracker::makeTracker() const {
-  if (config_.tracker == TrackerKind::kCsrt) return cv::TrackerCSRT::create();
-  return cv::TrackerKCF::create();
-}
-
 bool WorkerTracker::initTracker(const cv::Mat& frame, const cv::Rect2f& box) {
   const cv::Rect r(static_cast<int>(std::lround(box.x)), static_cast<int>(std::lround(box.y)),
                    std::max(1, static_cast<int>(std::lround(box.width))), std::max(1, static_cast<int>(std::lround(box.height))));
-  try {
-    tracker_ = makeTracker();
-    tracker_->init(frame, r);
-  } catch (const cv::Exception&) {
-    tracker_.reset();
-    return false;
-  }
-  return true;
+  return tracker_.init(frame, r);
 }
 
 common::Result<std::vector<Detection>> WorkerTracker::detectIn(const cv::Mat& frame, const cv::Rect& window) {
@@ -344,16 +340,11 @@ common::Result<TrackStep> WorkerTracker::step(const cv::Mat& frame) {
   // 1. visual tracker prediction; a box that stopped looking like the worker is a failure
   cv::Rect2f predicted;
   bool have_pred = false;
-  if (tracking_ && tracker_) {
+  if (tracking_ && tracker_.active()) {
     const int64_t t0 = cv::getTickCount();
-    cv::Rect r;
-    bool ok = false;
-    try {
-      ok = tracker_->update(frame, r);
-    } catch (const cv::Exception&) {
-      ok = false;
-    }
-    predicted = cv::Rect2f(r) & image_rect;
+    cv::Rect2f r;
+    const bool ok = tracker_.update(frame, r);
+    predicted = r & image_rect;
     have_pred = ok && predicted.width >= config_.min_box_px && predicted.height >= config_.min_box_px;
     if (have_pred && appearance_.established()) {
       out.similarity = appearance_.similarity(appearance_.describe(frame, predicted));

@@ -41,6 +41,7 @@
 #include "gesture_formation/common/result.hpp"
 #include "gesture_formation/perception/appearance.hpp"
 #include "gesture_formation/perception/person_detector.hpp"
+#include "gesture_formation/perception/scaled_tracker.hpp"
 
 namespace gesture_formation::common {
 template <class Config>
@@ -49,14 +50,20 @@ struct FieldTable;
 
 namespace gesture_formation::perception {
 
-/// Visual tracker used between detections.
-enum class TrackerKind { kKcf, kCsrt };
 common::Result<TrackerKind> parseTrackerKind(const std::string& text);
 std::string toString(TrackerKind kind);
+
+/// Smallest non-zero `WorkerTrackerConfig::track_max_side_px` [px]: below it the trackers' features
+/// (KCF's 4-px cells, CSRT's HOG) have too few cells on the person.
+constexpr float kMinTrackSidePx = 16.0f;
 
 /// \brief Configuration of `WorkerTracker` (defaults: docs/perception.md measurements).
 struct WorkerTrackerConfig {
   TrackerKind tracker = TrackerKind::kKcf;  ///< KCF: ~1–3 ms on a worker-sized box; CSRT ~10×
+  /// The visual tracker works on the frame shrunk so that the box's longer side is at most this
+  /// [px] (ScaledTracker), so its cost does not grow with a close worker's box; 0: full
+  /// resolution (cost grows with the box). 0 or [16, 4096].
+  float track_max_side_px = 96.0f;
   int detect_every_k = 5;             ///< run the detector at least every k frames, ≥ 1
   float min_detection_score = 0.25f;  ///< detections below are ignored, [0, 1)
   float associate_min_iou = 0.2f;     ///< IoU to keep the identity, (0, 1]
@@ -153,7 +160,6 @@ class WorkerTracker {
 
  private:
   WorkerTracker(WorkerTrackerConfig config, std::unique_ptr<PersonDetector> detector);
-  cv::Ptr<cv::Tracker> makeTracker() const;
   bool initTracker(const cv::Mat& frame, const cv::Rect2f& box);
   /// Detections in `window` of `frame`, boxes in frame pixels.
   common::Result<std::vector<Detection>> detectIn(const cv::Mat& frame, const cv::Rect& window);
@@ -171,7 +177,7 @@ class WorkerTracker {
 
   WorkerTrackerConfig config_;
   std::unique_ptr<PersonDetector> detector_;
-  cv::Ptr<cv::Tracker> tracker_;
+  ScaledTracker tracker_;
   bool tracking_ = false;        ///< a live track exists
   cv::Rect2f box_;               ///< current (or last) worker box
   int id_ = -1;                  ///< current (or last) id
