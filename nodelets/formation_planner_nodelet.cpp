@@ -3,11 +3,10 @@
 // replanning step"): freshness and hold / search (docs/safety.md §1), listening before moving
 // (§2.4), the stage-1 reference on the worker's prediction, the request around the other UAVs'
 // received plans (planning::buildPlanRequest) and the verified plan or its fallback (flagged
-// `fallback`: every other UAV plans around it). The leader's instance also owns the formation's
-// parameters (onboard::ParamsOwnership): commands arrive on formation_command_in (gestures,
-// operator over LCM), the parameters go out on formation_params_out. With ~leadership true (optional,
-// default false) that role follows this UAV's own leadership_state_in (LeadershipState; docs/safety.md
-// §1.2): every UAV subscribes, the acting one owns the parameters (onboard::ParamsOwnership says how).
+// `fallback`: every other UAV plans around it). The leader's instance owns the formation's parameters
+// (onboard::ParamsOwnership; commands in on formation_command_in, parameters out on formation_params_out).
+// With ~leadership true (optional, default false) the role, the slot flown and whose plan is the leader's
+// follow this UAV's own leadership_state_in (LeadershipState; docs/safety.md §1.2).
 //
 // Topics: odometry_in (nav_msgs/Odometry, orientation = camera axis, docs/ros.md),
 //   worker_state_in (WorkerState: the leader's estimator, or the leader's share over LCM),
@@ -129,7 +128,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   void onLeadership(const gesture_formation::LeadershipState::ConstPtr& msg) {
     if (msg->uav_index != uav_index_) return;
     std::lock_guard<std::mutex> lock(mutex_);
-    const auto change = own_->setActing(msg->acting, msg->header.stamp.toSec());
+    const auto change = own_->setActing(msg->acting, msg->header.stamp.toSec(), msg->leader);  // also the slot flown
     if (change == onboard::ParamsOwnership::Change::kNone) return;
     const bool started = change == onboard::ParamsOwnership::Change::kStarted;
     NODELET_WARN_STREAM("FormationPlanner UAV " << uav_index_ << (started ? ": acts as leader (term " : ": no longer acts as leader (term ")
@@ -245,7 +244,9 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     if (const auto w = wind_.at(t)) in.wind_estimate_mps = *w;
     in.worker = worker ? &*worker : nullptr;
     in.params = &own_->role().params();
-    in.leader_plan = received_[0] ? &received_[0]->plan : nullptr;
+    in.slot = own_->slot();  // ~leadership: the acting leader flies slot 0 (docs/safety.md §1.2)
+    in.leader_index = own_->leaderIndex();
+    if (const auto& l = received_[static_cast<std::size_t>(in.leader_index)]) in.leader_plan = &l->plan;
     in.received = &received_;
     const planning::ReplanOutcome out = step_->step(in);
     if (!out.planned()) return;
@@ -287,11 +288,10 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   std::unique_ptr<planning::ReplanStep> step_;  ///< planner, hold / search, listening (shared with gfctl simulate)
   std::optional<planning::UavKinematicState> odom_;
   std::optional<gesture_formation::WorkerState> worker_;
-  std::vector<std::optional<planning::ReceivedPlan>> received_;  ///< by sender; [0] the leader's plan
+  std::vector<std::optional<planning::ReceivedPlan>> received_;  ///< by sender (the leader's: own_->leaderIndex())
   int abort_link_sender_ = -1;  ///< who delivered the accepted abort (LCM sender id; -1: ROS)
   ros::Publisher plan_pub_, traj_pub_, params_pub_, abort_pub_, ack_pub_, assistance_pub_;
-  ros::Subscriber odom_sub_, worker_sub_, plans_sub_, params_sub_, command_sub_, wind_sub_, abort_sub_, assistance_sub_,
-      leadership_sub_;
+  ros::Subscriber odom_sub_, worker_sub_, plans_sub_, params_sub_, command_sub_, wind_sub_, abort_sub_, assistance_sub_, leadership_sub_;
   ros::Timer timer_, params_timer_;
 };
 

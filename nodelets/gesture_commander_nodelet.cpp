@@ -21,7 +21,12 @@
 //   or ~mission_file (a scenario's mission.gestures), ~uav_count, ~sender_name, ~frame_wait_s.
 //   Command sequence numbers start at the wall clock in microseconds, so a restarted commander
 //   is never taken for a duplicate.
+// Leader hand-over (optional ~leadership, default false; docs/safety.md §1.2): the commander runs on
+// every UAV and follows this UAV's leadership_state_in (LeadershipState): only while it acts are
+// observations taken and commands sent; each time it starts acting the frames and the filter start
+// afresh (as gfctl simulate's new leader: no half-seen performance of the predecessor's fires).
 #include <algorithm>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -35,6 +40,7 @@
 #include "diagnostics.hpp"
 #include "gesture_formation/GestureObservation.h"
 #include "gesture_formation/GestureStatus.h"
+#include "gesture_formation/LeadershipState.h"
 #include "gesture_formation/gesture/gesture_frames.hpp"
 #include "param_loader.hpp"
 
@@ -81,7 +87,9 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
       NODELET_ERROR_STREAM("GestureCommander refuses to start; fix these parameters:\n" << params.report());
       return;
     }
-    frames_.emplace(fcfg, vcfg, mapping, uav_count, frame_wait_s_);
+    getPrivateNodeHandle().param("leadership", leadership_, false);  // optional: see the file comment
+    make_frames_ = [=] { frames_.emplace(fcfg, vcfg, mapping, uav_count, frame_wait_s_); };
+    make_frames_();
     last_seen_s_.assign(static_cast<std::size_t>(frames_->views()), -1e9);
     NODELET_INFO_STREAM("GestureCommander loaded:\n"
                         << params.loaded() << "  view_fusion: " << frames_->views() << " camera(s), min_agreeing_views "
@@ -100,8 +108,20 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
     peer_sub_ = nh.subscribe("peer_observations_in", 100, &GestureCommanderNodelet::onObservation, this);
     timer_ = nh.createTimer(ros::Duration(0.01), [this](const ros::TimerEvent&) {
       std::lock_guard<std::mutex> lock(mutex_);
+      if (!acts()) return;
       for (const auto& f : frames_->closeDue(ros::Time::now().toSec())) publishFrame(f);
     });
+    if (leadership_) {
+      leadership_sub_ = nh.subscribe<gesture_formation::LeadershipState>(
+          "leadership_state_in", 5, [this](const gesture_formation::LeadershipState::ConstPtr& m) {
+            std::lock_guard<std::mutex> lock(mutex_);
+            if (m->acting == acting_) return;
+            acting_ = m->acting;
+            make_frames_();  // a new leader's vote and filter start afresh
+            NODELET_WARN_STREAM("GestureCommander: " << (acting_ ? "acts as leader (term " + std::to_string(m->term) + "): votes from now on"
+                                                                 : std::string("no longer acts as leader: no vote")));
+          });
+    }
     diagnostics_.start(nh, 1.0, [this](double since_s) { return health(since_s); });
   }
 
@@ -111,6 +131,7 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
     std::lock_guard<std::mutex> lock(mutex_);
     const double t = ros::Time::now().toSec();
     Health h("GestureCommander", "leader");
+    if (!acts()) return {h.value("acting", 0).status()};  // ~leadership, not acting: no vote here
     std::string silent;
     for (std::size_t v = 0; v < last_seen_s_.size(); ++v) {
       if (!(t - last_seen_s_[v] <= 2.0)) silent += (silent.empty() ? "" : ", ") + std::to_string(v);
@@ -126,9 +147,11 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
     return {h.status()};
   }
 
+  bool acts() const { return !leadership_ || acting_; }
+
   void onObservation(const gesture_formation::GestureObservation::ConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (msg->uav_index >= frames_->views()) return;  // single camera: the followers do not vote
+    if (!acts() || msg->uav_index >= frames_->views()) return;  // single camera: the followers do not vote
     std::string skeleton_problem;
     const gesture::ViewObservation o = toViewObservation(*msg, &skeleton_problem);
     if (!skeleton_problem.empty()) {
@@ -211,10 +234,12 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
   std::string sender_;
   double frame_wait_s_ = 0.0;
   std::optional<gesture::GestureFrames> frames_;  ///< vote, filter, mapping (shared with gfctl simulate)
+  std::function<void()> make_frames_;             ///< (re)starts frames_ from the loaded settings
+  bool leadership_ = false, acting_ = false;      ///< ~leadership; this UAV acts as leader
   std::uint64_t sequence_ = 0;
   std::string last_fired_;
   ros::Publisher command_pub_, status_pub_, abort_pub_, assistance_pub_;
-  ros::Subscriber own_sub_, peer_sub_;
+  ros::Subscriber own_sub_, peer_sub_, leadership_sub_;
   ros::Timer timer_;
 };
 

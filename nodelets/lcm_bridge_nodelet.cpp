@@ -82,7 +82,7 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     link_->setRejectHandler([this](const comm::VerifyResult& r, std::optional<std::uint16_t> claimed) {
       onRejected(r, claimed);
     });
-    heartbeat_.uav_index = static_cast<std::uint16_t>(std::min(cfg.link.sender_id, comm::kMaxUavIndex));
+    heartbeat_.uav_index = static_cast<std::uint16_t>(std::min(sender_id_ = cfg.link.sender_id, comm::kMaxUavIndex));
     report_.emplace("LcmBridge sender " + std::to_string(cfg.link.sender_id));
 
     // Queues hold a burst: every peer's messages of ~1 s (several UAVs, 10–30 Hz each).
@@ -101,9 +101,8 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     leadership_pub_ = nh.advertise<gesture_formation::LeadershipMessage>("leadership_out", 100);
     leadership_sub_ = nh.subscribe<gesture_formation::LeadershipMessage>(
         "leadership_in", 100, [this](const gesture_formation::LeadershipMessage::ConstPtr& m) { sendChecked(fromMsg(*m), "leadership message"); });
-    // Single events, sent now and repeated like a command: the operator's and gestures' commands,
-    // the leader's acknowledgements, the leader's assistance state (also re-sent with every worker
-    // state while requested) and the ground station's acknowledgement of it.
+    // Single events, sent now and repeated like a command: commands, the leader's acknowledgements and
+    // assistance state (re-sent with every worker state while requested), the ground's acknowledgement.
     command_sub_ = subscribeRepeated<gesture_formation::FormationCommand>(
         nh, "formation_command_in", 100, "command", [](const auto& m) { return fromMsg(m); });
     ack_pub_ = nh.advertise<gesture_formation::CommandAck>("command_ack_out", 50);
@@ -210,6 +209,7 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
 
   // Called from drain() (mutex held). What to hand on: comm::LinkInbox.
   void onEnvelope(const comm::Envelope& e) {
+    if (e.sender_id == sender_id_) return;  // its own, echoed by the multicast loop: nothing to hand on
     const comm::InboxItem item = inbox_.take(e);
     if (const auto* w = std::get_if<comm::WorkerStateMessage>(&item)) {
       auto m = fromWire(*w);
@@ -274,6 +274,7 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
 
   std::mutex mutex_;
   std::string world_frame_;
+  int sender_id_ = -1;  ///< this bridge's sender id (~sender_id)
   std::unique_ptr<lcm_bridge::LcmTransport> transport_;
   std::unique_ptr<lcm_bridge::SecureLink> link_;
   comm::LinkInbox inbox_;  ///< decoding, peers' heartbeats, first command copies, refused observations

@@ -12,6 +12,11 @@
 // Parameters (all required): ~uav_index, and formation::leadershipFields() by their last key
 //   segment: ~uav_count, ~heartbeat_period_s, ~lease_s, ~silence_limit_s, ~candidacy_stagger_s,
 //   ~election_timeout_s, ~clock_drift, ~estimate_tolerance_s (config/ros/nodelets.yaml `leadership`).
+//   Optional ~start: mission (term 1, UAV 0 leads), restart (a member that lost its term and vote:
+//   quiet for the promise time, Leadership::Start::kRestart — e.g. a UAV whose computer rebooted
+//   mid-mission) or auto (default): restart when this launch (~launch_id, the launch file's
+//   $(anon ...)) already started it once — the manager respawned or the nodelet was reloaded — else
+//   mission. Without the quiet restart a member could vote twice in one term.
 #include <cmath>
 #include <limits>
 #include <mutex>
@@ -35,6 +40,9 @@ class LeadershipNodelet : public nodelet::Nodelet {
     formation::LeadershipConfig cfg;
     params.loadFields(formation::leadershipFields(), cfg);
     params.load("uav_index", uav_index_, 0, comm::kMaxUavIndex);
+    std::string start;
+    params.loadOptional("start", start, "auto");
+    if (start != "auto" && start != "mission" && start != "restart") params.addError("start: must be mission, restart or auto, got '" + start + "'");
     if (params.ok()) {
       for (const auto& e : cfg.validate()) params.addError(e);  // the cross-field rules, naming the key
       if (uav_index_ >= cfg.uav_count) params.addError("uav_index: must be < uav_count (" + std::to_string(cfg.uav_count) + ")");
@@ -44,7 +52,7 @@ class LeadershipNodelet : public nodelet::Nodelet {
       return;
     }
     NODELET_INFO_STREAM("Leadership (UAV " << uav_index_ << ") loaded:\n" << params.loaded());
-    lead_.emplace(cfg, uav_index_, formation::Leadership::Start::kMissionStart, now());
+    lead_.emplace(cfg, uav_index_, startKind(getPrivateNodeHandle(), start), now());
     out_pub_ = nh.advertise<gesture_formation::LeadershipMessage>("leadership_out", 50);
     state_pub_ = nh.advertise<gesture_formation::LeadershipState>("leadership_state", 5, true);
     publishState(now());
@@ -60,6 +68,17 @@ class LeadershipNodelet : public nodelet::Nodelet {
       send(lead_->tick(t, estimateAge(t)));
       update(t);
     });
+  }
+
+  /// ~start / ~launch_id (see the file comment); marks this launch as started.
+  formation::Leadership::Start startKind(ros::NodeHandle& pnh, const std::string& start) {
+    std::string launch_id, started_in;
+    pnh.param<std::string>("launch_id", launch_id, "");
+    pnh.param<std::string>("started_in_launch", started_in, "");
+    const bool again = start == "restart" || (start == "auto" && !launch_id.empty() && started_in == launch_id);
+    if (!launch_id.empty()) pnh.setParam("started_in_launch", launch_id);
+    NODELET_INFO_STREAM("Leadership UAV " << uav_index_ << ": " << (again ? "restart: quiet for the promise time" : "mission start"));
+    return again ? formation::Leadership::Start::kRestart : formation::Leadership::Start::kMissionStart;
   }
 
   static double now() { return ros::Time::now().toSec(); }

@@ -105,6 +105,12 @@ class ParamLoader {
     if (!nh_.getParam(name, value)) value = fallback;
     loaded_ << "  " << name << " = " << value << "\n";
   }
+  /// \brief An optional bool: absent → `fallback` (never an error); not a bool → an error.
+  void loadOptional(const std::string& name, bool& value, bool fallback) {
+    value = fallback;
+    if (nh_.hasParam(name) && !nh_.getParam(name, value)) errors_.push_back(nh_.resolveName(name) + ": not a bool");
+    loaded_ << "  " << name << " = " << (value ? "true" : "false") << "\n";
+  }
   /// \brief A line for the "loaded" report (e.g. a value taken from a file, not a parameter).
   void note(const std::string& line) { loaded_ << "  " << line << "\n"; }
   void addError(const std::string& error) { errors_.push_back(error); }

@@ -29,6 +29,7 @@ struct SimWorldSettings {
   int seed = 0;
   double real_time_factor = 1.0, clock_step_s = 0.01, duration_s = 0.0;  ///< duration ≤ 0: the mission's
   bool rendered = false;  ///< ~camera rendered (default synthetic)
+  bool leadership = false;  ///< ~leadership (optional): the leader's work follows the acting UAV
 };
 inline void loadSimWorldSettings(ParamLoader& params, SimWorldSettings& s) {
   params.load("mission_file", s.mission_file);
@@ -45,6 +46,11 @@ inline void loadSimWorldSettings(ParamLoader& params, SimWorldSettings& s) {
     params.addError("camera: must be synthetic or rendered, got '" + camera_mode + "'");
   }
   s.rendered = camera_mode == "rendered";
+  params.loadOptional("leadership", s.leadership, false);
+  if (s.leadership && s.rendered) params.addError("leadership: true needs camera synthetic (rendered cameras: UAV 0's Perception is the leader's)");
+  if (s.leadership && s.camera_frame.rfind("uav0/", 0) != 0) {
+    params.addError("leader_camera_frame: with leadership it must start with uav0/ (UAV k's camera is uav<k>/...), got '" + s.camera_frame + "'");
+  }
 }
 
 }  // namespace gesture_formation::nodelets

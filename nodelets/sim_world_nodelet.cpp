@@ -1,10 +1,14 @@
 // SimWorld nodelet: the simulated mission's world on the sim core of `gfctl simulate` (docs/ros.md
 // "SimWorld"): sim time (/clock, from when every UAV's planner is up), the worker (sim::WorkerModel),
 // the cameras (sim::LeaderCamera: box, stereo and UWB with the sensor faults; each UAV's classification
-// as its Perception nodelet would publish it), the operator's scheduled requests and faults.abort
-// (through the ground's OperatorInterface, as an operator), the record (sim::WorldRecord: metrics,
+// as its Perception nodelet would publish it), the operator's scheduled requests, faults.abort and
+// faults.leader_silence (sim_world_calls.hpp), the record (sim::WorldRecord: metrics,
 // plans, modes, outcomes, abort states, files). ~camera rendered: SimCamera renders the worker's body
 // (worker_body_out) for the Perception nodelets; the leader's detections (detection_in) feed the metrics.
+// ~leadership (optional, default false; docs/safety.md §1.2): the leader camera is the acting leader's
+// (every UAV's leadership_state; UAV 0 until another acts), and the leader's estimate, parameters and
+// gesture status are the acting UAV's (uav<k>/worker_state, every uav<k>/formation_params and
+// gesture_status) — the synthetic camera only (rendered: the detections of detection_in, UAV 0's).
 #include <algorithm>
 #include <mutex>
 #include <optional>
@@ -14,13 +18,13 @@
 #include <ros/ros.h>
 #include <rosgraph_msgs/Clock.h>
 #include <std_msgs/Bool.h>
-#include <tf2_ros/transform_broadcaster.h>
 
+#include "sim_camera_topics.hpp"
 #include "sim_config_sources.hpp"
-#include "sim_conversions.hpp"
 #include "sim_start_gate.hpp"
+#include "sim_world_calls.hpp"
 #include "gesture_formation/GestureStatus.h"
-#include "gesture_formation/SendAbort.h"
+#include "gesture_formation/LeadershipState.h"
 #include "gesture_formation/formation/worker_heading.hpp"
 #include "gesture_formation/sim/leader_camera.hpp"
 #include "gesture_formation/sim/random.hpp"
@@ -46,6 +50,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
       if (!c) params.addError("mission_file: gesture_model " + cfg_.gesture_model + ": " + c.reason());
       else classifier_ = std::move(*c);
     }
+    if (const auto why = SimWorldCalls::checkSilence(cfg_.faults.leader_silence, set_.leadership); !why.empty()) params.addError(why);
     if (!params.ok()) {
       NODELET_ERROR_STREAM("SimWorld refuses to start; fix these parameters:\n" << params.report());
       return;
@@ -65,19 +70,14 @@ class SimWorldNodelet : public nodelet::Nodelet {
 
     clock_pub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
     worker_pub_ = nh.advertise<nav_msgs::Odometry>("worker_truth_out", 10);
-    uwb_pub_ = nh.advertise<sensor_msgs::Range>("uwb_out", 10);
     follower_views_ = cfg_.view_fusion.min_agreeing_views > 1;  // as sim::runMission
+    camera_topics_.advertise(nh, n_, set_.rendered, toCameraInfo(cfg_.camera.camera), set_.camera_frame, cfg_.uwb.max_range_m,
+                             cfg_.view_fusion.usesCalibratedViews());
     if (set_.rendered) {
       // The cameras are rendered (SimCamera) and seen by the Perception nodelets: no detection and
       // no classification from here, only the body they render.
       body_pub_ = nh.advertise<gesture_formation::WorkerBody>("worker_body_out", 10);
       detection_sub_ = nh.subscribe("detection_in", 20, &SimWorldNodelet::onLeaderDetection, this);
-    } else {
-      detection_pub_ = nh.advertise<gesture_formation::WorkerDetection>("detection_out", 10);
-      info_pub_ = nh.advertise<sensor_msgs::CameraInfo>("camera_info_out", 2);  // the leader camera's, every frame
-      info_ = toCameraInfo(cfg_.camera.camera);
-      info_.header.frame_id = set_.camera_frame;
-      for (int i = 0; i < (follower_views_ ? n_ : 1); ++i) gesture_pubs_.push_back(nh.advertise<gesture_formation::Gesture>("uav" + std::to_string(i) + "/gesture_out", 10));
     }
     command_pub_ = nh.advertise<gesture_formation::FormationCommand>("operator_command_out", 20);
     done_pub_ = nh.advertise<std_msgs::Bool>("done_out", 1, true);
@@ -92,17 +92,18 @@ class SimWorldNodelet : public nodelet::Nodelet {
       }));
       abort_subs_.push_back(perUav<gesture_formation::AbortState>(
           nh, i, "abort_state", [this](int k, const gesture_formation::AbortState& m) { record_->abortState(toAbortReport(k, m)); }));
+      if (set_.leadership) subscribeLeader(nh, i);
     }
     // faults.abort: asked of the ground station's OperatorInterface as an operator does.
-    abort_client_ = nh.serviceClient<gesture_formation::SendAbort>("send_abort");
-    params_sub_ = nh.subscribe("leader_params_in", 20, &SimWorldNodelet::onParams, this);
-    estimate_sub_ = nh.subscribe<gesture_formation::WorkerState>(
-        "worker_estimate_in", 10, [this](const gesture_formation::WorkerState::ConstPtr& m) {
-          std::lock_guard<std::mutex> lock(mutex_);
-          estimate_ = *m;
-          if (!m->lost) heading_->update(toEigen(m->velocity));  // the leader's ^Hφ follows its estimate
-        });
-    status_sub_ = nh.subscribe("gesture_status_in", 50, &SimWorldNodelet::onGestureStatus, this);
+    calls_.init(nh);
+    if (!set_.leadership) {  // UAV 0 does the leader's work
+      leader_subs_.push_back(nh.subscribe<gesture_formation::FormationParams>(
+          "leader_params_in", 20, [this](const gesture_formation::FormationParams::ConstPtr& m) { locked([&] { onParams(*m); }); }));
+      leader_subs_.push_back(nh.subscribe<gesture_formation::WorkerState>(
+          "worker_estimate_in", 10, [this](const gesture_formation::WorkerState::ConstPtr& m) { locked([&] { onEstimate(*m); }); }));
+      leader_subs_.push_back(nh.subscribe<gesture_formation::GestureStatus>(
+          "gesture_status_in", 50, [this](const gesture_formation::GestureStatus::ConstPtr& m) { locked([&] { onGestureStatus(*m); }); }));
+    }
     gate_.arm();
     publishClock();
     clock_timer_ = nh.createWallTimer(ros::WallDuration(set_.clock_step_s / set_.real_time_factor), &SimWorldNodelet::onClock, this);
@@ -117,9 +118,32 @@ class SimWorldNodelet : public nodelet::Nodelet {
     });
   }
 
-  void onParams(const gesture_formation::FormationParams::ConstPtr& m) {
+  template <class F>
+  void locked(F f) {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!finished_) record_->params(toParamsReport(*m));
+    f();
+  }
+  /// ~leadership: UAV i's leadership state (its acting makes its camera the leader's) and its
+  /// planner's parameters, gesture status (published only while it acts) and estimate (the owner's).
+  void subscribeLeader(ros::NodeHandle& nh, int i) {
+    leader_subs_.push_back(perUav<gesture_formation::LeadershipState>(nh, i, "leadership_state", [this](int k, const auto& m) {
+      calls_.log(k, m);
+      if (m.acting && k != owner_) NODELET_WARN_STREAM("SimWorld: the leader camera is UAV " << k << "'s from t = " << t_ << " s");
+      if (m.acting) owner_ = k;
+    }));
+    leader_subs_.push_back(perUav<gesture_formation::FormationParams>(nh, i, "formation_params", [this](int, const auto& m) { onParams(m); }));
+    leader_subs_.push_back(perUav<gesture_formation::GestureStatus>(nh, i, "gesture_status", [this](int, const auto& m) { onGestureStatus(m); }));
+    leader_subs_.push_back(perUav<gesture_formation::WorkerState>(nh, i, "worker_state", [this](int k, const auto& m) {
+      if (k == owner_) onEstimate(m);
+    }));
+  }
+  // Mutex held. The leader's parameters, estimate (its ^Hφ follows it) and gesture status.
+  void onParams(const gesture_formation::FormationParams& m) {
+    if (!finished_) record_->params(toParamsReport(m));
+  }
+  void onEstimate(const gesture_formation::WorkerState& m) {
+    estimate_ = m;
+    if (!m.lost) heading_->update(toEigen(m.velocity));
   }
 
   /// Rendered cameras: `visible` holds this long after the leader's Perception last found the worker.
@@ -135,12 +159,11 @@ class SimWorldNodelet : public nodelet::Nodelet {
     record_->metrics().cameraFrame(m->detected, est ? &*est : nullptr, worker_->stateAt(t).p_world);
   }
 
-  void onGestureStatus(const gesture_formation::GestureStatus::ConstPtr& m) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    last_class_ = m->gesture_id;
-    last_ratio_ = m->dominant_ratio;
-    if (finished_ || !m->fired) return;
-    record_->gestureFired(m->header.stamp.toSec(), m->dominant_id, cfg_.gesture_mapping);
+  void onGestureStatus(const gesture_formation::GestureStatus& m) {
+    last_class_ = m.gesture_id;
+    last_ratio_ = m.dominant_ratio;
+    if (finished_ || !m.fired) return;
+    record_->gestureFired(m.header.stamp.toSec(), m.dominant_id, cfg_.gesture_mapping);
   }
 
   void publishClock() {
@@ -150,23 +173,19 @@ class SimWorldNodelet : public nodelet::Nodelet {
   }
 
   void onClock(const ros::WallTimerEvent&) {
-    // faults.abort at its time: the operator's abort through the OperatorInterface's send_abort (it
-    // numbers the command and has the ground station's LcmBridge send its copies to every UAV);
-    // outside the lock: the service call waits for the OperatorInterface.
-    if (!tick()) return;
-    gesture_formation::SendAbort srv;
-    const bool sent = abort_client_.call(srv) && srv.response.accepted;
-    if (!sent) NODELET_ERROR_STREAM("SimWorld: faults.abort: send_abort failed" << (abort_client_.exists() ? ": " : " (no service)") << srv.response.message);
-    else NODELET_WARN_STREAM("SimWorld: faults.abort: the operator's abort #" << srv.response.sequence << " sent (" << srv.response.copies << " copies)");
+    // faults.abort and faults.leader_silence at their time, outside the lock (sim_world_calls.hpp).
+    const SimWorldDue due = tick();
+    if (due.abort) calls_.abort();
+    if (due.silence >= 0) SimWorldCalls::silence(due.silence, due.t_s);
   }
 
-  /// One clock step; true when faults.abort falls due in it.
-  bool tick() {
+  /// One clock step; what falls due in it.
+  SimWorldDue tick() {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (finished_) return false;
+    if (finished_) return {};
     if (!gate_.open(plan_subs_)) {  // sim time starts once every UAV's planner is up
       publishClock();
-      return false;
+      return {};
     }
     ++k_;
     t_ = static_cast<double>(k_) * set_.clock_step_s;
@@ -181,11 +200,14 @@ class SimWorldNodelet : public nodelet::Nodelet {
     }
     const bool all = record_->sampleSafety(t_, truth_, ws);  // false until every UAV's truth came
     // With the followers' cameras a frame needs every UAV's truth (the same number of followers every call).
-    if (camera_frames_->due(k_) && (follower_views_ ? all : truth_[0].has_value())) cameraFrame(ws);
+    if (camera_frames_->due(k_) && (follower_views_ ? all : truth_[static_cast<std::size_t>(owner_)].has_value())) cameraFrame(ws);
     if (timeline_samples_->due(k_)) sample(ws, all);
-    const bool abort_due = record_->abortDue(t_);
+    SimWorldDue due{record_->abortDue(t_), -1, t_};
+    const auto& silence = cfg_.faults.leader_silence;  // for good (checked at start): once, the acting UAV
+    if (silence && !silenced_ && t_ >= silence->t_s) due.silence = owner_;
+    silenced_ = silenced_ || due.silence >= 0;
     if (t_ >= set_.duration_s - 1e-9) finish();
-    return abort_due;
+    return due;
   }
 
   /// The leader's estimate predicted to t_s (nullopt before the first one).
@@ -194,27 +216,17 @@ class SimWorldNodelet : public nodelet::Nodelet {
     return toWorkerKnowledge(*estimate_).positionAt(t_s);
   }
 
-  /// UAV `uav`'s classification as its Perception nodelet would publish it (with the 3-D
-  /// confirmation: the skeleton and its camera on tf, toGestureMsg).
-  void publishGesture(int uav, const gesture::Classification& c, const ros::Time& stamp,
-                      const gesture::CalibratedSkeleton* skeleton) {
-    const auto& truth = truth_[static_cast<std::size_t>(uav)];
-    geometry_msgs::TransformStamped T;
-    const auto g = toGestureMsg(uav, c, stamp, skeleton, truth ? &*truth : nullptr, &T);
-    if (!T.child_frame_id.empty()) tf_.sendTransform(T);
-    gesture_pubs_[static_cast<std::size_t>(uav)].publish(g);
-  }
-
   void cameraFrame(const sim::WorkerState& ws) {
     std::vector<sim::MultirotorState> followers;
     std::vector<bool> online;
-    for (int i = 1; follower_views_ && i < n_; ++i) {
+    for (int i = 0; follower_views_ && i < n_; ++i) {  // the other UAVs' cameras, in index order
+      if (i == owner_) continue;
       followers.push_back(*truth_[static_cast<std::size_t>(i)]);
       online.push_back(!cfg_.faults.followerOffline(i, t_));
     }
     // The worker's performance advances in both modes; rendered cameras: only its body leaves.
     const sim::LeaderCameraFrame cf =
-        camera_->frame(t_, *truth_[0], followers, online, ws, *worker_, set_.rendered ? nullptr : classifier_.get());
+        camera_->frame(t_, *truth_[static_cast<std::size_t>(owner_)], followers, online, ws, *worker_, set_.rendered ? nullptr : classifier_.get());
     record_->metrics().counters().range_outliers += cf.range_outliers;
     const ros::Time stamp(t_);
     if (set_.rendered) {
@@ -223,19 +235,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
       const std::optional<Eigen::Vector3d> est = estimateAt(t_);
       record_->metrics().cameraFrame(cf.sensors.visible(), est ? &*est : nullptr, ws.p_world);
     }
-    if (std::isfinite(cf.sensors.d_uwb_m)) uwb_pub_.publish(toUwbRange(cf.sensors.d_uwb_m, cfg_.uwb.max_range_m, stamp, set_.camera_frame));
-    if (set_.rendered) return;  // the Perception nodelets see the rendered images
-    info_.header.stamp = stamp;
-    info_pub_.publish(info_);
-    // Each UAV's classifier output, the followers' first (the leader's closes the frame at the GestureCommander).
-    for (std::size_t i = 0; i < cf.followers.size(); ++i) {
-      const auto& f = cf.followers[i];
-      if (f.classification) publishGesture(static_cast<int>(i) + 1, *f.classification, stamp,
-                                           cfg_.view_fusion.usesCalibratedViews() && f.visible ? &f.calibrated : nullptr);
-    }
-    if (!cf.sensors.visible()) return;
-    detection_pub_.publish(toDetectionMsg(cf.sensors, stamp, set_.camera_frame));
-    if (cf.classification) publishGesture(0, *cf.classification, stamp, cfg_.view_fusion.usesCalibratedViews() ? &cf.calibrated : nullptr);
+    camera_topics_.publish(cf, owner_, truth_, stamp);
   }
 
   void sample(const sim::WorkerState& ws, bool all_truths) {
@@ -261,6 +261,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
     const double wall = gate_.wallSinceStart();
     // metrics.json last: its appearance tells tools/run_ros_mission.sh that the files are complete.
     std::string err, warning;
+    if (!calls_.write(set_.output_dir)) NODELET_ERROR_STREAM("SimWorld: " << set_.output_dir << "/leadership.csv not written");
     if (!record_->finish(worker_->episodes(), t_, wall, set_.output_dir, &err, &warning)) NODELET_ERROR_STREAM("SimWorld: " << err);
     if (!warning.empty()) NODELET_WARN_STREAM("SimWorld: " << warning);
     NODELET_INFO_STREAM("SimWorld: mission done at t = " << t_ << " s (" << wall << " s wall); wrote " << set_.output_dir
@@ -280,18 +281,16 @@ class SimWorldNodelet : public nodelet::Nodelet {
   SimWorldSettings set_;  ///< the nodelet's parameters (duration: the mission's if not given)
   double t_ = 0.0, last_ratio_ = 0.0, last_detected_s_ = -1e9;  ///< last detected: the leader's Perception (rendered)
   long k_ = 0;
-  int n_ = 0, last_class_ = -1;
-  bool finished_ = false, follower_views_ = false;
+  int n_ = 0, last_class_ = -1, owner_ = 0;  ///< owner_: whose camera is the leader's (~leadership: the acting UAV)
+  bool finished_ = false, follower_views_ = false, silenced_ = false;
   SimStartGate gate_;  ///< sim time starts once every UAV's planner is up
   std::vector<std::optional<sim::MultirotorState>> truth_;
   std::optional<gesture_formation::WorkerState> estimate_;
-  ros::Publisher clock_pub_, worker_pub_, detection_pub_, uwb_pub_, command_pub_, done_pub_, body_pub_, info_pub_;
-  sensor_msgs::CameraInfo info_;  ///< synthetic camera: the leader camera's intrinsics (the estimator's camera model)
-  tf2_ros::TransformBroadcaster tf_;  ///< the gesture cameras (3-D confirmation)
-  std::vector<ros::Publisher> gesture_pubs_;  ///< per UAV (only the leader's without follower views)
-  std::vector<ros::Subscriber> truth_subs_, plan_subs_, abort_subs_;
-  ros::ServiceClient abort_client_;
-  ros::Subscriber params_sub_, estimate_sub_, status_sub_, detection_sub_;
+  ros::Publisher clock_pub_, worker_pub_, command_pub_, done_pub_, body_pub_;
+  SimCameraTopics camera_topics_;  ///< the leader camera's detection, CameraInfo, UWB; every UAV's classification
+  std::vector<ros::Subscriber> truth_subs_, plan_subs_, abort_subs_, leader_subs_;
+  SimWorldCalls calls_;  ///< faults.abort, faults.leader_silence; the leadership log
+  ros::Subscriber detection_sub_;
   ros::WallTimer clock_timer_;
 };
 

@@ -9,6 +9,13 @@
 // ~intrinsics_source: camera_info (default: the camera model from camera_info_in, detections
 // refused until it has arrived) or config (the YAML's camera section, an explicit override);
 // estimation::CameraModelSource.
+// Leader hand-over (optional ~leadership, default false; docs/safety.md §1.2): the estimator runs on
+// every UAV and follows this UAV's leadership_state_in (LeadershipState). While the UAV does not act
+// it ignores its detections and hands on the acting leader's estimate (shared_state_in, from the
+// LcmBridge) as worker_state_out; starting to act it takes the last shared estimate over
+// (HumanKalman::adopt: position, velocity, position covariance, last fusion) and fuses its own
+// camera from there, publishing on worker_state_out and on share_out (to the LcmBridge) — as
+// gfctl simulate's new leader does.
 #include <mutex>
 #include <optional>
 
@@ -22,6 +29,7 @@
 #include "conversions.hpp"
 #include "diagnostics.hpp"
 #include "gesture_formation/estimation/camera_model_source.hpp"
+#include "gesture_formation/LeadershipState.h"
 #include "gesture_formation/estimation/estimator_config.hpp"
 #include "param_loader.hpp"
 
@@ -40,6 +48,7 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
     params.load("tf_timeout_s", tf_timeout_s_, 0.0, 1.0);
     double rate_hz = 0.0;
     params.load("publish_rate_hz", rate_hz, 0.1, 200.0);
+    pnh.param("leadership", leadership_, false);  // optional: see the file comment
     std::string source_name;
     params.loadOptional("intrinsics_source", source_name, "camera_info");
     const auto source = estimation::parseIntrinsicsSource(source_name);
@@ -71,6 +80,11 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
     detection_sub_ = nh.subscribe("detection_in", 10, &WorkerEstimatorNodelet::onDetection, this);
     uwb_sub_ = nh.subscribe("uwb_in", 10, &WorkerEstimatorNodelet::onUwb, this);
     timer_ = nh.createTimer(ros::Duration(1.0 / rate_hz), &WorkerEstimatorNodelet::onTimer, this);
+    if (leadership_) {
+      share_pub_ = nh.advertise<gesture_formation::WorkerState>("share_out", 10);
+      shared_sub_ = nh.subscribe("shared_state_in", 10, &WorkerEstimatorNodelet::onShared, this);
+      leadership_sub_ = nh.subscribe("leadership_state_in", 5, &WorkerEstimatorNodelet::onLeadership, this);
+    }
     diagnostics_.start(nh, 1.0, [this](double since_s) { return health(since_s); });
   }
 
@@ -83,6 +97,11 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
     const double uwb_age_s = last_uwb_stamp_.isZero() ? -1.0 : t - last_uwb_stamp_.toSec();
     const bool lost = filter_.confirmed() && filter_.lost(t);
     Health h("WorkerEstimator", "leader");
+    if (!estimates()) {  // ~leadership, not acting: hands on the leader's estimate
+      h.value("acting", 0).value("relayed_per_s", published_since_report_ / since_s);
+      fused_since_report_ = rejected_since_report_ = published_since_report_ = 0;
+      return {h.status()};
+    }
     h.warn(!camera_->model(), camera_->refusal())
         .warn(!filter_.confirmed(), "no confirmed track of the worker")
         .warn(lost, "worker lost (no measurement fused for " + std::to_string(fused_age_s) + " s)")
@@ -96,6 +115,48 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
         .value("published_per_s", published_since_report_ / since_s);
     fused_since_report_ = rejected_since_report_ = published_since_report_ = 0;
     return {h.status()};
+  }
+
+  /// ~leadership: the estimate is this UAV's own only while it acts as leader.
+  bool estimates() const { return !leadership_ || acting_; }
+  void publish(const gesture_formation::WorkerState& out) {
+    state_pub_.publish(out);
+    if (leadership_) share_pub_.publish(out);
+    ++published_since_report_;
+  }
+
+  // The acting leader's estimate over LCM: handed on while this UAV does not act, kept for a take-over.
+  void onShared(const gesture_formation::WorkerState::ConstPtr& msg) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (acting_) return;
+    last_share_ = *msg;
+    state_pub_.publish(*msg);
+    ++published_since_report_;
+  }
+
+  // This UAV's leadership view: starting to act, the estimator continues from the last share.
+  void onLeadership(const gesture_formation::LeadershipState::ConstPtr& msg) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (msg->acting == acting_) return;
+    acting_ = msg->acting;
+    filter_ = estimation::HumanKalman(config_.filter);
+    last_fused_ = ros::Time();
+    if (!acting_ || !last_share_) {
+      NODELET_WARN_STREAM("WorkerEstimator: " << (acting_ ? "acts as leader with no shared estimate: starts from its own detections"
+                                                           : "no longer acts as leader: hands on the leader's estimate"));
+      return;
+    }
+    const auto& w = *last_share_;
+    const double t = w.header.stamp.toSec(), fused = std::min(w.last_fused.toSec(), t);
+    Eigen::Matrix3d cov;
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) cov(r, c) = w.covariance[static_cast<std::size_t>(r * 6 + c)];
+    }
+    const bool adopted = filter_.adopt(t, toEigen(w.position), w.lost ? Eigen::Vector3d::Zero() : toEigen(w.velocity), cov, fused);
+    if (adopted) last_fused_ = ros::Time(fused);
+    NODELET_WARN_STREAM("WorkerEstimator: acts as leader (term " << msg->term << "): "
+                        << (adopted ? "continues from the shared estimate of t = " + std::to_string(t) + " s"
+                                    : std::string("the shared estimate was not usable: starts from its own detections")));
   }
 
   void onUwb(const sensor_msgs::Range::ConstPtr& msg) {
@@ -116,6 +177,7 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
       return;
     }
     std::lock_guard<std::mutex> lock(mutex_);
+    if (!estimates()) return;
     const double t = msg->header.stamp.toSec();
     const double uwb_age_s = std::abs((msg->header.stamp - last_uwb_stamp_).toSec());
     const double d_uwb = uwb_age_s <= uwb_max_age_s_ ? last_uwb_m_ : std::nan("");
@@ -147,13 +209,12 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
     out.lost = filter_.lost(t);
     out.predicted = false;
     out.last_fused = last_fused_;
-    state_pub_.publish(out);
-    ++published_since_report_;
+    publish(out);
   }
 
   void onTimer(const ros::TimerEvent& event) {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!filter_.confirmed()) return;
+    if (!estimates() || !filter_.confirmed()) return;
     const double t = event.current_real.toSec();
     const auto s = filter_.predicted(t);
     estimation::Vector6d x;
@@ -168,8 +229,7 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
     out.lost = filter_.lost(t);
     out.predicted = true;
     out.last_fused = last_fused_;
-    state_pub_.publish(out);
-    ++published_since_report_;
+    publish(out);
   }
 
   std::mutex mutex_;
@@ -186,8 +246,10 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
   ros::Time last_fused_;  ///< the last accepted measurement's stamp (WorkerState.last_fused)
   tf2_ros::Buffer tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
-  ros::Publisher state_pub_;
-  ros::Subscriber detection_sub_;
+  bool leadership_ = false, acting_ = false;  ///< ~leadership; this UAV acts as leader
+  std::optional<gesture_formation::WorkerState> last_share_;  ///< the acting leader's last estimate (~leadership)
+  ros::Publisher state_pub_, share_pub_;
+  ros::Subscriber detection_sub_, shared_sub_, leadership_sub_;
   ros::Subscriber uwb_sub_, info_sub_;
   ros::Timer timer_;
 };

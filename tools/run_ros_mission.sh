@@ -7,14 +7,17 @@
 # multicast route. Root runs it directly; another user needs sudo, used for that namespace only
 # (the launch itself runs as the user, setpriv).
 #   tools/run_ros_mission.sh [--out DIR] [--duration S] [--rtf X] [--seed N] [--mission FILE]
-#                            [--faults FILE] [--rviz] [--manager-prefix CMD] [--rss-budget-mb MB]
+#                            [--faults FILE] [--leadership] [--rviz] [--manager-prefix CMD]
+#                            [--rss-budget-mb MB]
 # --faults: a fault profile (e.g. config/faults/worker_lost_5s.yaml) merged into the mission for
 # every nodelet, as gfctl simulate --faults (simulation.launch faults:=).
+# --leadership: simulation.launch leadership:=true (the leader hand-over, docs/ros.md; needed by the
+# leader_dropout_for_good profile); SimWorld then also writes leadership.csv.
 # --manager-prefix: a launch-prefix for each UAV's nodelet manager (simulation.launch manager_prefix:=),
 # e.g. --manager-prefix "heaptrack -o /tmp/uav" to profile their memory.
 # --rss-budget-mb: each UAV nodelet manager's peak resident set (VmHWM, read from /proc/PID/status
-# at the mission's end) must stay within it (default 150, the budget of docs/design.md §7; 0: not
-# checked); the summary prints every process's peak.
+# at the mission's end) must stay within it (tools/run_demo.sh gives 150, the budget of
+# docs/design.md §7; default 0: not checked); the summary prints every process's peak either way.
 # Defaults: --out results/demo, the whole mission (451 s), --rtf 2 (sim seconds per wall second).
 # Exit code: 0 when the mission finished without a collision and within the memory budget; 1 when
 # it did not finish, a UAV collided or a UAV manager exceeded the budget; 2 for bad arguments or a
@@ -31,8 +34,9 @@ SEED=1
 MISSION=$SRC/config/scenarios/power_towers.yaml
 RVIZ=false
 FAULTS=
+LEADERSHIP=false
 MANAGER_PREFIX=
-RSS_BUDGET_MB=150
+RSS_BUDGET_MB=0
 while [ $# -gt 0 ]; do
   case $1 in
     --out) OUT=$2; shift 2 ;;
@@ -42,9 +46,10 @@ while [ $# -gt 0 ]; do
     --mission) MISSION=$(realpath "$2"); shift 2 ;;
     --faults) FAULTS=$(realpath "$2"); [ -f "$FAULTS" ] || { echo "$0: --faults: no file '$2'" >&2; exit 2; }; shift 2 ;;
     --rviz) RVIZ=true; shift ;;
+    --leadership) LEADERSHIP=true; shift ;;
     --manager-prefix) MANAGER_PREFIX=$2; shift 2 ;;
     --rss-budget-mb) RSS_BUDGET_MB=$2; [[ "$2" =~ ^[0-9]+$ ]] || { echo "$0: --rss-budget-mb: expected whole megabytes (0: no check), got '$2'" >&2; exit 2; }; shift 2 ;;
-    *) echo "usage: $0 [--out DIR] [--duration S] [--rtf X] [--seed N] [--mission FILE] [--faults FILE] [--rviz] [--manager-prefix CMD] [--rss-budget-mb MB]" >&2; exit 2 ;;
+    *) echo "usage: $0 [--out DIR] [--duration S] [--rtf X] [--seed N] [--mission FILE] [--faults FILE] [--leadership] [--rviz] [--manager-prefix CMD] [--rss-budget-mb MB]" >&2; exit 2 ;;
   esac
 done
 DEVEL=$(gf_devel_dir "$SRC") || exit 2
@@ -81,7 +86,7 @@ export DISPLAY=${DISPLAY:-} XAUTHORITY=${XAUTHORITY:-${HOME:-/root}/.Xauthority}
 source "$DEVEL/setup.bash"
 roslaunch --screen -p 11311 gesture_formation simulation.launch mission:=$MISSION seed:=$SEED \
   real_time_factor:=$RTF duration:=$DURATION output_dir:=$OUT key_dir:=$T/keys record:=true \
-  bag:=$OUT/mission.bag rviz:=$RVIZ faults:=$FAULTS manager_prefix:="$MANAGER_PREFIX" > "$T/launch.log" 2>&1 &
+  bag:=$OUT/mission.bag rviz:=$RVIZ faults:=$FAULTS leadership:=$LEADERSHIP manager_prefix:="$MANAGER_PREFIX" > "$T/launch.log" 2>&1 &
 launch=\$!
 # The world writes metrics.json when the mission ends; then stop everything (rosbag closes the bag).
 while kill -0 \$launch 2>/dev/null && [ ! -f "$OUT/metrics.json" ]; do sleep 1; done

@@ -51,8 +51,10 @@ ParamsOwnership::ParamsOwnership(const formation::FormationConfig& config, int u
   role_.emplace(config, uav_index);
 }
 
-ParamsOwnership::Change ParamsOwnership::setActing(bool acting, double t_s) {
-  if (!follow_ || acting == acting_) return Change::kNone;
+ParamsOwnership::Change ParamsOwnership::setActing(bool acting, double t_s, int leader) {
+  if (!follow_) return Change::kNone;
+  leader_ = leader;
+  if (acting == acting_) return Change::kNone;
   acting_ = acting;
   if (!acting_) return Change::kStopped;
   formation::FormationConfig cfg = config_;
@@ -61,6 +63,18 @@ ParamsOwnership::Change ParamsOwnership::setActing(bool acting, double t_s) {
   role_.emplace(cfg, formation::kLeader);
   took_over_s_ = t_s;
   return Change::kStarted;
+}
+
+int ParamsOwnership::slot() const {
+  if (!follow_) return -1;
+  if (acting_) return formation::kLeader;
+  return uav_index_ == formation::kLeader && leader_ > formation::kLeader ? leader_ : -1;
+}
+
+int ParamsOwnership::leaderIndex() const {
+  if (!follow_) return formation::kLeader;
+  if (acting_) return uav_index_;
+  return leader_ >= 0 ? leader_ : formation::kLeader;
 }
 
 common::Result<bool> ParamsOwnership::receive(const formation::FormationParams& params, std::uint64_t version) {

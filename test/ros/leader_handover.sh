@@ -6,12 +6,14 @@
 # UAV 0 alone acts before; it stops acting within its lease; a follower acts within the election's
 # limit; never two acting in any instant (every UAV's latched leadership_state, intervals from the
 # stamps); the new leader's term is newer and every UAV still heard from agrees on it; an operator
-# request after the hand-over is applied by the new leader (params_senders [0, 1, 2]: any UAV may
-# own the parameters; each planner publishes them only while it acts) and reaches the other follower.
+# request after the hand-over is applied by the new leader (leadership:=true lets any UAV send the
+# parameters; each planner publishes them only while it acts) and reaches the other follower; the new
+# leader's estimator fuses its own camera (SimWorld's leader camera follows the acting UAV) and the
+# other follower receives its estimate.
 set -o pipefail
 source "$(dirname "$0")/common.bash"
 need_netns
-sim_inner_start duration:=40 leadership:=true "params_senders:=[0,1,2]" gesture_prefix:=/world/unused
+sim_inner_start duration:=40 leadership:=true gesture_prefix:=/world/unused
 cat >> "$T/inner.sh" <<INNER
 timeout 80 python3 "$SRC/test/ros/leader_handover_check.py" "$SRC"
 rc=\$?

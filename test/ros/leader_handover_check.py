@@ -10,8 +10,10 @@ stamped with its end by the nodelet); the new leader's term is newer than 1 and 
 names it as leader. Then an operator request (`tools/gf_command.py followers distance_m 1`, through the
 ground station and LCM) is applied by the new leader — acknowledged as applied, its parameters
 published with a newer version than it took over — and reaches the other follower over LCM; UAV 0,
-which no longer acts, publishes no parameters after its lease. Prints one line per check; exit code =
-number of failures."""
+which no longer acts, publishes no parameters after its lease. The estimator follows too: the new
+leader's WorkerEstimator fuses its own camera's detections after the take-over (SimWorld's leader
+camera moves to the acting UAV; last_fused later than the take-over, not lost) and the other follower
+receives that estimate over LCM. Prints one line per check; exit code = number of failures."""
 import os
 import re
 import signal
@@ -20,7 +22,7 @@ import sys
 import time
 
 import rospy
-from gesture_formation.msg import FormationParams, LeadershipState
+from gesture_formation.msg import FormationParams, LeadershipState, WorkerState
 
 UAVS = 3
 SILENCE_AT_S = 8.0
@@ -82,6 +84,21 @@ def check_request(src, new, other, published, received, t_silence):
     check(not late, f"UAV 0 published no parameters after its lease ({len(late)} did)")
 
 
+def check_estimate(new, other, t_new, estimates, shared):
+    """The new leader's estimator fuses its own camera after the take-over; the other follower gets it."""
+    t1 = time.time()
+    while time.time() - t1 < 10:
+        fused = [m for m in estimates[new] if m.last_fused.to_sec() > t_new + 0.5 and not m.lost]
+        got = [m for m in shared[other] if m.last_fused.to_sec() > t_new + 0.5]
+        if fused and got:
+            break
+        time.sleep(0.1)
+    last = estimates[new][-1] if estimates[new] else None
+    seen = f"last estimate: last_fused {last.last_fused.to_sec():.2f} s, lost {last.lost}" if last else "no estimate at all"
+    check(bool(fused), f"UAV {new}'s estimator fuses its own camera after the take-over at {t_new:.2f} s ({seen})")
+    check(bool(got), f"UAV {other} receives UAV {new}'s estimate over LCM ({len(got)} fused after the take-over)")
+
+
 def main():
     src = sys.argv[1]
     rospy.init_node("leader_handover_check", anonymous=True)
@@ -93,6 +110,11 @@ def main():
         rospy.Subscriber(f"/uav{i}/lcm/formation_params", FormationParams, lambda m, i=i: received[i].append(m))
     for i in range(UAVS):
         rospy.Subscriber(f"/uav{i}/leadership_state", LeadershipState, lambda m, i=i: states[i].append(m))
+    estimates = {i: [] for i in range(UAVS)}  # each UAV's worker_state (its own estimate or the relayed share)
+    shared = {i: [] for i in range(UAVS)}     # the estimates each LcmBridge received (lcm/worker_state)
+    for i in range(UAVS):
+        rospy.Subscriber(f"/uav{i}/worker_state", WorkerState, lambda m, i=i: estimates[i].append(m))
+        rospy.Subscriber(f"/uav{i}/lcm/worker_state", WorkerState, lambda m, i=i: shared[i].append(m))
     t0 = time.time()
     while rospy.get_time() < SILENCE_AT_S and time.time() - t0 < 60:
         time.sleep(0.05)
@@ -144,6 +166,8 @@ def main():
               f"{states[other][-1].leader if states[other] else None}, term {states[other][-1].term if states[other] else None})")
     if new is not None:
         check_request(src, new, [i for i in range(1, UAVS) if i != new][0], published, received, t_silence)
+    if new is not None:
+        check_estimate(new, [i for i in range(1, UAVS) if i != new][0], t_new, estimates, shared)
     print(f"acting intervals: {iv}", flush=True)
     return fails
 

@@ -74,9 +74,18 @@ class ParamsOwnership {
 
   /// This UAV owns the parameters now.
   bool owns() const { return follow_ ? acting_ : uav_index_ == formation::kLeader; }
-  /// \brief Following the leadership: this UAV's acting state (its own LeadershipState) at `t_s`.
-  /// Starting to act, the role becomes the leader's from the parameters held, version carried on.
-  Change setActing(bool acting, double t_s);
+  /// \brief Following the leadership: this UAV's acting state (its own LeadershipState) at `t_s`
+  /// and the leader of its term as far as it knows (`leader`, −1: none). Starting to act, the role
+  /// becomes the leader's from the parameters held, version carried on.
+  Change setActing(bool acting, double t_s, int leader = -1);
+  /// \brief The formation slot this UAV flies (planning::ReplanInputs::slot), as gfctl simulate's
+  /// hand-over assigns it: the acting leader flies the leader's (0); UAV 0, no longer acting,
+  /// the slot its successor left (the successor's index; −1 before one is known: its own); every
+  /// other UAV its own (−1). Not following the leadership: −1.
+  int slot() const;
+  /// \brief Whose plan is the leader's (planning::ReplanInputs::leader_index): this UAV while it
+  /// acts, else the leader it knows (UAV 0 before one is known or without the leadership).
+  int leaderIndex() const;
   /// \brief A command sent at `stamp_s` is this UAV's to apply.
   bool takesCommand(double stamp_s) const { return owns() && (!follow_ || stamp_s >= took_over_s_); }
   /// \brief The owner's parameters as received; ignored (ok(false)) while this UAV owns them.
@@ -92,6 +101,7 @@ class ParamsOwnership {
   std::optional<FormationParamsRole> role_;
   int uav_index_ = 0;
   bool follow_ = false, acting_ = false;
+  int leader_ = -1;                 ///< the leader of this UAV's term as it knows it (−1: none)
   std::uint64_t base_version_ = 0;  ///< the version taken over (0: the role's own)
   double took_over_s_ = 0.0;        ///< when this UAV last started acting
 };

@@ -156,3 +156,35 @@ TEST(ParamsOwnershipTest, TheActingUavTakesTheParametersOverWithTheirVersion) {
   EXPECT_TRUE(by_index.owns());
   EXPECT_TRUE(by_index.takesCommand(0.0));
 }
+
+TEST(ParamsOwnershipTest, TheSlotAndTheLeadersPlanFollowTheLeadership) {
+  formation::FormationConfig config;
+  // Not following the leadership: by index, UAV 0 leads, every UAV flies its own slot.
+  onboard::ParamsOwnership by_index(config, 2, false);
+  by_index.setActing(true, 1.0, 2);
+  EXPECT_EQ(by_index.slot(), -1);
+  EXPECT_EQ(by_index.leaderIndex(), 0);
+
+  onboard::ParamsOwnership uav1(config, 1, true);
+  EXPECT_EQ(uav1.slot(), -1) << "a follower flies its own slot";
+  EXPECT_EQ(uav1.leaderIndex(), 0) << "before any leadership state: UAV 0's plan is the leader's";
+  uav1.setActing(false, 1.0, 0);
+  EXPECT_EQ(uav1.leaderIndex(), 0);
+  ASSERT_EQ(uav1.setActing(true, 10.0, 1), onboard::ParamsOwnership::Change::kStarted);
+  EXPECT_EQ(uav1.slot(), 0) << "the acting leader flies the leader's slot";
+  EXPECT_EQ(uav1.leaderIndex(), 1);
+  uav1.setActing(false, 20.0, 2);
+  EXPECT_EQ(uav1.slot(), -1) << "no longer acting: its own slot again";
+  EXPECT_EQ(uav1.leaderIndex(), 2) << "the new leader's plan";
+
+  onboard::ParamsOwnership uav0(config, 0, true);
+  EXPECT_EQ(uav0.slot(), -1) << "its own index: the leader's slot";
+  uav0.setActing(true, 0.0, 0);
+  EXPECT_EQ(uav0.slot(), 0);
+  uav0.setActing(false, 8.0, 0);
+  EXPECT_EQ(uav0.slot(), -1) << "lease lapsed, no successor known: its own slot";
+  EXPECT_EQ(uav0.leaderIndex(), 0);
+  uav0.setActing(false, 12.0, 1);
+  EXPECT_EQ(uav0.slot(), 1) << "UAV 0 flies the slot its successor left";
+  EXPECT_EQ(uav0.leaderIndex(), 1);
+}
