@@ -9,8 +9,10 @@
 #   tools/run_demo.sh                     # seed 1 → results/demo/
 #   tools/run_demo.sh --rviz              # the same with rviz open
 #   GF_DEMO_SEED=7 tools/run_demo.sh      # another seed (any run_ros_mission.sh option may follow)
-# Exit code: non-zero when the setup, the build or the mission failed (did not finish, or a
-# collision). The one-process variant without ROS is `gfctl simulate` (README).
+#   GF_DEMO_RSS_BUDGET_MB=400 tools/run_demo.sh   # another memory budget per UAV manager (MB; 0: none)
+# Exit code: non-zero when the setup, the build or the mission failed (did not finish, a
+# collision, or a UAV nodelet manager's peak resident set above the budget, 150 MB by default).
+# The one-process variant without ROS is `gfctl simulate` (README).
 case "${1:-}" in -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;; esac  # the comment above
 set -eo pipefail
 cd "$(dirname "$0")/.."
@@ -34,4 +36,5 @@ if ! build; then
   fi
 fi
 echo "== the power-tower mission through launch/simulation.launch, seed ${GF_DEMO_SEED:-1} (451 s simulated at 2x real time)"
-exec tools/run_ros_mission.sh --seed "${GF_DEMO_SEED:-1}" "$@"
+# Each UAV's nodelet manager must stay within the memory budget (peak resident set, design.md §7).
+exec tools/run_ros_mission.sh --seed "${GF_DEMO_SEED:-1}" --rss-budget-mb "${GF_DEMO_RSS_BUDGET_MB:-150}" "$@"

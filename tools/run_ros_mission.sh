@@ -7,14 +7,21 @@
 # multicast route. Root runs it directly; another user needs sudo, used for that namespace only
 # (the launch itself runs as the user, setpriv).
 #   tools/run_ros_mission.sh [--out DIR] [--duration S] [--rtf X] [--seed N] [--mission FILE]
-#                            [--faults FILE] [--leadership] [--rviz]
+#                            [--faults FILE] [--leadership] [--rviz] [--manager-prefix CMD]
+#                            [--rss-budget-mb MB]
 # --faults: a fault profile (e.g. config/faults/worker_lost_5s.yaml) merged into the mission for
 # every nodelet, as gfctl simulate --faults (simulation.launch faults:=).
 # --leadership: simulation.launch leadership:=true (the leader hand-over, docs/ros.md; needed by the
 # leader_dropout_for_good profile); SimWorld then also writes leadership.csv.
+# --manager-prefix: a launch-prefix for each UAV's nodelet manager (simulation.launch manager_prefix:=),
+# e.g. --manager-prefix "heaptrack -o /tmp/uav" to profile their memory.
+# --rss-budget-mb: each UAV nodelet manager's peak resident set (VmHWM, read from /proc/PID/status
+# at the mission's end) must stay within it (tools/run_demo.sh gives 150, the budget of
+# docs/design.md §7; default 0: not checked); the summary prints every process's peak either way.
 # Defaults: --out results/demo, the whole mission (451 s), --rtf 2 (sim seconds per wall second).
-# Exit code: 0 when the mission finished without a collision; 1 when it did not finish or a UAV
-# collided; 2 for bad arguments or a missing build.
+# Exit code: 0 when the mission finished without a collision and within the memory budget; 1 when
+# it did not finish, a UAV collided or a UAV manager exceeded the budget; 2 for bad arguments or a
+# missing build.
 case "${1:-}" in -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;; esac  # the comment above
 set -eo pipefail  # not -u: devel/setup.bash reads unset variables
 cd "$(dirname "$0")/.."
@@ -28,6 +35,8 @@ MISSION=$SRC/config/scenarios/power_towers.yaml
 RVIZ=false
 FAULTS=
 LEADERSHIP=false
+MANAGER_PREFIX=
+RSS_BUDGET_MB=0
 while [ $# -gt 0 ]; do
   case $1 in
     --out) OUT=$2; shift 2 ;;
@@ -38,7 +47,9 @@ while [ $# -gt 0 ]; do
     --faults) FAULTS=$(realpath "$2"); [ -f "$FAULTS" ] || { echo "$0: --faults: no file '$2'" >&2; exit 2; }; shift 2 ;;
     --rviz) RVIZ=true; shift ;;
     --leadership) LEADERSHIP=true; shift ;;
-    *) echo "usage: $0 [--out DIR] [--duration S] [--rtf X] [--seed N] [--mission FILE] [--faults FILE] [--leadership] [--rviz]" >&2; exit 2 ;;
+    --manager-prefix) MANAGER_PREFIX=$2; shift 2 ;;
+    --rss-budget-mb) RSS_BUDGET_MB=$2; [[ "$2" =~ ^[0-9]+$ ]] || { echo "$0: --rss-budget-mb: expected whole megabytes (0: no check), got '$2'" >&2; exit 2; }; shift 2 ;;
+    *) echo "usage: $0 [--out DIR] [--duration S] [--rtf X] [--seed N] [--mission FILE] [--faults FILE] [--leadership] [--rviz] [--manager-prefix CMD] [--rss-budget-mb MB]" >&2; exit 2 ;;
   esac
 done
 DEVEL=$(gf_devel_dir "$SRC") || exit 2
@@ -75,13 +86,18 @@ export DISPLAY=${DISPLAY:-} XAUTHORITY=${XAUTHORITY:-${HOME:-/root}/.Xauthority}
 source "$DEVEL/setup.bash"
 roslaunch --screen -p 11311 gesture_formation simulation.launch mission:=$MISSION seed:=$SEED \
   real_time_factor:=$RTF duration:=$DURATION output_dir:=$OUT key_dir:=$T/keys record:=true \
-  bag:=$OUT/mission.bag rviz:=$RVIZ faults:=$FAULTS leadership:=$LEADERSHIP > "$T/launch.log" 2>&1 &
+  bag:=$OUT/mission.bag rviz:=$RVIZ faults:=$FAULTS leadership:=$LEADERSHIP manager_prefix:="$MANAGER_PREFIX" > "$T/launch.log" 2>&1 &
 launch=\$!
 # The world writes metrics.json when the mission ends; then stop everything (rosbag closes the bag).
 while kill -0 \$launch 2>/dev/null && [ ! -f "$OUT/metrics.json" ]; do sleep 1; done
 sleep 2
 # CPU time and memory of every process of the launch (nodelet managers: one per UAV + world).
-ps -eo pid,cputime,rss,args --sort=-cputime | grep -F "$T/log" | grep -E "nodelet manager|record|rosmaster|rviz" | grep -v grep > "$OUT/processes.txt" || true
+# Columns: pid, CPU time, resident KB now, peak resident KB (VmHWM of /proc/PID/status), args.
+ps -eo pid,cputime,rss,args --sort=-cputime | grep -F "$T/log" | grep -E "nodelet manager|record|rosmaster|rviz" | grep -v grep |
+  while read -r pid cpu rss args; do
+    hwm=\$(awk '/^VmHWM:/ { print \$2 }' /proc/\$pid/status 2>/dev/null)
+    echo "\$pid \$cpu \$rss \${hwm:-0} \$args"
+  done > "$OUT/processes.txt" || true
 kill -INT \$launch 2>/dev/null || true
 wait \$launch || true
 INNER
@@ -110,15 +126,35 @@ print(f"  distance error rms {f('distance_error_rms_m', ' m')}, angle error rms 
       f"brake {m['plans_fallback_brake']} of {m['plans']})")
 PY
 echo "  CPU time / memory per process (wall $(( $(date +%s) - start )) s):"
-python3 - "$OUT/processes.txt" <<'PY2' || true
+# Each UAV's nodelet manager against the memory budget (peak resident set, VmHWM; docs/design.md §7).
+memory_ok=true
+python3 - "$OUT/processes.txt" "$RSS_BUDGET_MB" <<'PY2' || memory_ok=false
 import re, sys
+budget_mb = float(sys.argv[2])
+peaks = {}
 for line in open(sys.argv[1]):
-    f = line.split(None, 3)
-    if len(f) < 4:
+    f = line.split(None, 4)
+    if len(f) < 5:
         continue
-    log = re.search(r"__log:=\S*/([^/ ]+?)(-\d+)?\.log", f[3])
-    name = log.group(1) if log else f[3].split()[0].split("/")[-1]
-    print(f"    {name:<24} cpu {f[1]}  rss {int(f[2]) / 1024:.0f} MB")
+    log = re.search(r"__log:=\S*/([^/ ]+?)(-\d+)?\.log", f[4])
+    name = log.group(1) if log else f[4].split()[0].split("/")[-1]
+    rss_mb, hwm_mb = int(f[2]) / 1024, int(f[3]) / 1024
+    if rss_mb < 8:
+        continue  # a launch-prefix wrapper (e.g. heaptrack's shell), not the process itself
+    print(f"    {name:<24} cpu {f[1]}  rss {rss_mb:.0f} MB  peak {hwm_mb:.0f} MB")
+    if re.fullmatch(r"uav\d+-manager", name):
+        peaks[name] = max(peaks.get(name, 0.0), hwm_mb)
+if not peaks:
+    print("  UAV managers' peak RSS: not measured (no UAV manager found)")
+    sys.exit(1 if budget_mb > 0 else 0)
+worst = max(peaks.values())
+listing = ", ".join(f"{n.split('-')[0]} {v:.0f} MB" for n, v in sorted(peaks.items()))
+if budget_mb <= 0:
+    print(f"  UAV managers' peak RSS (VmHWM): {listing} (no budget checked)")
+    sys.exit(0)
+verdict = "within" if worst <= budget_mb else "EXCEEDS"
+print(f"  UAV managers' peak RSS (VmHWM): {listing}: max {worst:.0f} MB {verdict} the budget of {budget_mb:.0f} MB")
+sys.exit(0 if worst <= budget_mb else 1)
 PY2
 python3 tools/bag_latency.py "$OUT/mission.bag" 2>/dev/null || true
 ls -la "$OUT/mission.bag" 2>/dev/null | awk '{print "  bag: " $NF " (" $5 " bytes)"}'
@@ -126,3 +162,4 @@ echo "replay: roslaunch gesture_formation replay.launch bag:=$OUT/mission.bag"
 collisions=$(python3 -c "import json, sys; print(json.load(open(sys.argv[1]))['collisions'])" "$OUT/metrics.json")
 [ -s "$OUT/mission.bag" ] || { echo "$0: FAILED: no bag recorded ($OUT/mission.bag)" >&2; exit 1; }
 [ "$collisions" = 0 ] || { echo "$0: FAILED: $collisions collision(s)" >&2; exit 1; }
+$memory_ok || { echo "$0: FAILED: a UAV nodelet manager's peak RSS exceeds the budget of $RSS_BUDGET_MB MB (--rss-budget-mb)" >&2; exit 1; }

@@ -1,6 +1,7 @@
 #include "gesture_formation/sim/leader_camera.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <condition_variable>
 #include <limits>
 #include <mutex>
@@ -22,8 +23,12 @@ std::vector<std::optional<gesture::Classification>> MissionClassifier::classifyA
 
 namespace {
 
-/// The ONNX LSTM; classifyAll spreads a frame's windows over `nets_.size()` threads: the caller
-/// takes windows 0, T, 2T, …, persistent worker j windows j, j + T, … with its own network.
+/// The ONNX LSTM; classifyAll spreads a frame's windows over `nets_.size()` threads, each with
+/// its own network: the caller and the persistent workers claim the windows one at a time from a
+/// shared counter, so the caller never waits for a worker that has not started yet (on a loaded
+/// machine it classifies them all itself) and waits only for windows a worker has claimed. The
+/// networks are copies of one model and keep no state between windows: which thread classifies a
+/// window does not change its result (test_sim ParallelClassifierTest).
 class OnnxClassifier : public MissionClassifier {
  public:
   explicit OnnxClassifier(std::vector<gesture::GestureClassifier> nets) : nets_(std::move(nets)) {
@@ -55,13 +60,16 @@ class OnnxClassifier : public MissionClassifier {
       std::lock_guard<std::mutex> lock(mutex_);
       batch_ = &windows;
       results_ = &out;
-      pending_ = static_cast<int>(workers_.size());
+      next_.store(0);
+      completed_.store(0);
+      open_ = true;
       ++generation_;
     }
     start_.notify_all();
-    share(0);
+    claim(0);
     std::unique_lock<std::mutex> lock(mutex_);
-    done_.wait(lock, [this] { return pending_ == 0; });
+    done_.wait(lock, [&] { return completed_.load() == windows.size() && active_ == 0; });
+    open_ = false;  // a worker waking from now on finds nothing to join
     batch_ = nullptr;
     results_ = nullptr;
     return out;
@@ -72,9 +80,13 @@ class OnnxClassifier : public MissionClassifier {
     auto c = nets_[net].classify(w);
     if (c) slot = *c;
   }
-  /// Thread j's share of the current batch (each slot is written by exactly one thread).
-  void share(std::size_t j) {
-    for (std::size_t i = j; i < batch_->size(); i += nets_.size()) run(j, *(*batch_)[i], (*results_)[i]);
+  /// Thread j classifies unclaimed windows of the open batch with its network until none is left
+  /// (each slot is written by exactly the thread that claimed it).
+  void claim(std::size_t j) {
+    for (std::size_t i = next_.fetch_add(1); i < batch_->size(); i = next_.fetch_add(1)) {
+      run(j, *(*batch_)[i], (*results_)[i]);
+      completed_.fetch_add(1);
+    }
   }
   void work(std::size_t j) {
     std::uint64_t seen = 0;
@@ -83,10 +95,13 @@ class OnnxClassifier : public MissionClassifier {
       start_.wait(lock, [&] { return stop_ || generation_ != seen; });
       if (stop_) return;
       seen = generation_;
+      if (!open_) continue;  // the caller already finished that batch alone
+      ++active_;             // the caller waits for this thread before it closes the batch
       lock.unlock();
-      share(j);
+      claim(j);
       lock.lock();
-      if (--pending_ == 0) done_.notify_one();
+      --active_;
+      done_.notify_one();
     }
   }
 
@@ -96,8 +111,11 @@ class OnnxClassifier : public MissionClassifier {
   std::condition_variable start_, done_;
   const std::vector<const gesture::SkeletonWindow*>* batch_ = nullptr;
   std::vector<std::optional<gesture::Classification>>* results_ = nullptr;
+  std::atomic<std::size_t> next_{0};       ///< the next unclaimed window of the open batch
+  std::atomic<std::size_t> completed_{0};  ///< windows of the open batch classified
   std::uint64_t generation_ = 0;
-  int pending_ = 0;
+  int active_ = 0;     ///< workers inside the open batch (guarded by mutex_)
+  bool open_ = false;  ///< a batch is published and not yet closed by the caller (guarded by mutex_)
   bool stop_ = false;
 };
 

@@ -105,3 +105,40 @@ TEST(ParallelClassifierTest, BadThreadCountsAreRefusedWithTheValue) {
   ASSERT_FALSE(missing);
   EXPECT_NE(missing.reason().find("/nonexistent/model.onnx"), std::string::npos) << missing.reason();
 }
+
+TEST(ParallelClassifierTest, ManyBatchesInARowGiveTheSameResultsWhoeverClaimsEachWindow) {
+  // The mission's pattern: thousands of frames of up to three windows, one after another. The
+  // threads claim windows as they come (a late worker finds its batch already done); every
+  // result must still be the one network's, whichever thread classified it.
+  const auto windows = syntheticWindows(3);
+  ASSERT_GE(windows.size(), 30u);
+  auto serial = gf::gesture::GestureClassifier::load(kModel);
+  ASSERT_TRUE(serial) << serial.reason();
+  std::vector<gf::gesture::Classification> expected;
+  for (const auto& w : windows) {
+    auto c = serial->classify(w);
+    ASSERT_TRUE(c) << c.reason();
+    expected.push_back(*c);
+  }
+  for (int threads : {2, 3}) {
+    auto mc = gf::sim::loadOnnxClassifier(kModel, threads);
+    ASSERT_TRUE(mc) << mc.reason();
+    int mismatches = 0;
+    for (int frame = 0; frame < 1500; ++frame) {
+      const std::size_t n = 2 + static_cast<std::size_t>(frame % 2);  // 2 or 3 views
+      std::vector<const gf::gesture::SkeletonWindow*> ptrs;
+      std::vector<std::size_t> index;
+      for (std::size_t v = 0; v < n; ++v) {
+        index.push_back((static_cast<std::size_t>(frame) * 7 + v * 11) % windows.size());
+        ptrs.push_back(&windows[index.back()]);
+      }
+      const auto got = (*mc)->classifyAll(ptrs);
+      ASSERT_EQ(got.size(), n);
+      for (std::size_t v = 0; v < n; ++v) {
+        const auto& e = expected[index[v]];
+        if (!got[v] || got[v]->gesture_id != e.gesture_id || got[v]->probabilities != e.probabilities) ++mismatches;
+      }
+    }
+    EXPECT_EQ(mismatches, 0) << "threads " << threads;
+  }
+}
