@@ -61,7 +61,7 @@ DistanceField::DistanceField(const OccupancyMap& map, double max_distance_m)
   dist_m_.assign(voxels, 0.0f);
   if (range_voxels_ == 0) {
     recomputeBox(map.denseGrid(), LocalBox{VoxelIndex::Zero(), size_ - VoxelIndex::Ones()});
-    scratch_ = std::vector<double>();  // a whole-grid scratch is not kept
+    scratch_ = std::vector<float>();  // a whole-grid scratch is not kept
     return;
   }
   const std::size_t nmax = static_cast<std::size_t>(size_.maxCoeff());
@@ -107,14 +107,23 @@ std::size_t DistanceField::recomputeBox(const std::vector<std::uint8_t>& occupan
   const VoxelIndex n = hi - lo + VoxelIndex::Ones();
   const VoxelIndex t0 = target.lo - lo, t1 = target.hi - lo;  // the target, relative to lo
   const std::size_t nx = static_cast<std::size_t>(n.x()), ny = static_cast<std::size_t>(n.y());
+  // The scratch holds squared voxel distances as float (half a double's memory: 128 -> 64 MB for the
+  // power-tower grid): each is 0, far — read back as exactly kFar, so that f ≤ kFar holds in
+  // transform1d — or an integer sum of squares of at most the box's diagonal², exact in a float below
+  // 2^24 (diagonals under 4096 voxels; beyond, rounded by less than 6e-8 of its value).
   scratch_.resize(nx * ny * static_cast<std::size_t>(n.z()));
-  auto at = [&](int i, int j, int k) -> double& {
-    return scratch_[static_cast<std::size_t>(i) + nx * (static_cast<std::size_t>(j) + ny * static_cast<std::size_t>(k))];
+  auto index = [&](int i, int j, int k) {
+    return static_cast<std::size_t>(i) + nx * (static_cast<std::size_t>(j) + ny * static_cast<std::size_t>(k));
   };
+  auto get = [&](int i, int j, int k) -> double {
+    const double x = scratch_[index(i, j, k)];
+    return x >= 0.5 * kFar ? kFar : x;
+  };
+  auto set = [&](int i, int j, int k, double x) { scratch_[index(i, j, k)] = static_cast<float>(x); };
   for (int k = 0; k < n.z(); ++k) {
     for (int j = 0; j < n.y(); ++j) {
       const std::size_t row = linear(lo.x(), lo.y() + j, lo.z() + k);
-      for (int i = 0; i < n.x(); ++i) at(i, j, k) = occupancy[row + static_cast<std::size_t>(i)] != 0 ? 0.0 : kFar;
+      for (int i = 0; i < n.x(); ++i) set(i, j, k, occupancy[row + static_cast<std::size_t>(i)] != 0 ? 0.0 : kFar);
     }
   }
   const int nmax = n.maxCoeff();
@@ -124,20 +133,20 @@ std::size_t DistanceField::recomputeBox(const std::vector<std::uint8_t>& occupan
   // One 1-D transform along axis `axis` through (i, j, k) (its own coordinate ignored).
   auto line = [&](int axis, int i, int j, int k) {
     VoxelIndex q(i, j, k);
-    for (q(axis) = 0; q(axis) < n(axis); ++q(axis)) f[static_cast<std::size_t>(q(axis))] = at(q.x(), q.y(), q.z());
+    for (q(axis) = 0; q(axis) < n(axis); ++q(axis)) f[static_cast<std::size_t>(q(axis))] = get(q.x(), q.y(), q.z());
     transform1d(f.data(), n(axis), d.data(), v.data(), z.data());
   };
   // x over the whole grown box; y only where the target's x lies; z only in the target's x-y.
   for (int k = 0; k < n.z(); ++k) {
     for (int j = 0; j < n.y(); ++j) {
       line(0, 0, j, k);
-      for (int i = 0; i < n.x(); ++i) at(i, j, k) = std::min(d[static_cast<std::size_t>(i)], kFar);
+      for (int i = 0; i < n.x(); ++i) set(i, j, k, std::min(d[static_cast<std::size_t>(i)], kFar));
     }
   }
   for (int k = 0; k < n.z(); ++k) {
     for (int i = t0.x(); i <= t1.x(); ++i) {
       line(1, i, 0, k);
-      for (int j = 0; j < n.y(); ++j) at(i, j, k) = std::min(d[static_cast<std::size_t>(j)], kFar);
+      for (int j = 0; j < n.y(); ++j) set(i, j, k, std::min(d[static_cast<std::size_t>(j)], kFar));
     }
   }
   for (int j = t0.y(); j <= t1.y(); ++j) {
@@ -272,7 +281,7 @@ common::Result<FieldUpdateStats> DistanceField::update(const OccupancyMap& map, 
       stats = updateTruncated(map.denseGrid(), changed_voxels);
     } else {
       recomputeBox(map.denseGrid(), LocalBox{VoxelIndex::Zero(), size_ - VoxelIndex::Ones()});
-      scratch_ = std::vector<double>();
+      scratch_ = std::vector<float>();
       stats.lines = size_.y() * size_.z() + size_.x() * size_.z() + size_.x() * size_.y();
       stats.voxels_written = dist_m_.size();
     }
