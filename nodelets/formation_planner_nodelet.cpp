@@ -71,7 +71,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     }
     if (uav_index_ >= uav_count_) params.addError("uav_index: must be < uav_count");
     loadWorldMap(scenario_file, params, world_);
-    live_map_.setUp(nh, getPrivateNodeHandle(), params, world_, world_frame_);  // ~mapping_config: planner_live_map.hpp
+    live_map_.setUp(nh, getPrivateNodeHandle(), params, world_, world_frame_, uav_index_);  // ~mapping_config: planner_live_map.hpp
     if (!params.ok()) {
       NODELET_ERROR_STREAM("FormationPlanner refuses to start; fix these parameters:\n" << params.report());
       return;

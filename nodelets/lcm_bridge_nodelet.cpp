@@ -1,16 +1,15 @@
 // LcmBridge nodelet: the only code that touches LCM (lcm_bridge::SecureLink: signed envelopes with
-// sender id, sequence and stamp; docs/security.md). A thin adapter between ROS topics and the link;
-// every topic, parameter and default: docs/ros.md "LcmBridge". ROS → LCM: the share, plans (their
-// fallback flag in a heartbeat sent just before), parameters, gesture observations, aborts (as they
-// come; the leader's accepted abort after every share), and single events repeated like a command
-// (~command_repeats copies, comm::OutgoingRepeats): commands, the leader's acknowledgements and
-// assistance state (also with every share while requested), the ground's acknowledgement of it;
-// leadership messages as they come (leadership_in → LCM, LCM → leadership_out: every one from a
-// UAV speaking for itself; docs/safety.md §1.2).
-// LCM → ROS: what each envelope yields (comm::LinkInbox: first copy of each command / ack id, every
-// abort and assistance copy). Start-up (keys, boot counter, high-water marks, verifier):
-// lcm_bridge::startLink; stamps use ROS time (sim time in simulation). Diagnostics: /diagnostics at
-// 1 Hz (lcm_bridge::linkDiagnostics); a throttled warning names the sender and class of each refusal.
+// sender id, sequence and stamp; docs/security.md); a thin adapter between ROS topics and the link
+// (topics, parameters, defaults: docs/ros.md "LcmBridge"). ROS → LCM: the share, plans (their
+// fallback flag in a heartbeat sent just before), parameters, gesture observations, aborts (the
+// leader's accepted abort also after every share), single events repeated like a command
+// (~command_repeats copies, comm::OutgoingRepeats: commands, the leader's acknowledgements and
+// assistance state — also with every share while requested —, the ground's acknowledgement of it),
+// leadership messages (docs/safety.md §1.2) and live-map changes (docs/mapping.md §8), both from UAVs
+// speaking for themselves. LCM → ROS: what each envelope yields (comm::LinkInbox: first copy of each
+// command / ack id, every abort and assistance copy; map updates as they come). Start-up:
+// lcm_bridge::startLink; stamps in ROS time (sim time in simulation); /diagnostics at 1 Hz
+// (lcm_bridge::linkDiagnostics); a throttled warning names the sender and class of each refusal.
 
 #include <mutex>
 #include <optional>
@@ -30,6 +29,7 @@
 #include "gesture_formation/lcm_bridge/link_diagnostics.hpp"
 #include "gesture_formation/lcm_bridge/link_startup.hpp"
 #include "link_params.hpp"
+#include "map_update_conversions.hpp"
 #include "param_loader.hpp"
 
 namespace gesture_formation::nodelets {
@@ -82,7 +82,7 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     link_->setRejectHandler([this](const comm::VerifyResult& r, std::optional<std::uint16_t> claimed) {
       onRejected(r, claimed);
     });
-    heartbeat_.uav_index = static_cast<std::uint16_t>(std::min(sender_id_ = cfg.link.sender_id, comm::kMaxUavIndex));
+    heartbeat_.uav_index = static_cast<std::uint16_t>(std::min(cfg.link.sender_id, comm::kMaxUavIndex));
     report_.emplace("LcmBridge sender " + std::to_string(cfg.link.sender_id));
 
     // Queues hold a burst: every peer's messages of ~1 s (several UAVs, 10–30 Hz each).
@@ -92,9 +92,14 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     command_pub_ = nh.advertise<gesture_formation::FormationCommand>("formation_command_out", 100);
     worker_sub_ = nh.subscribe("worker_state_in", 50, &LcmBridgeNodelet::onWorker, this);
     plan_sub_ = nh.subscribe("plan_in", 50, &LcmBridgeNodelet::onPlan, this);
-    params_sub_ = nh.subscribe("formation_params_in", 20, &LcmBridgeNodelet::onParams, this);
+    params_sub_ = nh.subscribe<gesture_formation::FormationParams>(
+        "formation_params_in", 20, [this](const gesture_formation::FormationParams::ConstPtr& m) { sendChecked(fromMsg(*m), "formation parameters"); });
     observations_pub_ = nh.advertise<gesture_formation::GestureObservation>("gesture_observations_out", 200);
-    observation_sub_ = nh.subscribe("gesture_observation_in", 100, &LcmBridgeNodelet::onObservation, this);
+    observation_sub_ = nh.subscribe<gesture_formation::GestureObservation>(
+        "gesture_observation_in", 100, [this](const gesture_formation::GestureObservation::ConstPtr& m) { sendChecked(toWire(*m), "gesture observation"); });
+    map_update_pub_ = nh.advertise<gesture_formation::MapUpdate>("map_update_out", 20);
+    map_update_sub_ = nh.subscribe<gesture_formation::MapUpdate>(
+        "map_update_in", 20, [this](const gesture_formation::MapUpdate::ConstPtr& m) { sendChecked(fromMsg(*m), "map update"); });
     abort_pub_ = nh.advertise<gesture_formation::AbortCommand>("abort_out", 100);
     abort_sub_ = nh.subscribe("abort_in", 100, &LcmBridgeNodelet::onAbort, this);
     relay_sub_ = nh.subscribe("abort_relay_in", 5, &LcmBridgeNodelet::onAbortState, this);
@@ -172,18 +177,12 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     send(heartbeat_, "heartbeat");  // before the plan: it carries the plan's fallback flag
     send(*plan, "plan");
   }
-  void onParams(const gesture_formation::FormationParams::ConstPtr& msg) {
-    auto p = fromMsg(*msg);
-    if (!p) return;
-    std::lock_guard<std::mutex> lock(mutex_);
-    send(*p, "formation parameters");
-  }
   // An abort to send (the ground station's copies: the OperatorInterface repeats it).
   void onAbort(const gesture_formation::AbortCommand::ConstPtr& msg) { sendChecked(toWire(*msg), "abort"); }
   template <class T>
   void sendChecked(const common::Result<T>& m, const char* what, int copies = 1, double period_s = 0.0) {
     if (!m) {
-      NODELET_WARN_STREAM("LcmBridge: " << what << " not sent: " << m.reason());
+      NODELET_WARN_STREAM_THROTTLE(1.0, "LcmBridge: " << what << " not sent: " << m.reason());
       return;
     }
     std::lock_guard<std::mutex> lock(mutex_);
@@ -197,19 +196,9 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     if (msg->phase != gesture_formation::AbortState::PHASE_NONE && a) relay_ = *a;
   }
 
-  void onObservation(const gesture_formation::GestureObservation::ConstPtr& msg) {
-    auto o = toWire(*msg);
-    if (!o) {
-      NODELET_WARN_STREAM_THROTTLE(1.0, "LcmBridge: gesture observation not sent: " << o.reason());
-      return;
-    }
-    std::lock_guard<std::mutex> lock(mutex_);
-    send(*o, "gesture observation");
-  }
-
   // Called from drain() (mutex held). What to hand on: comm::LinkInbox.
   void onEnvelope(const comm::Envelope& e) {
-    if (e.sender_id == sender_id_) return;  // its own, echoed by the multicast loop: nothing to hand on
+    if (e.type == comm::MessageType::kMapUpdate) return onMapUpdate(e);  // not an inbox item
     const comm::InboxItem item = inbox_.take(e);
     if (const auto* w = std::get_if<comm::WorkerStateMessage>(&item)) {
       auto m = fromWire(*w);
@@ -249,6 +238,15 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     }
   }
 
+  // Called from drain() (mutex held). A UAV's map changes, handed to the planner.
+  void onMapUpdate(const comm::Envelope& e) {
+    bool undecodable = false;
+    const auto m = mapUpdateFrom(e, &undecodable);
+    if (m) return map_update_pub_.publish(toMsg(*m));
+    if (undecodable) link_->verifier().countDecodeFailure(e.sender_id);
+    NODELET_WARN_STREAM_THROTTLE(1.0, "LcmBridge: map update from sender " << e.sender_id << " refused: " << m.reason());
+  }
+
   // Called from drain() (mutex held).
   void onRejected(const comm::VerifyResult& r, std::optional<std::uint16_t> claimed) {
     const std::string who = claimed ? "sender " + std::to_string(*claimed) : std::string("an unparsable datagram");
@@ -274,7 +272,6 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
 
   std::mutex mutex_;
   std::string world_frame_;
-  int sender_id_ = -1;  ///< this bridge's sender id (~sender_id)
   std::unique_ptr<lcm_bridge::LcmTransport> transport_;
   std::unique_ptr<lcm_bridge::SecureLink> link_;
   comm::LinkInbox inbox_;  ///< decoding, peers' heartbeats, first command copies, refused observations
@@ -288,8 +285,8 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
   static constexpr int kMaxDrainPerTick = 2000;
   lcm_bridge::HighWaterMarkSaver marks_;  ///< high_water_file, saved when the marks changed
   std::optional<comm::RejectionReport> report_;  ///< /diagnostics: counts and refusals since the last report
-  ros::Publisher worker_pub_, plans_pub_, params_pub_, command_pub_, observations_pub_, abort_pub_, ack_pub_, assistance_pub_, leadership_pub_;
-  ros::Subscriber worker_sub_, plan_sub_, params_sub_, command_sub_, observation_sub_, abort_sub_, relay_sub_, ack_sub_, assistance_sub_, leadership_sub_;
+  ros::Publisher worker_pub_, plans_pub_, params_pub_, command_pub_, observations_pub_, abort_pub_, ack_pub_, assistance_pub_, leadership_pub_, map_update_pub_;
+  ros::Subscriber worker_sub_, plan_sub_, params_sub_, command_sub_, observation_sub_, abort_sub_, relay_sub_, ack_sub_, assistance_sub_, leadership_sub_, map_update_sub_;
   ros::WallTimer drain_timer_;
   DiagnosticsPublisher diagnostics_;  ///< /diagnostics every wall second (also saves the high-water marks)
   ros::Timer heartbeat_timer_, repeat_timer_;

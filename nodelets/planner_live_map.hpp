@@ -7,7 +7,12 @@
 // default true). Frames are integrated at most ~mapping_rate_hz on the depth callback's thread
 // (ROS serialises one subscription's callbacks: never two integrate() at once); the planner holds
 // readLock() for a whole replanning. Without ~mapping_config nothing is subscribed and the planner
-// plans on the scenario's map, as before. Thread safety: the counters under their own mutex.
+// plans on the scenario's map, as before. With share.enabled in the mapping config (docs/mapping.md
+// §8) every share.rate_hz the planner publishes its own changes (mapping::LiveMap::takeChanges, the
+// nearest to its camera first, within share.max_bytes_per_s) on map_update_out and merges the other
+// UAVs' from map_update_in (the LcmBridge carries both over LCM). Thread safety: integrate(), merge()
+// and takeChanges() serialised by update_mutex_ (one subscription's callbacks are serialised, three
+// are not); the counters under their own mutex.
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -24,6 +29,7 @@
 
 #include "config_sources.hpp"
 #include "conversions.hpp"
+#include "map_update_conversions.hpp"
 #include "gesture_formation/common/config_reader.hpp"
 #include "gesture_formation/mapping/live_map.hpp"
 #include "param_loader.hpp"
@@ -33,7 +39,9 @@ namespace gesture_formation::nodelets {
 class PlannerLiveMap {
  public:
   /// load(), then (when configured and every parameter so far is fine) start(); problems into `params`.
-  void setUp(ros::NodeHandle& nh, ros::NodeHandle& pnh, ParamLoader& params, WorldMap& world, const std::string& world_frame) {
+  void setUp(ros::NodeHandle& nh, ros::NodeHandle& pnh, ParamLoader& params, WorldMap& world, const std::string& world_frame,
+             int uav_index) {
+    uav_index_ = static_cast<std::uint16_t>(uav_index);
     if (!load(pnh, params) || !params.ok()) return;
     if (const auto why = start(nh, world, world_frame); !why.empty()) params.addError(why);
   }
@@ -50,7 +58,6 @@ class PlannerLiveMap {
     config_ = mapping::readMappingConfig(r);
     for (const auto& e : r.errors()) params.addError("mapping_config: " + file_ + ": " + e);
     for (const auto& k : r.unusedKeys()) params.addError("mapping_config: " + file_ + ": unknown key " + k);
-    if (config_.share.enabled) params.addError("mapping_config: " + file_ + ": share.enabled true: map sharing is not relayed through ROS yet");
     return true;
   }
 
@@ -69,6 +76,10 @@ class PlannerLiveMap {
       info_ = *m;
     });
     depth_sub_ = nh.subscribe("depth_in", 2, &PlannerLiveMap::onDepth, this);
+    if (!config_.share.enabled) return "";
+    share_pub_ = nh.advertise<gesture_formation::MapUpdate>("map_update_out", 10);
+    share_sub_ = nh.subscribe("map_update_in", 20, &PlannerLiveMap::onUpdate, this);
+    share_timer_ = nh.createTimer(ros::Duration(1.0 / config_.share.rate_hz), [this](const ros::TimerEvent&) { share(); });
     return "";
   }
 
@@ -99,6 +110,14 @@ class PlannerLiveMap {
     kv("live_map_changes", std::to_string(c.map_changes));
     kv("live_map_frame_ms_mean", std::to_string(c.frames > 0 ? c.total_ms / c.frames : 0.0));
     kv("live_map_refused", std::to_string(c.refused));
+    if (config_.share.enabled) {
+      kv("live_map_updates_sent", std::to_string(c.updates_sent));
+      kv("live_map_voxels_sent", std::to_string(c.voxels_sent));
+      kv("live_map_changes_dropped", std::to_string(c.changes_dropped));
+      kv("live_map_updates_merged", std::to_string(c.updates_merged));
+      kv("live_map_voxels_merged", std::to_string(c.voxels_merged));
+      kv("live_map_updates_refused", std::to_string(c.updates_refused));
+    }
     if (c.refused == 0) return;
     st.level = std::max<std::uint8_t>(st.level, diagnostic_msgs::DiagnosticStatus::WARN);
     st.message += (st.message.empty() ? "" : "; ") + std::to_string(c.refused) + " depth frame(s) refused: " + c.last_refusal;
@@ -141,7 +160,12 @@ class PlannerLiveMap {
     } catch (const tf2::TransformException& e) {
       return refuse(std::string("depth frame not used: ") + e.what());
     }
-    const auto u = live_->integrate(frame);
+    common::Result<mapping::FrameUpdate> u = common::Result<mapping::FrameUpdate>::fail("");
+    {
+      std::lock_guard<std::mutex> serial(update_mutex_);
+      u = live_->integrate(frame);
+      if (u) camera_world_ = frame.T_world_camera.translation();
+    }
     if (!u) return refuse("depth frame refused: " + u.reason());
     std::lock_guard<std::mutex> lock(mutex_);
     ++counts_.frames;
@@ -149,7 +173,54 @@ class PlannerLiveMap {
     counts_.total_ms += u->total_ms;
   }
 
+  // Every share.rate_hz: this UAV's changes since its last update, if any, on map_update_out.
+  void share() {
+    mapping::OutgoingStats stats;
+    comm::MapUpdate m;
+    {
+      std::lock_guard<std::mutex> serial(update_mutex_);
+      if (!camera_world_) return;  // no frame integrated yet: nothing of its own to tell
+      m.delta = live_->takeChanges(*camera_world_, ros::Time::now().toSec(), mapping::shareVoxelBudget(config_.share),
+                                   config_.share.max_age_s, &stats);
+    }
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      counts_.changes_dropped += stats.dropped;
+      if (m.delta.size() == 0) return;
+      ++counts_.updates_sent;
+      counts_.voxels_sent += static_cast<int>(m.delta.size());
+    }
+    m.uav_index = uav_index_;
+    m.sequence = ++sequence_;
+    share_pub_.publish(toMsg(m));
+  }
+
+  // Another UAV's changes (from the LcmBridge): checked against this map's grid, then merged.
+  void onUpdate(const gesture_formation::MapUpdate::ConstPtr& msg) {
+    if (msg->uav_index == uav_index_) return;  // its own, looped back
+    const auto m = fromMsg(*msg);
+    common::Result<mapping::MergeResult> merged = common::Result<mapping::MergeResult>::fail(m ? "" : m.reason());
+    if (m) {  // merge() refuses, changing nothing, what does not fit this map's grid
+      std::lock_guard<std::mutex> serial(update_mutex_);
+      merged = live_->merge(m->delta);
+    }
+    if (!merged) return refuseUpdate("map update from UAV " + std::to_string(msg->uav_index) + " refused: " + merged.reason());
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++counts_.updates_merged;
+    counts_.voxels_merged += merged->voxels - merged->superseded;
+    counts_.map_changes += merged->map_changes;
+  }
+  void refuseUpdate(const std::string& why) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++counts_.updates_refused;
+    ROS_WARN_STREAM_THROTTLE(1.0, "FormationPlanner: " << why);
+  }
+
   std::string file_, world_frame_;
+  std::uint16_t uav_index_ = 0;
+  std::uint32_t sequence_ = 0;  ///< map updates sent
+  std::mutex update_mutex_;     ///< one of integrate(), merge(), takeChanges() at a time
+  std::optional<Eigen::Vector3d> camera_world_;  ///< the camera at the last integrated frame (under update_mutex_)
   double rate_hz_ = 5.0, tf_timeout_s_ = 0.1, next_frame_s_ = -1e18;
   bool prior_ = true;
   mapping::MappingConfig config_;
@@ -158,13 +229,16 @@ class PlannerLiveMap {
   std::optional<sensor_msgs::CameraInfo> info_;
   struct Counts {
     int frames = 0, refused = 0, map_changes = 0;
+    int updates_sent = 0, voxels_sent = 0, changes_dropped = 0, updates_merged = 0, voxels_merged = 0, updates_refused = 0;
     double total_ms = 0.0;
     std::string last_refusal;
   };
   Counts counts_;
   tf2_ros::Buffer tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
-  ros::Subscriber info_sub_, depth_sub_;
+  ros::Subscriber info_sub_, depth_sub_, share_sub_;
+  ros::Publisher share_pub_;
+  ros::Timer share_timer_;
 };
 
 }  // namespace gesture_formation::nodelets

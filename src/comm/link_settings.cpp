@@ -60,11 +60,12 @@ VerifierConfig verifierConfigOf(const LinkSettings& s, std::vector<common::Confi
     }
   }
   // Leadership messages (docs/safety.md §1.2) come from the UAVs only — the known senders with a UAV
-  // index (0..kMaxUavIndex), never a ground station.
+  // index (0..kMaxUavIndex), never a ground station; so do live-map changes (docs/mapping.md §8).
   auto& members = c.senders_by_type[MessageType::kLeadership];
   for (const std::uint16_t id : c.known_senders) {
     if (id <= kMaxUavIndex) members.push_back(id);
   }
+  c.senders_by_type[MessageType::kMapUpdate] = members;
   c.own_sender_id = static_cast<std::uint16_t>(std::clamp(s.sender_id, 0, 65535));
   c.max_age_s = age.contains(s.max_age_s) ? s.max_age_s : defaults.max_age_s;
   c.max_age_s_by_type[MessageType::kHeartbeat] = std::max(c.max_age_s, 2.0);

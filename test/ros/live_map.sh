@@ -60,8 +60,13 @@ while not rospy.is_shutdown():
     T.header.stamp = now
     info.publish(c)  # the CameraInfo and the pose before the image: a depth image before them is refused (counted)
     tf.publish(TFMessage(transforms=[T]))
-    if first:
-        rospy.sleep(0.5)
+    if first:  # for 1 s before the first image: the planner's subscriptions connect one by one (a first
+        for _ in range(10):  # image stamped before the tf listener's earliest pose is refused: extrapolation)
+            rospy.sleep(0.1)
+            T.header.stamp = rospy.Time.now()
+            info.publish(c)
+            tf.publish(TFMessage(transforms=[T]))
+        m.header.stamp = c.header.stamp = T.header.stamp
         first = False
     img.publish(m)
     rate.sleep()

@@ -76,6 +76,17 @@ TEST(LinkSettingsTest, LeadershipMessagesComeFromTheKnownUavsOnly) {
   EXPECT_EQ(c.senders_by_type.at(MessageType::kLeadership), (std::vector<std::uint16_t>{0, 2}));
 }
 
+// Live-map changes likewise: a ground station's map update is refused by the verifier.
+TEST(LinkSettingsTest, MapUpdatesComeFromTheKnownUavsOnly) {
+  LinkSettings s;
+  s.sender_id = 0;
+  s.known_senders = {0, 1, 2, 100};
+  std::vector<ConfigError> problems;
+  const VerifierConfig c = verifierConfigOf(s, problems);
+  EXPECT_TRUE(problems.empty());
+  EXPECT_EQ(c.senders_by_type.at(MessageType::kMapUpdate), (std::vector<std::uint16_t>{1, 2}));
+}
+
 // Aborts come from the ground station and the leader's relay: their own sender list.
 TEST(LinkSettingsTest, AbortSendersAreTheirOwnList) {
   LinkSettings s;
