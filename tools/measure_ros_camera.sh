@@ -33,7 +33,7 @@ while [ $# -gt 0 ]; do
 done
 [[ $WALL =~ ^[0-9]+$ ]] && [ "$WALL" -ge 10 ] || { echo "$0: --wall: expected whole seconds >= 10, got '$WALL'" >&2; exit 2; }
 DEVEL=$(gf_devel_dir .) || exit 2
-[ -f "$DEVEL/lib/libgesture_formation_sim_nodelets.so" ] || { echo "$0: $DEVEL lacks the simulation nodelets: build first (tools/build.sh)" >&2; exit 2; }
+[ -f "$DEVEL/lib/libgesture_formation_sim_camera_nodelets.so" ] || { echo "$0: $DEVEL lacks the simulation nodelets: build first (tools/build.sh)" >&2; exit 2; }
 [ "$(id -u)" -eq 0 ] || { echo "$0: needs root (unshare -n keeps LCM on this machine)" >&2; exit 2; }
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT

@@ -111,15 +111,21 @@ std::size_t DistanceField::recomputeBox(const std::vector<std::uint8_t>& occupan
   // power-tower grid): each is 0, far — read back as exactly kFar, so that f ≤ kFar holds in
   // transform1d — or an integer sum of squares of at most the box's diagonal², exact in a float below
   // 2^24 (diagonals under 4096 voxels; beyond, rounded by less than 6e-8 of its value).
-  scratch_.resize(nx * ny * static_cast<std::size_t>(n.z()));
+  // The whole grid (the constructor's full build) is transformed in place, in dist_m_ itself: its z
+  // pass reads each column into a line buffer before writing that column's metres back, and no
+  // other voxel's value is read after its column was written — the same floats as in a scratch,
+  // without a second grid at start-up (the power-tower grid: 64 MB less at the peak).
+  const bool in_place = lo == VoxelIndex::Zero() && n == size_ && t0 == VoxelIndex::Zero() && t1 == size_ - VoxelIndex::Ones();
+  std::vector<float>& squared = in_place ? dist_m_ : scratch_;
+  squared.resize(nx * ny * static_cast<std::size_t>(n.z()));
   auto index = [&](int i, int j, int k) {
     return static_cast<std::size_t>(i) + nx * (static_cast<std::size_t>(j) + ny * static_cast<std::size_t>(k));
   };
   auto get = [&](int i, int j, int k) -> double {
-    const double x = scratch_[index(i, j, k)];
+    const double x = squared[index(i, j, k)];
     return x >= 0.5 * kFar ? kFar : x;
   };
-  auto set = [&](int i, int j, int k, double x) { scratch_[index(i, j, k)] = static_cast<float>(x); };
+  auto set = [&](int i, int j, int k, double x) { squared[index(i, j, k)] = static_cast<float>(x); };
   for (int k = 0; k < n.z(); ++k) {
     for (int j = 0; j < n.y(); ++j) {
       const std::size_t row = linear(lo.x(), lo.y() + j, lo.z() + k);
@@ -157,7 +163,7 @@ std::size_t DistanceField::recomputeBox(const std::vector<std::uint8_t>& occupan
       }
     }
   }
-  return scratch_.size();
+  return squared.size();
 }
 
 namespace {

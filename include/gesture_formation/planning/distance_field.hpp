@@ -103,7 +103,7 @@ class DistanceField {
   VoxelIndex origin_;
   VoxelIndex size_;
   std::vector<float> dist_m_;
-  std::vector<float> scratch_;  ///< recomputeBox()'s squared distances (exact integers or far)
+  std::vector<float> scratch_;  ///< recomputeBox()'s squared distances of a box (the whole grid: in dist_m_ itself)
   /// Truncated fields: squared distances (voxels²) after the x pass and after the y pass, capped:
   /// values above range_voxels_² are kFarSquared.
   std::vector<std::uint16_t> pass1_, pass2_;
