@@ -58,10 +58,12 @@ DistanceField::DistanceField(const OccupancyMap& map, double max_distance_m)
   range_voxels_ = std::isfinite(max_distance_m_) ? static_cast<int>(std::ceil(max_distance_m_ / resolution_m_)) : 0;
   const std::size_t voxels =
       static_cast<std::size_t>(size_.x()) * static_cast<std::size_t>(size_.y()) * static_cast<std::size_t>(size_.z());
-  dist_m_.assign(voxels, 0.0f);
+  squared_.assign(voxels, kFarSquared);
+  metres_.resize(std::size_t{kFarSquared} + 1);
+  for (std::size_t n = 0; n < kFarSquared; ++n) metres_[n] = toMetres(static_cast<double>(n));
+  metres_[kFarSquared] = static_cast<float>(max_distance_m_);  // truncated: beyond the range
   if (range_voxels_ == 0) {
-    recomputeBox(map.denseGrid(), LocalBox{VoxelIndex::Zero(), size_ - VoxelIndex::Ones()});
-    scratch_ = std::vector<float>();  // a whole-grid scratch is not kept
+    recomputeAll(map.denseGrid());
     return;
   }
   const std::size_t nmax = static_cast<std::size_t>(size_.maxCoeff());
@@ -99,71 +101,44 @@ float DistanceField::toMetres(double squared_voxels) const {
   return static_cast<float>(std::min(std::sqrt(squared_voxels) * resolution_m_, max_distance_m_));
 }
 
-std::size_t DistanceField::recomputeBox(const std::vector<std::uint8_t>& occupancy, const LocalBox& target) {
-  // The box whose occupancy decides the target's values: every voxel within the range of one.
-  const VoxelIndex grow = range_voxels_ > 0 ? VoxelIndex::Constant(range_voxels_) : size_;
-  const VoxelIndex lo = (target.lo - grow).cwiseMax(VoxelIndex::Zero());
-  const VoxelIndex hi = (target.hi + grow).cwiseMin(size_ - VoxelIndex::Ones());
-  const VoxelIndex n = hi - lo + VoxelIndex::Ones();
-  const VoxelIndex t0 = target.lo - lo, t1 = target.hi - lo;  // the target, relative to lo
-  const std::size_t nx = static_cast<std::size_t>(n.x()), ny = static_cast<std::size_t>(n.y());
-  // The scratch holds squared voxel distances as float (half a double's memory: 128 -> 64 MB for the
-  // power-tower grid): each is 0, far — read back as exactly kFar, so that f ≤ kFar holds in
-  // transform1d — or an integer sum of squares of at most the box's diagonal², exact in a float below
-  // 2^24 (diagonals under 4096 voxels; beyond, rounded by less than 6e-8 of its value).
-  // The whole grid (the constructor's full build) is transformed in place, in dist_m_ itself: its z
-  // pass reads each column into a line buffer before writing that column's metres back, and no
-  // other voxel's value is read after its column was written — the same floats as in a scratch,
-  // without a second grid at start-up (the power-tower grid: 64 MB less at the peak).
-  const bool in_place = lo == VoxelIndex::Zero() && n == size_ && t0 == VoxelIndex::Zero() && t1 == size_ - VoxelIndex::Ones();
-  std::vector<float>& squared = in_place ? dist_m_ : scratch_;
-  squared.resize(nx * ny * static_cast<std::size_t>(n.z()));
-  auto index = [&](int i, int j, int k) {
-    return static_cast<std::size_t>(i) + nx * (static_cast<std::size_t>(j) + ny * static_cast<std::size_t>(k));
-  };
-  auto get = [&](int i, int j, int k) -> double {
-    const double x = squared[index(i, j, k)];
-    return x >= 0.5 * kFar ? kFar : x;
-  };
-  auto set = [&](int i, int j, int k, double x) { squared[index(i, j, k)] = static_cast<float>(x); };
-  for (int k = 0; k < n.z(); ++k) {
-    for (int j = 0; j < n.y(); ++j) {
-      const std::size_t row = linear(lo.x(), lo.y() + j, lo.z() + k);
-      for (int i = 0; i < n.x(); ++i) set(i, j, k, occupancy[row + static_cast<std::size_t>(i)] != 0 ? 0.0 : kFar);
-    }
+void DistanceField::recomputeAll(const std::vector<std::uint8_t>& occupancy) {
+  // The untruncated transform of the whole grid, in place in squared_ (2 bytes a voxel, no second
+  // grid): every pass's squared voxel distances capped at kFarSquared. Capping a pass's input at C
+  // caps its output at C and changes nothing below (min_q min(f_q, C) + (x − q)² = min(d_x, C): the
+  // term q = x gives C), so the stored values below the cap are the exact ones, and the cap stands
+  // for "at least sqrt(kFarSquared) voxels" (51.2 m at 0.2 m) — a lower bound, like every value.
+  // The z pass reads a whole column into the line buffer before writing it back.
+  const VoxelIndex n = size_;
+  constexpr double kCap = kFarSquared;
+  bool any = false;
+  for (std::size_t v = 0; v < squared_.size(); ++v) {
+    squared_[v] = occupancy[v] != 0 ? 0 : kFarSquared;
+    any = any || occupancy[v] != 0;
   }
+  // Beyond the cap: +inf on an empty map (no obstacle at all), else the cap's distance.
+  metres_[kFarSquared] = any ? static_cast<float>(std::sqrt(kCap) * resolution_m_) : std::numeric_limits<float>::infinity();
   const int nmax = n.maxCoeff();
   std::vector<double> f(static_cast<std::size_t>(nmax)), d(static_cast<std::size_t>(nmax)),
       z(static_cast<std::size_t>(nmax) + 1);
   std::vector<int> v(static_cast<std::size_t>(nmax));
-  // One 1-D transform along axis `axis` through (i, j, k) (its own coordinate ignored).
+  // One 1-D transform along `axis` through (i, j, k) (its own coordinate ignored), written back capped.
   auto line = [&](int axis, int i, int j, int k) {
     VoxelIndex q(i, j, k);
-    for (q(axis) = 0; q(axis) < n(axis); ++q(axis)) f[static_cast<std::size_t>(q(axis))] = get(q.x(), q.y(), q.z());
+    for (q(axis) = 0; q(axis) < n(axis); ++q(axis)) f[static_cast<std::size_t>(q(axis))] = squared_[linear(q.x(), q.y(), q.z())];
     transform1d(f.data(), n(axis), d.data(), v.data(), z.data());
+    for (q(axis) = 0; q(axis) < n(axis); ++q(axis)) {
+      squared_[linear(q.x(), q.y(), q.z())] = static_cast<std::uint16_t>(std::min(d[static_cast<std::size_t>(q(axis))], kCap));
+    }
   };
-  // x over the whole grown box; y only where the target's x lies; z only in the target's x-y.
   for (int k = 0; k < n.z(); ++k) {
-    for (int j = 0; j < n.y(); ++j) {
-      line(0, 0, j, k);
-      for (int i = 0; i < n.x(); ++i) set(i, j, k, std::min(d[static_cast<std::size_t>(i)], kFar));
-    }
+    for (int j = 0; j < n.y(); ++j) line(0, 0, j, k);
   }
   for (int k = 0; k < n.z(); ++k) {
-    for (int i = t0.x(); i <= t1.x(); ++i) {
-      line(1, i, 0, k);
-      for (int j = 0; j < n.y(); ++j) set(i, j, k, std::min(d[static_cast<std::size_t>(j)], kFar));
-    }
+    for (int i = 0; i < n.x(); ++i) line(1, i, 0, k);
   }
-  for (int j = t0.y(); j <= t1.y(); ++j) {
-    for (int i = t0.x(); i <= t1.x(); ++i) {
-      line(2, i, j, 0);
-      for (int k = t0.z(); k <= t1.z(); ++k) {
-        dist_m_[linear(lo.x() + i, lo.y() + j, lo.z() + k)] = toMetres(std::min(d[static_cast<std::size_t>(k)], kFar));
-      }
-    }
+  for (int j = 0; j < n.y(); ++j) {
+    for (int i = 0; i < n.x(); ++i) line(2, i, j, 0);
   }
-  return squared.size();
 }
 
 namespace {
@@ -214,11 +189,14 @@ void DistanceField::columnZ(int i, int j, int k_lo, int k_hi) {
     any = any || s != kFarSquared;
   }
   if (!any) {
-    for (int k = k_lo; k <= k_hi; ++k) dist_m_[linear(i, j, k)] = static_cast<float>(max_distance_m_);
+    for (int k = k_lo; k <= k_hi; ++k) squared_[linear(i, j, k)] = kFarSquared;
     return;
   }
   transform1d(line_f_.data(), n, line_d_.data(), line_v_.data(), line_z_.data());
-  for (int k = k_lo; k <= k_hi; ++k) dist_m_[linear(i, j, k)] = toMetres(std::min(line_d_[static_cast<std::size_t>(k)], kFar));
+  // Beyond the range the value is max_distance_m (metres_[kFarSquared]), as toMetres gives it.
+  for (int k = k_lo; k <= k_hi; ++k) {
+    squared_[linear(i, j, k)] = capSquared(line_d_[static_cast<std::size_t>(k)], range_voxels_, kFarSquared);
+  }
 }
 
 FieldUpdateStats DistanceField::updateTruncated(const std::vector<std::uint8_t>& occupancy,
@@ -286,10 +264,9 @@ common::Result<FieldUpdateStats> DistanceField::update(const OccupancyMap& map, 
     if (range_voxels_ > 0) {
       stats = updateTruncated(map.denseGrid(), changed_voxels);
     } else {
-      recomputeBox(map.denseGrid(), LocalBox{VoxelIndex::Zero(), size_ - VoxelIndex::Ones()});
-      scratch_ = std::vector<float>();
+      recomputeAll(map.denseGrid());
       stats.lines = size_.y() * size_.z() + size_.x() * size_.z() + size_.x() * size_.y();
-      stats.voxels_written = dist_m_.size();
+      stats.voxels_written = squared_.size();
     }
   }
   stats.changed_voxels = static_cast<int>(changed_voxels.size());

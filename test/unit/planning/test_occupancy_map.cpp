@@ -175,6 +175,43 @@ TEST(DistanceFieldTest, ExactAtVoxelCentresAndALowerBoundElsewhere) {
   EXPECT_TRUE(std::isinf(FclClearance(empty).clearance(Eigen::Vector3d::Zero())));
 }
 
+// The field stores squared voxel distances in 2 bytes: exact below 256 voxels (every voxel centre
+// of a 300-voxel-long grid with one obstacle at its end against the exact √n·res), and beyond it
+// the distance of 256 voxels (√65535·res: a lower bound of the truth), never more.
+TEST(DistanceFieldTest, ExactBelowTheCapAndTheCapsLowerBoundBeyond) {
+  MapConfig m;
+  m.resolution_m = 0.2;
+  m.bounds = Aabb{Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(60, 1, 1)};  // 300 x 5 x 5 voxels
+  PrimitiveSet set;
+  OrientedBox slab;  // the first x slab of voxels
+  slab.center_world = Eigen::Vector3d(0.1, 0.5, 0.5);
+  slab.size_m = Eigen::Vector3d(0.1, 1.0, 1.0);
+  set.boxes.push_back(slab);
+  const OccupancyMap map = OccupancyMap::fromPrimitives(m, set, GroundSpec{});
+  ASSERT_EQ(map.gridSize().x(), 300);
+  const DistanceField field(map);
+  const auto centres = map.occupiedCenters();
+  ASSERT_FALSE(centres.empty());
+  const float cap = static_cast<float>(std::sqrt(65535.0) * m.resolution_m);
+  int capped = 0, exact = 0;
+  for (int i = 0; i < map.gridSize().x(); ++i) {
+    const Eigen::Vector3d c = map.centerOf(map.gridOrigin() + VoxelIndex(i, 2, 2));
+    double truth = std::numeric_limits<double>::infinity();
+    for (const auto& o : centres) truth = std::min(truth, (o - c).norm());
+    const float stored = field.atLocal(i, 2, 2);
+    if (truth < cap) {
+      EXPECT_NEAR(stored, truth, 1e-5) << "voxel " << i;
+      ++exact;
+    } else {
+      EXPECT_EQ(stored, cap) << "voxel " << i << ", truth " << truth;
+      EXPECT_LE(stored, truth);
+      ++capped;
+    }
+  }
+  EXPECT_GT(exact, 200);
+  EXPECT_GT(capped, 30);
+}
+
 TEST(WorkerObstacleTest, CylinderAtThePredictedPosition) {
   WorkerObstacleConfig cfg;
   EXPECT_TRUE(cfg.validate().empty());
