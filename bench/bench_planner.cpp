@@ -11,8 +11,10 @@
 //      replanning's stage timings, the slowest 1 % and what they did (the tails: issue 38).
 //   gf_bench_planner --mission [--seed N] [--fault-profile NAME] [--slowest K] [--qp-instances]
 //   (section 4 only; --qp-instances: the slow replannings' QPs solved again alone, each formulation,
-//   median of 3 solves; --qp-repeats R: of R, e.g. to profile them; --results FILE.md: also a dated
-//   page with the output, e.g. docs/results/planning_tails.md)
+//   median of 3 solves, and the primal-infeasible ones' diagnosis; --qp-repeats R: of R, e.g. to
+//   profile them; --qp-dump DIR: those QPs as DIR/qp_NN.json (planning/qp_json.hpp) with ProxQP's
+//   answer and CPU time from the same matrices, for tools/bench_qp_osqp.py; --results FILE.md: also
+//   a dated page with the output, e.g. docs/results/planning_tails.md)
 // Figures and decisions: docs/planning.md §10.
 #include <algorithm>
 #include <chrono>
@@ -21,6 +23,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
+#include <filesystem>
+#include <fstream>
 #include <optional>
 #include <memory>
 #include <random>
@@ -41,6 +45,8 @@
 #include "gesture_formation/planning/distance_field.hpp"
 #include "gesture_formation/planning/occupancy_map.hpp"
 #include "gesture_formation/planning/path_search.hpp"
+#include "gesture_formation/planning/qp_diagnosis.hpp"
+#include "gesture_formation/planning/qp_json.hpp"
 #include "gesture_formation/planning/scenario.hpp"
 #include "gesture_formation/planning/trajectory_verifier.hpp"
 #include "gesture_formation/planning/uav_planner.hpp"
@@ -414,28 +420,33 @@ class RecordingPlanner final : public Planner {
 };
 
 /// The slow replannings' QPs solved again, alone: the product's solve (sparse, warm) beside the
-/// alternatives, CPU time (median of `repeats`).
-void benchQpInstances(std::FILE* out, const std::vector<QpInstance>& instances, int repeats) {
-  if (instances.empty()) return;
+/// alternatives, CPU time (median of `repeats`). Returns the product's status of each instance.
+std::vector<TrajectoryQpSolution::Status> benchQpVariants(std::FILE* out, const std::vector<QpInstance>& instances, int repeats) {
   struct Variant {
     const char* name;
     TrajectoryQpProblem::Formulation formulation;
     bool warm;
+    double eps_primal_inf;
   };
-  const Variant variants[] = {{"sparse, warm (the product)", TrajectoryQpProblem::Formulation::kSparse, true},
-                              {"sparse, cold", TrajectoryQpProblem::Formulation::kSparse, false},
-                              {"condensed dense, warm", TrajectoryQpProblem::Formulation::kCondensed, true}};
-  std::fprintf(out, "  the QPs of the %zu replannings over %.0f ms CPU, solved again alone (CPU ms, median of %d):\n",
-              instances.size(), RecordingPlanner::kInstanceCpuMs, repeats);
+  const double product_inf = TrajectoryQpProblem{}.eps_primal_inf;
+  const Variant variants[] = {{"sparse, warm (the product)", TrajectoryQpProblem::Formulation::kSparse, true, product_inf},
+                              {"sparse, cold", TrajectoryQpProblem::Formulation::kSparse, false, product_inf},
+                              {"condensed dense, warm", TrajectoryQpProblem::Formulation::kCondensed, true, product_inf},
+                              {"sparse, warm, eps_primal_inf 1e-3", TrajectoryQpProblem::Formulation::kSparse, true, 1e-3},
+                              {"sparse, warm, eps_primal_inf 1e-2", TrajectoryQpProblem::Formulation::kSparse, true, 1e-2}};
+  std::fprintf(out, "  the QPs of the %zu replannings over %.0f ms CPU, solved again alone (CPU ms, median of %d; product: "
+               "eps_primal_inf %.0e):\n", instances.size(), RecordingPlanner::kInstanceCpuMs, repeats, product_inf);
   const TrajectoryQp qp;
   std::vector<double> product_objective(instances.size(), NAN);
+  std::vector<TrajectoryQpSolution::Status> product_status(instances.size(), TrajectoryQpSolution::Status::kBadInput);
   for (const Variant& v : variants) {
     Stats t, it;
-    int solved = 0;
+    int solved = 0, same_status = 0;
     double worst_rel = 0.0;
     for (std::size_t i = 0; i < instances.size(); ++i) {
       TrajectoryQpProblem pr = instances[i].problem;
       pr.formulation = v.formulation;
+      pr.eps_primal_inf = v.eps_primal_inf;
       const bool use_warm = v.warm && !instances[i].warm.p.empty();
       Stats once;
       TrajectoryQpSolution sol;
@@ -446,6 +457,8 @@ void benchQpInstances(std::FILE* out, const std::vector<QpInstance>& instances, 
       }
       t.add(once.median());
       it.add(sol.iterations);
+      if (&v == &variants[0]) product_status[i] = sol.status;
+      same_status += sol.status == product_status[i] ? 1 : 0;
       if (!sol.solved()) continue;
       ++solved;
       if (&v == &variants[0]) product_objective[i] = sol.objective;
@@ -453,11 +466,107 @@ void benchQpInstances(std::FILE* out, const std::vector<QpInstance>& instances, 
         worst_rel = std::max(worst_rel, std::abs(sol.objective - product_objective[i]) / std::max(1.0, std::abs(product_objective[i])));
       }
     }
-    std::fprintf(out, "    %-28s solved %d/%zu, worst objective difference to the product %.1e (relative)\n", v.name, solved,
-                instances.size(), worst_rel);
+    std::fprintf(out, "    %-28s solved %d/%zu (status as the product's: %d), worst objective difference to the product %.1e "
+                 "(relative)\n", v.name, solved, instances.size(), same_status, worst_rel);
     row(out, "      time", t);
     row(out, "      iterations", it, "");
   }
+  return product_status;
+}
+
+/// The primal-infeasible instances: the failed solve beside the diagnosis that names its cause
+/// (planning::diagnoseInfeasibleQp: as the planner runs it, and cheaper settings), CPU ms.
+void benchDiagnosis(std::FILE* out, const std::vector<QpInstance>& instances,
+                    const std::vector<TrajectoryQpSolution::Status>& status, int repeats) {
+  std::vector<std::size_t> failed;
+  for (std::size_t i = 0; i < instances.size(); ++i) {
+    if (status[i] == TrajectoryQpSolution::Status::kInfeasible) failed.push_back(i);
+  }
+  if (failed.empty()) return;
+  struct Setting {
+    const char* name;
+    bool warm;
+    int max_iterations;  // 0: the problem's own
+  };
+  const Setting settings[] = {{"cold, uncapped (the planner)", false, 0},
+                              {"warm, uncapped", true, 0},
+                              {"warm, 10 outer iterations", true, 10},
+                              {"warm, 3 outer iterations", true, 3}};
+  std::fprintf(out, "  the %zu primal-infeasible QPs: the failed solve and the diagnosis of its cause (CPU ms, median of %d):\n",
+               failed.size(), repeats);
+  const TrajectoryQp qp;
+  Stats solve_ms;
+  for (const std::size_t i : failed) {
+    Stats once;
+    for (int r = 0; r < repeats; ++r) {
+      const double c0 = threadCpuMs();
+      (void)qp.solve(instances[i].problem, instances[i].warm.p.empty() ? nullptr : &instances[i].warm);
+      once.add(threadCpuMs() - c0);
+    }
+    solve_ms.add(once.median());
+  }
+  row(out, "    failed solve (the product's)", solve_ms);
+  std::vector<QpDiagnosis::Cause> reference;
+  for (const Setting& st : settings) {
+    Stats t, solves;
+    int agree = 0;
+    for (std::size_t j = 0; j < failed.size(); ++j) {
+      const QpInstance& in = instances[failed[j]];
+      const TrajectoryQpSolution* warm = st.warm && !in.warm.p.empty() ? &in.warm : nullptr;
+      Stats once;
+      QpDiagnosis d;
+      for (int r = 0; r < repeats; ++r) {
+        const double c0 = threadCpuMs();
+        d = diagnoseInfeasibleQp(qp, in.problem, warm, st.max_iterations > 0 ? st.max_iterations : in.problem.max_iterations);
+        once.add(threadCpuMs() - c0);
+      }
+      if (&st == &settings[0]) reference.push_back(d.cause);
+      agree += d.cause == reference[j] ? 1 : 0;
+      t.add(once.median());
+      solves.add(d.solves);
+    }
+    std::fprintf(out, "    diagnosis, %-40s same cause as uncapped: %d/%zu\n", st.name, agree, failed.size());
+    row(out, "      time", t);
+    row(out, "      relaxed solves", solves, "");
+  }
+}
+
+/// `--qp-dump DIR`: each instance as DIR/qp_NN.json (planning/qp_json.hpp) with ProxQP's answer
+/// from the same matrices and primal warm start (TrajectoryQp::solveMatrices, the product's
+/// limits) and its CPU time (median of `repeats`): the input of tools/bench_qp_osqp.py.
+bool dumpQpInstances(const std::string& dir, const std::vector<QpInstance>& instances, int repeats) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  for (std::size_t i = 0; i < instances.size(); ++i) {
+    const QpInstance& in = instances[i];
+    const QpMatrices m = TrajectoryQp::assemble(in.problem);
+    const Eigen::VectorXd x0 = TrajectoryQp::variables(in.problem.intervals, in.warm.p, in.warm.v, in.warm.a);
+    QpSolveLimits limits;
+    limits.eps_abs = in.problem.eps_abs;
+    limits.eps_primal_inf = in.problem.eps_primal_inf;
+    limits.max_iterations = in.problem.max_iterations;
+    limits.timeout_s = in.problem.solve_timeout_s;
+    Stats once;
+    QpMatricesSolution sol;
+    for (int r = 0; r < repeats; ++r) {
+      const double c0 = threadCpuMs();
+      sol = TrajectoryQp::solveMatrices(m, x0.size() == m.H.rows() ? &x0 : nullptr, limits);
+      once.add(threadCpuMs() - c0);
+    }
+    const bool solved = sol.status == TrajectoryQpSolution::Status::kSolved && sol.x.size() == m.H.rows();
+    const double objective = solved ? 0.5 * sol.x.dot(m.H * sol.x) + m.g.dot(sol.x) + m.cost_constant : NAN;
+    char name[32];
+    std::snprintf(name, sizeof name, "/qp_%02zu.json", i);
+    std::ofstream f(dir + name);
+    writeQpJson(f, m, {{"t_s", jsonNumber(in.t_s)}, {"uav", std::to_string(in.uav)},
+                       {"replanning_cpu_ms", jsonNumber(in.replanning_cpu_ms)}, {"eps_abs", jsonNumber(limits.eps_abs)},
+                       {"eps_primal_inf", jsonNumber(limits.eps_primal_inf)}, {"x0", jsonVector(x0)},
+                       {"status", solved ? "\"solved\"" : (sol.status == TrajectoryQpSolution::Status::kInfeasible ? "\"primal infeasible\"" : "\"failed\"")},
+                       {"x", jsonVector(sol.x)}, {"objective", jsonNumber(objective)}, {"iterations", std::to_string(sol.iterations)},
+                       {"proxqp_cpu_ms", jsonNumber(once.median())}, {"repeats", std::to_string(repeats)}});
+    if (!f) return false;
+  }
+  return true;
 }
 
 struct MissionSetup {
@@ -512,14 +621,14 @@ void printSlowest(std::FILE* out, const std::vector<ReplanRecord>& recs, int cou
   for (const auto& r : recs) by_time.push_back(&r);
   std::sort(by_time.begin(), by_time.end(), [](const auto* a, const auto* b) { return a->cpu_ms > b->cpu_ms; });
   std::fprintf(out, "  the %d slowest by CPU time (ms; planes: corridor planes, cons: QP rows, it: ProxQP iterations):\n", count);
-  std::fprintf(out, "    %8s %3s %9s %8s %8s %7s %8s %8s %7s %7s %6s %5s %6s %5s %7s  %s\n", "t_s", "uav", "status", "cpu", "wall", "path",
-              "corridor", "qp", "camera", "verify", "cons", "it", "corr", "A*", "expand", "reason");
+  std::fprintf(out, "    %8s %3s %9s %8s %8s %7s %8s %8s %7s %7s %7s %6s %5s %6s %5s %7s  %s\n", "t_s", "uav", "status", "cpu", "wall",
+              "path", "corridor", "qp", "(diag)", "camera", "verify", "cons", "it", "corr", "A*", "expand", "reason");
   for (int i = 0; i < count && i < static_cast<int>(by_time.size()); ++i) {
     const ReplanRecord& r = *by_time[static_cast<std::size_t>(i)];
     const auto& T = r.timings;
-    std::fprintf(out, "    %8.2f %3d %9s %8.2f %8.2f %7.2f %8.2f %8.2f %7.3f %7.2f %6d %5d %2d/%-3d %d/%-3d %7d  %.70s\n", r.t_s, r.uav,
-                r.status == PlanStatus::kOptimized ? "optimized" : (r.status == PlanStatus::kFallbackPrevious ? "previous" : "brake"),
-                r.cpu_ms, T.total_ms, T.path_ms, T.corridor_ms, T.qp_ms, T.heading_ms, T.verify_ms, r.qp_constraints,
+    std::fprintf(out, "    %8.2f %3d %9s %8.2f %8.2f %7.2f %8.2f %8.2f %7.2f %7.3f %7.2f %6d %5d %2d/%-3d %d/%-3d %7d  %.70s\n", r.t_s,
+                r.uav, r.status == PlanStatus::kOptimized ? "optimized" : (r.status == PlanStatus::kFallbackPrevious ? "previous" : "brake"),
+                r.cpu_ms, T.total_ms, T.path_ms, T.corridor_ms, T.qp_ms, T.qp_diagnosis_ms, T.heading_ms, T.verify_ms, r.qp_constraints,
                 r.qp_iterations, r.corridors, r.corridor_planes, r.searches_failed, r.path_searches, r.expansions, r.reason.c_str());
   }
 }
@@ -549,6 +658,22 @@ void printTail(std::FILE* out, const std::vector<ReplanRecord>& recs) {
               share(sorted, n_tail, &StageTimings::verify_ms));
   std::fprintf(out, "    QP rows median %.0f (all: see below), iterations median %.0f max %.0f, corridor planes median %.0f max %.0f\n",
               cons_tail.median(), it_tail.median(), it_tail.max(), planes_tail.median(), planes_tail.max());
+}
+
+/// The replannings whose QP was infeasible: the QP stage without and with the diagnosis of the cause.
+void printDiagnosisSplit(std::FILE* out, const std::vector<ReplanRecord>& recs) {
+  Stats solve, diagnosis, total;
+  for (const auto& r : recs) {
+    if (r.reason.rfind("QP primal infeasible", 0) != 0) continue;
+    solve.add(r.timings.qp_ms - r.timings.qp_diagnosis_ms);
+    diagnosis.add(r.timings.qp_diagnosis_ms);
+    total.add(r.cpu_ms);
+  }
+  if (total.v.empty()) return;
+  std::fprintf(out, "  the %zu replannings with a primal-infeasible QP (wall ms, but the total):\n", total.v.size());
+  row(out, "  QP stage without the diagnosis", solve);
+  row(out, "  diagnosis of the cause", diagnosis);
+  row(out, "  the replanning, CPU time", total);
 }
 
 struct MissionRecord {
@@ -598,9 +723,13 @@ void printMission(std::FILE* out, const MissionRecord& M, std::uint64_t seed, co
   row(out, "QP iterations", iters, "");
   row(out, "corridor planes per replanning", planes, "");
   std::fprintf(out, "  replannings over 10 / 20 / 50 ms CPU: %d / %d / %d of %zu\n", over[0], over[1], over[2], recs.size());
+  printDiagnosisSplit(out, recs);
   printTail(out, recs);
   printSlowest(out, recs, slowest);
-  if (qp_repeats > 0) benchQpInstances(out, M.instances, qp_repeats);
+  if (qp_repeats > 0 && !M.instances.empty()) {
+    const auto status = benchQpVariants(out, M.instances, qp_repeats);
+    benchDiagnosis(out, M.instances, status, qp_repeats);
+  }
 }
 
 std::string utcNow() {
@@ -628,7 +757,7 @@ bool writeResultsPage(const std::string& path, const MissionRecord& M, std::uint
 }
 
 int benchMission(std::uint64_t seed, const std::string& fault_profile, int slowest, int qp_repeats, const std::string& results,
-                 const std::string& command) {
+                 const std::string& qp_dump, const std::string& command) {
   MissionRecord M;
   M.load_before = loadAverage();
   auto setup = loadMission(fault_profile);
@@ -641,7 +770,8 @@ int benchMission(std::uint64_t seed, const std::string& fault_profile, int slowe
   world.solids = &S.solids;
   const sim::PlannerFactory product = sim::uavPlannerFactory(S.mission.planner, S.map, S.field);
   const sim::PlannerFactory recording = [&](int i) -> std::unique_ptr<sim::MissionPlanner> {
-    return std::make_unique<RecordingPlanner>(product(i), i, &M.replannings, qp_repeats > 0 ? &M.instances : nullptr);
+    return std::make_unique<RecordingPlanner>(product(i), i, &M.replannings,
+                                              qp_repeats > 0 || !qp_dump.empty() ? &M.instances : nullptr);
   };
   const auto out = sim::runMission(S.mission, world, recording, S.classifier.get(), seed);
   if (!out) {
@@ -655,6 +785,13 @@ int benchMission(std::uint64_t seed, const std::string& fault_profile, int slowe
     std::fprintf(stderr, "gf_bench_planner: cannot write %s\n", results.c_str());
     return 2;
   }
+  if (!qp_dump.empty()) {
+    if (!dumpQpInstances(qp_dump, M.instances, std::max(qp_repeats, 5))) {
+      std::fprintf(stderr, "gf_bench_planner: cannot write the QPs to %s\n", qp_dump.c_str());
+      return 2;
+    }
+    std::printf("  %zu QPs written to %s (tools/bench_qp_osqp.py %s)\n", M.instances.size(), qp_dump.c_str(), qp_dump.c_str());
+  }
   return 0;
 }
 
@@ -664,7 +801,7 @@ int main(int argc, char** argv) {
   int runs = 200, slowest = 20;
   bool mission = false;
   int qp_repeats = 0;
-  std::string results, command = "gf_bench_planner";
+  std::string results, qp_dump, command = "gf_bench_planner";
   std::uint64_t seed = 1;
   std::string fault_profile;
   for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
@@ -684,15 +821,17 @@ int main(int argc, char** argv) {
       slowest = std::max(0, std::atoi(argv[++i]));
     } else if (std::strcmp(argv[i], "--results") == 0 && has_value) {
       results = argv[++i];
+    } else if (std::strcmp(argv[i], "--qp-dump") == 0 && has_value) {
+      qp_dump = argv[++i];
     } else if (std::strcmp(argv[i], "--fault-profile") == 0 && has_value) {
       fault_profile = argv[++i];
     } else {
       std::fprintf(stderr, "gf_bench_planner: unknown or incomplete option '%s' (--runs N | --mission [--seed N] "
-                           "[--fault-profile NAME] [--slowest K] [--qp-instances | --qp-repeats R] [--results FILE.md])\n", argv[i]);
+                           "[--fault-profile NAME] [--slowest K] [--qp-instances | --qp-repeats R] [--qp-dump DIR] [--results FILE.md])\n", argv[i]);
       return 2;
     }
   }
-  if (mission) return benchMission(seed, fault_profile, slowest, qp_repeats, results, command);
+  if (mission) return benchMission(seed, fault_profile, slowest, qp_repeats, results, qp_dump, command);
   auto scenario = loadScenario(source("config/scenarios/power_towers.yaml"));
   if (!scenario) {
     std::fprintf(stderr, "cannot load the scenario (run from the source tree or set GF_SOURCE_DIR):\n%s", scenario.reason().c_str());

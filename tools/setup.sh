@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs everything gesture_formation needs on Debian 12 (bookworm): Debian packages,
-# ProxQP headers from the `proxsuite` PyPI wheel, and the tools venv (matplotlib, numpy, mannequin-x).
+# ProxQP headers from the `proxsuite` PyPI wheel, and the tools venv (matplotlib, numpy, osqp, mannequin-x).
 # Idempotent: a second run checks and returns in seconds. Works as root or through sudo.
 #
 #   tools/setup.sh            # packages + proxsuite + tools venv
@@ -74,8 +74,10 @@ fi
 # Debian's python3 (not a pyenv shim) so that the venv matches the system ROS Python.
 VENV="$GF_PREFIX/venv"
 STAMP="$VENV/.gf_requirements"
-# dask[distributed] + dask-jobqueue: tools/campaign.py (docs/campaigns.md).
-PY_REQS=(matplotlib==3.8.4 numpy==1.26.4 pyyaml==6.0.2 scipy==1.13.1 "dask[distributed]==2026.8.0" dask-jobqueue==0.9.0)
+# dask[distributed] + dask-jobqueue: tools/campaign.py (docs/campaigns.md). osqp: the anchor of the
+# trajectory QP's solve times (tools/bench_qp_osqp.py, docs/planning.md §10).
+PY_REQS=(matplotlib==3.8.4 numpy==1.26.4 pyyaml==6.0.2 scipy==1.13.1 "dask[distributed]==2026.8.0" dask-jobqueue==0.9.0
+         osqp==1.1.3)
 MANNEQUIN_VERSION="0.3.0"   # the worker mesh (tools/models/convert_mannequin.py)
 REQS="proxsuite==$PROXSUITE_VERSION ${PY_REQS[*]} mannequin-x==$MANNEQUIN_VERSION"
 if [ ! -f "$STAMP" ] || [ "$(cat "$STAMP")" != "$REQS" ]; then

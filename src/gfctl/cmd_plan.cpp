@@ -17,6 +17,7 @@
 #include "gesture_formation/formation/formation_geometry.hpp"
 #include "gesture_formation/planning/distance_field.hpp"
 #include "gesture_formation/planning/occupancy_map.hpp"
+#include "gesture_formation/planning/qp_json.hpp"
 #include "gesture_formation/planning/scenario.hpp"
 #include "gesture_formation/planning/trajectory_qp.hpp"
 #include "gesture_formation/planning/uav_planner.hpp"
@@ -45,31 +46,7 @@ Eigen::Vector3d readVec3(ConfigReader& r, const std::string& key, bool required)
   return v.size() == 3 ? Eigen::Vector3d(v[0], v[1], v[2]) : Eigen::Vector3d::Zero();
 }
 
-std::string num(double v) {
-  if (!std::isfinite(v)) return "null";
-  std::ostringstream os;
-  os << std::setprecision(17) << v;
-  return os.str();
-}
-
-void writeSparse(std::ostream& os, const Eigen::SparseMatrix<double>& m) {
-  // [[row, col, value], ...] with the shape separately.
-  os << "{\"rows\": " << m.rows() << ", \"cols\": " << m.cols() << ", \"entries\": [";
-  bool first = true;
-  for (int k = 0; k < m.outerSize(); ++k) {
-    for (Eigen::SparseMatrix<double>::InnerIterator it(m, k); it; ++it) {
-      os << (first ? "" : ", ") << "[" << it.row() << ", " << it.col() << ", " << num(it.value()) << "]";
-      first = false;
-    }
-  }
-  os << "]}";
-}
-
-void writeVector(std::ostream& os, const Eigen::VectorXd& v) {
-  os << "[";
-  for (int i = 0; i < v.size(); ++i) os << (i ? ", " : "") << (std::abs(v(i)) >= 1e20 ? (v(i) > 0 ? "1e20" : "-1e20") : num(v(i)));
-  os << "]";
-}
+std::string num(double v) { return planning::jsonNumber(v); }
 
 /// The request's scalars, state and the worker's constant-velocity prediction over the horizon
 /// (docs/design.md §3); false when a key is bad (reported by `r`).
@@ -231,28 +208,10 @@ int dumpQp(const Args& args, const planning::TrajectoryQpProblem* qp) {
   } else {
     const planning::QpMatrices m = planning::TrajectoryQp::assemble(*qp);
     const planning::TrajectoryQpSolution sol = planning::TrajectoryQp().solve(*qp);
-    Eigen::VectorXd x(9 * qp->intervals);
-    for (int k = 1; k <= qp->intervals; ++k) {
-      x.segment<3>(9 * (k - 1)) = sol.p[static_cast<std::size_t>(k)];
-      x.segment<3>(9 * (k - 1) + 3) = sol.v[static_cast<std::size_t>(k)];
-      x.segment<3>(9 * (k - 1) + 6) = sol.a[static_cast<std::size_t>(k)];
-    }
-    // The objective (H, g), the equalities (A, b), the inequalities (C, l, u).
-    const char* separator = "{";
-    for (const auto& [matrix, matrix_key, vector, vector_key] :
-         {std::tuple{&m.H, "H", &m.g, "g"}, std::tuple{&m.A, "A", &m.b, "b"}, std::tuple{&m.C, "C", &m.l, "l"}}) {
-      q << separator << "\"" << matrix_key << "\": ";
-      writeSparse(q, *matrix);
-      q << ", \"" << vector_key << "\": ";
-      writeVector(q, *vector);
-      separator = ", ";
-    }
-    q << ", \"u\": ";
-    writeVector(q, m.u);
-    q << ", \"cost_constant\": " << num(m.cost_constant) << ", \"status\": \"" << (sol.solved() ? "solved" : sol.reason)
-      << "\", \"x\": ";
-    writeVector(q, x);
-    q << ", \"objective\": " << num(sol.objective) << "}\n";
+    const Eigen::VectorXd x = planning::TrajectoryQp::variables(qp->intervals, sol.p, sol.v, sol.a);
+    planning::writeQpJson(q, m, {{"status", "\"" + (sol.solved() ? std::string("solved") : sol.reason) + "\""},
+                                 {"x", planning::jsonVector(x)},
+                                 {"objective", num(sol.objective)}});
   }
   q.flush();
   if (!q) return badInput(args, args.get("dump-qp") + ": write failed");

@@ -406,6 +406,7 @@ void runSolver(Qp& qp, const Eigen::VectorXd* x0, const QpSolveLimits& limits, C
                QpMatricesSolution& out) {
   qp.settings.eps_abs = limits.eps_abs;
   qp.settings.eps_rel = 0.0;
+  qp.settings.eps_primal_inf = limits.eps_primal_inf;
   qp.settings.verbose = false;
   qp.settings.compute_timings = false;
   int outer = 0;
@@ -454,6 +455,7 @@ void solveDense(const QpMatrices& m, const Eigen::VectorXd* x0, const QpSolveLim
 std::string QpSolveLimits::validate() const {
   std::ostringstream e;
   if (!(eps_abs > 0.0) || !std::isfinite(eps_abs)) e << "eps_abs must be > 0, got " << eps_abs << "; ";
+  if (!(eps_primal_inf > 0.0) || !std::isfinite(eps_primal_inf)) e << "eps_primal_inf must be > 0, got " << eps_primal_inf << "; ";
   if (max_iterations < 1) e << "max_iterations must be >= 1, got " << max_iterations << "; ";
   if (!(timeout_s > 0.0) || !std::isfinite(timeout_s)) e << "solve_timeout_s must be > 0, got " << timeout_s << "; ";
   if (iterations_per_check < 1) e << "iterations_per_check must be >= 1, got " << iterations_per_check << "; ";
@@ -521,11 +523,27 @@ void integrate(const TrajectoryQpProblem& pr, TrajectoryQpSolution& out) {
 
 }  // namespace
 
+Eigen::VectorXd TrajectoryQp::variables(int intervals, const std::vector<Eigen::Vector3d>& p,
+                                        const std::vector<Eigen::Vector3d>& v, const std::vector<Eigen::Vector3d>& a) {
+  const auto size = static_cast<std::size_t>(intervals) + 1;
+  Eigen::VectorXd x;
+  if (intervals < 1 || p.size() != size || v.size() != size || a.size() != size) return x;
+  x.resize(9 * intervals);
+  for (int k = 1; k <= intervals; ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    x.segment<3>(var(k, 0, 0)) = p[i];
+    x.segment<3>(var(k, 1, 0)) = v[i];
+    x.segment<3>(var(k, 2, 0)) = a[i];
+  }
+  return x;
+}
+
 namespace {
 
 QpSolveLimits limitsOf(const TrajectoryQpProblem& pr) {
   QpSolveLimits l;
   l.eps_abs = pr.eps_abs;
+  l.eps_primal_inf = pr.eps_primal_inf;
   l.max_iterations = pr.max_iterations;
   l.timeout_s = pr.solve_timeout_s;
   return l;
@@ -594,12 +612,7 @@ TrajectoryQpSolution TrajectoryQp::solve(const TrajectoryQpProblem& pr, const Tr
     out.inequalities = static_cast<int>(m.l.size());
     Eigen::VectorXd x0;
     if (have_warm) {
-      x0.resize(n);
-      for (int k = 1; k <= N; ++k) {
-        x0.segment<3>(var(k, 0, 0)) = warm->p[k];
-        x0.segment<3>(var(k, 1, 0)) = warm->v[k];
-        x0.segment<3>(var(k, 2, 0)) = warm->a[k];
-      }
+      x0 = variables(N, warm->p, warm->v, warm->a);
       if (!x0.allFinite()) x0.resize(0);
     }
     out.warm_started = x0.size() == n;

@@ -14,6 +14,7 @@
 #include "gesture_formation/planning/distance_field.hpp"
 #include "gesture_formation/planning/occupancy_map.hpp"
 #include "gesture_formation/planning/path_search.hpp"
+#include "gesture_formation/planning/qp_diagnosis.hpp"
 #include "gesture_formation/planning/trajectory_qp.hpp"
 #include "gesture_formation/planning/trajectory_verifier.hpp"
 
@@ -990,27 +991,19 @@ std::string UavPlanner::infeasibilityCause(const PlanContext& c, PlanResult& res
   // statistics need the cause; costs up to three more solves, only on failure). The most
   // frequent cause first: a relaxed problem that is still infeasible costs 2–4× the failed
   // solve before ProxQP proves it (power towers seed 7: ~450 ms of a 560 ms failed replanning
-  // with the worker and UAV families tried first, docs/planning.md §7). Not beyond the time
+  // with the worker and UAV families tried first, docs/planning.md §7.1). Not beyond the time
   // budget: the fallback must not wait for a diagnosis (harsh seed 1: 1.6 s, mostly re-solves).
-  using Kind = PositionConstraint::Kind;
-  for (const auto& [kind, name] : {std::pair{Kind::kCorridor, "corridors"}, std::pair{Kind::kUav, "UAV separation"},
-                                   std::pair{Kind::kWorker, "worker separation"}}) {
-    if (config_.time_budget_ms > 0.0 && msSince(c.t_start) > config_.time_budget_ms) {
-      std::ostringstream os;
-      os << " (cause not diagnosed: the time budget of " << config_.time_budget_ms << " ms is spent)";
-      return os.str();
-    }
-    TrajectoryQpProblem relaxed = c.qp;
-    const auto before = relaxed.constraints.size();
-    relaxed.constraints.erase(std::remove_if(relaxed.constraints.begin(), relaxed.constraints.end(),
-                                             [kind = kind](const PositionConstraint& pc) { return pc.kind == kind; }),
-                              relaxed.constraints.end());
-    if (relaxed.constraints.size() == before) continue;
-    const TrajectoryQpSolution relaxed_sol = qp_->solve(relaxed, nullptr);
-    result.qp_sparse_timeouts += stoppedSparse(relaxed_sol) ? 1 : 0;
-    if (relaxed_sol.solved()) return std::string(" (feasible without the ") + name + " constraints)";
-  }
-  return " (infeasible even without any single family: dynamics vs the initial state)";
+  // Cold and with the problem's own iterations: a warm start or a cap of 10 outer iterations per
+  // relaxed solve named the same causes in no less time on the mission's instances (planning.md §10).
+  const auto t_diagnosis = Clock::now();
+  const auto budget_spent = [&] { return config_.time_budget_ms > 0.0 && msSince(c.t_start) > config_.time_budget_ms; };
+  const QpDiagnosis d = diagnoseInfeasibleQp(*qp_, c.qp, nullptr, c.qp.max_iterations, budget_spent);
+  result.qp_sparse_timeouts += d.sparse_stops;
+  result.timings.qp_diagnosis_ms = msSince(t_diagnosis);
+  if (d.cause != QpDiagnosis::Cause::kStopped) return describe(d.cause);
+  std::ostringstream os;
+  os << " (cause not diagnosed: the time budget of " << config_.time_budget_ms << " ms is spent)";
+  return os.str();
 }
 
 // ---- camera heading / pitch (filter or Ceres) -----------------------------------------------

@@ -79,6 +79,9 @@ struct TrajectoryQpProblem {
   NormPolygon acceleration;
   double w_reference = 1.0, w_acceleration = 0.05, w_jerk = 0.01, w_terminal_velocity = 1.0;
   double eps_abs = 1e-6;
+  /// ProxQP's primal infeasibility tolerance (its `eps_primal_inf`, ProxQP's default 1e-4): the
+  /// relative tolerance of the Farkas certificate it builds from its Newton steps.
+  double eps_primal_inf = 1e-4;
   int max_iterations = 4000;
   /// Cooperative wall-clock bound (s) of each backend's solve, > 0 (checked between rounds of
   /// QpSolveLimits::kIterationsPerCheck outer iterations; past it: kTimeLimit).
@@ -119,6 +122,7 @@ struct QpSolveLimits {
   /// own iteration limits, not by the clock.
   static constexpr int kIterationsPerCheck = 100;
   double eps_abs = 1e-6;                         ///< > 0
+  double eps_primal_inf = 1e-4;                  ///< > 0, ProxQP's primal infeasibility tolerance
   int max_iterations = 4000;                     ///< outer iterations in all, ≥ 1
   double timeout_s = 2.0;                        ///< per backend, > 0
   int iterations_per_check = kIterationsPerCheck;  ///< ≥ 1
@@ -152,6 +156,10 @@ class TrajectoryQp {
   /// start. Invalid limits: kBadInput with the fields named in `reason`.
   static QpMatricesSolution solveMatrices(const QpMatrices& matrices, const Eigen::VectorXd* x0,
                                           const QpSolveLimits& limits);
+  /// \brief x = [p_1 v_1 a_1 … p_N v_N a_N] of the sparse form (QpMatrices) from p, v, a for
+  /// k = 0..N (sizes N + 1, e.g. a TrajectoryQpSolution or a warm start); empty when a size differs.
+  static Eigen::VectorXd variables(int intervals, const std::vector<Eigen::Vector3d>& p,
+                                   const std::vector<Eigen::Vector3d>& v, const std::vector<Eigen::Vector3d>& a);
   /// Dense iterations allowed to the condensed form before the sparse form takes the QP over.
   static constexpr int kCondensedMaxIterations = 100;
 

@@ -76,6 +76,8 @@ struct StageTimings {
   double path_ms = 0.0;
   double corridor_ms = 0.0;
   double qp_ms = 0.0;
+  /// Part of qp_ms: naming the cause of an infeasible QP (relaxed re-solves, docs/planning.md §7.1).
+  double qp_diagnosis_ms = 0.0;
   double heading_ms = 0.0;
   double verify_ms = 0.0;
   double total_ms = 0.0;
