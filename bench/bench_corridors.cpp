@@ -20,6 +20,7 @@
 #include <thread>
 #include <vector>
 
+#include "bench_machine.hpp"
 #include "decomp_reference.hpp"
 #include "gesture_formation/planning/corridor_builder.hpp"
 #include "gesture_formation/planning/occupancy_map.hpp"
@@ -31,6 +32,8 @@ using namespace gesture_formation::planning;
 namespace ref = gesture_formation::bench::decomp_reference;
 
 namespace {
+using gf_bench::loadAverage;
+using gf_bench::cpuModel;
 
 std::string source(const std::string& rel) {
   const char* src = std::getenv("GF_SOURCE_DIR");
@@ -167,11 +170,7 @@ double quantile(std::vector<double> v, double q) {
 
 /// The calling thread's CPU time (µs): a build takes tens of µs, far below a scheduler slice, so
 /// on a shared machine its CPU time is what it costs, its wall time what the neighbours left.
-double cpuUs() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return 1e6 * static_cast<double>(ts.tv_sec) + 1e-3 * static_cast<double>(ts.tv_nsec);
-}
+double cpuUs() { return 1e3 * gf_bench::threadCpuMs(); }
 
 /// Per segment: the median of `reps` builds of each, interleaved (ours, anchor, anchor with C⁻¹ kept).
 struct Timings {
@@ -256,32 +255,6 @@ void printReport(std::FILE* out, const std::vector<ClassRow>& rows, const BenchS
   printClasses(out, rows);
 }
 
-std::string loadAverage() {
-  std::FILE* f = std::fopen("/proc/loadavg", "r");
-  if (f == nullptr) return "?";
-  char buf[64] = {0};
-  const bool ok = std::fgets(buf, sizeof buf, f) != nullptr;
-  std::fclose(f);
-  std::string s = ok ? buf : "?";
-  return s.substr(0, s.find(' '));
-}
-
-std::string cpuModel() {
-  std::FILE* f = std::fopen("/proc/cpuinfo", "r");
-  if (f == nullptr) return "?";
-  char line[256];
-  std::string model = "?";
-  while (std::fgets(line, sizeof line, f) != nullptr) {
-    const std::string s(line);
-    if (s.rfind("model name", 0) == 0 && s.find(':') != std::string::npos) {
-      model = s.substr(s.find(':') + 2);
-      model.erase(model.find_last_not_of(" \n") + 1);
-      break;
-    }
-  }
-  std::fclose(f);
-  return model;
-}
 
 std::string utcNow() {
   const std::time_t now = std::time(nullptr);

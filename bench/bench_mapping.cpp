@@ -31,6 +31,7 @@
 #include <thread>
 #include <vector>
 
+#include "bench_machine.hpp"
 #include "gesture_formation/estimation/camera_model.hpp"
 #include "gesture_formation/mapping/live_map.hpp"
 #include "gesture_formation/planning/scenario.hpp"
@@ -41,6 +42,7 @@ using namespace gesture_formation;
 using Clock = std::chrono::steady_clock;
 
 namespace {
+using gf_bench::cpuModel;
 
 struct Stats {
   std::vector<double> v;
@@ -154,13 +156,6 @@ void print(const char* name, const Sections& s) {
   row("field voxels recomputed", s.field_written, "");
 }
 
-std::string cpuModel() {
-  std::ifstream in("/proc/cpuinfo");
-  for (std::string line; std::getline(in, line);) {
-    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-  }
-  return "?";
-}
 
 void markdownRows(std::FILE* f, const char* section, const Sections& s) {
   auto row = [&](const char* what, const Stats& st, int digits) {

@@ -39,6 +39,7 @@
 #include <ompl/geometric/planners/rrt/RRTConnect.h>
 #include <ompl/util/Console.h>
 
+#include "bench_machine.hpp"
 #include "gesture_formation/formation/formation_config.hpp"
 #include "gesture_formation/formation/formation_geometry.hpp"
 #include "gesture_formation/planning/camera_tracking.hpp"
@@ -59,6 +60,8 @@ using namespace gesture_formation::planning;
 using Clock = std::chrono::steady_clock;
 
 namespace {
+using gf_bench::loadAverage;
+using gf_bench::threadCpuMs;
 
 double ms(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); }
 
@@ -338,21 +341,7 @@ void benchCamera(int n) {
 
 // ---- 4. the power-tower mission: every replanning, the slowest 1 % ------------------------------
 
-double threadCpuMs() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return 1e3 * static_cast<double>(ts.tv_sec) + 1e-6 * static_cast<double>(ts.tv_nsec);
-}
 
-std::string loadAverage() {
-  std::FILE* f = std::fopen("/proc/loadavg", "r");
-  if (f == nullptr) return "?";
-  char buf[64] = {0};
-  const bool ok = std::fgets(buf, sizeof buf, f) != nullptr;
-  std::fclose(f);
-  std::string s = ok ? buf : "?";
-  return s.substr(0, s.find(' '));
-}
 
 struct ReplanRecord {
   int uav = 0;
