@@ -87,6 +87,9 @@ ViewFusionConfig readViewFusionConfig(ConfigReader& r) {
   const std::string k = "view_fusion.";
   r.readBool(k + "gate_envelope", c.gate_envelope);
   r.readBool(k + "confirm_3d", c.confirm_3d);
+  std::string scope = c.confirm_3d_scope == ViewFusionConfig::ConfirmScope::kAll ? "all" : "one_arm";
+  r.readString(k + "confirm_3d_scope", scope, {"one_arm", "all"});
+  c.confirm_3d_scope = scope == "all" ? ViewFusionConfig::ConfirmScope::kAll : ViewFusionConfig::ConfirmScope::kOneArm;
   r.readBool(k + "require_3d", c.require_3d);
   std::string rules = toString(c.geometry.rules);
   r.readString(k + "geometry_3d", rules, {toString(GeometryRules::kDesign), toString(GeometryRules::kNetworkTolerant)});
@@ -198,7 +201,8 @@ FusedGesture ViewFusion::fuse(double t_now) const {
   }
   out.agreeing_views = best_votes;
   const bool one_short = config_.confirm_3d && unique && best_votes + 1 == config_.min_agreeing_views &&
-                         (best == kExtendArmSide || best == kRaiseArmUp);
+                         (config_.confirm_3d_scope == ViewFusionConfig::ConfirmScope::kAll || best == kExtendArmSide ||
+                          best == kRaiseArmUp);
   const bool passed = best_votes >= config_.min_agreeing_views && unique;
   if (!passed && !one_short) return out;
   // The 3-D frames of the window, triangulated once for both tests.
@@ -257,17 +261,27 @@ std::vector<Skeleton3D> ViewFusion::framesIn3D(double t_now) const {
   return out;
 }
 
-bool ViewFusion::holdsIn3D(int g, const std::vector<Skeleton3D>& frames) const {
+std::size_t ViewFusion::framesInRegion(int g, const std::vector<Skeleton3D>& frames) const {
   const auto half = static_cast<std::size_t>(std::max(0, (config_.require_3d_median_frames - 1) / 2));
   std::size_t holds = 0;
   for (std::size_t k = 0; k < frames.size(); ++k) {
     const Skeleton3D s = half == 0 ? frames[k] : medianSkeleton(frames, k >= half ? k - half : 0, k + half);
     if (classifyPose3D(s, config_.geometry).gesture_id == g) ++holds;
   }
-  return static_cast<double>(holds) >= config_.require_3d_min_fraction * static_cast<double>(frames.size());
+  return holds;
+}
+
+bool ViewFusion::holdsIn3D(int g, const std::vector<Skeleton3D>& frames) const {
+  return static_cast<double>(framesInRegion(g, frames)) >=
+         config_.require_3d_min_fraction * static_cast<double>(frames.size());
 }
 
 bool ViewFusion::confirmedIn3D(int g, const std::vector<Skeleton3D>& frames3d) const {
+  if (config_.confirm_3d_scope == ViewFusionConfig::ConfirmScope::kAll) {
+    const auto n = static_cast<int>(frames3d.size());
+    return n >= config_.confirm_3d_min_frames &&
+           static_cast<double>(framesInRegion(g, frames3d)) >= config_.confirm_3d_min_fraction * n;
+  }
   int frames = 0, hits = 0;
   for (const Skeleton3D& s : frames3d) {
     if (!bodyFrameOf(s)) continue;

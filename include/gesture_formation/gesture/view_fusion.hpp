@@ -29,7 +29,12 @@
 ///  - with confirm_3d, a one-arm gesture (extend, raise) exactly one vote short still passes when
 ///    the views' skeletons of the vote window, triangulated (gesture/view_triangulation.hpp), show
 ///    the arm in that pose in at least confirm_3d_min_fraction of the 3-D frames: the geometry
-///    that no 2-D view can tell apart from a pointing arm (docs/gestures.md §6).
+///    that no 2-D view can tell apart from a pointing arm (docs/gestures.md §6). With
+///    confirm_3d_scope all, every gesture one vote short is confirmed the same way, on its
+///    geometry_3d region (gesture/gesture_geometry.hpp, each frame read on the median of
+///    require_3d_median_frames): a two-arm gesture that only the frontal view reads in 2-D (the
+///    side and rear views' networks name the hands by image side) passes when the formation's
+///    3-D skeleton shows it.
 ///  - with require_3d (default on), every gesture the vote (or the confirmation) passes is checked in
 ///    3-D whenever two or more calibrated views see the worker in the vote window (an instant at
 ///    which two or more views' skeletons, at most confirm_3d_max_dt_s apart, triangulate): it goes
@@ -80,6 +85,10 @@ struct ViewFusionConfig {
   /// (gesture/view_triangulation.hpp) in at least confirm_3d_min_fraction of at least
   /// confirm_3d_min_frames frames. Needs observations that carry calibrated skeletons.
   bool confirm_3d = false;
+  /// Which gestures confirm_3d may confirm (YAML `view_fusion.confirm_3d_scope`): one_arm (extend,
+  /// raise; oneArmGesture3D) or all (every gesture, on its geometry_3d region as require_3d reads it).
+  enum class ConfirmScope { kOneArm, kAll };
+  ConfirmScope confirm_3d_scope = ConfirmScope::kOneArm;
   double confirm_3d_min_fraction = 0.5;  ///< (0, 1]
   int confirm_3d_min_frames = 5;         ///< ≥ 1
   double confirm_3d_max_dt_s = 0.034;    ///< views' frames at most this apart form one 3-D frame [s], > 0 (also require_3d's)
@@ -114,7 +123,7 @@ struct ViewFusionConfig {
 
 /// \brief Reads `view_fusion.{min_agreeing_views, max_age_s, gate_envelope, distance_min_m,
 /// distance_max_m, elevation_min_deg, elevation_max_deg, vote_window_s, vote_min_fraction, confirm_3d,
-/// confirm_3d_min_fraction, confirm_3d_min_frames, confirm_3d_max_dt_s, require_3d, require_3d_min_fraction,
+/// confirm_3d_scope, confirm_3d_min_fraction, confirm_3d_min_frames, confirm_3d_max_dt_s, require_3d, require_3d_min_fraction,
 /// require_3d_min_frames, require_3d_median_frames, geometry_3d, tolerant_3d.*, fusion_lag_s}` (missing keys: the defaults above
 /// unless the reader requires every key).
 ViewFusionConfig readViewFusionConfig(common::ConfigReader& reader);
@@ -181,8 +190,13 @@ class ViewFusion {
   /// Whether design.md §2's geometry of gesture g holds in require_3d_min_fraction of the frames, each
   /// read on the median of require_3d_median_frames around it (require_3d).
   bool holdsIn3D(int g, const std::vector<Skeleton3D>& frames) const;
-  /// Whether the triangulated frames show one-arm gesture g (confirm_3d).
+  /// Whether the triangulated frames show gesture g (confirm_3d): a one-arm gesture in
+  /// confirm_3d_min_fraction of the frames with a body frame (oneArmGesture3D); with scope all any
+  /// gesture on its geometry_3d region read as holdsIn3D reads it (medians), same fraction.
   bool confirmedIn3D(int g, const std::vector<Skeleton3D>& frames) const;
+  /// How many of the frames, each read on the median of require_3d_median_frames around it, fall in
+  /// gesture g's geometry_3d region.
+  std::size_t framesInRegion(int g, const std::vector<Skeleton3D>& frames) const;
 };
 
 }  // namespace gesture_formation::gesture

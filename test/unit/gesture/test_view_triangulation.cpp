@@ -457,6 +457,46 @@ TEST(ViewFusionRequire3DTest, AConfirmedOneArmGestureMustAlsoHoldItsGeometry) {
   EXPECT_FALSE(band.confirmed_3d);
 }
 
+TEST(ViewFusion3DTest, WithScopeAllATwoArmGestureOneViewReadsIsConfirmedOnItsRegion) {
+  SkeletonSynthesizer synth(SynthConfig{}, 12);
+  gf::gesture::ViewFusionConfig c;
+  c.confirm_3d = true;
+  c.confirm_3d_scope = gf::gesture::ViewFusionConfig::ConfirmScope::kAll;
+  // One view reads "cross arms" / "palms together", the other none: the 3-D skeleton shows the gesture.
+  for (const auto& [motion, id] : {std::pair{Motion::kCrossArms, 1}, std::pair{Motion::kPalmsTogether, 3}}) {
+    SCOPED_TRACE(gf::gesture::toString(motion));
+    const auto body = synth.pose(motion, 1.0, 0.0, true);
+    c.confirm_3d_scope = gf::gesture::ViewFusionConfig::ConfirmScope::kOneArm;
+    EXPECT_EQ(fuseTwoViews(body, id, 0, c).gesture_id, 0);  // one_arm: two-arm gestures are never confirmed
+    c.confirm_3d_scope = gf::gesture::ViewFusionConfig::ConfirmScope::kAll;
+    const auto f = fuseTwoViews(body, id, 0, c);
+    EXPECT_EQ(f.gesture_id, id);
+    EXPECT_TRUE(f.confirmed_3d);
+    EXPECT_TRUE(f.checked_3d);
+    EXPECT_EQ(f.agreeing_views, 1);
+  }
+  // The near-misses one view misreads stay none: the 3-D skeleton is not in the gesture's region.
+  for (const auto& [motion, id] : {std::pair{Motion::kToolAtWaist, 3}, std::pair{Motion::kArmsFoldedLow, 1},
+                                   std::pair{Motion::kHoldObjectAtChest, 3}, std::pair{Motion::kReachUpBolt, 4}}) {
+    SCOPED_TRACE(gf::gesture::toString(motion));
+    const auto f = fuseTwoViews(synth.pose(motion, 1.0, 0.0, true), id, 0, c);
+    EXPECT_EQ(f.gesture_id, 0);
+    EXPECT_FALSE(f.confirmed_3d);
+  }
+  // Read and validated: one_arm | all, anything else refused naming the key and the value.
+  using gf::common::ConfigReader;
+  ConfigReader ok = ConfigReader::fromString("view_fusion: {confirm_3d_scope: all}\n", "ok.yaml",
+                                             ConfigReader::MissingKeys::kUseDefaults);
+  EXPECT_EQ(gf::gesture::readViewFusionConfig(ok).confirm_3d_scope, gf::gesture::ViewFusionConfig::ConfirmScope::kAll);
+  EXPECT_TRUE(ok.ok()) << ok.errorReport();
+  ConfigReader bad = ConfigReader::fromString("view_fusion: {confirm_3d_scope: both}\n", "bad.yaml",
+                                              ConfigReader::MissingKeys::kUseDefaults);
+  (void)gf::gesture::readViewFusionConfig(bad);
+  EXPECT_FALSE(bad.ok());
+  EXPECT_NE(bad.errorReport().find("view_fusion.confirm_3d_scope"), std::string::npos) << bad.errorReport();
+  EXPECT_NE(bad.errorReport().find("both"), std::string::npos) << bad.errorReport();
+}
+
 TEST(ViewFusionRequire3DTest, RequireKeysAreValidatedAndRead) {
   gf::gesture::ViewFusionConfig c;
   EXPECT_TRUE(c.require_3d);  // default on
