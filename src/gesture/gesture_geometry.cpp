@@ -65,16 +65,17 @@ Test crossArms(const PoseMeasures& m, const GestureGeometryNumbers& n) {
   return Test::kBand;
 }
 
-/// Both wrists within max_midline_offset_H of the body's midline (either naming of the wrists).
-bool wristsNearMidline(const PoseMeasures& m, const TolerantGeometryNumbers& t) {
-  const double max_m = t.max_midline_offset_H * m.height_m;
+/// Both wrists within max_offset_H of the body's midline (either naming of the wrists).
+bool wristsNearMidline(const PoseMeasures& m, double max_offset_H) {
+  const double max_m = max_offset_H * m.height_m;
   return std::abs(m.left.wrist_body.y()) <= max_m && std::abs(m.right.wrist_body.y()) <= max_m;
 }
 
 /// Palms together as the networks see it (GeometryRules::kNetworkTolerant): hands a hand-width apart.
 Test palmsTolerant(const PoseMeasures& m, const GestureGeometryNumbers& n) {
   const TolerantGeometryNumbers& t = n.tolerant;
-  if (!m.left.valid || !m.right.valid || m.wrist_separation_H > t.palms_max_separation_H || !wristsNearMidline(m, t)) {
+  if (!m.left.valid || !m.right.valid || m.wrist_separation_H > t.palms_max_separation_H ||
+      !wristsNearMidline(m, t.max_midline_offset_H)) {
     return Test::kOut;
   }
   const double mean = 0.5 * (m.left.wrist_height_H + m.right.wrist_height_H);
@@ -86,14 +87,15 @@ Test palmsTolerant(const PoseMeasures& m, const GestureGeometryNumbers& n) {
   return mean <= t.palms_max_height_H && in_front && level ? Test::kInside : Test::kOut;
 }
 
-/// Cross arms without trusting which wrist the network names: both wrists high near the midline,
-/// or the design's crossed wrists.
+/// Cross arms without trusting which wrist the network names: both wrists near the midline between
+/// the shoulders and the face (not above it: a ladder's rungs), or the design's crossed wrists.
 Test crossTolerant(const PoseMeasures& m, const GestureGeometryNumbers& n) {
   if (crossArms(m, n) == Test::kInside) return Test::kInside;
   const TolerantGeometryNumbers& t = n.tolerant;
-  if (!m.left.valid || !m.right.valid || !wristsNearMidline(m, t)) return Test::kOut;
+  if (!m.left.valid || !m.right.valid || !wristsNearMidline(m, t.cross_max_midline_offset_H)) return Test::kOut;
   const double lo = std::min(m.left.wrist_height_H, m.right.wrist_height_H);
   const double hi = std::max(m.left.wrist_height_H, m.right.wrist_height_H);
+  if (hi > t.cross_max_height_H) return Test::kOut;
   if (lo >= t.cross_min_height_H) return Test::kInside;
   if (hi <= t.folded_max_height_H) return Test::kNearMiss;  // arms folded low
   return Test::kBand;

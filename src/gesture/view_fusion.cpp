@@ -40,7 +40,10 @@ const common::FieldTable<ViewFusionConfig>& fields() {
       {"view_fusion.tolerant_3d.tool_max_height_H", Range::closed(0.0, 1.2), [](C& c) { return &c.geometry.tolerant.tool_max_height_H; }},
       {"view_fusion.tolerant_3d.max_midline_offset_H", Range::openClosed(0.0, 0.5),
        [](C& c) { return &c.geometry.tolerant.max_midline_offset_H; }},
+      {"view_fusion.tolerant_3d.cross_max_midline_offset_H", Range::openClosed(0.0, 0.5),
+       [](C& c) { return &c.geometry.tolerant.cross_max_midline_offset_H; }},
       {"view_fusion.tolerant_3d.cross_min_height_H", Range::closed(0.0, 1.2), [](C& c) { return &c.geometry.tolerant.cross_min_height_H; }},
+      {"view_fusion.tolerant_3d.cross_max_height_H", Range::closed(0.0, 1.2), [](C& c) { return &c.geometry.tolerant.cross_max_height_H; }},
       {"view_fusion.tolerant_3d.folded_max_height_H", Range::closed(0.0, 1.2), [](C& c) { return &c.geometry.tolerant.folded_max_height_H; }},
       {"view_fusion.tolerant_3d.raise_min_shoulder_wrist_deg", Range::closed(90.0, 180.0),
        [](C& c) { return &c.geometry.tolerant.raise_min_shoulder_wrist_deg; }},
@@ -65,6 +68,8 @@ std::vector<common::ConfigError> problems(const ViewFusionConfig& c) {
                     "must exceed " + k + "palms_min_height_H " + common::formatDouble(t.palms_min_height_H));
   common::checkRule(e, t.tool_max_height_H <= t.palms_min_height_H, k + "tool_max_height_H", t.tool_max_height_H,
                     "must not exceed " + k + "palms_min_height_H " + common::formatDouble(t.palms_min_height_H));
+  common::checkRule(e, t.cross_max_height_H > t.cross_min_height_H, k + "cross_max_height_H", t.cross_max_height_H,
+                    "must exceed " + k + "cross_min_height_H " + common::formatDouble(t.cross_min_height_H));
   common::checkRule(e, t.folded_max_height_H <= t.cross_min_height_H, k + "folded_max_height_H", t.folded_max_height_H,
                     "must not exceed " + k + "cross_min_height_H " + common::formatDouble(t.cross_min_height_H));
   common::checkRule(e, t.reach_max_shoulder_wrist_deg <= t.raise_min_shoulder_wrist_deg, k + "reach_max_shoulder_wrist_deg",

@@ -78,7 +78,10 @@ def features(P):
         if el in P and wr in P:
             up, fore, whole = body(P[el]) - body(P[sh]), body(P[wr]) - body(P[el]), body(P[wr]) - body(P[sh])
             ang = lambda a, b: np.degrees(np.arccos(np.clip(a @ b / (np.linalg.norm(a) * np.linalg.norm(b)), -1, 1)))  # noqa: E731
+            outward = up[1] * (1.0 if side == "l" else -1.0)
             f[side] = {"elev": ang(up, np.array([0, 0, -1.0])), "whole": ang(whole, np.array([0, 0, -1.0])),
+                       "abd": float(np.degrees(np.arctan2(outward, abs(up[0])))),
+                       "wabd": float(np.degrees(np.arctan2(whole[1] * (1.0 if side == "l" else -1.0), abs(whole[0])))),
                        "elbow": ang(-up, fore), "fore_h": abs(np.degrees(np.arcsin(np.clip(fore[2] / np.linalg.norm(fore), -1, 1)))),
                        "w": body(P[wr]), "e": body(P[el])}
     if "l" in f and "r" in f:
@@ -122,6 +125,23 @@ def rules(f):
     for ch in (0.74, 0.76, 0.78):
         for cg in (0.16, 0.20, 9):
             out[f"crossN h_min>={ch} off<=0.10 gap<={cg}"] = both and f["wh_min"] >= ch and f["off"] <= 0.10 and f["gap"] <= cg
+    # Label-free cross with a ceiling (session 27, chosen on rendered_tuning + rendered_tuning_2): the
+    # hands in front of the upper chest or face, not above the head (a ladder's rungs).
+    if both:
+        f["wh_max"] = f["wh_min"] + 2 * (f["wh"] - f["wh_min"])
+    for ch in (0.76, 0.78, 0.80):
+        for top in (0.90, 0.92, 0.94):
+            for o in (0.10, 0.12, 0.14):
+                out[f"crossC h_min>={ch} h_max<={top} off<={o}"] = (both and f["wh_min"] >= ch and f["wh_max"] <= top
+                                                                    and f["off"] <= o)
+    # Extend: the design's region on the upper arm (elevation 70-110, out of the sagittal plane >= 70,
+    # elbow >= 150), and on the line shoulder -> wrist (the elbow of a straight arm reads bent).
+    out["extend design"] = any(70 <= a["elev"] <= 110 and a["abd"] >= 70 and a["elbow"] >= 150 for a in arms)
+    for lo, hi in ((70, 110), (65, 115), (60, 120)):
+        for ab in (70, 60):
+            for e in (150, 140, 130):
+                out[f"extendW whole{lo}-{hi} wabd>={ab} elbow>={e}"] = any(
+                    lo <= a["whole"] <= hi and a["wabd"] >= ab and a["elbow"] >= e for a in arms)
     for w in (135, 140, 145, 150):
         for e in (120, 130, 140):
             out[f"raise whole>={w} elbow>={e}"] = any(a["whole"] >= w and a["elbow"] >= e for a in arms)
@@ -164,6 +184,12 @@ def main():
                 if s in f:
                     fl = feats.setdefault(motion, {})
                     fl.setdefault("whole_max", []).append(f[s]["whole"])
+            arms_ = [f[s] for s in ("l", "r") if s in f]
+            if arms_:
+                arm = max(arms_, key=lambda x: x["whole"] if x["whole"] < 125 else -1)
+                fl = feats.setdefault(motion, {})
+                for k in ("elev", "abd", "elbow", "whole", "wabd"):
+                    fl.setdefault("ext_" + k, []).append(arm[k])
     motions = sorted(acc)
     names = list(next(iter(acc.values())).keys())
     res = {m: {k: round(float(np.mean(v)), 3) for k, v in acc[m].items()} for m in motions}

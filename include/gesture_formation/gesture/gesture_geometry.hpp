@@ -72,8 +72,10 @@ struct TolerantGeometryNumbers {
   double palms_max_separation_H = 0.13;   ///< MoveNet's palms: median 0.10 H, p90 0.12 H apart
   double palms_min_height_H = 0.65, palms_max_height_H = 0.78;  ///< the wrists' mean height
   double tool_max_height_H = 0.61;        ///< band: tool_max .. palms_min
-  double max_midline_offset_H = 0.10;     ///< palms and label-free cross: each wrist this near the midline
-  double cross_min_height_H = 0.76;       ///< label-free cross: both wrists at least this high
+  double max_midline_offset_H = 0.10;     ///< palms: each wrist this near the midline
+  double cross_max_midline_offset_H = 0.12;  ///< label-free cross: each wrist this near the midline
+  double cross_min_height_H = 0.80;       ///< label-free cross: both wrists at least this high (design.md's 0.80)
+  double cross_max_height_H = 0.92;       ///< label-free cross: neither wrist above this (the face; a ladder's rungs are higher)
   double folded_max_height_H = 0.70;      ///< band: folded_max .. cross_min
   double raise_min_shoulder_wrist_deg = 145.0, raise_min_elbow_deg = 130.0;
   double reach_max_shoulder_wrist_deg = 130.0, reach_max_elbow_deg = 120.0;  ///< band between

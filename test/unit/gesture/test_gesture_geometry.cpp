@@ -441,7 +441,9 @@ TEST(GestureGeometryTolerantTest, TheDefaultsAreTheDesignsAndTheTolerantNumbersA
   EXPECT_EQ(t.palms_max_height_H, 0.78);
   EXPECT_EQ(t.tool_max_height_H, 0.61);
   EXPECT_EQ(t.max_midline_offset_H, 0.10);
-  EXPECT_EQ(t.cross_min_height_H, 0.76);
+  EXPECT_EQ(t.cross_max_midline_offset_H, 0.12);  // session 27: both rendered tuning sets (3701, 3702)
+  EXPECT_EQ(t.cross_min_height_H, 0.80);
+  EXPECT_EQ(t.cross_max_height_H, 0.92);
   EXPECT_EQ(t.folded_max_height_H, 0.70);
   EXPECT_EQ(t.raise_min_shoulder_wrist_deg, 145.0);
   EXPECT_EQ(t.raise_min_elbow_deg, 130.0);
@@ -503,6 +505,21 @@ TEST(GestureGeometryTolerantTest, LadderRungsFoldedArmsAndTheBandAreNotCrossArms
   EXPECT_EQ(band.gesture_id, gf::gesture::kNone);
   EXPECT_EQ(band.region, PoseRegion::kBand);
   EXPECT_EQ(band.nearest_gesture, gf::gesture::kCrossArms);
+}
+
+// The label-free cross between the shoulders and the face (rendered_tuning_2: without the ceiling it
+// held in 29 % of the ladder-climbing frames and, from 0.76 H, in 26 % of an object held at the chest).
+TEST(GestureGeometryTolerantTest, LabelFreeCrossLiesBetweenTheShouldersAndTheFace) {
+  Worker w;
+  w.hands({0.10, 0.16, 0.74}, {0.17, 0.11, 0.85});  // 0.11 H off the midline at 0.85 H
+  EXPECT_EQ(tolerantVerdict(w).gesture_id, gf::gesture::kCrossArms);
+  w.hands({0.12, 0.14, 0.84}, {0.20, 0.06, 0.95});  // near the midline above the face: rungs, not a cross
+  EXPECT_EQ(tolerantVerdict(w).gesture_id, gf::gesture::kNone);
+  w.hands({0.10, 0.16, 0.70}, {0.20, 0.07, 0.79});  // a box held at the chest (wrists 0.14 H apart): below 0.80 H
+  const PoseVerdict chest = tolerantVerdict(w);
+  EXPECT_EQ(chest.gesture_id, gf::gesture::kNone);
+  w.hands({0.10, 0.16, 0.74}, {0.17, 0.13, 0.85});  // 0.13 H off the midline: out
+  EXPECT_EQ(tolerantVerdict(w).gesture_id, gf::gesture::kNone);
 }
 
 TEST(GestureGeometryTolerantTest, ARaisedArmWithABentReadElbowIsRaiseAReachIsNot) {

@@ -564,12 +564,14 @@ TEST(ViewFusionRequire3DTest, GeometryKeysAreValidatedAndRead) {
   gf::gesture::ViewFusionConfig c;
   EXPECT_EQ(c.geometry.rules, gf::gesture::GeometryRules::kDesign);
   c.geometry.tolerant.palms_max_separation_H = 0.0;
-  c.geometry.tolerant.folded_max_height_H = 0.8;  // above cross_min_height_H 0.76: no band
+  c.geometry.tolerant.folded_max_height_H = 0.85;  // above cross_min_height_H 0.80: no band
+  c.geometry.tolerant.cross_max_height_H = 0.78;   // below cross_min_height_H: no region
   const auto e = c.validate();
-  ASSERT_EQ(e.size(), 2u);
+  ASSERT_EQ(e.size(), 3u);
   EXPECT_NE(e[0].find("view_fusion.tolerant_3d.palms_max_separation_H"), std::string::npos) << e[0];
-  EXPECT_NE(e[1].find("view_fusion.tolerant_3d.folded_max_height_H"), std::string::npos) << e[1];
-  EXPECT_NE(e[1].find("cross_min_height_H"), std::string::npos) << e[1];
+  EXPECT_NE(e[1].find("view_fusion.tolerant_3d.cross_max_height_H"), std::string::npos) << e[1];
+  EXPECT_NE(e[2].find("view_fusion.tolerant_3d.folded_max_height_H"), std::string::npos) << e[2];
+  EXPECT_NE(e[2].find("cross_min_height_H"), std::string::npos) << e[2];
   using gf::common::ConfigReader;
   ConfigReader ok = ConfigReader::fromString("view_fusion: {geometry_3d: network_tolerant, tolerant_3d: "
                                              "{palms_max_separation_H: 0.12, raise_min_shoulder_wrist_deg: 150}}\n",
