@@ -96,6 +96,7 @@ ViewFusionConfig readViewFusionConfig(ConfigReader& r) {
   r.readString(k + "confirm_3d_scope", scope, {"one_arm", "all"});
   c.confirm_3d_scope = scope == "all" ? ViewFusionConfig::ConfirmScope::kAll : ViewFusionConfig::ConfirmScope::kOneArm;
   r.readBool(k + "require_3d", c.require_3d);
+  r.readBool(k + "resolve_sides", c.resolve_sides);
   std::string rules = toString(c.geometry.rules);
   r.readString(k + "geometry_3d", rules, {toString(GeometryRules::kDesign), toString(GeometryRules::kNetworkTolerant)});
   c.geometry.rules = rules == toString(GeometryRules::kNetworkTolerant) ? GeometryRules::kNetworkTolerant : GeometryRules::kDesign;
@@ -248,6 +249,8 @@ std::vector<Skeleton3D> ViewFusion::framesIn3D(double t_now) const {
     }
   }
   if (ref_count == 0) return out;
+  TriangulationConfig triangulation;
+  triangulation.resolve_sides = config_.resolve_sides;
   std::vector<CalibratedSkeleton> views;
   for (const ViewObservation& o : history_[ref]) {
     if (!usable(o)) continue;
@@ -261,7 +264,7 @@ std::vector<Skeleton3D> ViewFusion::framesIn3D(double t_now) const {
       }
       if (nearest != nullptr) views.push_back(*nearest->calibrated);
     }
-    if (views.size() >= 2) out.push_back(triangulate(views, TriangulationConfig{}));
+    if (views.size() >= 2) out.push_back(triangulate(views, triangulation));
   }
   return out;
 }

@@ -1,6 +1,7 @@
 #include "gesture_formation/gesture/view_triangulation.hpp"
 
 #include <algorithm>
+#include <bitset>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -67,6 +68,9 @@ std::vector<std::string> TriangulationConfig::validate() const {
   if (!(min_confidence >= 0.0 && min_confidence < 1.0)) {
     e.push_back("min_confidence: expected [0, 1), got " + std::to_string(min_confidence));
   }
+  if (!(nose_behind_m >= 0.0 && nose_behind_m <= 1.0)) {
+    e.push_back("nose_behind_m: expected [0, 1], got " + std::to_string(nose_behind_m));
+  }
   if (!(min_ray_angle_deg > 0.0 && min_ray_angle_deg < 90.0)) {
     e.push_back("min_ray_angle_deg: expected (0, 90), got " + std::to_string(min_ray_angle_deg));
   }
@@ -90,13 +94,23 @@ std::vector<std::string> ArmGestureThresholds::validate() const {
   return e;
 }
 
-Skeleton3D triangulate(const std::vector<CalibratedSkeleton>& views, const TriangulationConfig& config) {
-  Skeleton3D out;
-  std::vector<estimation::CameraModel> cameras;
-  cameras.reserve(views.size());
-  for (const auto& v : views) cameras.emplace_back(v.intrinsics);
+namespace {
+
+/// The COCO-17 keypoint of the other side (nose: itself).
+constexpr std::array<int, kNumKeypoints> kMirror{0, 2, 1, 4, 3, 6, 5, 8, 7, 10, 9, 12, 11, 14, 13, 16, 15};
+/// The keypoints that decide which views are mirrored: the body, not the arms (the arms' own
+/// naming errors are what the gesture geometry allows for).
+constexpr std::array<int, 12> kBodyKeypoints{1, 2, 3, 4, 5, 6, 11, 12, 13, 14, 15, 16};
+
+/// Triangulates the keypoints `which` with view v's keypoint k read as kMirror[k] when bit v of
+/// `mirrored` is set; returns the sum of the confidence-weighted squared reprojection errors [px²].
+double triangulateSome(const std::vector<CalibratedSkeleton>& views, const std::vector<estimation::CameraModel>& cameras,
+                       const TriangulationConfig& config, unsigned mirrored, const int* which, std::size_t count,
+                       Skeleton3D& out) {
   const double min_sin = std::sin(common::degToRad(config.min_ray_angle_deg));
-  for (int k = 0; k < kNumKeypoints; ++k) {
+  double total = 0.0;
+  for (std::size_t w = 0; w < count; ++w) {
+    const int k = which[w];
     const auto i = static_cast<std::size_t>(k);
     // Least squares: Σ w (I − r rᵀ) p = Σ w (I − r rᵀ) c over the rays (c, r), r unit, world frame.
     Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
@@ -105,10 +119,11 @@ Skeleton3D triangulate(const std::vector<CalibratedSkeleton>& views, const Trian
     std::vector<std::size_t> used;
     for (std::size_t v = 0; v < views.size(); ++v) {
       const CalibratedSkeleton& cs = views[v];
-      const double c = cs.skeleton.c[i];
+      const auto j = static_cast<std::size_t>(v < 32 && ((mirrored >> v) & 1U) ? kMirror[i] : k);
+      const double c = cs.skeleton.c[j];
       if (!(c >= config.min_confidence) || c <= 0.0) continue;
       if (!cs.R_world_camera.allFinite() || !cs.p_world_camera.allFinite()) continue;
-      const auto ray_camera = cameras[v].rayThroughPixel(Eigen::Vector2d(cs.skeleton.x[i], cs.skeleton.y[i]));
+      const auto ray_camera = cameras[v].rayThroughPixel(Eigen::Vector2d(cs.skeleton.x[j], cs.skeleton.y[j]));
       if (!ray_camera) continue;
       const Eigen::Vector3d r = (cs.R_world_camera * *ray_camera).normalized();
       const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - r * r.transpose();
@@ -125,21 +140,76 @@ Skeleton3D triangulate(const std::vector<CalibratedSkeleton>& views, const Trian
     if (widest < min_sin) continue;
     const Eigen::Vector3d p = A.ldlt().solve(b);
     if (!p.allFinite()) continue;
-    double worst = 0.0;
+    double worst = 0.0, squared = 0.0;
     for (std::size_t v : used) {
       const CalibratedSkeleton& cs = views[v];
+      const auto j = static_cast<std::size_t>(v < 32 && ((mirrored >> v) & 1U) ? kMirror[i] : k);
       const auto px = cameras[v].project(cs.R_world_camera.transpose() * (p - cs.p_world_camera));
       if (!px) {
         worst = std::numeric_limits<double>::infinity();
         break;
       }
-      worst = std::max(worst, (*px - Eigen::Vector2d(cs.skeleton.x[i], cs.skeleton.y[i])).norm());
+      const double e = (*px - Eigen::Vector2d(cs.skeleton.x[j], cs.skeleton.y[j])).norm();
+      worst = std::max(worst, e);
+      squared += cs.skeleton.c[j] * e * e;
     }
-    if (!std::isfinite(worst)) continue;  // behind a camera that saw it: inconsistent rays
+    if (!std::isfinite(worst)) {  // behind a camera that saw it: inconsistent rays
+      total += 1e12;
+      continue;
+    }
+    total += squared;
     out.p_world[i] = p;
     out.valid[i] = true;
     out.views[i] = static_cast<int>(used.size());
     out.reprojection_px[i] = worst;
+  }
+  return total;
+}
+
+}  // namespace
+
+Skeleton3D triangulate(const std::vector<CalibratedSkeleton>& views, const TriangulationConfig& config) {
+  std::vector<estimation::CameraModel> cameras;
+  cameras.reserve(views.size());
+  for (const auto& v : views) cameras.emplace_back(v.intrinsics);
+  std::array<int, kNumKeypoints> all{};
+  for (int k = 0; k < kNumKeypoints; ++k) all[static_cast<std::size_t>(k)] = k;
+  unsigned mirrored = 0;
+  if (config.resolve_sides && views.size() >= 2) {
+    const std::size_t n = std::min<std::size_t>(views.size(), 6);
+    double best = std::numeric_limits<double>::infinity();
+    int best_count = 0;
+    for (unsigned m = 0; m < (1U << n); ++m) {
+      Skeleton3D body;
+      const double e = triangulateSome(views, cameras, config, m, kBodyKeypoints.data(), kBodyKeypoints.size(), body);
+      const auto count = static_cast<int>(std::bitset<32>(m).count());
+      if (e < best || (e == best && count < best_count)) {
+        best = e;
+        best_count = count;
+        mirrored = m;
+      }
+    }
+  }
+  Skeleton3D out;
+  triangulateSome(views, cameras, config, mirrored, all.data(), all.size(), out);
+  out.mirrored_views = mirrored;
+  if (config.resolve_sides) {
+    // The views agree; all of them may still have named the sides from behind: the face says.
+    const auto frame = bodyFrameOf(out);
+    if (frame && out.valid[kNose] &&
+        (out.p_world[kNose] - frame->p_world_origin).dot(frame->R_world_body.col(0)) < -config.nose_behind_m) {
+      Skeleton3D mirrored_out;
+      for (std::size_t k = 0; k < out.p_world.size(); ++k) {
+        const auto o = static_cast<std::size_t>(kMirror[k]);
+        mirrored_out.p_world[o] = out.p_world[k];
+        mirrored_out.valid[o] = out.valid[k];
+        mirrored_out.views[o] = out.views[k];
+        mirrored_out.reprojection_px[o] = out.reprojection_px[k];
+      }
+      mirrored_out.mirrored_views = mirrored;
+      mirrored_out.mirrored_all = true;
+      out = mirrored_out;
+    }
   }
   return out;
 }

@@ -102,6 +102,10 @@ struct ViewFusionConfig {
   /// (this many frames centred on it; gesture::medianSkeleton): a held gesture's single frames are
   /// noisy (the elbow of a triangulated arm moves by centimetres), its median is not. 1: frame by frame.
   int require_3d_median_frames = 5;
+  /// The 3-D tests' triangulation takes each view's skeleton as named or mirrored, whichever agrees
+  /// with the other views, and mirrors all when the nose lies behind (TriangulationConfig::resolve_sides:
+  /// skeleton networks name the sides by the image's, docs/gestures.md §6).
+  bool resolve_sides = false;
   /// The regions require_3d tests (YAML `view_fusion.geometry_3d`: design | network_tolerant) and, for
   /// network_tolerant, their numbers (`view_fusion.tolerant_3d.*`, gesture_geometry.hpp); the other
   /// numbers are design.md's and not configurable.
@@ -124,7 +128,7 @@ struct ViewFusionConfig {
 /// \brief Reads `view_fusion.{min_agreeing_views, max_age_s, gate_envelope, distance_min_m,
 /// distance_max_m, elevation_min_deg, elevation_max_deg, vote_window_s, vote_min_fraction, confirm_3d,
 /// confirm_3d_scope, confirm_3d_min_fraction, confirm_3d_min_frames, confirm_3d_max_dt_s, require_3d, require_3d_min_fraction,
-/// require_3d_min_frames, require_3d_median_frames, geometry_3d, tolerant_3d.*, fusion_lag_s}` (missing keys: the defaults above
+/// require_3d_min_frames, require_3d_median_frames, resolve_sides, geometry_3d, tolerant_3d.*, fusion_lag_s}` (missing keys: the defaults above
 /// unless the reader requires every key).
 ViewFusionConfig readViewFusionConfig(common::ConfigReader& reader);
 

@@ -53,6 +53,16 @@ CalibratedSkeleton cameraAround(double distance_m, double elevation_deg, double 
 struct TriangulationConfig {
   double min_confidence = 0.3;      ///< a keypoint below this confidence is not used, in [0, 1)
   double min_ray_angle_deg = 10.0;  ///< the widest angle between a keypoint's rays must reach this, in (0, 90)
+  /// Skeleton networks name a person's sides by the side of the image they appear on (seen from
+  /// behind, or with crossed arms, "left" is the image's left). With resolve_sides, each view's
+  /// skeleton is taken as named or mirrored (every left/right pair exchanged), whichever combination
+  /// of views makes the body's keypoints (eyes, ears, shoulders, hips, knees, ankles) triangulate
+  /// with the least confidence-weighted squared reprojection error (ties: fewer mirrored views;
+  /// at most 6 views are resolved, more are taken as named); then, if the nose triangulates more
+  /// than nose_behind_m behind the shoulders (the body frame's forward axis), every label is
+  /// mirrored — the views agreed with each other, and all named the sides from behind.
+  bool resolve_sides = false;
+  double nose_behind_m = 0.05;      ///< ≥ 0 [m]
 
   /// \brief Every problem, each naming the field and the value; empty when valid.
   std::vector<std::string> validate() const;
@@ -65,6 +75,8 @@ struct Skeleton3D {
   std::array<bool, kNumKeypoints> valid{};
   std::array<int, kNumKeypoints> views{};                   ///< views that contributed
   std::array<double, kNumKeypoints> reprojection_px{};      ///< the largest reprojection error over those views [px]
+  unsigned mirrored_views = 0;  ///< resolve_sides: bit v set when view v was taken mirrored
+  bool mirrored_all = false;    ///< resolve_sides: every label exchanged after the nose test
 };
 
 /// \brief Triangulates every keypoint from `views` (any number; views with a non-finite pose or a

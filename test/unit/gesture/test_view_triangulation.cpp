@@ -79,6 +79,79 @@ TEST(ViewTriangulationTest, ExactViewsRecoverTheBodyAndItsFrame) {
   EXPECT_EQ(gf::gesture::oneArmGesture3D(s), gf::gesture::kExtendArmSide);
 }
 
+/// The skeleton with every left/right pair exchanged: how a skeleton network names the sides of a
+/// person it sees from behind (by the image's sides).
+void mirrorLabels(CalibratedSkeleton& cam) {
+  auto& sk = cam.skeleton;
+  for (const auto& [a, b] : {std::pair{1, 2}, std::pair{3, 4}, std::pair{5, 6}, std::pair{7, 8}, std::pair{9, 10},
+                             std::pair{11, 12}, std::pair{13, 14}, std::pair{15, 16}}) {
+    const auto i = static_cast<std::size_t>(a), j = static_cast<std::size_t>(b);
+    std::swap(sk.x[i], sk.x[j]);
+    std::swap(sk.y[i], sk.y[j]);
+    std::swap(sk.c[i], sk.c[j]);
+  }
+}
+
+TEST(ViewTriangulationTest, ResolveSidesTakesAViewThatNamedTheSidesFromBehindAsMirrored) {
+  SkeletonSynthesizer synth(SynthConfig{}, 13);
+  const gf::gesture::Body3D body = synth.pose(Motion::kExtendArmSide, 1.0, 0.0, true);
+  // Leader in front-left, one follower behind the worker (150°), one beside (-90°).
+  std::vector<CalibratedSkeleton> views{cameraAt(10.0, 20.0, 30.0, 1.0), cameraAt(9.0, 25.0, 150.0, 1.0),
+                                        cameraAt(11.0, 15.0, -90.0, 1.0)};
+  for (auto& v : views) projectInto(body, v);
+  mirrorLabels(views[1]);  // the view from behind names the sides by the image's
+  const Skeleton3D plain = gf::gesture::triangulate(views, TriangulationConfig{});
+  const auto plain_frame = gf::gesture::bodyFrameOf(plain);
+  // Without resolving, the shoulders triangulate between the two true ones: no usable body frame, or a wrong one.
+  const bool plain_right = plain_frame && (plain_frame->R_world_body - Eigen::Matrix3d::Identity()).norm() < 0.05;
+  EXPECT_FALSE(plain_right);
+  TriangulationConfig resolve;
+  resolve.resolve_sides = true;
+  const Skeleton3D s = gf::gesture::triangulate(views, resolve);
+  EXPECT_EQ(s.mirrored_views, 2U);  // view 1 only
+  EXPECT_FALSE(s.mirrored_all);
+  for (int k = 0; k < gf::gesture::kNumKeypoints; ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    ASSERT_TRUE(s.valid[i]) << "keypoint " << k;
+    EXPECT_LT((s.p_world[i] - body.p[i]).norm(), 1e-6) << "keypoint " << k;
+  }
+  EXPECT_EQ(gf::gesture::oneArmGesture3D(s), gf::gesture::kExtendArmSide);
+  // Correctly named views stay as they are.
+  for (auto& v : views) projectInto(body, v);
+  EXPECT_EQ(gf::gesture::triangulate(views, resolve).mirrored_views, 0U);
+}
+
+TEST(ViewTriangulationTest, ResolveSidesMirrorsEveryLabelWhenAllViewsNamedThemFromBehind) {
+  SkeletonSynthesizer synth(SynthConfig{}, 14);
+  const gf::gesture::Body3D body = synth.pose(Motion::kRaiseArmUp, 1.0, 0.0, true);
+  std::vector<CalibratedSkeleton> views{cameraAt(10.0, 20.0, 10.0, 1.0), cameraAt(9.0, 25.0, 70.0, 1.0),
+                                        cameraAt(11.0, 15.0, -50.0, 1.0)};
+  for (auto& v : views) {
+    projectInto(body, v);
+    mirrorLabels(v);  // all three agree, all wrong: the body would face backwards, its raised arm swap sides
+  }
+  const Skeleton3D plain = gf::gesture::triangulate(views, TriangulationConfig{});
+  const auto plain_frame = gf::gesture::bodyFrameOf(plain);
+  ASSERT_TRUE(plain_frame);
+  EXPECT_LT(plain_frame->R_world_body(0, 0), -0.9);  // forward axis backwards
+  TriangulationConfig resolve;
+  resolve.resolve_sides = true;
+  const Skeleton3D s = gf::gesture::triangulate(views, resolve);
+  EXPECT_TRUE(s.mirrored_all);  // the nose lies in front of the body
+  const auto frame = gf::gesture::bodyFrameOf(s);
+  ASSERT_TRUE(frame);
+  EXPECT_LT((frame->R_world_body - Eigen::Matrix3d::Identity()).norm(), 0.05);
+  for (int k = 0; k < gf::gesture::kNumKeypoints; ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    ASSERT_TRUE(s.valid[i]);
+    EXPECT_LT((s.p_world[i] - body.p[i]).norm(), 1e-6) << "keypoint " << k;
+  }
+  TriangulationConfig bad = resolve;
+  bad.nose_behind_m = -0.1;
+  ASSERT_EQ(bad.validate().size(), 1u);
+  EXPECT_NE(bad.validate()[0].find("nose_behind_m"), std::string::npos);
+}
+
 // A side kick or a lunge can hold an arm exactly where "extend" holds it (docs/gestures.md §6):
 // the arm test alone says "extend"; the stance says no. Exact views, so the numbers are the body's.
 TEST(ViewTriangulationTest, TheArmOfTheGestureWithoutAnUprightStanceIsNoGesture) {
