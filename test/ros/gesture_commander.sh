@@ -1,6 +1,6 @@
 #!/bin/bash
-# The GestureCommander's vote (docs/gestures.md §4.1) on the shipped config/gestures.yaml
-# (min_agreeing_views 2) and on a copy with min_agreeing_views 1 (the paper's single camera),
+# The GestureCommander's vote (docs/gestures.md §4.1) on a copy of the shipped config/gestures.yaml
+# with confirm_3d off (the vote alone: min_agreeing_views 2) and on a copy with min_agreeing_views 1 (the paper's single camera),
 # fed GestureObservation messages directly (test/ros/gesture_commander_check.py): one camera fires
 # with 1 and never with 2; two cameras outside the classifier's envelope never fire; two inside
 # fire once with 2 agreeing views; with view_fusion.confirm_3d (a third copy) one camera's "extend"
@@ -16,11 +16,13 @@ sed 's/^\( *min_agreeing_views:\) .*/\1 1/' "$CFG/gestures.yaml" > "$T/gestures_
 grep -q "min_agreeing_views: 1" "$T/gestures_single.yaml" || fail "could not set min_agreeing_views 1 in a copy"
 sed 's/^\( *confirm_3d:\) .*/\1 true/' "$CFG/gestures.yaml" > "$T/gestures_3d.yaml"
 grep -q "confirm_3d: true" "$T/gestures_3d.yaml" || fail "could not set confirm_3d true in a copy"
+sed 's/^\( *confirm_3d:\) .*/\1 false/' "$CFG/gestures.yaml" > "$T/gestures_vote.yaml"
+grep -q "confirm_3d: false" "$T/gestures_vote.yaml" || fail "could not set confirm_3d false in a copy"
 sed 's/^\( *fusion_lag_s:\) .*/\1 0.8/' "$CFG/gestures.yaml" > "$T/gestures_lagged.yaml"
 grep -q "fusion_lag_s: 0.8" "$T/gestures_lagged.yaml" || fail "could not set fusion_lag_s 0.8 in a copy"
 sed 's/^\( *fusion_lag_s:\) .*/\1 0.0/' "$CFG/gestures.yaml" > "$T/gestures_nolag.yaml"
 grep -q "fusion_lag_s: 0.0" "$T/gestures_nolag.yaml" || fail "could not set fusion_lag_s 0 in a copy"
-for v in single:$T/gestures_single.yaml voted:$CFG/gestures.yaml confirm3d:$T/gestures_3d.yaml lagged:$T/gestures_lagged.yaml \
+for v in single:$T/gestures_single.yaml voted:$T/gestures_vote.yaml confirm3d:$T/gestures_3d.yaml lagged:$T/gestures_lagged.yaml \
          nolag:$T/gestures_nolag.yaml; do
   name=${v%%:*} file=${v#*:}
   timeout 60 rosrun nodelet nodelet standalone gesture_formation/GestureCommander __name:=gc_$name \

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Feeds three GestureCommanders (test/ros/gesture_commander.sh: /single with min_agreeing_views 1,
-/voted with the shipped 2, /confirm3d with 2 and view_fusion.confirm_3d on) GestureObservation
+/voted with the shipped 2 and confirm_3d off, /confirm3d with 2 and view_fusion.confirm_3d on) GestureObservation
 messages of gesture 2 at 15 Hz for 2 s (30 frames: 20 agreeing ones fill the filter's window,
 f_d = 1 > 0.8) and checks which fire. For the 3-D confirmation the observations carry the skeleton
 of a worker projected through three calibrated cameras (pinhole, the commander's pose convention:
