@@ -285,7 +285,9 @@ bool ViewFusion::holdsIn3D(int g, const std::vector<Skeleton3D>& frames) const {
 }
 
 bool ViewFusion::confirmedIn3D(int g, const std::vector<Skeleton3D>& frames3d) const {
-  if (config_.confirm_3d_scope == ViewFusionConfig::ConfirmScope::kAll) {
+  // Two-arm gestures (scope all) on their region; one-arm gestures always on oneArmGesture3D, whose
+  // upright-stance test keeps a lunge's or a side kick's arm out (the regions have no stance).
+  if (config_.confirm_3d_scope == ViewFusionConfig::ConfirmScope::kAll && g != kExtendArmSide && g != kRaiseArmUp) {
     const auto n = static_cast<int>(frames3d.size());
     return n >= config_.confirm_3d_min_frames &&
            static_cast<double>(framesInRegion(g, frames3d)) >= config_.confirm_3d_min_fraction * n;

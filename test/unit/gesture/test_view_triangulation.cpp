@@ -556,6 +556,25 @@ TEST(ViewFusion3DTest, WithScopeAllATwoArmGestureOneViewReadsIsConfirmedOnItsReg
     EXPECT_EQ(f.gesture_id, 0);
     EXPECT_FALSE(f.confirmed_3d);
   }
+  // One-arm gestures are confirmed as with one_arm, upright stance included: a balancing lunge whose
+  // arm is where "extend" puts it, read as extend by one view, stays none (rendered held-out set 9102:
+  // the regions alone let 22 fused lunge frames through).
+  {
+    gf::gesture::Body3D kick = synth.pose(Motion::kExtendArmSide, 1.0, 0.0, true);
+    const auto i = [](int k) { return static_cast<std::size_t>(k); };
+    const Eigen::Vector3d hip = 0.5 * (kick.p[i(gf::gesture::kLeftHip)] + kick.p[i(gf::gesture::kRightHip)]);
+    const double torso = (0.5 * (kick.p[i(gf::gesture::kLeftShoulder)] + kick.p[i(gf::gesture::kRightShoulder)]) - hip).norm();
+    kick.p[i(gf::gesture::kRightAnkle)] = hip + Eigen::Vector3d(0.0, -1.0 * torso, 0.15);  // a side kick
+    kick.p[i(gf::gesture::kLeftAnkle)] = hip + Eigen::Vector3d(0.0, 1.0 * torso, 0.15);
+    const auto f = fuseTwoViews(kick, 2, 0, c);
+    EXPECT_EQ(f.gesture_id, 0);
+    EXPECT_FALSE(f.confirmed_3d);
+    c.confirm_3d_scope = gf::gesture::ViewFusionConfig::ConfirmScope::kOneArm;
+    EXPECT_EQ(fuseTwoViews(kick, 2, 0, c).gesture_id, 0);
+    c.confirm_3d_scope = gf::gesture::ViewFusionConfig::ConfirmScope::kAll;
+    // Upright, the same arm is confirmed.
+    EXPECT_EQ(fuseTwoViews(synth.pose(Motion::kExtendArmSide, 1.0, 0.0, true), 2, 0, c).gesture_id, 2);
+  }
   // Read and validated: one_arm | all, anything else refused naming the key and the value.
   using gf::common::ConfigReader;
   ConfigReader ok = ConfigReader::fromString("view_fusion: {confirm_3d_scope: all}\n", "ok.yaml",
