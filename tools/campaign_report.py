@@ -105,8 +105,10 @@ def report(args, campaign):
     store = Store(args.store, create=False)
     try:
         commits = args.commit or default_commits(store, scenario, profiles, seeds)
-        all_rows = matrix_rows(store, scenario, profiles, commits) if commits else []
-        every = matrix_rows(store, scenario, profiles)
+        # --seeds selects the seeds of the tables too (the store may hold more of the same commit)
+        wanted = set(seeds)
+        all_rows = [r for r in matrix_rows(store, scenario, profiles, commits) if r["seed"] in wanted] if commits else []
+        every = [r for r in matrix_rows(store, scenario, profiles) if r["seed"] in wanted]
         fails = [f for f in store.failures("scenario = ? AND config_hash = ?", (scenario, BASE_CONFIG_HASH))
                  if any(f["source_commit"].startswith(c) for c in commits)]
     finally:

@@ -58,6 +58,9 @@ check "the tables' commit" '`abc1234567` / `0123456789abcdef` (3)' "$R"
 check "the other commit by its safety figures" '`def7654321`: 2 missions (seeds up to 1): min mutual 3.20 m, min obstacle 0.880 m, 0 collisions — no safety violation' "$R"
 $C report "$T/matrix.yaml" --commit def7 --out "$T/r2.md" > /dev/null 2>&1
 check "--commit selects the tables" '| `nominal` | 1 | 5.90 / 5.90 / 5.90 |' "$T/r2.md"
+$C report "$T/matrix.yaml" --seeds 1..1 --commit abc --out "$T/r3.md" > "$T/out3.txt" 2>&1
+check "--seeds selects the tables' seeds (the store holds seed 2 too)" '| `nominal` | 1 | 6.50 / 6.50 / 6.50 |' "$T/r3.md"
+check "--seeds: the summary counts those seeds only" '2 missions, 1 with a safety violation' "$T/out3.txt"
 if "$PY" -c "import matplotlib" 2>/dev/null; then
   [ -s "$T/results/fault_matrix.png" ] && { echo "PASS: figure drawn"; passes=$((passes + 1)); } || { echo "FAIL: no $T/results/fault_matrix.png"; fails=$((fails + 1)); }
   check "figure linked" '](fault_matrix.png)' "$R"
