@@ -11,6 +11,9 @@ namespace gesture_formation::mapping {
 
 namespace {
 
+constexpr std::uint8_t kAnnouncedOccupied = 1;  ///< LiveMap::announced_ bit 0
+constexpr std::uint8_t kInRefreshList = 2;      ///< LiveMap::announced_ bit 1
+
 double msSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -193,7 +196,7 @@ bool LiveMap::fusedOccupied(std::size_t index, const planning::VoxelIndex& voxel
 
 void LiveMap::notePending(std::size_t index, const planning::VoxelIndex& voxel, bool own_occupied, double stamp_s) {
   if (prior_ && prior_->isOccupied(voxel)) return;  // every UAV holds the prior: nothing to tell
-  if ((own_occupied ? 1 : 0) == announced_[index] && pending_mark_[index] == 0) return;
+  if ((own_occupied ? 1 : 0) == (announced_[index] & kAnnouncedOccupied) && pending_mark_[index] == 0) return;
   pending_s_[index] = stamp_s;
   if (pending_mark_[index] == 0) {
     pending_mark_[index] = 1;
@@ -349,7 +352,7 @@ MapDelta LiveMap::takeChanges(const Eigen::Vector3d& p_sender_world, double now_
   std::vector<Candidate> candidates;
   for (const std::size_t index : pending_) {
     const bool occupied = ownOccupied(index);
-    if ((occupied ? 1 : 0) == announced_[index]) {
+    if ((occupied ? 1 : 0) == (announced_[index] & kAnnouncedOccupied)) {
       pending_mark_[index] = 0;  // changed back: receivers hold the right class
     } else if (now_s - pending_s_[index] > max_age_s) {
       pending_mark_[index] = 0;
@@ -363,6 +366,7 @@ MapDelta LiveMap::takeChanges(const Eigen::Vector3d& p_sender_world, double now_
     return a.distance_m != b.distance_m ? a.distance_m < b.distance_m : a.stamp_s > b.stamp_s;
   });
   pending_.clear();
+  std::vector<std::size_t> newly_occupied;
   for (std::size_t i = 0; i < candidates.size(); ++i) {
     const Candidate& c = candidates[i];
     if (i >= max_voxels) {
@@ -371,9 +375,34 @@ MapDelta LiveMap::takeChanges(const Eigen::Vector3d& p_sender_world, double now_
       continue;
     }
     pending_mark_[c.index] = 0;
-    announced_[c.index] = c.occupied ? 1 : 0;
+    auto& a = announced_[c.index];
+    a = static_cast<std::uint8_t>((a & kInRefreshList) | (c.occupied ? kAnnouncedOccupied : 0));
+    if (c.occupied && (a & kInRefreshList) == 0) newly_occupied.push_back(c.index);
     const octomap::OcTreeKey k = keyOfIndex(c.index);
     (c.occupied ? delta.occupied : delta.free).push_back(VoxelKey{{k[0], k[1], k[2]}});
+  }
+  // Resend voxels announced occupied in earlier updates, round robin, in the room left (not the ones
+  // just sent: they join the list after this pass). Entries no longer announced occupied leave it.
+  const std::size_t room = max_voxels > delta.size() ? max_voxels - delta.size() : 0;
+  std::size_t want = std::min(room, static_cast<std::size_t>(config_.share.refresh_share * static_cast<double>(max_voxels)));
+  for (std::size_t scanned = 0, n = refresh_.size(); want > 0 && scanned < n && !refresh_.empty(); ++scanned) {
+    if (refresh_cursor_ >= refresh_.size()) refresh_cursor_ = 0;
+    const std::size_t index = refresh_[refresh_cursor_];
+    if ((announced_[index] & kAnnouncedOccupied) == 0) {
+      announced_[index] = static_cast<std::uint8_t>(announced_[index] & ~kInRefreshList);
+      refresh_[refresh_cursor_] = refresh_.back();
+      refresh_.pop_back();
+      continue;
+    }
+    const octomap::OcTreeKey k = keyOfIndex(index);
+    delta.occupied.push_back(VoxelKey{{k[0], k[1], k[2]}});
+    ++s.refreshed;
+    --want;
+    ++refresh_cursor_;
+  }
+  for (const std::size_t index : newly_occupied) {
+    announced_[index] = static_cast<std::uint8_t>(announced_[index] | kInRefreshList);
+    refresh_.push_back(index);
   }
   s.sent = static_cast<int>(delta.size());
   if (stats != nullptr) *stats = s;

@@ -26,6 +26,7 @@ const common::FieldTable<MappingConfig>& mappingConfigFields() {
       {"share.rate_hz", Range::openClosed(0.0, 10.0), [](C& c) { return &c.share.rate_hz; }},
       {"share.max_bytes_per_s", Range::closed(1000.0, 1e7), [](C& c) { return &c.share.max_bytes_per_s; }},
       {"share.max_age_s", Range::openClosed(0.0, 60.0), [](C& c) { return &c.share.max_age_s; }},
+      {"share.refresh_share", Range::closed(0.0, 1.0), [](C& c) { return &c.share.refresh_share; }},
   }};
   return t;
 }

@@ -3,7 +3,8 @@
 # onboard.launch (UAV 0 and 1, namespaces uav0 / uav1, mapping:=true with share.enabled, LCM udpm in a
 # private network namespace). Only UAV 0 has a depth camera, 4 m in front of a wall; its planner
 # publishes its changes, the bridges carry them, UAV 1's planner merges them: UAV 1's map changes
-# without a camera, and every voxel UAV 0 sent is merged by UAV 1 (/diagnostics live_map_*). A map
+# without a camera, and every voxel UAV 0 sent (its wall, resent every update) is merged by UAV 1 but
+# those of the update last sent at most (/diagnostics live_map_*). A map
 # update that claims UAV 0's index but comes from UAV 1's bridge is refused by UAV 0's bridge.
 set -o pipefail
 source "$(dirname "$0")/common.bash"
@@ -108,8 +109,11 @@ sent=$(val uav0 live_map_voxels_sent); merged=$(val uav1 live_map_voxels_merged)
 awk -v s="$sent" -v u="$(val uav0 live_map_updates_sent)" 'BEGIN { exit !(s >= 100 && u >= 1) }' \
   && echo "PASS: UAV 0's planner sent its wall: $sent voxels in $(val uav0 live_map_updates_sent) updates" \
   || fail "UAV 0 sent no map changes (voxels '$sent')"
-awk -v s="$sent" -v m="$merged" -v c="$changed" 'BEGIN { exit !(m == s && c >= 100) }' \
-  && echo "PASS: UAV 1's planner, without a camera, merged every voxel UAV 0 sent ($merged of $sent; $changed voxels of its map changed)" \
+# UAV 0 resends its wall every update (share.refresh_share); the two diagnostics are read at two moments,
+# so UAV 1 may not have merged the update last sent: at most one update (sent / updates voxels) behind.
+awk -v s="$sent" -v m="$merged" -v c="$changed" -v u="$(val uav0 live_map_updates_sent)" \
+  'BEGIN { exit !(m <= s && m >= s - s / u && c >= 100) }' \
+  && echo "PASS: UAV 1's planner, without a camera, merged every voxel UAV 0 sent but the last update's at most ($merged of $sent; $changed voxels of its map changed)" \
   || fail "UAV 1 merged '$merged' of '$sent' voxels ($changed of its map changed)"
 awk -v f="$(val uav1 live_map_frames_per_s)" -v r="$(val uav1 live_map_updates_refused)" 'BEGIN { exit !(f == 0 && r == 0) }' \
   && echo "PASS: UAV 1 integrated no frame of its own and refused no update" || fail "UAV 1: frames or refusals: $(grep ^uav1 "$T/diag.txt")"

@@ -73,7 +73,8 @@ struct MergeResult {
 
 /// \brief What one takeChanges() did.
 struct OutgoingStats {
-  int sent = 0;      ///< voxels in the returned delta
+  int sent = 0;      ///< voxels in the returned delta (new changes and resent ones)
+  int refreshed = 0; ///< of them, occupied voxels sent before, resent (share.refresh_share)
   int deferred = 0;  ///< changes left for a later update (over the voxel budget)
   int dropped = 0;   ///< changes older than max_age_s when their turn came: never sent
 };
@@ -177,7 +178,9 @@ class LiveMap {
   std::vector<double> own_s_;             ///< the last own frame whose ray crossed or ended in it (−inf: none)
   std::vector<std::uint8_t> received_;    ///< kReceivedNone / kReceivedOccupied / kReceivedFree
   std::vector<double> received_s_;        ///< the received class's stamp
-  std::vector<std::uint8_t> announced_;   ///< 1: sent as occupied (receivers hold it occupied)
+  std::vector<std::uint8_t> announced_;   ///< bit 0: sent as occupied (receivers hold it occupied); bit 1: in refresh_
+  std::vector<std::size_t> refresh_;      ///< voxels sent as occupied, resent round robin (share.refresh_share)
+  std::size_t refresh_cursor_ = 0;
   std::vector<std::uint8_t> pending_mark_;
   std::vector<double> pending_s_;         ///< when the pending change was observed
   std::vector<std::size_t> pending_;      ///< grid voxels with an unsent own change

@@ -32,6 +32,11 @@ struct ShareConfig {
   /// `share.max_age_s` [5, in (0, 60]]: a change still unsent this long after it was observed is
   /// dropped (counted), not sent stale.
   double max_age_s = 5.0;
+  /// `share.refresh_share` [0.25, in [0, 1]]: share of each update's voxel budget that resends voxels
+  /// already sent as occupied (round robin, once the new changes are in), so that an update lost on
+  /// the link costs a receiver an obstacle for at most one pass over the sender's obstacles, not for
+  /// good; a lost "free" stays lost (the receiver keeps the obstacle: the safe side). 0: never resend.
+  double refresh_share = 0.25;
 };
 
 /// \brief Voxels one update may carry under `share`'s budget (0: not even one).

@@ -116,8 +116,11 @@ void expectFieldIsFullRebuild(const LiveMap& live) {
   EXPECT_EQ(mismatches, 0);
 }
 
-std::unique_ptr<LiveMap> makeLiveMap(std::shared_ptr<const planning::OccupancyMap> prior = nullptr) {
-  auto live = LiveMap::create(MappingConfig{}, grid(), std::move(prior));
+std::unique_ptr<LiveMap> makeLiveMap(std::shared_ptr<const planning::OccupancyMap> prior = nullptr,
+                                     double refresh_share = 0.0) {
+  MappingConfig config;
+  config.share.refresh_share = refresh_share;  // 0: updates carry new changes only (MapShareRefreshTest: resends)
+  auto live = LiveMap::create(config, grid(), std::move(prior));
   EXPECT_TRUE(live) << live.reason();
   return live ? std::move(*live) : nullptr;
 }
@@ -537,6 +540,50 @@ TEST(MapShareTest, TheBudgetSendsTheNearestFirstAndDropsWhatWaitedTooLong) {
   EXPECT_EQ(late.size(), 0u);
   EXPECT_EQ(stats.dropped, 30);
   EXPECT_EQ(a->pendingChanges(), 0u);
+}
+
+// share.refresh_share: voxels sent as occupied are resent round robin in the room an update leaves,
+// so a receiver that lost an update gets the obstacle again.
+TEST(MapShareRefreshTest, ALostUpdateReachesTheReceiverWithTheResends) {
+  auto a = makeLiveMap(nullptr, 0.5), b = makeLiveMap();
+  ASSERT_TRUE(a && b);
+  ASSERT_TRUE(a->integrate(boxFrame(kBoxALo, kBoxAHi, 1.0)));
+  const std::set<Key> face = faceVoxels(4.7, -0.9, 0.9, 0.9, 2.1);
+  mapping::OutgoingStats stats;
+  const mapping::MapDelta lost = a->takeChanges(kCamera, 1.0, 40, 5.0, &stats);  // never reaches b
+  EXPECT_EQ(stats.sent, 40);
+  EXPECT_EQ(stats.refreshed, 0);  // nothing was sent before
+  EXPECT_EQ(stats.deferred, 30);
+  // Next update: the 30 deferred changes, then resends in the 10 left (at most 0.5 x 40 = 20).
+  const mapping::MapDelta second = a->takeChanges(kCamera, 1.5, 40, 5.0, &stats);
+  EXPECT_EQ(stats.sent, 40);
+  EXPECT_EQ(stats.refreshed, 10);
+  ASSERT_TRUE(b->merge(second));
+  // Nothing new: each update resends 20 of the 70 announced, round robin; after a pass b holds the whole face.
+  std::set<Key> resent;
+  for (int i = 0; i < 4; ++i) {
+    const mapping::MapDelta d = a->takeChanges(kCamera, 2.0 + i, 40, 5.0, &stats);
+    EXPECT_EQ(stats.refreshed, 20);
+    EXPECT_TRUE(d.free.empty());
+    for (const auto& k : keysToVoxels(d.occupied)) resent.insert(k);
+    ASSERT_TRUE(b->merge(d));
+  }
+  EXPECT_EQ(resent, face);
+  EXPECT_EQ(occupiedVoxels(*b->map()), face);
+  expectFieldIsFullRebuild(*b);
+  // The box moves away: its old face is sent free once and never resent; the new face is.
+  for (int i = 0; i < 10; ++i) ASSERT_TRUE(a->integrate(boxFrame(kBoxBLo, kBoxBHi, 10.0 + 0.1 * i)));
+  for (int i = 0; i < 8; ++i) ASSERT_TRUE(b->merge(a->takeChanges(kCamera, 12.0 + i, 40, 5.0, &stats)));
+  for (int i = 0; i < 6; ++i) {
+    const mapping::MapDelta d = a->takeChanges(kCamera, 20.0 + i, 40, 5.0, &stats);
+    for (const auto& k : keysToVoxels(d.occupied)) EXPECT_EQ(face.count(k), 0u);
+  }
+  // refresh_share 0: nothing is ever resent.
+  auto c = makeLiveMap();
+  ASSERT_TRUE(c->integrate(boxFrame(kBoxALo, kBoxAHi, 1.0)));
+  EXPECT_EQ(c->takeChanges(kCamera, 1.0, 100, 5.0).size(), 70u);
+  EXPECT_EQ(c->takeChanges(kCamera, 2.0, 100, 5.0, &stats).size(), 0u);
+  EXPECT_EQ(stats.refreshed, 0);
 }
 
 TEST(MapShareTest, ADeltaThatDoesNotFitIsRefusedNamingTheFieldAndChangesNothing) {
