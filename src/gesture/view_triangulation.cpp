@@ -1,6 +1,7 @@
 #include "gesture_formation/gesture/view_triangulation.hpp"
 
 #include <algorithm>
+#include <utility>
 #include <bitset>
 #include <cmath>
 #include <limits>
@@ -198,17 +199,15 @@ Skeleton3D triangulate(const std::vector<CalibratedSkeleton>& views, const Trian
     const auto frame = bodyFrameOf(out);
     if (frame && out.valid[kNose] &&
         (out.p_world[kNose] - frame->p_world_origin).dot(frame->R_world_body.col(0)) < -config.nose_behind_m) {
-      Skeleton3D mirrored_out;
-      for (std::size_t k = 0; k < out.p_world.size(); ++k) {
+      for (std::size_t k = 0; k < out.p_world.size(); ++k) {  // each left/right pair exchanged once
         const auto o = static_cast<std::size_t>(kMirror[k]);
-        mirrored_out.p_world[o] = out.p_world[k];
-        mirrored_out.valid[o] = out.valid[k];
-        mirrored_out.views[o] = out.views[k];
-        mirrored_out.reprojection_px[o] = out.reprojection_px[k];
+        if (o <= k) continue;
+        std::swap(out.p_world[k], out.p_world[o]);
+        std::swap(out.valid[k], out.valid[o]);
+        std::swap(out.views[k], out.views[o]);
+        std::swap(out.reprojection_px[k], out.reprojection_px[o]);
       }
-      mirrored_out.mirrored_views = mirrored;
-      mirrored_out.mirrored_all = true;
-      out = mirrored_out;
+      out.mirrored_all = true;
     }
   }
   return out;

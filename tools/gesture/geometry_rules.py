@@ -89,6 +89,7 @@ def features(P):
         f["gap"] = float(np.linalg.norm(wl - wr_))
         f["wh"] = 0.82 + 0.5 * (wl[2] + wr_[2])  # mean wrist height / H (shoulders at 0.82 H)
         f["wh_min"] = 0.82 + min(wl[2], wr_[2])
+        f["wh_max"] = 0.82 + max(wl[2], wr_[2])
         f["off"] = max(abs(wl[1]), abs(wr_[1]))  # the wrists' largest offset from the midline
         f["fwd"] = min(wl[0], wr_[0])
         f["elb_out"] = min(abs(f["l"]["e"][1]) - abs(wl[1]), abs(f["r"]["e"][1]) - abs(wr_[1]))  # elbows lateral of the wrists
@@ -127,8 +128,6 @@ def rules(f):
             out[f"crossN h_min>={ch} off<=0.10 gap<={cg}"] = both and f["wh_min"] >= ch and f["off"] <= 0.10 and f["gap"] <= cg
     # Label-free cross with a ceiling (session 27, chosen on rendered_tuning + rendered_tuning_2): the
     # hands in front of the upper chest or face, not above the head (a ladder's rungs).
-    if both:
-        f["wh_max"] = f["wh_min"] + 2 * (f["wh"] - f["wh_min"])
     for ch in (0.76, 0.78, 0.80):
         for top in (0.90, 0.92, 0.94):
             for o in (0.10, 0.12, 0.14):
