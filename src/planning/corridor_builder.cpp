@@ -60,88 +60,205 @@ Eigen::Matrix3d frameAlong(const Eigen::Vector3d& u) {
   return R;
 }
 
-/// Points (segment frame) strictly inside the ellipsoid with semi-axes `a` (1e-9 slack so
-/// that points placed on the surface by a shrink step count as outside).
-bool inside(const Eigen::Vector3d& q, const Eigen::Vector3d& a) { return q.cwiseQuotient(a).squaredNorm() < 1.0 - 1e-9; }
+/// The squared metric of q (segment frame) in the ellipsoid with semi-axes `a`; < 1 − 1e-9 is
+/// "strictly inside" (the slack makes a point that a shrink step placed on the surface count as
+/// outside). The one expression every inside test, closest-point choice and plane order uses.
+double metric(const Eigen::Vector3d& q, const Eigen::Vector3d& a) { return q.cwiseQuotient(a).squaredNorm(); }
+constexpr double kInside = 1.0 - 1e-9;
+
+/// A point above this squared distance from the centre, as a multiple of the largest semi-axis
+/// squared, is outside the ellipsoid whatever the rounding (1e-7 ≫ the ~1e-15 relative rounding
+/// of metric()): the cheap test that spares most points the divisions.
+constexpr double kSurelyOutside = 1.0 + 1e-7;
 
 struct Plane {
   Eigen::Vector3d n;
   double b;
 };
 
-/// The point of `in` closest to the ellipsoid's centre in its metric (`in` not empty).
-std::size_t closestInside(const std::vector<std::size_t>& in, const std::vector<Eigen::Vector3d>& q,
-                          const Eigen::Vector3d& axes) {
-  std::size_t best = in.front();
-  double best_m = q[best].cwiseQuotient(axes).squaredNorm();
+/// `in`: indices into q in increasing order (stable). Removes `drop` and every point no longer
+/// strictly inside the ellipsoid with semi-axes `axes`, and returns the one of the rest closest
+/// to the centre in its metric (the first of equals; `in.size()` when none is left) — the
+/// closest-point search of the next shrink step done in the same pass as the filtering. The
+/// divisions of metric() are paid only where they can decide: its value made with
+/// multiplications is within a relative 1e-14 of it (rounding: a few 1e-16), so a point is
+/// surely in or out, and surely not the closest, unless that value lies within 1e-12 of the
+/// threshold or of the best exact metric so far.
+std::size_t shrinkTo(std::vector<std::size_t>& in, std::size_t drop, const std::vector<Eigen::Vector3d>& q,
+                     const Eigen::Vector3d& axes) {
+  const Eigen::Vector3d inv_a2 = axes.cwiseProduct(axes).cwiseInverse();
+  constexpr double kLow = 1.0 - 1e-12, kHigh = 1.0 + 1e-12;
+  std::size_t keep = 0, best = 0;
+  double best_m = std::numeric_limits<double>::infinity();
   for (const std::size_t i : in) {
-    const double m = q[i].cwiseQuotient(axes).squaredNorm();
-    if (m < best_m) best_m = m, best = i;
+    if (i == drop) continue;
+    const double approx = q[i].cwiseProduct(q[i]).dot(inv_a2);
+    if (approx * kLow >= kInside) continue;  // surely outside
+    if (approx * kHigh >= kInside || approx * kLow <= best_m) {
+      const double m = metric(q[i], axes);
+      if (!(m < kInside)) continue;
+      if (keep == 0 || m < best_m) best_m = m, best = keep;
+    }
+    in[keep++] = i;
   }
-  return best;
+  in.resize(keep);
+  return keep == 0 ? in.size() : best;
 }
 
-/// Keeps in `in` the points other than `best` still inside the ellipsoid with semi-axes `axes`.
-void keepInside(std::vector<std::size_t>& in, std::size_t best, const std::vector<Eigen::Vector3d>& q,
-                const Eigen::Vector3d& axes) {
-  std::vector<std::size_t> still;
-  for (const std::size_t i : in) {
-    if (i != best && inside(q[i], axes)) still.push_back(i);
-  }
-  in.swap(still);
-}
-
-/// The corridor's ellipsoid (step 1), in the segment frame R (x along the segment) with
-/// semi-axes `axes`; q: the points in that frame.
+/// The corridor's ellipsoid (step 1): the segment frame R0 (x along the segment) turned about x
+/// by `roll`, semi-axes `axes`.
 struct EllipsoidFit {
-  Eigen::Matrix3d R;
+  Eigen::Matrix3d R0, Rroll, R;
   Eigen::Vector3d axes;
-  std::vector<Eigen::Vector3d> q;
 };
+
+/// The point in the fitted frame: the initial frame's coordinates turned by the roll — the same
+/// two products, in the same order, wherever a point's coordinates are needed.
+Eigen::Vector3d initialFrame(const Eigen::Matrix3d& R0, const Eigen::Vector3d& p, const Eigen::Vector3d& center) {
+  return R0.transpose() * (p - center);
+}
 
 /// Start from the sphere whose diameter is the segment; shrink the two cross axes together
 /// against the closest point inside, rotating the frame so that this point lies in the x–y
-/// plane; then shrink the remaining z axis alone against what is still inside.
-EllipsoidFit fitEllipsoid(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& center,
+/// plane; then shrink the remaining z axis alone against what is still inside. `near`: the
+/// points (world) that may lie inside that sphere — no other can be inside any ellipsoid of the
+/// fit, whose semi-axes never exceed the sphere's radius.
+EllipsoidFit fitEllipsoid(const std::vector<Eigen::Vector3d>& near, const Eigen::Vector3d& center,
                           const Eigen::Vector3d& u, double length) {
-  Eigen::Matrix3d Rw = frameAlong(u);
+  EllipsoidFit fit;
+  fit.R0 = frameAlong(u);
   const double a0 = 0.5 * length;
   Eigen::Vector3d axes(a0, a0, a0);
-  std::vector<Eigen::Vector3d> q(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) q[i] = Rw.transpose() * (points[i] - center);
+  std::vector<Eigen::Vector3d> q;  // initial frame
+  q.reserve(near.size());
   std::vector<std::size_t> in;
-  for (std::size_t i = 0; i < q.size(); ++i) {
-    if (inside(q[i], axes)) in.push_back(i);
+  for (const Eigen::Vector3d& p : near) {
+    q.push_back(initialFrame(fit.R0, p, center));
+    if (metric(q.back(), axes) < kInside) in.push_back(q.size() - 1);
   }
   double roll = 0.0;
-  while (!in.empty()) {
-    const std::size_t best = closestInside(in, q, axes);
-    const Eigen::Vector3d& qb = q[best];
+  std::size_t best = shrinkTo(in, q.size(), q, axes);  // the closest of `in` (nothing dropped)
+  while (best < in.size()) {
+    const std::size_t b = in[best];
+    const Eigen::Vector3d& qb = q[b];
     const double radial = std::hypot(qb.y(), qb.z());
     const double along = std::min(std::abs(qb.x()) / a0, 1.0 - 1e-12);
     axes.y() = axes.z() = radial / std::sqrt(1.0 - along * along);
     roll = std::atan2(qb.z(), qb.y());
-    keepInside(in, best, q, axes);
+    best = shrinkTo(in, b, q, axes);
   }
   // Rotate the frame about x by `roll`: the last closest point now lies on the new y axis side.
-  const Eigen::Matrix3d Rroll = Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()).toRotationMatrix();
-  Rw = Rw * Rroll;
-  for (auto& qi : q) qi = Rroll.transpose() * qi;
+  fit.Rroll = Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  fit.R = fit.R0 * fit.Rroll;
+  for (auto& qi : q) qi = fit.Rroll.transpose() * qi;
   axes.z() = std::max(a0, axes.y());
   for (std::size_t i = 0; i < q.size(); ++i) {
-    if (inside(q[i], axes)) in.push_back(i);
+    if (metric(q[i], axes) < kInside) in.push_back(i);
   }
-  while (!in.empty()) {
-    const std::size_t best = closestInside(in, q, axes);
-    const Eigen::Vector3d& qb = q[best];
+  best = shrinkTo(in, q.size(), q, axes);
+  while (best < in.size()) {
+    const std::size_t b = in[best];
+    const Eigen::Vector3d& qb = q[b];
     const double rest = 1.0 - std::pow(qb.x() / axes.x(), 2) - std::pow(qb.y() / axes.y(), 2);
     // rest > (z/a2)² ≥ 0 for a point inside; a2 ≥ a1 holds because every point is already
     // outside the symmetric ellipsoid of pass 1 (clamped against rounding).
     axes.z() = std::max(axes.y(), rest > 0.0 ? std::abs(qb.z()) / std::sqrt(rest) : axes.y());
-    keepInside(in, best, q, axes);
+    best = shrinkTo(in, b, q, axes);
   }
-  return EllipsoidFit{Rw, axes, std::move(q)};
+  fit.axes = axes;
+  return fit;
 }
+
+/// The obstacle points of step 2 and the search for the one closest to the centre in the fitted
+/// ellipsoid's metric among those left. The metric's divisions are paid only where they can
+/// decide: each point keeps a lower bound of its metric, made with multiplications in one product
+/// with the fitted frame and lowered by a relative margin `m` far above their rounding (≤ ~6e-15
+/// × the axes' ratio), so metric ≤ bound · (1 + m) / (1 − m). The exact metric() of the point's
+/// fitted-frame coordinates — the expression that defines the order — is computed for the point
+/// of least bound, and then only for the points whose bound does not exceed it (noted during the
+/// same pass: any point with a bound ≤ (least bound so far) · (1 + m) / (1 − m)). Same choice as taking
+/// metric() of every point, the first of equals included.
+class PlaneCandidates {
+ public:
+  PlaneCandidates(const std::vector<Eigen::Vector3d>& points, const EllipsoidFit& fit, const Eigen::Vector3d& center)
+      : fit_(fit), center_(center) {
+    const double ratio = fit.axes.maxCoeff() / fit.axes.minCoeff();
+    const double margin = std::min(1e-12 + 1e-12 * ratio, 0.5);
+    widen_ = (1.0 + margin) / (1.0 - margin);
+    const Eigen::Vector3d inv_a2 = fit.axes.cwiseProduct(fit.axes).cwiseInverse() * (1.0 - margin);
+    const Eigen::Matrix3d Rt = fit.R.transpose();
+    items_.reserve(points.size());
+    Least least;
+    for (const Eigen::Vector3d& p : points) {
+      const Eigen::Vector3d q = Rt * (p - center);
+      items_.push_back(Item{p, q.cwiseProduct(q).dot(inv_a2)});
+      note(items_.size() - 1, least);
+    }
+    first_ = select(least);
+  }
+  std::size_t size() const { return items_.size(); }
+  const Eigen::Vector3d& point(std::size_t i) const { return items_[i].p; }
+
+  /// The index of the closest point (the first of equals); size() when none is left.
+  std::size_t closest() const { return first_; }
+
+  /// Removes `drop` and every point p with n·p ≥ threshold (the others keep their order) and
+  /// returns closest() of what is left.
+  std::size_t dropBeyond(std::size_t drop, const Eigen::Vector3d& n, double threshold) {
+    std::size_t keep = 0;
+    Least least;
+    for (std::size_t i = 0; i < items_.size(); ++i) {
+      if (i == drop || !(n.dot(items_[i].p) < threshold)) continue;
+      items_[keep] = items_[i];
+      note(keep++, least);
+    }
+    items_.resize(keep);
+    return select(least);
+  }
+
+ private:
+  struct Item {
+    Eigen::Vector3d p;  // world
+    double bound;       // ≤ the exact metric
+  };
+  struct Least {
+    std::size_t index = 0;
+    double bound = std::numeric_limits<double>::infinity();
+  };
+  double exact(std::size_t i) const {
+    return metric(fit_.Rroll.transpose() * initialFrame(fit_.R0, items_[i].p, center_), fit_.axes);
+  }
+  /// Item i (in its final place) during a pass: the least bound so far, and i as a candidate if
+  /// it may still turn out to be the closest.
+  void note(std::size_t i, Least& least) {
+    const double b = items_[i].bound;
+    if (b < least.bound) least.bound = b, least.index = i;
+    if (b <= least.bound * widen_) candidates_.push_back(i);
+  }
+  /// The closest point among the pass's candidates (none: size()). The minimum exact metric is ≤
+  /// exact(least), so only points bounded by that can have it.
+  std::size_t select(const Least& least) {
+    std::size_t best = items_.size();
+    if (!candidates_.empty()) {
+      const double cap = exact(least.index);
+      double best_m = cap;
+      best = least.index;
+      for (const std::size_t i : candidates_) {
+        if (i == least.index || items_[i].bound > cap) continue;
+        const double m = exact(i);
+        if (m < best_m || (m == best_m && i < best)) best_m = m, best = i;
+      }
+    }
+    candidates_.clear();
+    return best;
+  }
+  const EllipsoidFit& fit_;
+  Eigen::Vector3d center_;
+  double widen_ = 1.0;
+  std::vector<Item> items_;
+  std::vector<std::size_t> candidates_;
+  std::size_t first_ = 0;
+};
 
 }  // namespace
 
@@ -170,44 +287,43 @@ common::Result<SegmentCorridor> CorridorBuilder::buildSegment(const Eigen::Vecto
   const Eigen::Vector3d center = 0.5 * (p0 + p1);
   const Eigen::Vector3d u = (p1 - p0) / length;
   const double needed_gap = c.min_exclusion_m + c.seed_margin_m;  // includes 2 kSlackM
-  out.segment_clearance_m = std::numeric_limits<double>::infinity();
+  // The nearest point to the segment: squared distances, one square root (of the least; exact,
+  // as the root is monotonic and correctly rounded) — and the root of any point that may lie
+  // closer than needed_gap, the first of which fails the segment.
+  // In the same pass, the points that may lie inside the sphere the ellipsoid starts from.
+  const double fail_sq = needed_gap * needed_gap * kSurelyOutside;
+  const double near_sq = 0.25 * length * length * kSurelyOutside;
+  double least_sq = std::numeric_limits<double>::infinity();
+  std::vector<Eigen::Vector3d> near;
   for (const auto& o : points) {
     const double t = std::clamp((o - p0).dot(u), 0.0, length);
-    const double d = (o - (p0 + t * u)).norm();
-    out.segment_clearance_m = std::min(out.segment_clearance_m, d);
-    if (d < needed_gap) {
-      return R::fail("obstacle point " + str(o) + " lies " + std::to_string(d) + " m from the segment " + str(p0) + " → " +
-                     str(p1) + " (a corridor needs > " + std::to_string(needed_gap) + " m)");
+    const double d_sq = (o - (p0 + t * u)).squaredNorm();
+    least_sq = std::min(least_sq, d_sq);
+    if ((o - center).squaredNorm() <= near_sq) near.push_back(o);
+    if (d_sq < fail_sq && std::sqrt(d_sq) < needed_gap) {
+      return R::fail("obstacle point " + str(o) + " lies " + std::to_string(std::sqrt(d_sq)) + " m from the segment " + str(p0) +
+                     " → " + str(p1) + " (a corridor needs > " + std::to_string(needed_gap) + " m)");
     }
   }
+  out.segment_clearance_m = std::sqrt(least_sq);
 
   // (1) Ellipsoid, in the segment frame (x along the segment).
-  const EllipsoidFit fit = fitEllipsoid(points, center, u, length);
+  const EllipsoidFit fit = fitEllipsoid(near, center, u, length);
   const Eigen::Matrix3d& Rw = fit.R;
   const Eigen::Vector3d& axes = fit.axes;
-  const std::vector<Eigen::Vector3d>& q = fit.q;
   out.ellipsoid.R_world_ellipsoid = Rw;
   out.ellipsoid.axes_m = axes;
   out.ellipsoid.center_world = center;
 
   // (2) Planes, closest point first in the ellipsoid's metric.
   const Eigen::Vector3d inv_a2 = axes.cwiseProduct(axes).cwiseInverse();
-  struct Candidate {
-    Eigen::Vector3d p;
-    double metric;
-  };
-  std::vector<Candidate> remaining(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) remaining[i] = Candidate{points[i], q[i].cwiseQuotient(axes).squaredNorm()};
+  PlaneCandidates remaining(points, fit, center);
   std::vector<Plane> planes;
   // A plane never passes through its point: it moves at least min_exclusion_m.
   const double clearance = std::max(c.clearance_m, c.min_exclusion_m);
   double achieved = clearance;
-  while (!remaining.empty()) {
-    std::size_t best = 0;
-    for (std::size_t i = 1; i < remaining.size(); ++i) {
-      if (remaining[i].metric < remaining[best].metric) best = i;
-    }
-    const Eigen::Vector3d o = remaining[best].p;
+  for (std::size_t best = remaining.closest(); best < remaining.size(); ) {
+    const Eigen::Vector3d o = remaining.point(best);
     // Tangent plane of the ellipsoid's level set through o.
     Eigen::Vector3d n = Rw * inv_a2.cwiseProduct(Rw.transpose() * (o - center));
     double gap = -1.0;
@@ -229,12 +345,8 @@ common::Result<SegmentCorridor> CorridorBuilder::buildSegment(const Eigen::Vecto
     achieved = std::min(achieved, shift);
     const double threshold = n.dot(o);
     planes.push_back(Plane{n, threshold - shift});
-    // Drop every point at least as far along n as o: it is ≥ shift outside the new plane.
-    std::size_t keep = 0;
-    for (std::size_t i = 0; i < remaining.size(); ++i) {
-      if (i != best && n.dot(remaining[i].p) < threshold) remaining[keep++] = remaining[i];
-    }
-    remaining.resize(keep);
+    // Drop o and every point at least as far along n: it is ≥ shift outside the new plane.
+    best = remaining.dropBeyond(best, n, threshold);
   }
 
   // (3) The local box: x_i ≤ max_i and −x_i ≤ −min_i for every axis.
