@@ -180,7 +180,7 @@ class SimCameraNodelet : public nodelet::Nodelet {
     if (!statesAt(t, uavs)) return;  // not every UAV is up yet
     next_frame_s_ = (std::floor((t + half_s) * rate_hz_) + 1.0) / rate_hz_;
     const auto wall0 = ros::WallTime::now();
-    const auto set = scene_->setScene(*body, toEigen(m.feet_world), m.heading_rad, cfg_.worker.height_m, uavs);
+    const auto set = scene_->setScene(*body, toEigen(m.feet_world), m.heading_rad, cfg_.worker.height_m, uavs, t);
     if (!set) NODELET_WARN_STREAM_THROTTLE(5.0, "SimCamera: t " << t << " s: " << set.reason());
     auto frame = scene_->render(static_cast<std::size_t>(index_), intrinsics_);
     if (!frame) {

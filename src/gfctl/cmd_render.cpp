@@ -1,7 +1,8 @@
 // gfctl render --scenario FILE --t T --uav I --out frame.png [--depth depth.png] [--seed S]
 //              [--truth truth.csv] [--at reference|initial] [--motion NAME] [--progress S]
 //              [--outfit hivis_helmet|work_clothes] [--skin-tone N] [--models DIR]
-// Renders one frame of a scenario's mission from UAV I's camera (docs/rendering.md).
+// Renders one frame of a scenario's mission from UAV I's camera (docs/rendering.md), the
+// scenario's unmapped obstacles included (where they are at T).
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -18,6 +19,8 @@
 #include "gesture_formation/planning/scenario.hpp"
 #include "gesture_formation/render/renderer.hpp"
 #include "gesture_formation/sim/mission_config.hpp"
+#include "gesture_formation/sim/scene_renderer.hpp"
+#include "gesture_formation/sim/unmapped_obstacles.hpp"
 #include "gesture_formation/sim/worker_model.hpp"
 
 namespace gesture_formation::gfctl {
@@ -141,6 +144,8 @@ int cmdRender(const Args& args) {
   if (!scenario) return badInput(args, scenario.reason());
   auto mission = sim::loadMissionConfig(path);
   if (!mission) return badInput(args, mission.reason());
+  auto unmapped = sim::loadUnmappedObstacles(path);
+  if (!unmapped) return badInput(args, unmapped.reason());
   const sim::MissionConfig& m = *mission;
   if (uav >= static_cast<long>(m.uavs.size())) {
     return badInput(args, "--uav: " + std::to_string(uav) + " but " + path + " has " + std::to_string(m.uavs.size()) + " UAVs (0 = leader)");
@@ -182,6 +187,7 @@ int cmdRender(const Args& args) {
     return kExitNoRenderer;
   }
   auto r = (*renderer)->setWorld(*scenario);
+  if (r) r = (*renderer)->setSiteObstacles(sim::unmappedObstaclesMesh(*unmapped, *t));  // in the world, not in the prior map
   if (r) r = (*renderer)->setWorker(joints, m.worker.height_m, look);
   if (!r) return badInput(args, r.reason());
   (*renderer)->setUavs(bodies);

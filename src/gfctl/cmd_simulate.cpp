@@ -172,7 +172,7 @@ std::unique_ptr<sim::RenderedCamera> makeRenderedCamera(const Args& args, const 
     rc = badInput(args, "--camera-video: cannot create directory " + video_dir);
     return nullptr;
   }
-  auto cam = sim::RenderedCamera::create(cc, L.mission, L.scenario, L.map.get(), seed);
+  auto cam = sim::RenderedCamera::create(cc, L.mission, L.scenario, L.map.get(), seed, L.unmapped);
   if (cam) return std::move(*cam);
   if (cam.reason().find("worker asset") != std::string::npos || cam.reason().find("perception networks") != std::string::npos ||
       cam.reason().find("--camera-video") != std::string::npos) {
@@ -235,6 +235,7 @@ int runOne(const Args& args, Loaded& L, std::uint64_t seed, double duration, con
     auto made = sim::SiteMapping::create(L.mission, L.scenario.map, L.map, L.solids, world.ground_height_m, L.unmapped);
     if (!made) return badInput(args, made.reason());
     site = std::move(*made);
+    if (L.rendered && L.mission.mapping.enabled) site->useOfferedDepth();  // the live maps integrate the rendered depth images
     world.site = site.get();
   }
   const auto planners = site ? site->plannerFactory(L.mission.planner, L.map, L.field)

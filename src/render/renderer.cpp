@@ -171,7 +171,9 @@ struct GpuMesh {
   GLuint vao = 0, vbo = 0, ibo = 0;
   GLsizei count = 0;
   std::size_t vbo_bytes = 0, ibo_bytes = 0;
-  void upload(const TriangleMesh& m, GLenum usage) {
+  /// `same_indices`: the caller promises the index list is unchanged when its size is (a posed
+  /// worker); otherwise the indices are sent again whenever they are uploaded.
+  void upload(const TriangleMesh& m, GLenum usage, bool same_indices = true) {
     if (vao == 0) {
       glGenVertexArrays(1, &vao);
       glGenBuffers(1, &vbo);
@@ -196,6 +198,8 @@ struct GpuMesh {
     if (ib != ibo_bytes) {
       glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(ib), m.indices.data(), usage);
       ibo_bytes = ib;
+    } else if (!same_indices && ib > 0) {
+      glBufferSubData(GL_ELEMENT_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(ib), m.indices.data());
     }
     count = static_cast<GLsizei>(m.indices.size());
   }
@@ -245,7 +249,7 @@ struct Renderer::Impl {
   GLuint program = 0, sky_program = 0, sky_vao = 0;
   GLuint fbo = 0, rb_colour = 0, rb_depth_m = 0, rb_class = 0, rb_z = 0;
   int fb_width = 0, fb_height = 0;
-  GpuMesh world, ground, uav, worker;
+  GpuMesh world, site, ground, uav, worker;
   std::shared_ptr<WorkerMesh> worker_mesh;
   bool worker_set = false;
   PosedKeypoints worker_keypoints;   ///< the worker's, kept apart from the bystanders' posing
@@ -266,7 +270,7 @@ struct Renderer::Impl {
   ~Impl() {
     if (display == EGL_NO_DISPLAY) return;
     if (context != EGL_NO_CONTEXT && makeCurrent()) {
-      for (GpuMesh* m : {&world, &ground, &uav, &worker}) m->release();
+      for (GpuMesh* m : {&world, &site, &ground, &uav, &worker}) m->release();
       for (GpuMesh& m : bystanders) m.release();
       if (fbo != 0) {
         glDeleteFramebuffers(1, &fbo);
@@ -409,6 +413,19 @@ common::Result<bool> Renderer::setWorldMesh(const TriangleMesh& obstacles, doubl
   return R::ok(true);
 }
 
+common::Result<bool> Renderer::setSiteObstacles(const TriangleMesh& obstacles) {
+  using R = common::Result<bool>;
+  for (const Vertex& v : obstacles.vertices) {
+    if (!std::isfinite(v.p[0]) || !std::isfinite(v.p[1]) || !std::isfinite(v.p[2])) return R::fail("site obstacles: a vertex is not finite");
+  }
+  for (const std::uint32_t i : obstacles.indices) {
+    if (i >= obstacles.vertices.size()) return R::fail("site obstacles: index " + std::to_string(i) + " beyond the vertices");
+  }
+  if (!impl_->makeCurrent()) return R::fail("eglMakeCurrent failed: " + eglErrorText());
+  impl_->site.upload(obstacles, GL_DYNAMIC_DRAW, /*same_indices=*/false);
+  return R::ok(true);
+}
+
 common::Result<bool> Renderer::setWorld(const planning::Scenario& scenario) {
   const Vector3d centre = 0.5 * (scenario.map.bounds.min_world + scenario.map.bounds.max_world);
   return setWorldMesh(obstacleMesh(scenario), scenario.ground.enabled ? scenario.ground.height_m : 0.0, centre);
@@ -513,6 +530,7 @@ void Renderer::Impl::drawScene(const CameraView& cam, std::optional<std::size_t>
   ground.draw();
   setUniforms(program, I, view, proj, 0, PixelClass::kObstacle, eye);
   world.draw();
+  site.draw();
   for (std::size_t i = 0; i < uavs.size(); ++i) {
     if (skip_uav && *skip_uav == i) continue;
     setUniforms(program, uavs[i].matrix(), view, proj, 0, PixelClass::kUav, eye);

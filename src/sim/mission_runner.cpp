@@ -558,6 +558,15 @@ void MissionRun::cameraFrame(double t, const WorkerState& ws) {
     }
   }
   const LeaderCameraFrame cf = camera_.frame(t, uav(owner_).plant.state(), follower_states, online, ws, worker_, classifier_);
+  if (world_.site != nullptr) {  // rendered cameras: their depth images for the live maps (site_mapping.hpp)
+    for (const CameraDepth& d : cf.depth) {
+      int u = owner_;  // camera 0: the leader's; camera k: the k-th UAV other than the leader
+      for (int i = 0, k = 0; d.camera > 0 && i < n_; ++i) {
+        if (i != owner_ && ++k == static_cast<int>(d.camera)) u = i;
+      }
+      world_.site->offerDepth(u, d);
+    }
+  }
   const SensorFrame& frame = cf.sensors;
   M_.range_outliers += cf.range_outliers;
   (void)cam_model_.receive(cf.intrinsics);  // invalid intrinsics keep the model held (or none: no measurement)

@@ -282,8 +282,23 @@ void SiteMapping::step(double t_s, const std::vector<MultirotorState>& uavs, con
   }
 }
 
+void SiteMapping::useOfferedDepth() {
+  offered_depth_ = true;
+  held_.assign(static_cast<std::size_t>(n_), std::nullopt);
+}
+
+void SiteMapping::offerDepth(int uav, const CameraDepth& depth) {
+  if (!offered_depth_ || uav < 0 || uav >= n_) return;
+  held_[static_cast<std::size_t>(uav)] = depth;
+}
+
 void SiteMapping::depthFrame(int uav, double t_s, const MultirotorState& state) {
-  integrateFrame(uav, t_s, opticalPoseFromHeadingPitch(state.p_world, state.heading_rad, state.pitch_rad), intrinsics_);
+  if (!offered_depth_) {
+    integrateFrame(uav, t_s, opticalPoseFromHeadingPitch(state.p_world, state.heading_rad, state.pitch_rad), intrinsics_);
+  } else if (auto& held = held_[static_cast<std::size_t>(uav)]) {
+    integrateDepth(uav, held->t_s, held->T_world_camera, held->intrinsics, held->depth_m);
+    held.reset();
+  }
   if (config_.travel_camera_hfov_deg > 0.0) {
     const auto [heading, pitch] = travelDirection(uav, state);
     integrateFrame(uav, t_s, opticalPoseFromHeadingPitch(state.p_world, heading, pitch), travel_intrinsics_);
@@ -304,6 +319,18 @@ void SiteMapping::integrateFrame(int uav, double t_s, const Eigen::Isometry3d& T
   depth_ms_.push_back(msSince(t0));
   const auto t1 = std::chrono::steady_clock::now();
   live_[static_cast<std::size_t>(uav)]->integrate(frame);  // a bad frame changes nothing (cannot happen: finite pose)
+  integrate_ms_.push_back(msSince(t1));
+}
+
+void SiteMapping::integrateDepth(int uav, double t_s, const Eigen::Isometry3d& T_world_camera,
+                                 const estimation::CameraIntrinsics& intrinsics, cv::Mat depth_m) {
+  mapping::DepthFrame frame;
+  frame.T_world_camera = T_world_camera;
+  frame.intrinsics = mapping::PinholeIntrinsics{intrinsics.fx, intrinsics.fy, intrinsics.cx, intrinsics.cy};
+  frame.stamp_s = t_s;
+  frame.depth_m = std::move(depth_m);
+  const auto t1 = std::chrono::steady_clock::now();
+  live_[static_cast<std::size_t>(uav)]->integrate(frame);  // a bad frame (wrong type, non-finite pose) changes nothing
   integrate_ms_.push_back(msSince(t1));
 }
 
@@ -390,7 +417,7 @@ SiteMappingSummary SiteMapping::summary() const {
   SiteMappingSummary s;
   s.mapping = mapping();
   s.prior_map = config_.prior_map;
-  s.camera = "synthetic";
+  s.camera = offered_depth_ ? "rendered" : "synthetic";
   s.clearance_m = clearance_m_;
   s.depth_frames = static_cast<int>(integrate_ms_.size());
   s.depth_ms_median = quantile(depth_ms_, 0.5);

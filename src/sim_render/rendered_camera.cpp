@@ -209,7 +209,8 @@ common::Result<std::unique_ptr<RenderedCamera>> RenderedCamera::create(const Ren
                                                                        const MissionConfig& mission,
                                                                        const planning::Scenario& scenario,
                                                                        const planning::OccupancyMap* map,
-                                                                       std::uint64_t seed) {
+                                                                       std::uint64_t seed,
+                                                                       const std::vector<UnmappedObstacle>& unmapped) {
   using R = common::Result<std::unique_ptr<RenderedCamera>>;
   const auto problems = config.validate();
   if (!problems.empty()) {
@@ -224,6 +225,7 @@ common::Result<std::unique_ptr<RenderedCamera>> RenderedCamera::create(const Ren
   auto scene = SceneRenderer::create(config.models_root, scenario, seed);
   if (!scene) return R::fail("rendered camera: " + scene.reason());
   cam->scene_ = std::move(*scene);
+  if (auto set = cam->scene_->setUnmappedObstacles(unmapped); !set) return R::fail("rendered camera: " + set.reason());
   const std::size_t n = mission.uavs.size();
   for (std::size_t i = 0; i < n; ++i) {
     auto c = std::make_unique<Camera>();
@@ -348,7 +350,7 @@ LeaderCameraFrame RenderedCamera::frame(double t, const MultirotorState& leader,
   out.skeleton.t_s = t;
   out.skeleton.label = worker.skeletonsAt(t, camera_world).front().label;  // the truth label only
   const auto t0 = Clock::now();
-  const auto posed = scene_->setScene(worker.bodyAt(t), ws.feet_world, ws.heading_rad, cfg_.worker.height_m, states);
+  const auto posed = scene_->setScene(worker.bodyAt(t), ws.feet_world, ws.heading_rad, cfg_.worker.height_m, states, t);
   if (!posed && error_.empty()) error_ = "t " + std::to_string(t) + " s: " + posed.reason();
   CameraPoses cameras;
   for (std::size_t i = 0; i < states.size(); ++i) cameras.push_back(scene_->cameraPose(i));
@@ -362,6 +364,9 @@ LeaderCameraFrame RenderedCamera::frame(double t, const MultirotorState& leader,
   for (std::size_t i = 0; i < followers.size(); ++i) wanted[i + 1] = i >= online.size() || online[i];  // offline: none
   processCameras(t, ws, results, wanted, cameras, pose_ms);
   out.sensors = leaderSensors(t, results[0], blackout, leader, ws, out.range_outliers);
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    if (results[i].rendered && !results[i].depth_m.empty()) out.depth.push_back(CameraDepth{i, t, results[i].T_world_camera, intrinsics_, results[i].depth_m});
+  }
   out.followers.resize(followers.size());
   for (std::size_t i = 0; i < followers.size(); ++i) out.followers[i].visible = results[i + 1].found;
   // Every full window of the frame, classified together (MissionClassifier::classifyAll).

@@ -1,5 +1,7 @@
 #include "gesture_formation/sim/scene_renderer.hpp"
 
+#include "gesture_formation/render/mesh.hpp"
+
 namespace gesture_formation::sim {
 
 estimation::CameraIntrinsics renderedIntrinsics(const MissionConfig& mission) {
@@ -8,7 +10,24 @@ estimation::CameraIntrinsics renderedIntrinsics(const MissionConfig& mission) {
   return k;
 }
 
+render::TriangleMesh unmappedObstaclesMesh(const std::vector<UnmappedObstacle>& obstacles, double t_s) {
+  render::TriangleMesh mesh;
+  for (const UnmappedObstacle& o : obstacles) {
+    const planning::PrimitiveSet now = o.primitivesAt(t_s);  // empty when gone
+    for (const auto& b : now.boxes) mesh.append(render::boxMesh(b, render::kSiteObstacleColour));
+    for (const auto& c : now.cylinders) mesh.append(render::cylinderMesh(c, render::kSiteObstacleColour));
+  }
+  return mesh;
+}
+
 SceneRenderer::~SceneRenderer() = default;
+
+common::Result<bool> SceneRenderer::setUnmappedObstacles(std::vector<UnmappedObstacle> obstacles) {
+  unmapped_ = std::move(obstacles);
+  site_key_.clear();
+  if (unmapped_.empty()) return renderer_->setSiteObstacles(render::TriangleMesh());
+  return common::Result<bool>::ok(true);
+}
 
 common::Result<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const std::string& models_root,
                                                                      const planning::Scenario& scenario,
@@ -28,7 +47,7 @@ common::Result<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const std::
 
 common::Result<bool> SceneRenderer::setScene(const gesture::Body3D& body, const Eigen::Vector3d& feet_world,
                                              double heading_rad, double height_m,
-                                             const std::vector<MultirotorState>& uavs) {
+                                             const std::vector<MultirotorState>& uavs, double t_s) {
   Poses bodies;
   cameras_.clear();
   for (const MultirotorState& s : uavs) {
@@ -39,6 +58,18 @@ common::Result<bool> SceneRenderer::setScene(const gesture::Body3D& body, const 
     cameras_.push_back(render::cameraPoseFromHeadingPitch(s.p_world, s.heading_rad, s.pitch_rad));
   }
   renderer_->setUavs(bodies);
+  if (!unmapped_.empty()) {
+    std::vector<double> key;
+    for (const UnmappedObstacle& o : unmapped_) {
+      const Eigen::Vector3d d = o.motion.offsetAt(t_s);
+      key.insert(key.end(), {o.presentAt(t_s) ? 1.0 : 0.0, d.x(), d.y(), d.z()});
+    }
+    if (key != site_key_) {
+      auto set = renderer_->setSiteObstacles(unmappedObstaclesMesh(unmapped_, t_s));
+      if (!set) return common::Result<bool>::fail("the unmapped obstacles: " + set.reason());
+      site_key_ = std::move(key);
+    }
+  }
   auto posed = renderer_->setWorker(render::WorkerJoints::fromBody(body, feet_world, heading_rad), height_m, appearance_);
   if (!posed) return common::Result<bool>::fail("the worker mesh: " + posed.reason());
   return common::Result<bool>::ok(true);

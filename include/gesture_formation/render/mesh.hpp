@@ -54,6 +54,10 @@ struct WorldColours {
   Rgb cylinder{0.55f, 0.55f, 0.52f};   ///< pillars (scenario cylinders)
 };
 
+/// \brief The colour of the site's obstacles that no map holds (Renderer::setSiteObstacles: crane
+/// arms, scaffolding, trucks): construction yellow, apart from the world's greys.
+inline const Rgb kSiteObstacleColour{0.86f, 0.66f, 0.12f};
+
 /// \brief The scenario's obstacles as one mesh, from the planner's own expansion: scenario
 /// boxes and cylinders, insulators, every tower through planning::towerPrimitives (its
 /// planning keep-out plates left out: they are not physical) and every conductor through

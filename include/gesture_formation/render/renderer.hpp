@@ -131,6 +131,11 @@ class Renderer {
   common::Result<bool> setWorld(const planning::Scenario& scenario);
   /// \brief Uploads an arbitrary static mesh as obstacles (tests) with the ground at `ground_z_m`.
   common::Result<bool> setWorldMesh(const TriangleMesh& obstacles, double ground_z_m, const Eigen::Vector3d& centre_world);
+  /// \brief Obstacles of the site that are not part of the world mesh and may change between frames
+  /// (a crane arm, scaffolding, a truck that drives off: sim::UnmappedObstacle): drawn as obstacles
+  /// (class kObstacle) from the next render on, replacing the previous set; an empty mesh removes
+  /// them. Fails (changing nothing) on a non-finite vertex or an index beyond the vertices.
+  common::Result<bool> setSiteObstacles(const TriangleMesh& obstacles);
   /// \brief Poses, dresses and uploads the worker (call once per simulation frame).
   common::Result<bool> setWorker(const WorkerJoints& joints, double height_m, const Appearance& appearance);
   /// \brief No worker in the next frames.

@@ -13,6 +13,9 @@
 #include <optional>
 #include <vector>
 
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
 #include "gesture_formation/gesture/gesture_classifier.hpp"
 #include "gesture_formation/gesture/skeleton_synth.hpp"
 #include "gesture_formation/gesture/view_triangulation.hpp"
@@ -33,6 +36,17 @@ struct FollowerView {
 };
 
 /// \brief One frame of the leader's camera.
+/// \brief One UAV camera's depth image of a frame: REP 118 float depth (metres along the optical
+/// axis, NaN: no return), the camera's optical-frame pose and the frame's time.
+struct CameraDepth {
+  std::size_t camera = 0;  ///< 0: the leader's camera, k ≥ 1: the k-th follower's of CameraSource::frame
+  double t_s = 0.0;
+  Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity();
+  estimation::CameraIntrinsics intrinsics;  ///< of depth_m's pixels (no distortion)
+  cv::Mat depth_m;  ///< CV_32FC1
+  EIGEN_MAKE_ALIGNED_OPERATOR_NEW
+};
+
 struct LeaderCameraFrame {
   SensorFrame sensors;         ///< box (when visible) and ranges after the injected faults
   /// The leader camera's calibration, with every frame as a driver's CameraInfo: the estimator's
@@ -46,6 +60,10 @@ struct LeaderCameraFrame {
   std::optional<gesture::Classification> classification;
   /// The followers' cameras at the same instant (empty unless followers were given).
   std::vector<FollowerView> followers;
+  /// Every depth image this frame produced, one per UAV camera that rendered one (rendered
+  /// cameras only; the synthetic camera has none): what sim::SiteMapping integrates into that
+  /// UAV's live map in place of its ray-cast depth (SiteMapping::offerDepth).
+  std::vector<CameraDepth> depth;
 };
 
 /// \brief The formation's cameras (leader + followers' views) for sim::runMission.

@@ -76,11 +76,13 @@ class RenderedCamera : public CameraSource {
   /// perception pipeline per UAV of `mission` and the video writers. Fails naming what is
   /// missing and how to get it (no EGL device, the asset, a network file) — there is no
   /// fall-back to the synthetic camera. `mission`, `map` (UWB line of sight; may be null)
-  /// must outlive this.
+  /// must outlive this. `unmapped`: the site's obstacles that the prior map lacks, drawn where
+  /// they are at each frame's time (SceneRenderer::setUnmappedObstacles).
   static common::Result<std::unique_ptr<RenderedCamera>> create(const RenderedCameraConfig& config,
                                                                 const MissionConfig& mission,
                                                                 const planning::Scenario& scenario,
-                                                                const planning::OccupancyMap* map, std::uint64_t seed);
+                                                                const planning::OccupancyMap* map, std::uint64_t seed,
+                                                                const std::vector<UnmappedObstacle>& unmapped = {});
   ~RenderedCamera() override;
   RenderedCamera(const RenderedCamera&) = delete;
   RenderedCamera& operator=(const RenderedCamera&) = delete;

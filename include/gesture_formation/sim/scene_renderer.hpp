@@ -26,11 +26,16 @@
 #include "gesture_formation/render/renderer.hpp"
 #include "gesture_formation/sim/mission_config.hpp"
 #include "gesture_formation/sim/multirotor.hpp"
+#include "gesture_formation/sim/unmapped_obstacles.hpp"
 
 namespace gesture_formation::sim {
 
 /// \brief The mission's camera as it is rendered: its intrinsics with zero distortion.
 estimation::CameraIntrinsics renderedIntrinsics(const MissionConfig& mission);
+
+/// \brief The unmapped obstacles present at t_s, where their motion puts them, as one mesh in
+/// render::kSiteObstacleColour (for render::Renderer::setSiteObstacles).
+render::TriangleMesh unmappedObstaclesMesh(const std::vector<UnmappedObstacle>& obstacles, double t_s);
 
 class SceneRenderer {
  public:
@@ -45,12 +50,18 @@ class SceneRenderer {
   SceneRenderer(const SceneRenderer&) = delete;
   SceneRenderer& operator=(const SceneRenderer&) = delete;
 
+  /// \brief The site's obstacles that the prior map lacks (scenario `unmapped_obstacles:`): drawn
+  /// from the next setScene on, each where its motion puts it at that scene's time and gone after
+  /// its `gone_after_s` (colour: render::kSiteObstacleColour). An empty list removes them (fails
+  /// only when the GL context cannot be made current).
+  common::Result<bool> setUnmappedObstacles(std::vector<UnmappedObstacle> obstacles);
   /// \brief The scene of one instant: the worker's body (body frame, WorkerModel::bodyAt) with its
   /// feet at `feet_world` facing `heading_rad`, `height_m` tall; the UAVs' true states (element i:
   /// UAV i; their bodies are drawn, their cameras are the ones render() renders). On failure (the
-  /// worker mesh) the UAVs are set, the worker is the previous one.
+  /// worker mesh) the UAVs and the obstacles are set, the worker is the previous one.
+  /// `t_s`: the mission time (poses the unmapped obstacles).
   common::Result<bool> setScene(const gesture::Body3D& body, const Eigen::Vector3d& feet_world, double heading_rad,
-                                double height_m, const std::vector<MultirotorState>& uavs);
+                                double height_m, const std::vector<MultirotorState>& uavs, double t_s);
   /// \brief UAV `uav`'s camera (of the last setScene; `uav` < its UAV count) with `intrinsics`
   /// (distortion must be zero): colour (RGB), depth [m along the optical axis, NaN = nothing],
   /// classes, the worker's truth. Its own UAV is not drawn.
@@ -65,6 +76,8 @@ class SceneRenderer {
   std::unique_ptr<render::Renderer> renderer_;
   render::Appearance appearance_;
   Poses cameras_;  ///< optical frames of the last setScene's UAVs
+  std::vector<UnmappedObstacle> unmapped_;
+  std::vector<double> site_key_;  ///< what the drawn obstacles were made of (presence, offset), to upload only changes
 };
 
 }  // namespace gesture_formation::sim

@@ -30,6 +30,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -41,6 +42,7 @@
 #include "gesture_formation/mapping/live_map.hpp"
 #include "gesture_formation/planning/occupancy_map.hpp"
 #include "gesture_formation/planning/scenario.hpp"
+#include "gesture_formation/sim/camera_source.hpp"
 #include "gesture_formation/sim/depth_raycaster.hpp"
 #include "gesture_formation/sim/link.hpp"
 #include "gesture_formation/sim/mission_config.hpp"
@@ -86,6 +88,14 @@ class SiteMapping {
   /// \brief Every plant step, before the safety sample: the clock, due depth frames, distances,
   /// and map updates sent and received; `offline[i]` (optional): UAV i's radio is down.
   void step(double t_s, const std::vector<MultirotorState>& uavs, const std::vector<bool>& offline = {});
+  /// \brief From now on UAV i's depth frames are the images its camera rendered (offerDepth; `gfctl
+  /// simulate --camera rendered`) instead of ray-cast ones: each frame that falls due integrates
+  /// the newest offered image not integrated yet — with that image's own pose and time, at most one
+  /// camera period old — and none when there is none (a blackout, a UAV without a rendered view).
+  /// The travel camera (travel_camera_hfov_deg) stays ray-cast: no such camera is rendered.
+  void useOfferedDepth();
+  /// \brief UAV i's camera image of `depth` (see useOfferedDepth; ignored before it is called).
+  void offerDepth(int uav, const CameraDepth& depth);
   /// \brief After UAV i's replanning at t_s; `reference` (stage 1, steps of `reference_dt_s` from
   /// t_s) gives the travel camera its direction.
   void planned(int uav, double t_s, const planning::PlanResult& result, const formation::ReferenceTrajectory& reference = {},
@@ -104,6 +114,9 @@ class SiteMapping {
   void depthFrame(int uav, double t_s, const MultirotorState& state);
   /// One frame of UAV i's camera at `T_world_camera` with `intrinsics` into its live map.
   void integrateFrame(int uav, double t_s, const Eigen::Isometry3d& T_world_camera, const estimation::CameraIntrinsics& intrinsics);
+  /// A depth image (REP 118) of UAV i's camera into its live map.
+  void integrateDepth(int uav, double t_s, const Eigen::Isometry3d& T_world_camera, const estimation::CameraIntrinsics& intrinsics,
+                      cv::Mat depth_m);
   /// The travel camera's heading and pitch for UAV i now (travel_camera_hfov_deg).
   std::pair<double, double> travelDirection(int uav, const MultirotorState& state);
   /// Marks what UAV i's live map now holds of the obstacles near `p_world`.
@@ -132,6 +145,8 @@ class SiteMapping {
   std::vector<std::vector<double>> seen_s_, avoided_s_;  ///< [uav][obstacle]
   std::vector<UnmappedObstacleRecord> records_;
   std::vector<double> depth_ms_, integrate_ms_;
+  bool offered_depth_ = false;                     ///< useOfferedDepth()
+  std::vector<std::optional<CameraDepth>> held_;   ///< per UAV: the newest offered image not integrated yet
   // Sharing (openShareLinks):
   using ShareLink = Link<std::vector<std::uint8_t>>;
   std::vector<std::vector<std::unique_ptr<ShareLink>>> share_links_;  ///< [from][to]

@@ -58,7 +58,7 @@ struct MapShareSummary {
 struct SiteMappingSummary {
   bool mapping = false;        ///< the UAVs kept live maps (mission.mapping.enabled)
   bool prior_map = true;       ///< the live maps started from the prior map
-  std::string camera;          ///< "synthetic" (the analytic depth camera) or "rendered"
+  std::string camera;          ///< "synthetic" (the analytic depth camera) or "rendered" (SiteMapping::useOfferedDepth)
   double clearance_m = 0.0;    ///< planner.obstacle_clearance_m: the avoidance criterion
   int depth_frames = 0;        ///< integrated, all UAVs
   /// Surface voxels of all unmapped obstacles seen / all: the map coverage.

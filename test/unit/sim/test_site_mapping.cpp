@@ -1,6 +1,7 @@
 // sim::SiteMapping (docs/mapping.md §7): a UAV whose camera looks at an unmapped box maps it at
 // its depth frames' rate, its live field sees the box, the world's obstacle distance counts it, a
-// plan through the box is not "avoiding" it and one clear of it is; without mapping nothing is seen.
+// plan through the box is not "avoiding" it and one clear of it is; without mapping nothing is seen;
+// with the cameras' own depth images (rendered cameras) the frames integrate those, not ray casts.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -121,6 +122,42 @@ TEST(SiteMappingTest, WithoutMappingNothingIsSeenAndBadSettingsAreRefused) {
   ASSERT_FALSE(static_cast<bool>(bad));
   EXPECT_NE(bad.reason().find("mission.mapping.rate_hz"), std::string::npos) << bad.reason();
   EXPECT_NE(bad.reason().find("-1"), std::string::npos) << bad.reason();
+}
+
+// useOfferedDepth (gfctl simulate --camera rendered): the due frames integrate the offered images,
+// each once, with their own pose and time — never a ray cast. UAV 1 faces the wall but is offered
+// nothing: its map stays empty; UAV 0 (whose view misses the wall) is offered an image of a plane
+// 5 m ahead that the world does not hold: its map gets that plane.
+TEST(SiteMappingTest, OfferedDepthImagesReplaceTheRayCastFrames) {
+  const gf::sim::test::EmptyWorld w;
+  gf::sim::MissionConfig cfg = gf::sim::test::openFieldWithoutRequests();
+  cfg.mapping.enabled = true;
+  cfg.mapping.rate_hz = 5.0;
+  cfg.mapping.travel_camera_hfov_deg = 0.0;
+  auto prior = std::make_shared<const gf::planning::OccupancyMap>(w.map);
+  auto site = gf::sim::SiteMapping::create(cfg, grid(), prior, gf::planning::PrimitiveSet{}, 0.0, wallAhead());
+  ASSERT_TRUE(static_cast<bool>(site)) << site.reason();
+  gf::sim::SiteMapping& s = **site;
+  s.useOfferedDepth();
+  const int n = static_cast<int>(cfg.uavs.size());
+  for (int k = 0; k <= 100; ++k) s.step(k * 0.01, uavsLookingEast(n));
+  EXPECT_EQ(s.summary().depth_frames, 0) << "frames fell due but no image was offered";
+  EXPECT_EQ(s.summary().camera, "rendered");
+  const Eigen::Vector3d before_wall(5.2, 0.0, 3.0), ahead_of_uav0(5.0, -10.0, 3.0);
+  EXPECT_GT(s.field(1)->clearance(before_wall), 2.0);
+  gf::sim::CameraDepth image;
+  image.t_s = 1.05;
+  image.intrinsics = cfg.estimator.camera;
+  image.intrinsics.distortion.fill(0.0);
+  image.T_world_camera = gf::sim::opticalPoseFromHeadingPitch(uavsLookingEast(n)[0].p_world, 0.0, 0.0);
+  image.depth_m = cv::Mat(image.intrinsics.height_px, image.intrinsics.width_px, CV_32FC1, cv::Scalar(5.0));
+  s.offerDepth(0, image);
+  for (int k = 101; k <= 120; ++k) s.step(k * 0.01, uavsLookingEast(n));  // UAV 0's frame at 1.2 s
+  EXPECT_EQ(s.summary().depth_frames, 1);
+  EXPECT_LT(s.field(0)->clearance(ahead_of_uav0), 0.5) << "the offered plane is in UAV 0's map";
+  EXPECT_GT(s.field(1)->clearance(before_wall), 2.0) << "UAV 1 was offered nothing";
+  for (int k = 121; k <= 160; ++k) s.step(k * 0.01, uavsLookingEast(n));  // UAV 0's frame at 1.4 s: nothing new
+  EXPECT_EQ(s.summary().depth_frames, 1) << "an offered image is integrated once";
 }
 
 // The travel camera (mission.mapping.travel_camera_hfov_deg): UAV 0 looks north (its worker
