@@ -118,10 +118,20 @@ class SimCameraNodelet : public nodelet::Nodelet {
     }
     std::promise<std::string> opened;
     std::future<std::string> error = opened.get_future();
-    render_thread_ = std::thread([this, sc = std::move(*scenario), models_root, seed, &opened]() {
+    render_thread_ = std::thread([this, sc = std::move(*scenario), mission_file, models_root, seed, &opened]() {
       auto scene = sim::SceneRenderer::create(models_root, sc, seed);
       if (!scene) {
         opened.set_value(scene.reason());
+        return;
+      }
+      // The scenario's unmapped obstacles, drawn where they are at each frame's time.
+      auto unmapped = sim::loadUnmappedObstacles(mission_file);
+      if (!unmapped) {
+        opened.set_value("mission_file: " + unmapped.reason());
+        return;
+      }
+      if (auto set = (*scene)->setUnmappedObstacles(std::move(*unmapped)); !set) {
+        opened.set_value(set.reason());
         return;
       }
       scene_ = std::move(*scene);

@@ -5,6 +5,8 @@
 
 #include "config_sources.hpp"
 #include "gesture_formation/sim/mission_config.hpp"
+#include "gesture_formation/sim/mission_metrics.hpp"
+#include "gesture_formation/sim/unmapped_obstacles.hpp"
 
 namespace gesture_formation::nodelets {
 
@@ -22,6 +24,26 @@ inline bool loadMission(const std::string& mission_file, ParamLoader& params, si
   out = std::move(*m);
   return true;
 }
+
+/// The scenario's unmapped obstacles (`unmapped_obstacles:`, docs/simulation.md §2): in the simulated
+/// world — SimCamera draws them, SimWorld's obstacle distance and collisions count them — but not in
+/// the prior map the planners get.
+struct SiteObstacles {
+  std::vector<sim::UnmappedObstacle> unmapped;
+  /// Every problem into `params` (naming the obstacle and key).
+  void load(const std::string& mission_file, ParamLoader& params) {
+    auto u = sim::loadUnmappedObstacles(mission_file);
+    if (u) unmapped = std::move(*u);
+    else params.addError("mission_file: " + u.reason());
+  }
+  /// The world's obstacle distance: the mapped world's, and the unmapped obstacles where they are at
+  /// *clock_s (the simulation time; must outlive the result).
+  sim::ObstacleDistance distance(const WorldMap& w, const double* clock_s) const {
+    sim::ObstacleDistance d{w.field.get(), w.solids.get(), w.ground_height_m};
+    if (!unmapped.empty()) d.extra = [this, clock_s](const Eigen::Vector3d& p) { return sim::unmappedDistance(unmapped, p, *clock_s); };
+    return d;
+  }
+};
 
 /// The SimWorld nodelet's own parameters (docs/ros.md "SimWorld"); every problem into `params`.
 struct SimWorldSettings {
@@ -51,6 +73,16 @@ inline void loadSimWorldSettings(ParamLoader& params, SimWorldSettings& s) {
   if (s.leadership && s.camera_frame.rfind("uav0/", 0) != 0) {
     params.addError("leader_camera_frame: with leadership it must start with uav0/ (UAV k's camera is uav<k>/...), got '" + s.camera_frame + "'");
   }
+}
+
+/// SimWorld's inputs: its parameters, then the mission of ~mission_file, the map of its scenario
+/// and the unmapped obstacles; every problem into `params`.
+inline void loadSimWorld(ParamLoader& params, SimWorldSettings& set, sim::MissionConfig& mission, WorldMap& world,
+                         SiteObstacles& site) {
+  loadSimWorldSettings(params, set);
+  if (set.mission_file.empty() || !loadMission(set.mission_file, params, mission)) return;
+  loadWorldMap(set.mission_file, params, world);
+  site.load(set.mission_file, params);
 }
 
 }  // namespace gesture_formation::nodelets

@@ -42,9 +42,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
   void onInit() override {
     ros::NodeHandle& nh = getNodeHandle();
     ParamLoader params(getPrivateNodeHandle());
-    loadSimWorldSettings(params, set_);
-    const std::string& mission_file = set_.mission_file;
-    if (!mission_file.empty() && loadMission(mission_file, params, cfg_)) loadWorldMap(mission_file, params, world_);
+    loadSimWorld(params, set_, cfg_, world_, site_);
     if (params.ok() && !cfg_.gesture_model.empty()) {
       auto c = sim::loadOnnxClassifier(cfg_.gesture_model);
       if (!c) params.addError("mission_file: gesture_model " + cfg_.gesture_model + ": " + c.reason());
@@ -63,7 +61,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
     camera_.emplace(cfg_, world_.map.get(), s);
     camera_frames_.emplace(1.0 / cfg_.camera.rate_hz, set_.clock_step_s);
     timeline_samples_.emplace(1.0 / cfg_.timeline_rate_hz, set_.clock_step_s);
-    record_.emplace(cfg_, sim::ObstacleDistance{world_.field.get(), world_.solids.get(), world_.ground_height_m}, s);
+    record_.emplace(cfg_, site_.distance(world_, &t_), s);  // the unmapped obstacles where they are at t_
     heading_.emplace(cfg_.formation.worker_heading);
     n_ = cfg_.formation.params.uavCount();
     truth_.resize(static_cast<std::size_t>(n_));
@@ -272,6 +270,7 @@ class SimWorldNodelet : public nodelet::Nodelet {
   std::mutex mutex_;
   sim::MissionConfig cfg_;
   WorldMap world_;
+  SiteObstacles site_;  ///< the unmapped obstacles (counted by record_'s obstacle distance)
   std::unique_ptr<sim::MissionClassifier> classifier_;
   std::optional<sim::WorkerModel> worker_;
   std::optional<sim::LeaderCamera> camera_;

@@ -8,7 +8,8 @@
 # (the launch itself runs as the user, setpriv).
 #   tools/run_ros_mission.sh [--out DIR] [--duration S] [--rtf X] [--seed N] [--mission FILE]
 #                            [--faults FILE] [--leadership] [--rviz] [--manager-prefix CMD]
-#                            [--rss-budget-mb MB]
+#                            [--rss-budget-mb MB] [--camera synthetic|rendered] [--camera-rate HZ]
+#                            [--mapping] [--no-prior-map]
 # --faults: a fault profile (e.g. config/faults/worker_lost_5s.yaml) merged into the mission for
 # every nodelet, as gfctl simulate --faults (simulation.launch faults:=).
 # --leadership: simulation.launch leadership:=true (the leader hand-over, docs/ros.md; needed by the
@@ -18,6 +19,10 @@
 # --rss-budget-mb: each UAV nodelet manager's peak resident set (VmHWM, read from /proc/PID/status
 # at the mission's end) must stay within it (tools/run_demo.sh gives 150, the budget of
 # docs/design.md §7; default 0: not checked); the summary prints every process's peak either way.
+# --camera rendered: every UAV's camera rendered and seen by the Perception nodelet
+# (simulation.launch camera:=rendered, frames at --camera-rate, default 5 per simulated second);
+# --mapping (needs --camera rendered): every FormationPlanner plans on a live map of its rendered
+# depth (simulation.launch mapping:=true), from the scenario's map unless --no-prior-map.
 # Defaults: --out results/demo, the whole mission (451 s), --rtf 2 (sim seconds per wall second).
 # Exit code: 0 when the mission finished without a collision and within the memory budget; 1 when
 # it did not finish, a UAV collided or a UAV manager exceeded the budget; 2 for bad arguments or a
@@ -37,6 +42,7 @@ FAULTS=
 LEADERSHIP=false
 MANAGER_PREFIX=
 RSS_BUDGET_MB=0
+CAMERA=synthetic CAMERA_RATE=5.0 MAPPING=false MAPPING_PRIOR=true
 while [ $# -gt 0 ]; do
   case $1 in
     --out) OUT=$2; shift 2 ;;
@@ -48,10 +54,15 @@ while [ $# -gt 0 ]; do
     --rviz) RVIZ=true; shift ;;
     --leadership) LEADERSHIP=true; shift ;;
     --manager-prefix) MANAGER_PREFIX=$2; shift 2 ;;
+    --camera) CAMERA=$2; [ "$2" = synthetic ] || [ "$2" = rendered ] || { echo "$0: --camera: expected synthetic or rendered, got '$2'" >&2; exit 2; }; shift 2 ;;
+    --camera-rate) CAMERA_RATE=$2; shift 2 ;;
+    --mapping) MAPPING=true; shift ;;
+    --no-prior-map) MAPPING_PRIOR=false; shift ;;
     --rss-budget-mb) RSS_BUDGET_MB=$2; [[ "$2" =~ ^[0-9]+$ ]] || { echo "$0: --rss-budget-mb: expected whole megabytes (0: no check), got '$2'" >&2; exit 2; }; shift 2 ;;
-    *) echo "usage: $0 [--out DIR] [--duration S] [--rtf X] [--seed N] [--mission FILE] [--faults FILE] [--leadership] [--rviz] [--manager-prefix CMD] [--rss-budget-mb MB]" >&2; exit 2 ;;
+    *) echo "usage: $0 [--out DIR] [--duration S] [--rtf X] [--seed N] [--mission FILE] [--faults FILE] [--leadership] [--rviz] [--manager-prefix CMD] [--rss-budget-mb MB] [--camera synthetic|rendered] [--camera-rate HZ] [--mapping] [--no-prior-map]" >&2; exit 2 ;;
   esac
 done
+[ "$MAPPING" = false ] || [ "$CAMERA" = rendered ] || { echo "$0: --mapping needs --camera rendered (the live maps integrate the rendered depth)" >&2; exit 2; }
 DEVEL=$(gf_devel_dir "$SRC") || exit 2
 [ -f "$DEVEL/lib/libgesture_formation_nodelets.so" ] && [ -f "$DEVEL/lib/libgesture_formation_sim_nodelets.so" ] || { echo "$0: $DEVEL lacks the nodelet libraries: build first (tools/build.sh)" >&2; exit 2; }
 NETNS=(unshare -n)
@@ -86,7 +97,8 @@ export DISPLAY=${DISPLAY:-} XAUTHORITY=${XAUTHORITY:-${HOME:-/root}/.Xauthority}
 source "$DEVEL/setup.bash"
 roslaunch --screen -p 11311 gesture_formation simulation.launch mission:=$MISSION seed:=$SEED \
   real_time_factor:=$RTF duration:=$DURATION output_dir:=$OUT key_dir:=$T/keys record:=true \
-  bag:=$OUT/mission.bag rviz:=$RVIZ faults:=$FAULTS leadership:=$LEADERSHIP manager_prefix:="$MANAGER_PREFIX" > "$T/launch.log" 2>&1 &
+  bag:=$OUT/mission.bag rviz:=$RVIZ faults:=$FAULTS leadership:=$LEADERSHIP manager_prefix:="$MANAGER_PREFIX" \
+  camera:=$CAMERA camera_rate:=$CAMERA_RATE mapping:=$MAPPING mapping_prior:=$MAPPING_PRIOR > "$T/launch.log" 2>&1 &
 launch=\$!
 # The world writes metrics.json when the mission ends; then stop everything (rosbag closes the bag).
 while kill -0 \$launch 2>/dev/null && [ ! -f "$OUT/metrics.json" ]; do sleep 1; done
