@@ -10,7 +10,10 @@
 // plans on the scenario's map, as before. With share.enabled in the mapping config (docs/mapping.md
 // §8) every share.rate_hz the planner publishes its own changes (mapping::LiveMap::takeChanges, the
 // nearest to its camera first, within share.max_bytes_per_s) on map_update_out and merges the other
-// UAVs' from map_update_in (the LcmBridge carries both over LCM). Thread safety: integrate(), merge()
+// UAVs' from map_update_in (the LcmBridge carries both over LCM). Once a second it publishes what its
+// live map holds around its camera on live_map_markers_out (latched visualization_msgs/Marker, a cube
+// list: voxels the prior map holds grey, those only the camera or another UAV found construction
+// yellow, the ground's layer left out; within ~mapping_markers_range_m, default 20 m, 0: none) for rviz. Thread safety: integrate(), merge()
 // and takeChanges() serialised by update_mutex_ (one subscription's callbacks are serialised, three
 // are not); the counters under their own mutex.
 #include <algorithm>
@@ -21,6 +24,7 @@
 #include <string>
 
 #include <diagnostic_msgs/DiagnosticStatus.h>
+#include <visualization_msgs/Marker.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
@@ -54,6 +58,10 @@ class PlannerLiveMap {
     params.load("mapping_rate_hz", rate_hz_, 0.1, 30.0);
     params.loadOptional("mapping_prior", prior_, true);
     pnh.param("mapping_tf_timeout_s", tf_timeout_s_, 0.1);
+    pnh.param("mapping_markers_range_m", markers_range_m_, 20.0);
+    if (!(markers_range_m_ >= 0.0 && markers_range_m_ <= 200.0)) {
+      params.addError("mapping_markers_range_m: must be in [0, 200] m, got " + std::to_string(markers_range_m_));
+    }
     common::ConfigReader r = common::ConfigReader::fromFile(file_, common::ConfigReader::MissingKeys::kError);
     config_ = mapping::readMappingConfig(r);
     for (const auto& e : r.errors()) params.addError("mapping_config: " + file_ + ": " + e);
@@ -67,6 +75,8 @@ class PlannerLiveMap {
     auto live = mapping::LiveMap::create(config_, world.grid, prior_ ? world.map : nullptr);
     if (!live) return "mapping_config: " + live.reason();
     live_ = std::move(*live);
+    prior_map_ = prior_ ? world.map : nullptr;
+    ground_z_m_ = world.ground_height_m;
     world.map = live_->map();
     world.field = live_->field();
     world_frame_ = world_frame;
@@ -76,6 +86,10 @@ class PlannerLiveMap {
       info_ = *m;
     });
     depth_sub_ = nh.subscribe("depth_in", 2, &PlannerLiveMap::onDepth, this);
+    if (markers_range_m_ > 0.0) {
+      markers_pub_ = nh.advertise<visualization_msgs::Marker>("live_map_markers_out", 1, true);
+      markers_timer_ = nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { publishMarkers(); });
+    }
     if (!config_.share.enabled) return "";
     share_pub_ = nh.advertise<gesture_formation::MapUpdate>("map_update_out", 10);
     share_sub_ = nh.subscribe("map_update_in", 20, &PlannerLiveMap::onUpdate, this);
@@ -195,6 +209,42 @@ class PlannerLiveMap {
     share_pub_.publish(toMsg(m));
   }
 
+  // The live map's occupied voxels within markers_range_m_ of the camera, as one cube list.
+  void publishMarkers() {
+    std::optional<Eigen::Vector3d> camera;
+    {
+      std::lock_guard<std::mutex> serial(update_mutex_);
+      camera = camera_world_;
+    }
+    if (!camera || markers_pub_.getNumSubscribers() == 0) return;
+    std::vector<Eigen::Vector3d> points;
+    {
+      const auto lock = live_->readLock();  // not while a frame's changes are applied
+      live_->map()->pointsInBox(planning::Aabb{*camera - Eigen::Vector3d::Constant(markers_range_m_),
+                                               *camera + Eigen::Vector3d::Constant(markers_range_m_)}, points);
+    }
+    visualization_msgs::Marker m;
+    m.header.frame_id = world_frame_;
+    m.header.stamp = ros::Time::now();
+    m.ns = "live_map";
+    m.type = visualization_msgs::Marker::CUBE_LIST;
+    m.pose.orientation.w = 1.0;
+    m.scale.x = m.scale.y = m.scale.z = live_->map()->resolution();
+    m.color.a = 1.0f;
+    const double floor_z = ground_z_m_ + live_->map()->resolution();  // the ground's voxels are left out
+    for (const Eigen::Vector3d& p : points) {
+      if (p.z() < floor_z) continue;
+      geometry_msgs::Point q;
+      q.x = p.x(), q.y = p.y(), q.z = p.z();
+      m.points.push_back(q);
+      std_msgs::ColorRGBA c;
+      const bool known = prior_map_ && prior_map_->isOccupied(p);
+      c.r = known ? 0.55f : 0.86f, c.g = known ? 0.55f : 0.66f, c.b = known ? 0.58f : 0.12f, c.a = 1.0f;
+      m.colors.push_back(c);
+    }
+    markers_pub_.publish(m);
+  }
+
   // Another UAV's changes (from the LcmBridge): checked against this map's grid, then merged.
   void onUpdate(const gesture_formation::MapUpdate::ConstPtr& msg) {
     if (msg->uav_index == uav_index_) return;  // its own, looped back
@@ -221,7 +271,9 @@ class PlannerLiveMap {
   std::uint32_t sequence_ = 0;  ///< map updates sent
   std::mutex update_mutex_;     ///< one of integrate(), merge(), takeChanges() at a time
   std::optional<Eigen::Vector3d> camera_world_;  ///< the camera at the last integrated frame (under update_mutex_)
-  double rate_hz_ = 5.0, tf_timeout_s_ = 0.1, next_frame_s_ = -1e18;
+  double rate_hz_ = 5.0, tf_timeout_s_ = 0.1, next_frame_s_ = -1e18, markers_range_m_ = 20.0;
+  std::shared_ptr<const planning::OccupancyMap> prior_map_;  ///< the scenario's map (null: no prior)
+  double ground_z_m_ = -1e9;  ///< the scenario's ground (its voxels are not drawn)
   bool prior_ = true;
   mapping::MappingConfig config_;
   std::unique_ptr<mapping::LiveMap> live_;
@@ -237,8 +289,8 @@ class PlannerLiveMap {
   tf2_ros::Buffer tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
   ros::Subscriber info_sub_, depth_sub_, share_sub_;
-  ros::Publisher share_pub_;
-  ros::Timer share_timer_;
+  ros::Publisher share_pub_, markers_pub_;
+  ros::Timer share_timer_, markers_timer_;
 };
 
 }  // namespace gesture_formation::nodelets

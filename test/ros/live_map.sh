@@ -95,6 +95,21 @@ wait $diag
 awk '$1 > 0 { f++ } $2 > 0 { c++ } $3 > 0 && !/no CameraInfo on depth_info_in yet/ { r++ } END { exit !(f >= 2 && c >= 1 && r == 0) }' "$T/diag_wall.txt" \
   && echo "PASS: the wall's depth frames are integrated: $(awk '{ f += $1 > 0; c += $2 } END { print f " reports with frames, " c " voxels of the planner map changed" }' "$T/diag_wall.txt"), none refused but before the CameraInfo" \
   || fail "no live-map integration of the wall: $(tr "\n" "|" < "$T/diag_wall.txt")"
+# rviz's view of it: the live map's voxels around the camera on live_map_markers (a latched cube
+# list); the wall, 4 m east of the camera, is there in the colour of what the prior map lacks.
+cat > "$T/markers.py" <<'PY'
+import rospy
+from visualization_msgs.msg import Marker
+rospy.init_node("markers", anonymous=True)
+m = rospy.wait_for_message("/live_map_markers", Marker, timeout=15)
+wall = [i for i, p in enumerate(m.points) if abs(p.x - 14.0) < 0.5 and abs(p.y - 10.0) < 3.0 and abs(p.z - 4.0) < 3.0]
+new = [i for i in wall if m.colors[i].r > 0.8 and m.colors[i].b < 0.3]
+print(m.type, len(m.points), len(wall), len(new), m.header.frame_id)
+PY
+read -r mtype mpoints mwall mnew mframe < <(timeout 30 python3 "$T/markers.py" 2>/dev/null || echo "- 0 0 0 -")
+[ "$mtype" = 6 ] && [ "$mwall" -gt 100 ] && [ "$mnew" -eq "$mwall" ] \
+  && echo "PASS: live_map_markers: a cube list in $mframe of $mpoints voxels, $mwall of them the wall's, all in the colour of what the prior map lacks" \
+  || fail "live_map_markers: type $mtype, $mpoints voxels, $mwall on the wall, $mnew of them new"
 kill "$depth" 2>/dev/null; wait "$depth" 2>/dev/null
 python3 "$T/depth.py" rgb8 & pids+=($!)
 sleep 2
