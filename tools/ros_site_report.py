@@ -32,8 +32,10 @@ def live_map(diag_csv):
         kv = {r[i]: r[i + 1] for i in range(len(r) - 1) if r[i].startswith("live_map_")}
         if not name or not kv:
             continue
-        t = out.setdefault(name, {"n": 0, "fps": 0.0, "changes": 0, "refused": 0})
+        t = out.setdefault(name, {"n": 0, "fps": 0.0, "changes": 0, "refused": 0, "sent": 0, "merged": 0})
         t["n"] += 1
+        t["sent"] += int(kv.get("live_map_updates_sent", 0))
+        t["merged"] += int(kv.get("live_map_updates_merged", 0))
         t["fps"] += float(kv["live_map_frames_per_s"])
         t["changes"] += int(kv["live_map_changes"])
         t["refused"] += int(kv["live_map_refused"])
@@ -61,20 +63,24 @@ def main():
     ap.add_argument("--date", required=True)
     ap.add_argument("--load", required=True)
     ap.add_argument("--out", required=True)
+    ap.add_argument("--share", default="0", help="1: the runs shared their live-map changes (share.enabled)")
     a = ap.parse_args()
-    L = ["# Results: the construction site through ROS, rendered cameras and live maps", "",
+    L = ["# Results: the construction site through ROS, rendered cameras and live maps"
+         + (" shared between the UAVs" if a.share == "1" else ""), "",
          f"Written by `tools/run_ros_site_mapping.sh` on {a.date} at commit {a.commit}: per seed "
          "`tools/run_ros_mission.sh --mission config/scenarios/construction_site.yaml --camera rendered --mapping "
          f"--rtf {a.rtf}` — every UAV's camera rendered by SimCamera (the crane arm, the scaffolding and the truck "
          "drawn where they are), seen by the onboard Perception nodelet, and integrated into its FormationPlanner's "
-         "live map (depth and CameraInfo topics of the camera, pose from tf), fused with the scenario's map; "
+         "live map (depth and CameraInfo topics of the camera, pose from tf), fused with the scenario's map"
+         + ("; with map sharing (share.enabled: every UAV sends its own live-map changes over LCM and merges the "
+            "others', docs/mapping.md §8)" if a.share == "1" else "") + "; "
          "SimWorld's obstacle distance and collisions count the unmapped obstacles. How: "
          "[mapping.md](../mapping.md) §9, [ros.md](../ros.md).", "",
          f"Machine: {a.load}. Wall-clock figures (planning, frames per wall second) under load are upper / lower bounds.", "",
          "| seed | collisions | min obstacle [m] | min mutual [m] | min human [m] | requests applied | planning median / p99 [ms] "
          "| fallbacks previous / brake of plans | live map frames per wall s (UAV 0/1/2) | voxel changes (0/1/2) | refused frames "
-         "| managers' peak RSS [MB] |",
-         "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+         "| map updates sent / merged (0/1/2) | managers' peak RSS [MB] |",
+         "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     bad = []
     for run in a.runs:
         try:
@@ -88,10 +94,12 @@ def main():
         fps = " / ".join(f"{lm[n]['fps'] / lm[n]['n']:.2f}" if n in lm else "–" for n in names)
         ch = " / ".join(str(lm[n]["changes"]) if n in lm else "–" for n in names)
         refused = sum(lm[n]["refused"] for n in names if n in lm)
+        updates = " / ".join(f"{lm[n]['sent']}/{lm[n]['merged']}" if n in lm else "–" for n in names)
         L.append(f"| {m['seed']} | {m['collisions']} | {m['min_obstacle_distance_m']:.2f} | {m['min_mutual_distance_m']:.2f} | "
                  f"{m['min_human_distance_m']:.2f} | {m['requests_applied']}/{m['requests_total']} | "
                  f"{m['planning_ms_median']:.1f} / {m['planning_ms_p99']:.1f} | {m['plans_fallback_previous']} / "
                  f"{m['plans_fallback_brake']} of {m['plans']} | {fps} | {ch} | {refused} | "
+                 f"{updates} | "
                  f"{' / '.join(str(rss.get(f'uav{i}', '–')) for i in range(3))} |")
         if m["collisions"] > 0 or m["min_obstacle_distance_m"] < CLEARANCE_M:
             bad.append(str(m["seed"]))

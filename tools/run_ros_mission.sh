@@ -9,7 +9,7 @@
 #   tools/run_ros_mission.sh [--out DIR] [--duration S] [--rtf X] [--seed N] [--mission FILE]
 #                            [--faults FILE] [--leadership] [--rviz] [--manager-prefix CMD]
 #                            [--rss-budget-mb MB] [--camera synthetic|rendered] [--camera-rate HZ]
-#                            [--mapping] [--no-prior-map]
+#                            [--mapping] [--no-prior-map] [--mapping-config FILE]
 # --faults: a fault profile (e.g. config/faults/worker_lost_5s.yaml) merged into the mission for
 # every nodelet, as gfctl simulate --faults (simulation.launch faults:=).
 # --leadership: simulation.launch leadership:=true (the leader hand-over, docs/ros.md; needed by the
@@ -22,7 +22,8 @@
 # --camera rendered: every UAV's camera rendered and seen by the Perception nodelet
 # (simulation.launch camera:=rendered, frames at --camera-rate, default 5 per simulated second);
 # --mapping (needs --camera rendered): every FormationPlanner plans on a live map of its rendered
-# depth (simulation.launch mapping:=true), from the scenario's map unless --no-prior-map.
+# depth (simulation.launch mapping:=true), from the scenario's map unless --no-prior-map, with the
+# live maps' settings of --mapping-config (default config/mapping.yaml; share.enabled: map sharing).
 # Defaults: --out results/demo, the whole mission (451 s), --rtf 2 (sim seconds per wall second).
 # Exit code: 0 when the mission finished without a collision and within the memory budget; 1 when
 # it did not finish, a UAV collided or a UAV manager exceeded the budget; 2 for bad arguments or a
@@ -42,7 +43,7 @@ FAULTS=
 LEADERSHIP=false
 MANAGER_PREFIX=
 RSS_BUDGET_MB=0
-CAMERA=synthetic CAMERA_RATE=5.0 MAPPING=false MAPPING_PRIOR=true
+CAMERA=synthetic CAMERA_RATE=5.0 MAPPING=false MAPPING_PRIOR=true MAPPING_CONFIG=$SRC/config/mapping.yaml
 while [ $# -gt 0 ]; do
   case $1 in
     --out) OUT=$2; shift 2 ;;
@@ -58,8 +59,9 @@ while [ $# -gt 0 ]; do
     --camera-rate) CAMERA_RATE=$2; shift 2 ;;
     --mapping) MAPPING=true; shift ;;
     --no-prior-map) MAPPING_PRIOR=false; shift ;;
+    --mapping-config) MAPPING_CONFIG=$(realpath "$2"); [ -f "$MAPPING_CONFIG" ] || { echo "$0: --mapping-config: no file '$2'" >&2; exit 2; }; shift 2 ;;
     --rss-budget-mb) RSS_BUDGET_MB=$2; [[ "$2" =~ ^[0-9]+$ ]] || { echo "$0: --rss-budget-mb: expected whole megabytes (0: no check), got '$2'" >&2; exit 2; }; shift 2 ;;
-    *) echo "usage: $0 [--out DIR] [--duration S] [--rtf X] [--seed N] [--mission FILE] [--faults FILE] [--leadership] [--rviz] [--manager-prefix CMD] [--rss-budget-mb MB] [--camera synthetic|rendered] [--camera-rate HZ] [--mapping] [--no-prior-map]" >&2; exit 2 ;;
+    *) echo "usage: $0 [--out DIR] [--duration S] [--rtf X] [--seed N] [--mission FILE] [--faults FILE] [--leadership] [--rviz] [--manager-prefix CMD] [--rss-budget-mb MB] [--camera synthetic|rendered] [--camera-rate HZ] [--mapping] [--no-prior-map] [--mapping-config FILE]" >&2; exit 2 ;;
   esac
 done
 [ "$MAPPING" = false ] || [ "$CAMERA" = rendered ] || { echo "$0: --mapping needs --camera rendered (the live maps integrate the rendered depth)" >&2; exit 2; }
@@ -98,7 +100,7 @@ source "$DEVEL/setup.bash"
 roslaunch --screen -p 11311 gesture_formation simulation.launch mission:=$MISSION seed:=$SEED \
   real_time_factor:=$RTF duration:=$DURATION output_dir:=$OUT key_dir:=$T/keys record:=true \
   bag:=$OUT/mission.bag rviz:=$RVIZ faults:=$FAULTS leadership:=$LEADERSHIP manager_prefix:="$MANAGER_PREFIX" \
-  camera:=$CAMERA camera_rate:=$CAMERA_RATE mapping:=$MAPPING mapping_prior:=$MAPPING_PRIOR > "$T/launch.log" 2>&1 &
+  camera:=$CAMERA camera_rate:=$CAMERA_RATE mapping:=$MAPPING mapping_prior:=$MAPPING_PRIOR mapping_config:=$MAPPING_CONFIG > "$T/launch.log" 2>&1 &
 launch=\$!
 # The world writes metrics.json when the mission ends; then stop everything (rosbag closes the bag).
 while kill -0 \$launch 2>/dev/null && [ ! -f "$OUT/metrics.json" ]; do sleep 1; done
