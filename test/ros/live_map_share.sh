@@ -3,8 +3,8 @@
 # onboard.launch (UAV 0 and 1, namespaces uav0 / uav1, mapping:=true with share.enabled, LCM udpm in a
 # private network namespace). Only UAV 0 has a depth camera, 4 m in front of a wall; its planner
 # publishes its changes, the bridges carry them, UAV 1's planner merges them: UAV 1's map changes
-# without a camera, and every voxel UAV 0 sent (its wall, resent every update) is merged by UAV 1 but
-# those of the update last sent at most (/diagnostics live_map_*). A map
+# without a camera, and every voxel UAV 0 had sent 3 s before the end (its wall, resent every update) is
+# merged by UAV 1 by the end, nothing it did not send (/diagnostics live_map_*). A map
 # update that claims UAV 0's index but comes from UAV 1's bridge is refused by UAV 0's bridge.
 set -o pipefail
 source "$(dirname "$0")/common.bash"
@@ -61,6 +61,7 @@ rospy.init_node("diag", anonymous=True)
 keys = ["live_map_frames_per_s", "live_map_changes", "live_map_updates_sent", "live_map_voxels_sent",
         "live_map_updates_merged", "live_map_voxels_merged", "live_map_updates_refused"]
 total = {u: {k: 0.0 for k in keys} for u in ("uav0", "uav1")}
+history = {"uav0": [], "uav1": []}  # (wall time, voxels UAV 0 sent / UAV 1 merged so far)
 def on(a):
     for s in a.status:
         for u in total:
@@ -68,12 +69,18 @@ def on(a):
                 v = {k.key: k.value for k in s.values}
                 for k in keys:
                     total[u][k] += float(v.get(k, 0))
+                history[u].append((time.time(), total[u]["live_map_voxels_sent" if u == "uav0" else "live_map_voxels_merged"]))
 rospy.Subscriber("/diagnostics", DiagnosticArray, on)
 t0 = time.time()
 while time.time() - t0 < float(sys.argv[1]):
     time.sleep(0.1)
 for u in total:
     print(u, " ".join("%s=%g" % (k, total[u][k]) for k in keys))
+# The counts 3 s before the end (a report every second, two updates a second, the link's latency:
+# 3 s covers what is in flight and what a report has not told yet).
+for u, k in (("uav0", "live_map_voxels_sent"), ("uav1", "live_map_voxels_merged")):
+    early = [s for t, s in history[u] if t <= time.time() - 3.0]
+    print(u + "_early", "%s=%g" % (k, early[-1] if early else 0))
 PY
 cat > "$T/inner.sh" <<INNER
 ip link set lo up && ip route add 224.0.0.0/4 dev lo || exit 1
@@ -109,12 +116,15 @@ sent=$(val uav0 live_map_voxels_sent); merged=$(val uav1 live_map_voxels_merged)
 awk -v s="$sent" -v u="$(val uav0 live_map_updates_sent)" 'BEGIN { exit !(s >= 100 && u >= 1) }' \
   && echo "PASS: UAV 0's planner sent its wall: $sent voxels in $(val uav0 live_map_updates_sent) updates" \
   || fail "UAV 0 sent no map changes (voxels '$sent')"
-# UAV 0 resends its wall every update (share.refresh_share); the two diagnostics are read at two moments,
-# so UAV 1 may not have merged the update last sent: at most one update (sent / updates voxels) behind.
-awk -v s="$sent" -v m="$merged" -v c="$changed" -v u="$(val uav0 live_map_updates_sent)" \
-  'BEGIN { exit !(m <= s && m >= s - s / u && c >= 100) }' \
-  && echo "PASS: UAV 1's planner, without a camera, merged every voxel UAV 0 sent but the last update's at most ($merged of $sent; $changed voxels of its map changed)" \
-  || fail "UAV 1 merged '$merged' of '$sent' voxels ($changed of its map changed)"
+# UAV 0 resends its wall every update (share.refresh_share), so updates are always in flight (and not yet
+# reported) when the counting stops: by the end UAV 1 must have merged every voxel UAV 0 had sent 3 s
+# before, and what UAV 1 had merged 3 s before the end UAV 0 must have sent by the end (nothing merged
+# that was not sent).
+early=$(val uav0_early live_map_voxels_sent); merged_early=$(val uav1_early live_map_voxels_merged)
+awk -v s="$sent" -v e="$early" -v m="$merged" -v me="$merged_early" -v c="$changed" \
+  'BEGIN { exit !(e >= 100 && m >= e && me <= s && c >= 100) }' \
+  && echo "PASS: UAV 1's planner, without a camera, merged every voxel UAV 0 sent, nothing else ($merged merged by the end >= $early sent 3 s before; $merged_early merged 3 s before <= $sent sent by the end; $changed voxels of its map changed)" \
+  || fail "UAV 1 merged '$merged' by the end, '$merged_early' 3 s before; UAV 0 had sent '$early' 3 s before the end, '$sent' by the end ($changed of its map changed)"
 awk -v f="$(val uav1 live_map_frames_per_s)" -v r="$(val uav1 live_map_updates_refused)" 'BEGIN { exit !(f == 0 && r == 0) }' \
   && echo "PASS: UAV 1 integrated no frame of its own and refused no update" || fail "UAV 1: frames or refusals: $(grep ^uav1 "$T/diag.txt")"
 matches "map update from sender 1 refused: map_update.uav_index 0 is not its sender 1" "$T/rosout.txt" \
