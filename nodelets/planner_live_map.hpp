@@ -146,7 +146,9 @@ class PlannerLiveMap {
 
   void onDepth(const sensor_msgs::Image::ConstPtr& m) {
     const double t = m->header.stamp.toSec();
-    if (t < next_frame_s_) return;  // at most mapping_rate_hz
+    // At most mapping_rate_hz; 1 ms of slack, or a camera at exactly that rate loses frames to
+    // rounding (0.4 + 0.2 > 0.6 in binary: every third frame at 5 Hz).
+    if (t + 1e-3 < next_frame_s_) return;
     next_frame_s_ = t + 1.0 / rate_hz_;
     mapping::DepthFrame frame;
     frame.stamp_s = t;
