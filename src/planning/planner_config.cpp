@@ -112,6 +112,7 @@ PlannerConfig readPlannerConfig(ConfigReader& r, const std::string& prefix) {
   std::string solver = c.camera_solver == PlannerConfig::CameraSolver::kCeres ? "ceres" : "filter";
   r.readString(prefix + "camera.solver", solver, {"filter", "ceres"});
   c.camera_solver = solver == "ceres" ? PlannerConfig::CameraSolver::kCeres : PlannerConfig::CameraSolver::kFilter;
+  r.readBool(prefix + "qp.truncate_on_infeasible", c.qp_truncate_on_infeasible);
   // The rules between fields, always: a key outside its range was reported while reading and
   // kept its default, so these add only what is new.
   common::addProblems(r, prefix, problems(c));

@@ -158,7 +158,7 @@ QpMatrices TrajectoryQp::assemble(const TrajectoryQpProblem& pr) {
   const int N = pr.intervals;
   const double dt = pr.dt_s;
   const int n = 9 * N;
-  const int n_eq = 6 * N;
+  const int n_eq = 6 * N + (pr.terminal_rest ? 6 : 0);
   const int n_in = inequalityCount(pr);
   QpMatrices m;
 
@@ -219,6 +219,11 @@ QpMatrices TrajectoryQp::assemble(const TrajectoryQpProblem& pr) {
         at.emplace_back(row, var(k, 2, i), -dt / 2.0);
       }
       ++row;
+    }
+  }
+  if (pr.terminal_rest) {  // v_N = 0, a_N = 0
+    for (int j = 1; j <= 2; ++j) {
+      for (int i = 0; i < 3; ++i) at.emplace_back(row++, var(N, j, i), 1.0);
     }
   }
   m.A.resize(n_eq, n);
@@ -567,7 +572,7 @@ TrajectoryQpSolution TrajectoryQp::solve(const TrajectoryQpProblem& pr, const Tr
   out.a.assign(N + 1, pr.a0);
 
   QpMatricesSolution r;
-  if (pr.formulation == TrajectoryQpProblem::Formulation::kCondensed) {
+  if (pr.formulation == TrajectoryQpProblem::Formulation::kCondensed && !pr.terminal_rest) {
     const Condensed q = condense(pr);
     Eigen::VectorXd x0;
     if (have_warm) {

@@ -983,7 +983,49 @@ std::string UavPlanner::solveQp(PlanContext& c, PlanResult& result) {
   result.qp_iterations = c.sol.iterations;
   result.qp_sparse_timeouts += stoppedSparse(c.sol) ? 1 : 0;
   if (c.sol.solved()) return {};
+  if (config_.qp_truncate_on_infeasible && c.sol.status == TrajectoryQpSolution::Status::kInfeasible &&
+      solveTruncated(c, result)) {
+    return {};
+  }
   return c.sol.reason + infeasibilityCause(c, result);
+}
+
+bool UavPlanner::solveTruncated(PlanContext& c, PlanResult& result) {
+  const int N = c.N;
+  int best_k = 0;
+  TrajectoryQpSolution best;
+  const auto attempt = [&](int k) {
+    if (k < 1 || k >= N) return false;
+    TrajectoryQpProblem t = c.qp;
+    t.intervals = k;
+    t.reference.resize(static_cast<std::size_t>(k) + 1);
+    t.constraints.erase(std::remove_if(t.constraints.begin(), t.constraints.end(),
+                                       [k](const PositionConstraint& pc) { return pc.sample > k; }),
+                        t.constraints.end());
+    t.terminal_rest = true;
+    TrajectoryQpSolution s = qp_->solve(t, nullptr);
+    result.qp_sparse_timeouts += stoppedSparse(s) ? 1 : 0;
+    if (!s.solved()) return false;
+    best_k = k;
+    best = std::move(s);
+    return true;
+  };
+  const int half = N / 2;
+  if (attempt(half)) {
+    attempt(half + (N - half) / 2);
+  } else {
+    attempt(half / 2);
+  }
+  if (best_k == 0) return false;
+  // Hover where it stopped: at rest at sample K (v = a = 0), so the dynamics hold with a = 0.
+  for (int k = best_k + 1; k <= N; ++k) {
+    best.p.push_back(best.p.back());
+    best.v.push_back(Eigen::Vector3d::Zero());
+    best.a.push_back(Eigen::Vector3d::Zero());
+  }
+  c.sol = std::move(best);
+  result.qp_truncated_at = best_k;
+  return true;
 }
 
 std::string UavPlanner::infeasibilityCause(const PlanContext& c, PlanResult& result) {

@@ -140,6 +140,11 @@ struct PlannerConfig {
   /// Wall-clock bound (s) of ProxQP's sparse solve; past it the QP is re-solved by the dense
   /// backend (trajectory_qp.hpp, docs/safety.md §4.5), > 0.
   double qp_solve_timeout_s = 2.0;
+  /// When the QP over the whole horizon is primal infeasible, re-solve it cut to fewer samples
+  /// ending at rest (UavPlanner::solveTruncated) before falling back: a plan that makes progress and
+  /// stops inside the last corridor it can reach, instead of the previous plan or a brake. Key
+  /// `qp.truncate_on_infeasible`; default false (docs/planning.md §6.3, §12).
+  bool qp_truncate_on_infeasible = false;
 
   // --- camera heading / pitch -------------------------------------------------------------
   /// Solver of the camera angles (camera_tracking.hpp): the closed-form rate-limited filter

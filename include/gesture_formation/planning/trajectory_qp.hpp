@@ -87,6 +87,9 @@ struct TrajectoryQpProblem {
   /// QpSolveLimits::kIterationsPerCheck outer iterations; past it: kTimeLimit).
   double solve_timeout_s = 2.0;
   enum class Formulation { kCondensed, kSparse } formulation = Formulation::kSparse;
+  /// The trajectory ends at rest: v_N = 0 and a_N = 0 as six more equality rows (solved in the
+  /// sparse form whatever `formulation` says). Used by UavPlanner's truncated re-solve.
+  bool terminal_rest = false;
 };
 
 struct TrajectoryQpSolution {

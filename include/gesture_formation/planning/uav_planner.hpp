@@ -96,6 +96,9 @@ struct PlanResult {
   /// (TrajectoryQp, docs/safety.md §4.5).
   int qp_sparse_timeouts = 0;
   double min_obstacle_clearance_m = 0.0;  ///< verified clearance of the returned plan
+  /// PlannerConfig::qp_truncate_on_infeasible: the QP over the whole horizon was primal infeasible
+  /// and the plan is the truncated re-solve's — K samples ending at rest, then hovering there (0: not).
+  int qp_truncated_at = 0;
   // --- added by the planner implementation (fields may be added, never renamed) ---------
   /// False only for a braking plan that itself failed verification (the last resort is
   /// returned anyway, `reason` says why), or an empty trajectory when the state is not finite.
@@ -191,6 +194,9 @@ class UavPlanner {
   Eigen::Vector3d linearisationPoint(const PlanContext& c, int k) const;
   std::string solveQp(PlanContext& c, PlanResult& result);
   std::string infeasibilityCause(const PlanContext& c, PlanResult& result);
+  /// qp_truncate_on_infeasible: re-solves c.qp cut to K < N samples ending at rest (K = N/2, then
+  /// 3N/4 or N/4: the largest that solves); on success c.sol holds it, hovering from K to N.
+  bool solveTruncated(PlanContext& c, PlanResult& result);
   std::string planCamera(PlanContext& c) const;
   std::string verifyAndAccept(PlanContext& c, PlanResult& result);
   PlanResult fallback(const PlanRequest& request, PlanResult result, const std::string& reason);

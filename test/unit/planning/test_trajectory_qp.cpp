@@ -247,6 +247,36 @@ TEST_P(TrajectoryQpFormulationTest, WarmStartGivesTheSameSolution) {
   for (int k = 0; k <= 40; ++k) EXPECT_LT((warm.p[static_cast<std::size_t>(k)] - cold.p[static_cast<std::size_t>(k)]).norm(), 1e-4);
 }
 
+// terminal_rest (UavPlanner's truncated re-solve): the solution ends at rest, v_N = a_N = 0 to the
+// solver's accuracy, keeps the dynamics and every row, and costs at least the free-ended optimum;
+// asked of the condensed form it is solved in the sparse form (which has the rows).
+TEST(TrajectoryQpTest, TerminalRestEndsTheTrajectoryAtRest) {
+  std::mt19937 rng(21);
+  const TrajectoryQp solver;
+  for (int trial = 0; trial < 10; ++trial) {
+    TrajectoryQpProblem pr = randomProblem(rng, 12);
+    const TrajectoryQpSolution free_end = solver.solve(pr);
+    ASSERT_TRUE(free_end.solved()) << free_end.reason;
+    EXPECT_GT(free_end.v.back().norm(), 0.1) << "the free end moves (else the test shows nothing)";
+    pr.terminal_rest = true;
+    pr.formulation = trial % 2 == 0 ? TrajectoryQpProblem::Formulation::kSparse : TrajectoryQpProblem::Formulation::kCondensed;
+    const TrajectoryQpSolution s = solver.solve(pr);
+    ASSERT_TRUE(s.solved()) << s.reason;
+    EXPECT_FALSE(s.condensed);
+    EXPECT_EQ(s.equalities, 6 * pr.intervals + 6);
+    EXPECT_LT(s.v.back().norm(), 1e-5);
+    EXPECT_LT(s.a.back().norm(), 1e-5);
+    const double dt = pr.dt_s;
+    for (int k = 0; k < pr.intervals; ++k) {
+      const auto i = static_cast<std::size_t>(k);
+      EXPECT_LT((s.p[i + 1] - (s.p[i] + s.v[i] * dt + s.a[i] * (dt * dt / 3.0) + s.a[i + 1] * (dt * dt / 6.0))).norm(), 1e-5);
+      EXPECT_LT((s.v[i + 1] - (s.v[i] + (s.a[i] + s.a[i + 1]) * (dt / 2.0))).norm(), 1e-5);
+    }
+    for (const auto& c : pr.constraints) EXPECT_LE(c.a.dot(s.p[static_cast<std::size_t>(c.sample)]), c.b + 1e-5);
+    EXPECT_GE(TrajectoryQp::cost(pr, s.p, s.v, s.a) + 1e-6, TrajectoryQp::cost(pr, free_end.p, free_end.v, free_end.a));
+  }
+}
+
 TEST(TrajectoryQpTest, InfeasibleAndBadInputAreReported) {
   std::mt19937 rng(9);
   const TrajectoryQp solver;

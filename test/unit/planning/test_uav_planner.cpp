@@ -172,6 +172,20 @@ TEST(UavPlannerTest, YamlListsEveryBadKeyAtOnce) {
   EXPECT_NE(report.find("verify.substeps"), std::string::npos) << report;    // missing
 }
 
+// qp.truncate_on_infeasible: off in the shipped file, read when given, refused naming the key when
+// it is not a boolean.
+TEST(UavPlannerTest, TruncateOnInfeasibleIsReadAndChecked) {
+  const auto shipped = loadPlannerConfig(std::string(GF_SOURCE_DIR) + "/config/planner.yaml", common::ConfigReader::MissingKeys::kError);
+  ASSERT_TRUE(shipped) << shipped.reason();
+  EXPECT_FALSE(shipped->qp_truncate_on_infeasible);
+  auto on = common::ConfigReader::fromString("qp: {truncate_on_infeasible: true}\n", "p.yaml", common::ConfigReader::MissingKeys::kUseDefaults);
+  EXPECT_TRUE(readPlannerConfig(on).qp_truncate_on_infeasible);
+  EXPECT_TRUE(on.ok()) << on.errorReport();
+  auto bad = common::ConfigReader::fromString("qp: {truncate_on_infeasible: sometimes}\n", "p.yaml", common::ConfigReader::MissingKeys::kUseDefaults);
+  readPlannerConfig(bad);
+  EXPECT_NE(bad.errorReport().find("qp.truncate_on_infeasible"), std::string::npos) << bad.errorReport();
+}
+
 // Rules between keys run even when a single key is already wrong (every problem at once), and
 // each key's range is the same whether the value comes from YAML or from code.
 TEST(UavPlannerTest, YamlReportsRulesBetweenKeysBesideABadKey) {
