@@ -112,8 +112,9 @@ struct EllipsoidFit {
   Eigen::Vector3d axes;
 };
 
-/// The point in the fitted frame: the initial frame's coordinates turned by the roll — the same
-/// two products, in the same order, wherever a point's coordinates are needed.
+/// The point in the initial segment frame R0 (x along the segment, origin at its centre): the one
+/// expression of it, so that the fitted-frame coordinates (this, turned by the roll) are the same
+/// bits wherever they are computed.
 Eigen::Vector3d initialFrame(const Eigen::Matrix3d& R0, const Eigen::Vector3d& p, const Eigen::Vector3d& center) {
   return R0.transpose() * (p - center);
 }

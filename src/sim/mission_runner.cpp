@@ -550,21 +550,19 @@ void MissionRun::cameraFrame(double t, const WorkerState& ws) {
   // the leader's sensors), the others' cameras vote.
   std::vector<MultirotorState> follower_states;
   std::vector<bool> online;
+  std::vector<int> camera_uav{owner_};  // camera k of the frame → its UAV
   if (follower_views_) {
     for (int i = 0; i < n_; ++i) {
       if (i == owner_) continue;
       follower_states.push_back(uav(i).plant.state());
       online.push_back(!uav(i).offline);
+      camera_uav.push_back(i);
     }
   }
   const LeaderCameraFrame cf = camera_.frame(t, uav(owner_).plant.state(), follower_states, online, ws, worker_, classifier_);
   if (world_.site != nullptr) {  // rendered cameras: their depth images for the live maps (site_mapping.hpp)
     for (const CameraDepth& d : cf.depth) {
-      int u = owner_;  // camera 0: the leader's; camera k: the k-th UAV other than the leader
-      for (int i = 0, k = 0; d.camera > 0 && i < n_; ++i) {
-        if (i != owner_ && ++k == static_cast<int>(d.camera)) u = i;
-      }
-      world_.site->offerDepth(u, d);
+      if (d.camera < camera_uav.size()) world_.site->offerDepth(camera_uav[d.camera], d);
     }
   }
   const SensorFrame& frame = cf.sensors;

@@ -310,16 +310,10 @@ void SiteMapping::integrateFrame(int uav, double t_s, const Eigen::Isometry3d& T
                                  const estimation::CameraIntrinsics& intrinsics) {
   planning::PrimitiveSet now;
   for (const UnmappedObstacle& o : unmapped_) now.append(o.primitivesAt(t_s));
-  mapping::DepthFrame frame;
-  frame.T_world_camera = T_world_camera;
-  frame.intrinsics = mapping::PinholeIntrinsics{intrinsics.fx, intrinsics.fy, intrinsics.cx, intrinsics.cy};
-  frame.stamp_s = t_s;
   const auto t0 = std::chrono::steady_clock::now();
-  frame.depth_m = raycaster_.render(intrinsics, frame.T_world_camera, config_.live.pixel_stride, config_.camera_range_m, now);
+  cv::Mat depth = raycaster_.render(intrinsics, T_world_camera, config_.live.pixel_stride, config_.camera_range_m, now);
   depth_ms_.push_back(msSince(t0));
-  const auto t1 = std::chrono::steady_clock::now();
-  live_[static_cast<std::size_t>(uav)]->integrate(frame);  // a bad frame changes nothing (cannot happen: finite pose)
-  integrate_ms_.push_back(msSince(t1));
+  integrateDepth(uav, t_s, T_world_camera, intrinsics, std::move(depth));
 }
 
 void SiteMapping::integrateDepth(int uav, double t_s, const Eigen::Isometry3d& T_world_camera,
