@@ -1,11 +1,11 @@
 // gfctl render-gestures --seed S --count N --out DIR [--config FILE] [--views D1,D2,…]
-//                       [--motions M1,M2,…] [--models DIR]
+//                       [--motions M1,M2,…] [--models DIR] [--skeleton movenet_lightning|blazepose_landmark]
 // The gesture generator's performances (gesture::SkeletonSynthesizer, the same 3-D bodies and
 // timing as `gfctl synth-gestures`) RENDERED — the skinned mannequin posed every frame from the
 // generator's 3-D body, dressed per sequence (render::Appearance) — from one camera per view, and
 // each view's pixels put through the real perception pipeline (MoveNet multipose detector ⇄ KCF
-// tracker → MoveNet lightning; docs/perception.md), as onboard. Writes per view (suffix "" for
-// the leader, "_view1", … for the further views, as synth-gestures):
+// tracker → MoveNet lightning, or the --skeleton network; docs/perception.md), as onboard. Writes
+// per view (suffix "" for the leader, "_view1", … for the further views, as synth-gestures):
 //   skeletons*.csv  the pipeline's skeletons (design.md §8.7 + label, sequence, segment): one row
 //                   per frame in which the pipeline found the worker; `segment` changes whenever the
 //                   pipeline lost the worker or started another identity (its FIFO restarts there;
@@ -46,7 +46,7 @@ namespace {
 int cmdRenderGestures(const Args& args);
 const Registrar kRegistrar{
     "render-gestures",
-    "--seed S --count N --out DIR [--config FILE] [--views D1,D2] [--motions M1,M2] [--models DIR]   generator "
+    "--seed S --count N --out DIR [--config FILE] [--views D1,D2] [--motions M1,M2] [--models DIR] [--skeleton KIND]   generator "
     "performances rendered per view and put through the real detector + tracker + MoveNet (docs/gestures.md §9)",
     cmdRenderGestures};
 
@@ -67,6 +67,7 @@ struct Options {
   std::vector<double> offsets_deg;
   std::vector<gesture::Motion> motions;
   gesture::SynthConfig synth;
+  perception::SkeletonKind skeleton = perception::SkeletonKind::kMoveNetLightning;
 };
 
 std::string parseOptions(const Args& args, Options& o) {
@@ -103,6 +104,11 @@ std::string parseOptions(const Args& args, Options& o) {
     gesture::synthConfigFields().readFields(r, "", o.synth);
     common::addProblems(r, "", gesture::synthConfigProblems(o.synth));
     if (!r.ok()) return "invalid configuration " + args.get("config") + ":\n" + r.errorReport();
+  }
+  if (args.has("skeleton")) {
+    const auto k = perception::parseSkeletonKind(args.get("skeleton"));
+    if (!k) return "--skeleton: " + k.reason();
+    o.skeleton = *k;
   }
   o.synth.camera.distortion.fill(0.0);  // the rendered image is the rectified one
   o.dir = args.get("out");
@@ -238,7 +244,7 @@ std::string renderSequence(render::Renderer& renderer, std::vector<ViewOut>& out
 }
 
 int cmdRenderGestures(const Args& args) {
-  if (!checkOptions(args, {"seed", "count", "out"}, {"config", "views", "motions", "models"})) return kExitBadInput;
+  if (!checkOptions(args, {"seed", "count", "out"}, {"config", "views", "motions", "models", "skeleton"})) return kExitBadInput;
   Options o;
   if (const std::string e = parseOptions(args, o); !e.empty()) return badInput(args, e);
   render::RendererConfig rc;
@@ -253,6 +259,7 @@ int cmdRenderGestures(const Args& args) {
   (*renderer)->setUavs({});
   perception::PerceptionConfig pc;
   pc.models_root = o.models;
+  pc.skeleton = o.skeleton;
   const std::size_t n_views = 1 + o.offsets_deg.size();
   std::vector<ViewOut> out(n_views);
   for (std::size_t v = 0; v < n_views; ++v) {

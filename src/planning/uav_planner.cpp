@@ -984,18 +984,20 @@ std::string UavPlanner::solveQp(PlanContext& c, PlanResult& result) {
   result.qp_sparse_timeouts += stoppedSparse(c.sol) ? 1 : 0;
   if (c.sol.solved()) return {};
   if (config_.qp_truncate_on_infeasible && c.sol.status == TrajectoryQpSolution::Status::kInfeasible &&
-      solveTruncated(c, result)) {
+      solveTruncated(c, c.have_prev ? &warm : nullptr, result)) {
     return {};
   }
   return c.sol.reason + infeasibilityCause(c, result);
 }
 
-bool UavPlanner::solveTruncated(PlanContext& c, PlanResult& result) {
+bool UavPlanner::solveTruncated(PlanContext& c, const TrajectoryQpSolution* warm, PlanResult& result) {
   const int N = c.N;
   int best_k = 0;
   TrajectoryQpSolution best;
   const auto attempt = [&](int k) {
     if (k < 1 || k >= N) return false;
+    // A plan finished beyond the time budget is refused anyway (verifyAndAccept): no attempt then.
+    if (config_.time_budget_ms > 0.0 && msSince(c.t_start) > config_.time_budget_ms) return false;
     TrajectoryQpProblem t = c.qp;
     t.intervals = k;
     t.reference.resize(static_cast<std::size_t>(k) + 1);
@@ -1003,7 +1005,14 @@ bool UavPlanner::solveTruncated(PlanContext& c, PlanResult& result) {
                                        [k](const PositionConstraint& pc) { return pc.sample > k; }),
                         t.constraints.end());
     t.terminal_rest = true;
-    TrajectoryQpSolution s = qp_->solve(t, nullptr);
+    // Warm start: the last verified plan re-timed, cut to the K samples (primal only, as solveQp).
+    TrajectoryQpSolution w;
+    if (warm != nullptr && warm->p.size() > static_cast<std::size_t>(k)) {
+      w.p.assign(warm->p.begin(), warm->p.begin() + k + 1);
+      w.v.assign(warm->v.begin(), warm->v.begin() + k + 1);
+      w.a.assign(warm->a.begin(), warm->a.begin() + k + 1);
+    }
+    TrajectoryQpSolution s = qp_->solve(t, w.p.empty() ? nullptr : &w);
     result.qp_sparse_timeouts += stoppedSparse(s) ? 1 : 0;
     if (!s.solved()) return false;
     best_k = k;

@@ -32,6 +32,7 @@ import heldout_eval as he  # noqa: E402
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 PROTOCOL = os.path.join(ROOT, "tools/gesture/heldout/protocol_v2_rendered.yaml")
 DATA_DIR = "/work/gestrend_data"  # default cache of the rendered sets (--data)
+SKELETON = "movenet_lightning"  # the pipeline's skeleton network (--skeleton); others render into their own directory
 CLASSES = ev.CLASSES
 
 
@@ -41,7 +42,8 @@ def load_protocol(path):
 
 
 def set_dir(data, name, spec):
-    return os.path.join(data, f"{name}_seed{spec['seed']}_n{spec['count']}")
+    tag = "" if SKELETON == "movenet_lightning" else f"_{SKELETON}"
+    return os.path.join(data, f"{name}_seed{spec['seed']}_n{spec['count']}{tag}")
 
 
 def render(gfctl, protocol, name, data, models=None):
@@ -55,6 +57,8 @@ def render(gfctl, protocol, name, data, models=None):
            "--config", cfg, "--views", ",".join(str(v) for v in spec["views_deg"]), "--motions", ",".join(spec["motions"])]
     if models:
         cmd += ["--models", models]
+    if SKELETON != "movenet_lightning":
+        cmd += ["--skeleton", SKELETON]
     with open(os.path.join(d, "render.log"), "w") as log:
         log.write(f"# {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC load {os.getloadavg()}\n")
         log.flush()
@@ -538,9 +542,9 @@ def report(protocol, protocol_path, tuning_errors, tuning_eval, heldout_eval, ou
                    "heldout_eval": heldout_eval, "protocol_v1": list(v1_runs)}, f, indent=1)
 
 
-def set_data_dir(path):
-    global DATA_DIR
-    DATA_DIR = path
+def set_data_dir(path, skeleton="movenet_lightning"):
+    global DATA_DIR, SKELETON
+    DATA_DIR, SKELETON = path, skeleton
 
 
 def main():
@@ -560,6 +564,9 @@ def main():
     ap.add_argument("--data", default="/work/gestrend_data", help="cache of the rendered sets (not in git)")
     ap.add_argument("--protocol", default=PROTOCOL)
     ap.add_argument("--models", default=None)
+    ap.add_argument("--skeleton", default="movenet_lightning", choices=["movenet_lightning", "blazepose_landmark"],
+                    help="render: the pipeline's skeleton network (gfctl render-gestures --skeleton); every action "
+                         "reads the set rendered with it (its own directory in --data)")
     ap.add_argument("--model", default=he.MODEL)
     ap.add_argument("--config", default=he.GESTURES_YAML)
     ap.add_argument("--out", default=None)
@@ -568,7 +575,7 @@ def main():
                          "check and the filter leave of perfect readings; the leader's window figures stay the model's)")
     a = ap.parse_args()
     protocol = load_protocol(a.protocol)
-    set_data_dir(a.data)
+    set_data_dir(a.data, a.skeleton)
     if a.action == "report":
         load = lambda p: json.load(open(p)) if p else None  # noqa: E731
         loads = lambda ps: [load(p) for p in ps.split(",")] if ps else []  # noqa: E731

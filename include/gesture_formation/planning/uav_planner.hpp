@@ -195,8 +195,9 @@ class UavPlanner {
   std::string solveQp(PlanContext& c, PlanResult& result);
   std::string infeasibilityCause(const PlanContext& c, PlanResult& result);
   /// qp_truncate_on_infeasible: re-solves c.qp cut to K < N samples ending at rest (K = N/2, then
-  /// 3N/4 or N/4: the largest that solves); on success c.sol holds it, hovering from K to N.
-  bool solveTruncated(PlanContext& c, PlanResult& result);
+  /// 3N/4 or N/4: the largest that solves), warm-started from `warm` cut to K (may be null), no
+  /// attempt once the time budget is spent; on success c.sol holds it, hovering from K to N.
+  bool solveTruncated(PlanContext& c, const TrajectoryQpSolution* warm, PlanResult& result);
   std::string planCamera(PlanContext& c) const;
   std::string verifyAndAccept(PlanContext& c, PlanResult& result);
   PlanResult fallback(const PlanRequest& request, PlanResult result, const std::string& reason);
