@@ -1,5 +1,6 @@
 // gfctl render-gestures --seed S --count N --out DIR [--config FILE] [--views D1,D2,…]
 //                       [--motions M1,M2,…] [--models DIR] [--skeleton movenet_lightning|blazepose_landmark]
+//                       [--frames-every N]
 // The gesture generator's performances (gesture::SkeletonSynthesizer, the same 3-D bodies and
 // timing as `gfctl synth-gestures`) RENDERED — the skinned mannequin posed every frame from the
 // generator's 3-D body, dressed per sequence (render::Appearance) — from one camera per view, and
@@ -14,7 +15,10 @@
 //                   image was rendered from, in the body frame) — the columns of synth-gestures —
 //                   plus outfit, skin_tone, frames_found;
 //   truth*.csv      every rendered frame: found, segment, the truth's visible box and the 17 truth
-//                   keypoints (u, v, visible) of the posed mesh (render::WorkerTruth).
+//                   keypoints (u, v, visible) of the posed mesh (render::WorkerTruth);
+//   frames/         with --frames-every N: every N-th frame of every view, the worker's region
+//                   enlarged 3×, the truth's stick figure in green and the pipeline's in red (left
+//                   side solid, right side thin): the networks' errors to look at.
 // Viewpoints: the leader's distance, elevation and azimuth drawn in the config's ranges; each
 // further view at its azimuth offset from the leader with its OWN distance and elevation drawn in
 // the same ranges (formation-like: the followers fly their own heights). Motions: cycled through
@@ -29,6 +33,7 @@
 #include <random>
 
 #include <opencv2/core/utility.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "commands.hpp"
@@ -46,7 +51,7 @@ namespace {
 int cmdRenderGestures(const Args& args);
 const Registrar kRegistrar{
     "render-gestures",
-    "--seed S --count N --out DIR [--config FILE] [--views D1,D2] [--motions M1,M2] [--models DIR] [--skeleton KIND]   generator "
+    "--seed S --count N --out DIR [--config FILE] [--views D1,D2] [--motions M1,M2] [--models DIR] [--skeleton KIND] [--frames-every N]   generator "
     "performances rendered per view and put through the real detector + tracker + MoveNet (docs/gestures.md §9)",
     cmdRenderGestures};
 
@@ -68,6 +73,7 @@ struct Options {
   std::vector<gesture::Motion> motions;
   gesture::SynthConfig synth;
   perception::SkeletonKind skeleton = perception::SkeletonKind::kMoveNetLightning;
+  int frames_every = 0;  ///< 0: no annotated frames
 };
 
 std::string parseOptions(const Args& args, Options& o) {
@@ -105,6 +111,13 @@ std::string parseOptions(const Args& args, Options& o) {
     common::addProblems(r, "", gesture::synthConfigProblems(o.synth));
     if (!r.ok()) return "invalid configuration " + args.get("config") + ":\n" + r.errorReport();
   }
+  if (args.has("frames-every")) {
+    const auto n = common::parseDouble(args.get("frames-every"));
+    if (!n || *n < 1 || *n > 1e6 || *n != std::floor(*n)) {
+      return "--frames-every: expected an integer in [1, 1000000], got '" + args.get("frames-every") + "'";
+    }
+    o.frames_every = static_cast<int>(*n);
+  }
   if (args.has("skeleton")) {
     const auto k = perception::parseSkeletonKind(args.get("skeleton"));
     if (!k) return "--skeleton: " + k.reason();
@@ -124,7 +137,63 @@ struct ViewOut {
   std::unique_ptr<perception::PerceptionPipeline> pipeline;
   std::ofstream skeletons, sequences, truth;
   long frames = 0, found = 0;
+  int index = 0;           ///< 0 leader, 1… further views
+  int frames_every = 0;    ///< --frames-every (0: none)
+  std::string frames_dir;  ///< where the annotated frames go
+  float crop_scale = 1.25f;  ///< the skeleton network's crop around the box (drawn)
 };
+
+/// COCO-17 limbs: (a, b, left side).
+constexpr std::array<std::array<int, 3>, 12> kLimbs{{{5, 7, 1}, {7, 9, 1}, {6, 8, 0}, {8, 10, 0}, {11, 13, 1}, {13, 15, 1},
+                                                     {12, 14, 0}, {14, 16, 0}, {5, 6, 1}, {11, 12, 1}, {5, 11, 1}, {6, 12, 0}}};
+
+/// The worker's region of one rendered frame enlarged, truth (green) and pipeline (red) stick figures.
+void writeAnnotatedFrame(const ViewOut& v, const cv::Mat& bgr, const render::WorkerTruth& truth,
+                         const perception::Skeleton* net, const cv::Rect2f* box_px, int sequence, std::size_t k) {
+  cv::Rect2d box(1e9, 1e9, 0, 0);
+  double u1 = -1e9, v1 = -1e9;
+  for (const render::KeypointTruth& kt : truth.keypoints) {
+    if (!kt.in_image) continue;
+    box.x = std::min(box.x, kt.uv_px.x()), box.y = std::min(box.y, kt.uv_px.y());
+    u1 = std::max(u1, kt.uv_px.x()), v1 = std::max(v1, kt.uv_px.y());
+  }
+  if (u1 < box.x) return;  // the worker is not in the image
+  if (box_px != nullptr) {  // and the skeleton network's crop
+    const double half = 0.5 * v.crop_scale * std::max(box_px->width, box_px->height);
+    const double bu = box_px->x + 0.5 * box_px->width, bv = box_px->y + 0.5 * box_px->height;
+    box.x = std::min(box.x, bu - half), box.y = std::min(box.y, bv - half);
+    u1 = std::max(u1, bu + half), v1 = std::max(v1, bv + half);
+  }
+  const double side = std::max({u1 - box.x, v1 - box.y, 20.0}) * 1.2;
+  const double cu = 0.5 * (box.x + u1), cv_ = 0.5 * (box.y + v1);
+  const cv::Rect roi = cv::Rect(static_cast<int>(cu - side / 2), static_cast<int>(cv_ - side / 2), static_cast<int>(side),
+                                static_cast<int>(side)) &
+                       cv::Rect(0, 0, bgr.cols, bgr.rows);
+  if (roi.area() == 0) return;
+  constexpr double kScale = 3.0;
+  cv::Mat crop;
+  cv::resize(bgr(roi), crop, cv::Size(), kScale, kScale, cv::INTER_NEAREST);
+  const auto at = [&](double u, double w) { return cv::Point2d((u - roi.x + 0.5) * kScale, (w - roi.y + 0.5) * kScale); };
+  if (box_px != nullptr) {  // the tracker's box (yellow) and the skeleton network's square crop around it (cyan)
+    const cv::Rect2f& b = *box_px;
+    cv::rectangle(crop, at(b.x, b.y), at(b.x + b.width, b.y + b.height), {0, 220, 255}, 1);
+    const double half = 0.5 * v.crop_scale * std::max(b.width, b.height);
+    const double bu = b.x + 0.5 * b.width, bv = b.y + 0.5 * b.height;
+    cv::rectangle(crop, at(bu - half, bv - half), at(bu + half, bv + half), {255, 255, 0}, 1);
+  }
+  for (const auto& l : kLimbs) {
+    const render::KeypointTruth &a = truth.keypoints[static_cast<std::size_t>(l[0])], &b = truth.keypoints[static_cast<std::size_t>(l[1])];
+    if (a.in_image && b.in_image) {
+      cv::line(crop, at(a.uv_px.x(), a.uv_px.y()), at(b.uv_px.x(), b.uv_px.y()), {0, 200, 0}, l[2] ? 2 : 1, cv::LINE_AA);
+    }
+    if (net == nullptr) continue;
+    const perception::Keypoint &p = (*net)[static_cast<std::size_t>(l[0])], &q = (*net)[static_cast<std::size_t>(l[1])];
+    if (p.c >= 0.3f && q.c >= 0.3f) cv::line(crop, at(p.x, p.y), at(q.x, q.y), {0, 0, 255}, l[2] ? 2 : 1, cv::LINE_AA);
+  }
+  const std::string name = v.frames_dir + "/seq" + std::to_string(sequence) + "_view" + std::to_string(v.index) + "_f" +
+                           std::to_string(k) + ".png";
+  cv::imwrite(name, crop);
+}
 
 void writeHeaders(ViewOut& v) {
   v.skeletons << "t,u,v,w,h";
@@ -173,6 +242,9 @@ std::string processFrame(ViewOut& v, const render::RenderedFrame& frame, const g
   const auto f = [](double x) { return common::formatDouble(x); };
   const gesture::SynthFrame& sf = seq.frames[k];
   ++v.frames;
+  if (v.frames_every > 0 && k % static_cast<std::size_t>(v.frames_every) == 0) {
+    writeAnnotatedFrame(v, bgr, frame.worker, found ? &pf->skeleton : nullptr, found ? &pf->track.box_px : nullptr, seq.id, k);
+  }
   if (found) {
     st.in_segment = true;
     st.last_id = pf->track.id;
@@ -244,7 +316,7 @@ std::string renderSequence(render::Renderer& renderer, std::vector<ViewOut>& out
 }
 
 int cmdRenderGestures(const Args& args) {
-  if (!checkOptions(args, {"seed", "count", "out"}, {"config", "views", "motions", "models", "skeleton"})) return kExitBadInput;
+  if (!checkOptions(args, {"seed", "count", "out"}, {"config", "views", "motions", "models", "skeleton", "frames-every"})) return kExitBadInput;
   Options o;
   if (const std::string e = parseOptions(args, o); !e.empty()) return badInput(args, e);
   render::RendererConfig rc;
@@ -266,6 +338,16 @@ int cmdRenderGestures(const Args& args) {
     auto p = perception::PerceptionPipeline::create(pc);
     if (!p) return badInput(args, p.reason() + " (models root: " + o.models + ")");
     out[v].pipeline = std::move(*p);
+    out[v].index = static_cast<int>(v);
+    if (o.frames_every > 0) {
+      out[v].frames_every = o.frames_every;
+      out[v].frames_dir = o.dir + "/frames";
+      out[v].crop_scale = o.skeleton == perception::SkeletonKind::kBlazePoseLandmark ? pc.blazepose_landmark.crop_scale
+                                                                                     : pc.lightning.crop_scale;
+      std::error_code ec;
+      std::filesystem::create_directories(out[v].frames_dir, ec);
+      if (ec) return badInput(args, out[v].frames_dir + ": cannot create directory");
+    }
     const std::string suffix = v == 0 ? "" : "_view" + std::to_string(v);
     out[v].skeletons.open(o.dir + "/skeletons" + suffix + ".csv");
     out[v].sequences.open(o.dir + "/sequences" + suffix + ".csv");

@@ -28,6 +28,8 @@ expect_bad "\-\-motions: unknown motion 'moonwalk'" --seed 1 --count 1 --out "$O
 expect_bad "\-\-views: expected comma-separated" --seed 1 --count 1 --out "$OUT/x" --views 60,abc
 printf 'distance_max_m: 3.0\ndistance_min_m: 9.0\n' > "$OUT/bad.yaml"
 expect_bad "distance_max_m" --seed 1 --count 1 --out "$OUT/x" --config "$OUT/bad.yaml"
+expect_bad "\-\-skeleton: skeleton must be movenet_lightning or blazepose_landmark, got 'openpose'" --seed 1 --count 1 --out "$OUT/x" --skeleton openpose
+expect_bad "\-\-frames-every: expected an integer in \[1, 1000000\], got '0'" --seed 1 --count 1 --out "$OUT/x" --frames-every 0
 
 cat > "$OUT/short.yaml" <<'YAML'
 distance_min_m: 7.0
@@ -43,7 +45,7 @@ tempo_max: 1.4
 YAML
 set +e
 "$GFCTL" render-gestures --seed 3999 --count 1 --motions raise_arm_up --views 60 --config "$OUT/short.yaml" --out "$OUT/r" \
-  >"$OUT/stdout" 2>"$OUT/stderr"
+  --frames-every 10 >"$OUT/stdout" 2>"$OUT/stderr"
 rc=$?
 set -e
 if [ "$rc" -eq 1 ] && grep -q "EGL\|OpenGL" "$OUT/stderr"; then echo "SKIP: no EGL here: $(cat "$OUT/stderr")"; exit 77; fi
@@ -79,6 +81,15 @@ for suffix in ("", "_view1"):
     med = statistics.median(errs)
     print(f"view{suffix or '0'}: {len(sk)}/{frames} frames found, median keypoint error {100 * med:.1f} % of the box height")
     assert med <= 0.05, med
+    # --frames-every 10: frames 0, 10, 20, ... of the view, each a readable PNG (the worker stays in the image)
+    v = "0" if suffix == "" else suffix[-1]
+    import os
+    want = {f"seq{s['sequence']}_view{v}_f{k}.png" for k in range(0, frames, 10)}
+    got = {n for n in os.listdir(f"{d}/frames") if n.startswith(f"seq{s['sequence']}_view{v}_")}
+    assert got == want, (sorted(got ^ want))
+    for n in want:
+        with open(f"{d}/frames/{n}", "rb") as f:
+            assert f.read(8) == b"\x89PNG\r\n\x1a\n", n
 PY
 "$GFCTL" classify --in "$OUT/r/skeletons.csv" --out "$OUT/g.csv" >"$OUT/stdout" 2>"$OUT/stderr" || fail "classify: $(cat "$OUT/stderr")"
 # the window restarts with every (sequence, segment): one classification per row from the 9th of each

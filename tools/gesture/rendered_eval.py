@@ -33,6 +33,7 @@ ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 PROTOCOL = os.path.join(ROOT, "tools/gesture/heldout/protocol_v2_rendered.yaml")
 DATA_DIR = "/work/gestrend_data"  # default cache of the rendered sets (--data)
 SKELETON = "movenet_lightning"  # the pipeline's skeleton network (--skeleton); others render into their own directory
+SKELETON_NAMES = {"movenet_lightning": "MoveNet lightning", "blazepose_landmark": "BlazePose landmark full"}
 CLASSES = ev.CLASSES
 
 
@@ -142,7 +143,7 @@ def evaluate(gfctl, protocol, name, data, model, config, tag="shipped", labels_a
             e[0] += int(not any(x["sequence"] == seq for x in three["missed_list"]))
     found = {sfx or "_leader": sum(int(r["frames_found"]) for r in csv_rows(os.path.join(d, f"sequences{sfx}.csv"))) /
              sum(int(r["frames"]) for r in csv_rows(os.path.join(d, f"sequences{sfx}.csv"))) for sfx in VIEW_SUFFIXES(spec)}
-    return {"set": name, "seed": spec["seed"], "sequences": spec["count"],
+    return {"set": name, "seed": spec["seed"], "sequences": spec["count"], "skeleton": SKELETON,
             "model": "the frames' labels (diagnostic)" if labels_as_classifier else os.path.relpath(model, ROOT),
             "model_sha256": "n/a" if labels_as_classifier else he.sha256(model), "config": os.path.relpath(config, ROOT), "config_sha256": he.sha256(config),
             "worker_found_share": {k: round(v, 4) for k, v in found.items()},
@@ -419,7 +420,8 @@ def eval_lines(r, protocol):
     ok_a = t["false_adaptations"] <= tg["false_adaptations_max"]
     run = (f"Run {r['date_utc']} UTC at commit {r.get('commit', '?')}, load average "
            f"{', '.join(f'{x:.2f}' for x in r['load_average'])}. " if r.get("date_utc") and r.get("load_average") else "")
-    lines = [run + f"Set {r['set']} (seed {r['seed']}, {r['sequences']} performances × 3 views); model `{r['model']}` sha256 "
+    lines = [run + f"Set {r['set']} (seed {r['seed']}, {r['sequences']} performances × 3 views, skeletons by "
+             f"{SKELETON_NAMES[r.get('skeleton', 'movenet_lightning')]}); model `{r['model']}` sha256 "
              f"{r['model_sha256'][:16]}…; filter and vote `{r['config']}` sha256 {r['config_sha256'][:16]}…. Worker found "
              "(share of rendered frames, per view): " + ", ".join(f"{k.strip('_')} {pct(v)}" for k, v in r["worker_found_share"].items()) + ".",
              "",
@@ -503,7 +505,7 @@ def report(protocol, protocol_path, tuning_errors, tuning_eval, heldout_eval, ou
              f"Machine: {he.machine()['cpu']}, {os.cpu_count()} cores; load average {', '.join(f'{x:.2f}' for x in load_start)} "
              "when the evaluation started (the renders' own logs in the data cache give theirs; shared machine).",
              "", "Sets rendered by `gfctl render-gestures` (the mannequin posed from the generator's 3-D bodies, three "
-             "formation-like views, the real MoveNet multipose + KCF + MoveNet lightning on the pixels); definitions: "
+             f"formation-like views, the real MoveNet multipose + KCF + {SKELETON_NAMES[SKELETON]} on the pixels); definitions: "
              "docs/gestures.md §9 and the protocol file.", ""]
     for name, spec in protocol["sets"].items():
         log = os.path.join(DATA_DIR, os.path.basename(set_dir("", name, spec)), "render.log")
