@@ -96,6 +96,7 @@ const common::FieldTable<WorkerTrackerConfig>& workerTrackerFields() {
       {"tracker.min_detection_score", Range{0.0, 1.0, true, false}, [](C& c) { return &c.min_detection_score; }},
       {"tracker.associate_min_iou", Range::openClosed(0.0, 1.0), [](C& c) { return &c.associate_min_iou; }},
       {"tracker.associate_gate", Range::positive(), [](C& c) { return &c.associate_gate; }},
+      {"tracker.associate_max_foot_shift", Range::closed(0.0, 10.0), [](C& c) { return &c.associate_max_foot_shift; }},
       {"tracker.drift_iou", Range::openClosed(0.0, 1.0), [](C& c) { return &c.drift_iou; }},
       {"tracker.max_missed_detections", Range::nonNegative(), [](C& c) { return &c.max_missed_detections; }},
       {"tracker.reacquire_frames", Range::nonNegative(), [](C& c) { return &c.reacquire_frames; }},
@@ -143,6 +144,7 @@ void WorkerTracker::reset() {
   hint_pending_ = false;
   locked_ = false;
   announce_new_id_ = false;
+  detected_height_ = 0.0f;
   appearance_.reset();
 }
 
@@ -231,6 +233,7 @@ void WorkerTracker::take(const cv::Mat& frame, int idx, TrackStep& out) {
   out.track_ms += msSince(t1);
   missed_detections_ = 0;
   box_ = det;
+  detected_height_ = det.height;
   out.found = true;
   out.source = BoxSource::kDetector;
   out.worker_detection = idx;
@@ -239,12 +242,27 @@ void WorkerTracker::take(const cv::Mat& frame, int idx, TrackStep& out) {
   if (clearOfOthers(out.detections, idx)) appearance_.update(d);
 }
 
+std::vector<char> WorkerTracker::standingAt(const cv::Rect2f& ref, const std::vector<Detection>& dets, std::vector<char> allowed,
+                                            float allowance) const {
+  if (config_.associate_max_foot_shift <= 0.0f || detected_height_ <= 0.0f) return allowed;
+  // The feet: the box's centre (the visual trackers follow it well) and half the height the detector
+  // last gave the worker (a tracker's scale is not trusted: CSRT's grows, KCF's is fixed).
+  const float feet = ref.y + 0.5f * ref.height + 0.5f * detected_height_;
+  const float tolerance = config_.associate_max_foot_shift * allowance * detected_height_;
+  for (std::size_t i = 0; i < allowed.size() && i < dets.size(); ++i) {
+    const cv::Rect2f& b = dets[i].box_px;
+    if (std::abs(b.y + b.height - feet) > tolerance) allowed[i] = 0;
+  }
+  return allowed;
+}
+
 bool WorkerTracker::associate(const cv::Mat& frame, const cv::Rect2f& predicted, bool have_pred, TrackStep& out) {
   const cv::Rect2f ref = have_pred ? predicted : box_;
   const std::vector<char> alike = lookAlikes();
+  const std::vector<char> eligible = standingAt(ref, out.detections, alike, 1.0f);
   float best_iou = 0.0f;
-  int idx = bestOverlap(ref, out.detections, best_iou, alike);
-  if (best_iou < config_.associate_min_iou) idx = nearestWithin(ref, out.detections, config_.associate_gate, alike);
+  int idx = bestOverlap(ref, out.detections, best_iou, eligible);
+  if (best_iou < config_.associate_min_iou) idx = nearestWithin(ref, out.detections, config_.associate_gate, eligible);
   // Detections the geometry alone would have taken but that do not look like the worker.
   float geo_iou = 0.0f;
   int geo = bestOverlap(ref, out.detections, geo_iou);
@@ -287,7 +305,13 @@ void WorkerTracker::acquire(const cv::Mat& frame, bool lost_now, TrackStep& out)
   }
   const bool remembering = (id_ >= 0 || hint_pending_) && frames_since_lost_ >= 0 &&
                            frames_since_lost_ <= config_.reacquire_frames;
-  const std::vector<char> alike = lookAlikes();
+  // A worker lost moments ago (a hint is the operator's point, not a person) stands about where he
+  // stood: a box on another feet line is someone else or a box merging him with someone in front.
+  // The allowance grows with the time since the loss (he may walk), to 4× when the memory ends.
+  const float allowance =
+      1.0f + 3.0f * static_cast<float>(frames_since_lost_) / static_cast<float>(std::max(1, config_.reacquire_frames));
+  const std::vector<char> alike =
+      remembering && !hint_pending_ ? standingAt(box_, out.detections, lookAlikes(), allowance) : lookAlikes();
   int idx = remembering ? nearestWithin(box_, out.detections, config_.reacquire_gate, alike) : -1;
   if (idx >= 0 && hint_pending_) {
     id_ = next_id_++;
@@ -296,6 +320,7 @@ void WorkerTracker::acquire(const cv::Mat& frame, bool lost_now, TrackStep& out)
   } else if (idx < 0 && !hint_pending_ && id_ >= 0 && appearance_.established()) {
     double best = config_.appearance.min_similarity;
     for (std::size_t i = 0; i < out.detections.size(); ++i) {
+      if (!alike[i]) continue;
       const double s = appearance_.similarity(descriptor(static_cast<int>(i)));
       if (s >= best) {
         best = s;

@@ -26,7 +26,10 @@
 /// Identity by appearance (`appearance`, perception/appearance.hpp): once the worker's colour model
 /// is established, a detection that does not look like the worker is never associated with it nor
 /// re-acquired as it, and a tracker box that stops looking like the worker counts as a tracker
-/// failure (the tracker slid onto someone crossing in front). After a loss the worker is found
+/// failure (the tracker slid onto someone crossing in front). A detection whose feet are not where
+/// the worker's are (`associate_max_foot_shift`) is not associated either: a person passing in front
+/// or behind stands on another image row, and a box merging the worker with them reaches down to
+/// the nearer one's feet. After a loss the worker is found
 /// again by appearance anywhere in the frame (same id). When the operator chose the worker
 /// (`selectWorker`), the tracker never starts a new identity by itself: without the chosen person
 /// it reports nobody, so a stranger's arms never reach the gesture classifier.
@@ -68,6 +71,13 @@ struct WorkerTrackerConfig {
   float min_detection_score = 0.25f;  ///< detections below are ignored, [0, 1)
   float associate_min_iou = 0.2f;     ///< IoU to keep the identity, (0, 1]
   float associate_gate = 1.0f;        ///< centre distance gate / max(w, h) of the current box, > 0
+  /// A detection whose bottom edge lies further than this × the worker's height (at its last
+  /// detection) from the worker's feet (the tracked box's centre + half that height) is not
+  /// associated with the worker: someone in front of or behind him stands on another image row, and
+  /// a box merging him with someone in front reaches down to that person's feet. After a loss the
+  /// allowance grows with the frames since, to 4× at reacquire_frames (docs/perception.md
+  /// "Identity by appearance"); [0, 10], 0 disables.
+  float associate_max_foot_shift = 0.10f;
   float drift_iou = 0.5f;             ///< tracker-vs-detection IoU below this counts as drift, (0, 1]
   int max_missed_detections = 2;      ///< detection rounds without the worker before the track is lost, ≥ 0
   int reacquire_frames = 30;          ///< frames after a loss during which the old id can be reacquired, ≥ 0
@@ -166,6 +176,11 @@ class WorkerTracker {
   /// Which of the last round's detections may be the worker by appearance (1) — all when the model
   /// is not established.
   std::vector<char> lookAlikes() const;
+  /// `allowed` without the detections whose bottom edge is further than associate_max_foot_shift ×
+  /// `allowance` × the worker's detected height from the worker's feet (ref's centre + half that
+  /// height): those do not stand where the worker stands.
+  std::vector<char> standingAt(const cv::Rect2f& ref, const std::vector<Detection>& dets, std::vector<char> allowed,
+                               float allowance) const;
   /// The appearance descriptor of the last round's detection `i` (empty with appearance off).
   const cv::Mat& descriptor(int i) const { return round_descriptors_[static_cast<std::size_t>(i)]; }
   /// Associates this round's detections with the live track; true when the track was lost now.
@@ -180,6 +195,7 @@ class WorkerTracker {
   ScaledTracker tracker_;
   bool tracking_ = false;        ///< a live track exists
   cv::Rect2f box_;               ///< current (or last) worker box
+  float detected_height_ = 0.0f; ///< the worker's box height at its last detection [px] (0: none yet)
   int id_ = -1;                  ///< current (or last) id
   int next_id_ = 0;
   int frames_since_detection_ = 0;

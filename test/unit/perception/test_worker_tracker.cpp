@@ -1,6 +1,7 @@
 // Detector–tracker alternation on Debian's vtest.avi: one pedestrian (the blonde woman in a
 // black coat, frames 580–700) is kept with one identity; the track overlaps the boxes
 // labelled by hand at frames 580, 610, 640, 670, 700 (IoU ≥ 0.5).
+#include <algorithm>
 #include <map>
 
 #include <gtest/gtest.h>
@@ -302,6 +303,61 @@ TEST(WorkerTrackerTest, APersonCrossingInFrontDoesNotTakeTheWorkersIdentity) {
   cfg.appearance.enabled = 0;
   const Crossing g = crossing(cfg);
   EXPECT_GT(std::abs(g.x.back() - (80 + 4 * 39)), 40.0f) << "geometry alone was expected to swap to B";
+}
+
+/// A person dressed like the worker passes in front of him, nearer the camera: taller in the image
+/// and standing lower (feet 20 px below the worker's, a third of his height); while they overlap
+/// the detector sees one box around both, reaching down to the nearer one's feet. Returns the
+/// worker's box per frame (x = −1 when not found).
+std::vector<cv::Rect2f> frontCrossing(const WorkerTrackerConfig& cfg, int frames = 40) {
+  cv::setRNGSeed(13);
+  const auto xa = [](int i) { return 80 + 4 * i; };
+  const auto xb = [](int i) { return 236 - 4 * i; };
+  std::vector<std::vector<Detection>> script;
+  for (int i = 0; i < frames; ++i) {
+    const bool overlap = std::abs(xa(i) - xb(i)) < 24;
+    const float lo = static_cast<float>(std::min(xa(i), xb(i))), hi = static_cast<float>(std::max(xa(i), xb(i)));
+    if (i < 4) script.push_back({det(static_cast<float>(xa(i)), 60, 20, 60, 0.5f)});
+    else if (overlap) script.push_back({det(lo, 60, hi + 24 - lo, 80, 0.9f)});  // one box around both
+    else script.push_back({det(static_cast<float>(xb(i)), 60, 24, 80, 0.9f), det(static_cast<float>(xa(i)), 60, 20, 60, 0.5f)});
+  }
+  auto t = WorkerTracker::create(cfg, std::make_unique<ScriptedDetector>(script));
+  EXPECT_TRUE(t) << t.reason();
+  std::vector<cv::Rect2f> out;
+  for (int i = 0; i < frames; ++i) {
+    cv::Mat img(240, 320, CV_8UC3);
+    cv::randu(img, cv::Scalar::all(90), cv::Scalar::all(160));
+    cv::rectangle(img, cv::Rect(xa(i), 60, 20, 60), cv::Scalar(20, 20, 20), -1);
+    if (i >= 4) cv::rectangle(img, cv::Rect(xb(i), 60, 24, 80), cv::Scalar(20, 20, 20), -1);  // B in front, alike
+    auto r = (*t)->step(img);
+    EXPECT_TRUE(r) << r.reason();
+    out.push_back(r->found ? r->box_px : cv::Rect2f(-1, 0, 0, 0));
+  }
+  return out;
+}
+
+TEST(WorkerTrackerTest, ABoxStandingOnAnotherFeetLineIsNotTheWorker) {
+  WorkerTrackerConfig cfg;
+  cfg.detect_every_k = 1;
+  cfg.roi_detection = false;
+  const std::vector<cv::Rect2f> boxes = frontCrossing(cfg);
+  int found = 0;
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    if (boxes[i].x < 0) continue;
+    ++found;
+    // Wherever the worker is reported the box is his: his feet row (120), never B's (140) or a
+    // box around both, and near his x.
+    EXPECT_NEAR(boxes[i].y + boxes[i].height, 120.0f, 3.0f) << "frame " << i;
+    EXPECT_NEAR(boxes[i].x, 80 + 4 * static_cast<float>(i), 12.0f) << "frame " << i;
+  }
+  EXPECT_GE(found, 30);
+  EXPECT_NEAR(boxes.back().x, 80 + 4 * 39, 1.0f);  // found again after the crossing
+
+  // The control: without the feet line (and B dressed alike) a box on B's feet is taken.
+  cfg.associate_max_foot_shift = 0.0f;
+  const std::vector<cv::Rect2f> g = frontCrossing(cfg);
+  EXPECT_TRUE(std::any_of(g.begin(), g.end(), [](const cv::Rect2f& b) { return b.x >= 0 && b.y + b.height > 130.0f; }))
+      << "without the rule a box on the other feet line was expected";
 }
 
 TEST(WorkerTrackerTest, TheOperatorsChoiceIsKeptAndNoStrangerIsTaken) {
