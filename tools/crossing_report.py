@@ -16,6 +16,7 @@ is the held-out set for that rule, fixed before the rule was run on anything: ru
 
   tools/crossing_report.py --gfctl build/devel/lib/gesture_formation/gfctl [--seed 1] [--count 10]
                            [--work /tmp/crossings] [--out docs/results/crossings.md] [--load "..."]
+                           [--baseline GFCTL --baseline-label TEXT]   # + the shipped configuration of another build
 """
 import argparse
 import csv
@@ -50,8 +51,15 @@ def main():
     ap.add_argument("--out", default=os.path.join(os.path.dirname(__file__), "..", "docs", "results", "crossings.md"))
     ap.add_argument("--load", default="", help="the machine's load during the runs, for the page")
     ap.add_argument("--commit", default="", help="the source commit of the gfctl used")
+    ap.add_argument("--baseline", default="", help="another build's gfctl: its shipped configuration is added as a row")
+    ap.add_argument("--baseline-label", default="baseline", help="what --baseline is, for the page")
     a = ap.parse_args()
     results = {name: run(a.gfctl, a.seed, a.count, a.work, name, extra) for name, extra in CONFIGS}
+    configs = list(CONFIGS)
+    if a.baseline:
+        name = f"shipped, {a.baseline_label}"
+        results[name] = run(a.baseline, a.seed, a.count, a.work, "baseline", CONFIGS[0][1])
+        configs.append((name, CONFIGS[0][1]))
     lines = ["# Two people crossing on rendered frames: is the worker kept?", "",
              f"Made by `tools/crossing_report.py` on {datetime.date.today().isoformat()}"
              + (f" with gfctl of {a.commit}" if a.commit else "") + (f"; {a.load}" if a.load else "") + ".",
@@ -62,17 +70,17 @@ def main():
              "reported box on the worker or on the walker (IoU >= 0.3 and above the other's).", "",
              "| configuration | scenes with the identity on the walker | frames on the walker | frames on the worker / worker visible | ids per scene (max) | choice made |",
              "|---|---|---|---|---|---|"]
-    for name, _ in CONFIGS:
+    for name, _ in configs:
         rows = results[name]
         switched = sum(1 for r in rows if int(r["on_walker"]) > 0)
         lines.append(f"| {name} | {switched} / {len(rows)} | {sum(int(r['on_walker']) for r in rows)} | "
                      f"{sum(int(r['on_worker']) for r in rows)} / {sum(int(r['worker_visible']) for r in rows)} | "
                      f"{max(int(r['ids']) for r in rows)} | {sum(int(r['chosen']) for r in rows)} / {len(rows)} |")
-    lines += ["", "Per scene (shipped / geometry only / no choice: frames on the walker; frames on the worker):", "",
-              "| scene | walker | worker's motion | distance [m] | elevation [deg] | shipped | geometry only | no choice |",
-              "|---|---|---|---|---|---|---|---|"]
+    lines += ["", f"Per scene ({' / '.join(n for n, _ in configs)}: frames on the walker; frames on the worker):", "",
+              "| scene | walker | worker's motion | distance [m] | elevation [deg] | " + " | ".join(n for n, _ in configs) + " |",
+              "|---|---|---|---|---|" + "---|" * len(configs)]
     for i, r in enumerate(results["shipped"]):
-        cells = [f"{results[n][i]['on_walker']}; {results[n][i]['on_worker']}" for n, _ in CONFIGS]
+        cells = [f"{results[n][i]['on_walker']}; {results[n][i]['on_worker']}" for n, _ in configs]
         where = "in front" if float(r["walker_offset_m"]) > 0 else "behind"
         lines.append(f"| {i} | {where} | {r['worker_motion']} | {float(r['distance_m']):.1f} | "
                      f"{float(r['elevation_deg']):.0f} | " + " | ".join(cells) + " |")
@@ -81,13 +89,15 @@ def main():
     geo = results["geometry only"]
     pick = max(range(len(geo)), key=lambda i: (int(geo[i]["on_walker"]), -i))
     images = os.path.join(os.path.dirname(os.path.abspath(a.out)), "..", "images")
-    for name, target in (("shipped", "crossing_shipped.png"), ("geometry only", "crossing_geometry_only.png")):
+    tag = "" if a.seed == 1 else f"_seed{a.seed}"  # seed 1's pictures are results/crossings.md's
+    shipped_png, geometry_png = f"crossing_shipped{tag}.png", f"crossing_geometry_only{tag}.png"
+    for name, target in (("shipped", shipped_png), ("geometry only", geometry_png)):
         src = os.path.join(a.work, name.replace(" ", "_"), "images", f"scene{pick}.png")
         if os.path.exists(src):
             shutil.copy(src, os.path.join(images, target))
     lines += ["", f"Scene {pick} at the moment the walker hides most of the worker (green: the worker's visible pixels, "
               "red: the walker's, yellow: the tracker's worker box and id): shipped (left), geometry only (right).", "",
-              "![shipped](../images/crossing_shipped.png) ![geometry only](../images/crossing_geometry_only.png)"]
+              f"![shipped](../images/{shipped_png}) ![geometry only](../images/{geometry_png})"]
     with open(a.out, "w") as f:
         f.write("\n".join(lines) + "\n")
     print(f"crossing_report: wrote {a.out}")
