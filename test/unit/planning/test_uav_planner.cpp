@@ -510,6 +510,45 @@ TEST(UavPlannerTest, InfeasibleQpNamesItsCauseWithinTheTimeBudgetOnly) {
   EXPECT_EQ(quick.status, named.status);  // the same fallback either way
 }
 
+// qp.truncate_on_infeasible: the UAV flies its verified plan along the reference (3 m/s over the
+// 8-s horizon) when another UAV's plan appears, hovering on that path 9 m ahead. The separation
+// rows are linearised at the previous plan, which passes through it: the early samples must stay
+// before it, the late ones beyond it — the whole-horizon QP is infeasible only at its end. Cut
+// short and ending at rest it solves: a verified plan that stops before the other UAV.
+TEST(UavPlannerTest, AQpInfeasibleOnlyAtItsEndIsSolvedCutShortEndingAtRest) {
+  const World& w = towers();
+  const Eigen::Vector3d from(-8, -12, 10), to(16, -12, 10), other_p(1, -12, 10);
+  const auto run = [&](const PlannerConfig& cfg) {
+    UavPlanner planner(cfg, w.map, w.field);
+    const PlanResult first = planner.plan(straightRequest(1, 0.0, stateAt(from, 0.0), from, to, 3.0, Eigen::Vector3d(-5, -3, 1)));
+    EXPECT_EQ(first.status, PlanStatus::kOptimized) << first.reason;
+    PlanRequest next = straightRequest(1, 0.2, advance(first.trajectory, 0.2), from, to, 3.0, Eigen::Vector3d(-5, -3, 1));
+    next.higher_priority_plans = {hoveringPlan(0, 0.2, other_p)};
+    return planner.plan(next);
+  };
+  PlannerConfig cfg = testConfig();
+  const PlanResult whole = run(cfg);
+  ASSERT_NE(whole.status, PlanStatus::kOptimized) << "the whole-horizon QP was expected infeasible";
+  EXPECT_NE(whole.reason.find("QP primal infeasible"), std::string::npos) << whole.reason;
+  EXPECT_EQ(whole.qp_truncated_at, 0);
+
+  cfg.qp_truncate_on_infeasible = true;
+  const PlanResult cut = run(cfg);
+  ASSERT_EQ(cut.status, PlanStatus::kOptimized) << cut.reason;
+  ASSERT_TRUE(cut.verified);
+  const int N = static_cast<int>(cut.trajectory.samples.size()) - 1;
+  EXPECT_GT(cut.qp_truncated_at, 0);
+  EXPECT_LT(cut.qp_truncated_at, N);
+  expectSafe(cut.trajectory, *w.map, cfg);
+  const Eigen::Vector3d stop = cut.trajectory.samples[static_cast<std::size_t>(cut.qp_truncated_at)].p_world;
+  for (int k = cut.qp_truncated_at; k <= N; ++k) {  // at rest from K on, where it stopped
+    const auto& s = cut.trajectory.samples[static_cast<std::size_t>(k)];
+    EXPECT_LT(s.v_world.norm(), 1e-3) << k;
+    EXPECT_LT((s.p_world - stop).norm(), 1e-6) << k;
+  }
+  EXPECT_LT(stop.x(), other_p.x() - cfg.mutual_distance_m);  // before the other UAV, apart
+}
+
 TEST(UavPlannerTest, FailedVerificationFallsBack) {
   // A verification clearance larger than the corridors keep (0.8 m from centres − 0.17 m
   // half-diagonal ≈ 0.63 m from cubes) makes plans that pass close to the tower fail
