@@ -123,16 +123,17 @@ Eigen::Vector3d initialFrame(const Eigen::Matrix3d& R0, const Eigen::Vector3d& p
 /// against the closest point inside, rotating the frame so that this point lies in the x–y
 /// plane; then shrink the remaining z axis alone against what is still inside. `near`: the
 /// points (world) that may lie inside that sphere — no other can be inside any ellipsoid of the
-/// fit, whose semi-axes never exceed the sphere's radius.
+/// fit, whose semi-axes never exceed the sphere's radius. `q`, `in`: scratch (their contents are
+/// replaced).
 EllipsoidFit fitEllipsoid(const std::vector<Eigen::Vector3d>& near, const Eigen::Vector3d& center,
-                          const Eigen::Vector3d& u, double length) {
+                          const Eigen::Vector3d& u, double length, std::vector<Eigen::Vector3d>& q, std::vector<std::size_t>& in) {
   EllipsoidFit fit;
   fit.R0 = frameAlong(u);
   const double a0 = 0.5 * length;
   Eigen::Vector3d axes(a0, a0, a0);
-  std::vector<Eigen::Vector3d> q;  // initial frame
+  q.clear();  // initial frame
   q.reserve(near.size());
-  std::vector<std::size_t> in;
+  in.clear();
   for (const Eigen::Vector3d& p : near) {
     q.push_back(initialFrame(fit.R0, p, center));
     if (metric(q.back(), axes) < kInside) in.push_back(q.size() - 1);
@@ -181,8 +182,16 @@ EllipsoidFit fitEllipsoid(const std::vector<Eigen::Vector3d>& near, const Eigen:
 /// metric() of every point, the first of equals included.
 class PlaneCandidates {
  public:
-  PlaneCandidates(const std::vector<Eigen::Vector3d>& points, const EllipsoidFit& fit, const Eigen::Vector3d& center)
-      : fit_(fit), center_(center) {
+  struct Item {
+    Eigen::Vector3d p;  // world
+    double bound;       // ≤ the exact metric
+  };
+  /// `items`, `candidates`: scratch, cleared here (reused between segments: no allocation per call).
+  PlaneCandidates(const std::vector<Eigen::Vector3d>& points, const EllipsoidFit& fit, const Eigen::Vector3d& center,
+                  std::vector<Item>& items, std::vector<std::size_t>& candidates)
+      : fit_(fit), center_(center), items_(items), candidates_(candidates) {
+    items_.clear();
+    candidates_.clear();
     const double ratio = fit.axes.maxCoeff() / fit.axes.minCoeff();
     const double margin = std::min(1e-12 + 1e-12 * ratio, 0.5);
     widen_ = (1.0 + margin) / (1.0 - margin);
@@ -218,10 +227,6 @@ class PlaneCandidates {
   }
 
  private:
-  struct Item {
-    Eigen::Vector3d p;  // world
-    double bound;       // ≤ the exact metric
-  };
   struct Least {
     std::size_t index = 0;
     double bound = std::numeric_limits<double>::infinity();
@@ -256,9 +261,18 @@ class PlaneCandidates {
   const EllipsoidFit& fit_;
   Eigen::Vector3d center_;
   double widen_ = 1.0;
-  std::vector<Item> items_;
-  std::vector<std::size_t> candidates_;
+  std::vector<Item>& items_;
+  std::vector<std::size_t>& candidates_;
   std::size_t first_ = 0;
+};
+
+/// buildSegment's working vectors, kept per thread so that a segment allocates nothing once they
+/// have grown (a corridor of a few hundred points costs a few microseconds: allocations showed).
+struct Scratch {
+  std::vector<Eigen::Vector3d> points, near, q;
+  std::vector<std::size_t> in, candidates;
+  std::vector<PlaneCandidates::Item> items;
+  std::vector<Plane> planes;
 };
 
 }  // namespace
@@ -281,7 +295,9 @@ common::Result<SegmentCorridor> CorridorBuilder::buildSegment(const Eigen::Vecto
   out.local_box = Aabb{p0.cwiseMin(p1) - c.local_box_margin_m, p0.cwiseMax(p1) + c.local_box_margin_m};
   // Points farther than clearance (+ the exclusion margin) outside the local box cannot
   // come closer than that to the polytope: the box planes keep them out.
-  std::vector<Eigen::Vector3d> points;
+  thread_local Scratch scratch;
+  std::vector<Eigen::Vector3d>& points = scratch.points;
+  points.clear();
   obstacles.pointsInBox(out.local_box.inflated(c.clearance_m + c.min_exclusion_m), points);
   out.obstacle_points = points.size();
 
@@ -295,7 +311,8 @@ common::Result<SegmentCorridor> CorridorBuilder::buildSegment(const Eigen::Vecto
   const double fail_sq = needed_gap * needed_gap * kSurelyOutside;
   const double near_sq = 0.25 * length * length * kSurelyOutside;
   double least_sq = std::numeric_limits<double>::infinity();
-  std::vector<Eigen::Vector3d> near;
+  std::vector<Eigen::Vector3d>& near = scratch.near;
+  near.clear();
   for (const auto& o : points) {
     const double t = std::clamp((o - p0).dot(u), 0.0, length);
     const double d_sq = (o - (p0 + t * u)).squaredNorm();
@@ -309,7 +326,7 @@ common::Result<SegmentCorridor> CorridorBuilder::buildSegment(const Eigen::Vecto
   out.segment_clearance_m = std::sqrt(least_sq);
 
   // (1) Ellipsoid, in the segment frame (x along the segment).
-  const EllipsoidFit fit = fitEllipsoid(near, center, u, length);
+  const EllipsoidFit fit = fitEllipsoid(near, center, u, length, scratch.q, scratch.in);
   const Eigen::Matrix3d& Rw = fit.R;
   const Eigen::Vector3d& axes = fit.axes;
   out.ellipsoid.R_world_ellipsoid = Rw;
@@ -318,8 +335,9 @@ common::Result<SegmentCorridor> CorridorBuilder::buildSegment(const Eigen::Vecto
 
   // (2) Planes, closest point first in the ellipsoid's metric.
   const Eigen::Vector3d inv_a2 = axes.cwiseProduct(axes).cwiseInverse();
-  PlaneCandidates remaining(points, fit, center);
-  std::vector<Plane> planes;
+  PlaneCandidates remaining(points, fit, center, scratch.items, scratch.candidates);
+  std::vector<Plane>& planes = scratch.planes;
+  planes.clear();
   // A plane never passes through its point: it moves at least min_exclusion_m.
   const double clearance = std::max(c.clearance_m, c.min_exclusion_m);
   double achieved = clearance;
