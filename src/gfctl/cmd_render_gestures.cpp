@@ -158,11 +158,13 @@ void writeAnnotatedFrame(const ViewOut& v, const cv::Mat& bgr, const render::Wor
     u1 = std::max(u1, kt.uv_px.x()), v1 = std::max(v1, kt.uv_px.y());
   }
   if (u1 < box.x) return;  // the worker is not in the image
-  if (box_px != nullptr) {  // and the skeleton network's crop
-    const double half = 0.5 * v.crop_scale * std::max(box_px->width, box_px->height);
-    const double bu = box_px->x + 0.5 * box_px->width, bv = box_px->y + 0.5 * box_px->height;
-    box.x = std::min(box.x, bu - half), box.y = std::min(box.y, bv - half);
-    u1 = std::max(u1, bu + half), v1 = std::max(v1, bv + half);
+  // The skeleton network's square crop around the tracker's box (centre, side max(w, h) · crop_scale).
+  cv::Rect2d square;
+  if (box_px != nullptr) {
+    const double side = v.crop_scale * std::max(box_px->width, box_px->height);
+    square = cv::Rect2d(box_px->x + 0.5 * (box_px->width - side), box_px->y + 0.5 * (box_px->height - side), side, side);
+    box.x = std::min(box.x, square.x), box.y = std::min(box.y, square.y);
+    u1 = std::max(u1, square.x + side), v1 = std::max(v1, square.y + side);
   }
   const double side = std::max({u1 - box.x, v1 - box.y, 20.0}) * 1.2;
   const double cu = 0.5 * (box.x + u1), cv_ = 0.5 * (box.y + v1);
@@ -177,9 +179,7 @@ void writeAnnotatedFrame(const ViewOut& v, const cv::Mat& bgr, const render::Wor
   if (box_px != nullptr) {  // the tracker's box (yellow) and the skeleton network's square crop around it (cyan)
     const cv::Rect2f& b = *box_px;
     cv::rectangle(crop, at(b.x, b.y), at(b.x + b.width, b.y + b.height), {0, 220, 255}, 1);
-    const double half = 0.5 * v.crop_scale * std::max(b.width, b.height);
-    const double bu = b.x + 0.5 * b.width, bv = b.y + 0.5 * b.height;
-    cv::rectangle(crop, at(bu - half, bv - half), at(bu + half, bv + half), {255, 255, 0}, 1);
+    cv::rectangle(crop, at(square.x, square.y), at(square.x + square.width, square.y + square.height), {255, 255, 0}, 1);
   }
   for (const auto& l : kLimbs) {
     const render::KeypointTruth &a = truth.keypoints[static_cast<std::size_t>(l[0])], &b = truth.keypoints[static_cast<std::size_t>(l[1])];

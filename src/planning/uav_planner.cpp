@@ -30,6 +30,11 @@ bool stoppedSparse(const TrajectoryQpSolution& s) {
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
+/// The replanning's time budget (PlannerConfig::time_budget_ms, 0: none) is spent.
+bool budgetSpent(const PlannerConfig& config, Clock::time_point t_start) {
+  return config.time_budget_ms > 0.0 && msSince(t_start) > config.time_budget_ms;
+}
+
 std::string joinErrors(const std::vector<std::string>& e) {
   std::string s;
   for (const auto& x : e) s += (s.empty() ? "" : "; ") + x;
@@ -997,7 +1002,7 @@ bool UavPlanner::solveTruncated(PlanContext& c, const TrajectoryQpSolution* warm
   const auto attempt = [&](int k) {
     if (k < 1 || k >= N) return false;
     // A plan finished beyond the time budget is refused anyway (verifyAndAccept): no attempt then.
-    if (config_.time_budget_ms > 0.0 && msSince(c.t_start) > config_.time_budget_ms) return false;
+    if (budgetSpent(config_, c.t_start)) return false;
     TrajectoryQpProblem t = c.qp;
     t.intervals = k;
     t.reference.resize(static_cast<std::size_t>(k) + 1);
@@ -1047,7 +1052,7 @@ std::string UavPlanner::infeasibilityCause(const PlanContext& c, PlanResult& res
   // Cold and with the problem's own iterations: a warm start or a cap of 10 outer iterations per
   // relaxed solve named the same causes in no less time on the mission's instances (planning.md §10).
   const auto t_diagnosis = Clock::now();
-  const auto budget_spent = [&] { return config_.time_budget_ms > 0.0 && msSince(c.t_start) > config_.time_budget_ms; };
+  const auto budget_spent = [&] { return budgetSpent(config_, c.t_start); };
   const QpDiagnosis d = diagnoseInfeasibleQp(*qp_, c.qp, nullptr, c.qp.max_iterations, budget_spent);
   result.qp_sparse_timeouts += d.sparse_stops;
   result.timings.qp_diagnosis_ms = msSince(t_diagnosis);
@@ -1114,7 +1119,7 @@ std::string UavPlanner::verifyAndAccept(PlanContext& c, PlanResult& result) {
       verifier_->verify(tr, c.req.t_now_s, c.req.higher_priority_plans, c.req.worker, c.req.t_now_s, c.dt);
   result.timings.verify_ms = msSince(t_stage);
   if (!rep.ok) return rep.reason;
-  if (config_.time_budget_ms > 0.0 && msSince(c.t_start) > config_.time_budget_ms) {
+  if (budgetSpent(config_, c.t_start)) {
     std::ostringstream os;
     os << "time budget exceeded (" << msSince(c.t_start) << " ms > " << config_.time_budget_ms << " ms)";
     return os.str();
