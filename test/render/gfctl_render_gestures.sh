@@ -30,6 +30,7 @@ printf 'distance_max_m: 3.0\ndistance_min_m: 9.0\n' > "$OUT/bad.yaml"
 expect_bad "distance_max_m" --seed 1 --count 1 --out "$OUT/x" --config "$OUT/bad.yaml"
 expect_bad "\-\-skeleton: skeleton must be movenet_lightning or blazepose_landmark, got 'openpose'" --seed 1 --count 1 --out "$OUT/x" --skeleton openpose
 expect_bad "\-\-frames-every: expected an integer in \[1, 1000000\], got '0'" --seed 1 --count 1 --out "$OUT/x" --frames-every 0
+expect_bad "\-\-window-only: a flag without a value, got '0'" --seed 1 --count 1 --out "$OUT/x" --window-only 0
 
 cat > "$OUT/short.yaml" <<'YAML'
 distance_min_m: 7.0
@@ -102,5 +103,44 @@ with open(sys.argv[2]) as f:
 want = sum(max(0, c - 8) for c in n.values())
 print(f"segments {dict(n)}: {got} classifications (expected {want})")
 assert got == want > 10, (got, want)
+PY
+# --window-only (training data): the same performance and views; the network alone on the rendered
+# window around the worker, the box his visible box with the tracker's error. Every frame found, the
+# truth the same as the full frames' (keypoints; visible box within 1 px), the keypoints within 5 % of
+# the truth box of the truth and within 3 % (median) of the full pipeline's on the same frames.
+"$GFCTL" render-gestures --seed 3999 --count 1 --motions raise_arm_up --views 60 --config "$OUT/short.yaml" --out "$OUT/w" \
+  --window-only >"$OUT/stdout" 2>"$OUT/stderr" || fail "render-gestures --window-only: $(cat "$OUT/stderr")"
+cat "$OUT/stdout"
+/usr/bin/python3 - "$OUT/r" "$OUT/w" <<'PY' || fail "--window-only outputs"
+import csv, statistics, sys
+full, win = sys.argv[1], sys.argv[2]
+def rows(d, name):
+    with open(f"{d}/{name}") as f:
+        return list(csv.DictReader(f))
+for suffix in ("", "_view1"):
+    tf, tw = rows(full, f"truth{suffix}.csv"), rows(win, f"truth{suffix}.csv")
+    sf, sw = {r["t"]: r for r in rows(full, f"skeletons{suffix}.csv")}, rows(win, f"skeletons{suffix}.csv")
+    assert len(tw) == len(tf) == len(sw), (len(tw), len(tf), len(sw))
+    assert all(r["found"] == "1" and r["segment"] == "0" for r in tw)
+    assert [r["sequence"] for r in rows(win, f"sequences{suffix}.csv")] == ["0"]
+    for a, b in zip(tf, tw):
+        assert a["t"] == b["t"] and a["label"] == b["label"]
+        for k in range(17):
+            assert abs(float(a[f"tu{k}"]) - float(b[f"tu{k}"])) < 1e-6 and abs(float(a[f"tv{k}"]) - float(b[f"tv{k}"])) < 1e-6
+        for c in ("box_u", "box_v", "box_w", "box_h"):
+            assert abs(int(a[c]) - int(b[c])) <= 1, (c, a[c], b[c])
+    truth = {r["t"]: r for r in tw}
+    err, dev = [], []
+    for r in sw:
+        t, h = truth[r["t"]], float(truth[r["t"]]["box_h"])
+        for k in range(17):
+            if t[f"tvis{k}"] == "1" and float(r[f"c{k}"]) >= 0.3:
+                err.append(((float(r[f"x{k}"]) - float(t[f"tu{k}"])) ** 2 + (float(r[f"y{k}"]) - float(t[f"tv{k}"])) ** 2) ** 0.5 / h)
+            if r["t"] in sf:
+                q = sf[r["t"]]
+                dev.append(((float(r[f"x{k}"]) - float(q[f"x{k}"])) ** 2 + (float(r[f"y{k}"]) - float(q[f"y{k}"])) ** 2) ** 0.5 / h)
+    print(f"window view{suffix or '0'}: {len(sw)} frames, median keypoint error {100 * statistics.median(err):.1f} % of the box, "
+          f"median distance to the full pipeline's {100 * statistics.median(dev):.1f} % ({len(dev) // 17} frames)")
+    assert statistics.median(err) <= 0.05 and statistics.median(dev) <= 0.03 and len(dev) >= 17 * 0.7 * len(sw)
 PY
 echo PASS

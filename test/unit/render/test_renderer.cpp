@@ -209,6 +209,61 @@ TEST_F(RendererTest, ColourImageShowsTheWorkerWhereTheTruthBoxSays) {
   EXPECT_TRUE(f->worker.keypoints[gg::kRightShoulder].visible);
 }
 
+// A window of a camera (its principal point shifted, a smaller image: what `gfctl render-gestures
+// --window-only` renders) shows the full frame's pixels there: colour, classes and depth (but a
+// few silhouette pixels, float rounding), and the worker's truth shifted by the window's corner. What makes training data rendered in windows
+// the same data as the full pipeline's frames.
+TEST_F(RendererTest, AWindowOfTheCameraShowsTheFullFramesPixels) {
+  ASSERT_OK(renderer_->setWorldMesh(gr::TriangleMesh(), 0.0, Vector3d::Zero()));
+  double height = 0.0;
+  const auto joints = worker(gg::Motion::kExtendArmSide, Vector3d(9.0, -0.4, 0.0), 2.6, &height);
+  ASSERT_OK(renderer_->setWorker(joints, height, gr::Appearance::fromSeed(11)));
+  gr::CameraView cam;
+  cam.intrinsics = k_;
+  cam.T_world_camera = gr::cameraPoseFromHeadingPitch(Vector3d(0.0, 0.0, 3.0), 0.0, -0.2);
+  auto full = renderer_->render(cam);
+  ASSERT_TRUE(full) << full.reason();
+  const cv::Rect box = full->worker.visible_box_px;
+  ASSERT_GT(box.area(), 0);
+  const cv::Rect win(box.x - 17, box.y - 23, box.width + 41, box.height + 30);  // odd margins, inside the image
+  ASSERT_EQ(win & cv::Rect(0, 0, k_.width_px, k_.height_px), win);
+  gr::CameraView w = cam;
+  w.intrinsics.cx = k_.cx - win.x, w.intrinsics.cy = k_.cy - win.y;
+  w.intrinsics.width_px = win.width, w.intrinsics.height_px = win.height;
+  auto part = renderer_->render(w);
+  ASSERT_TRUE(part) << part.reason();
+  // llvmpipe rasterises the window in other tiles: the ground's texture shifts by a level here
+  // and there and a few silhouette pixels flip (the projection's float rounding); nothing else
+  cv::Mat diff, diff_max;
+  cv::absdiff(part->rgb, full->rgb(win), diff);
+  cv::Mat channels[3];
+  cv::split(diff, channels);
+  diff_max = cv::max(cv::max(channels[0], channels[1]), channels[2]);
+  const int differing = cv::countNonZero(diff_max), far_off = cv::countNonZero(diff_max > 8);
+  EXPECT_LE(cv::mean(diff_max)[0], 0.5) << differing << " pixels differ";
+  EXPECT_LE(far_off, win.area() / 500) << far_off << " pixels differ by more than 8 of 255";
+  EXPECT_LE(cv::countNonZero(part->classes != full->classes(win)), win.area() / 1000);
+  const cv::Mat fd = full->depth_m(win);
+  for (int v = 0; v < win.height; v += 3) {
+    for (int u = 0; u < win.width; u += 3) {
+      const float a = part->depth_m.at<float>(v, u), b = fd.at<float>(v, u);
+      if (part->classes.at<std::uint8_t>(v, u) != full->classes(win).at<std::uint8_t>(v, u)) continue;  // a flipped edge
+      ASSERT_EQ(std::isnan(a), std::isnan(b)) << u << "," << v;
+      if (!std::isnan(a)) {
+        ASSERT_NEAR(a, b, 1e-3 * b) << u << "," << v;
+      }
+    }
+  }
+  const cv::Rect pb = part->worker.visible_box_px + win.tl();
+  EXPECT_LE(std::abs(pb.x - box.x) + std::abs(pb.y - box.y), 1) << pb << " vs " << box;
+  EXPECT_LE(std::abs(pb.br().x - box.br().x) + std::abs(pb.br().y - box.br().y), 1) << pb << " vs " << box;
+  for (std::size_t k = 0; k < gg::kNumKeypoints; ++k) {
+    EXPECT_NEAR(part->worker.keypoints[k].uv_px.x() + win.x, full->worker.keypoints[k].uv_px.x(), 1e-9);
+    EXPECT_NEAR(part->worker.keypoints[k].uv_px.y() + win.y, full->worker.keypoints[k].uv_px.y(), 1e-9);
+    EXPECT_EQ(part->worker.keypoints[k].visible, full->worker.keypoints[k].visible) << k;
+  }
+}
+
 // Other people (Renderer::setBystanders): each drawn with its own class and truth box; the
 // worker's truth (keypoints, box) is the worker's whatever is posed after it; too many refused.
 TEST_F(RendererTest, BystandersHaveTheirOwnClassAndLeaveTheWorkersTruthAlone) {
