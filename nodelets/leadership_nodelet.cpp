@@ -6,9 +6,10 @@
 // role, acting; a lapsed lease is published stamped with the lease's end. The UAV that acts does
 // the leader's work (docs/ros.md "Leader hand-over").
 //
-// Topics: leadership_in (LeadershipMessage), worker_state_in (WorkerState: the estimate age it
-//   stands with, now − last_fused; none: +inf) → leadership_out (LeadershipMessage),
-//   leadership_state (LeadershipState, latched).
+// Topics: leadership_in (LeadershipMessage), worker_state_in (WorkerState) and detection_in (its
+//   own Perception's WorkerDetection): the estimate age it stands and votes with is the fresher of
+//   now − last_fused and now − its camera's last detection (none: +inf) → leadership_out
+//   (LeadershipMessage), leadership_state (LeadershipState, latched).
 // Parameters (all required): ~uav_index, and formation::leadershipFields() by their last key
 //   segment: ~uav_count, ~heartbeat_period_s, ~lease_s, ~silence_limit_s, ~candidacy_stagger_s,
 //   ~election_timeout_s, ~clock_drift, ~estimate_tolerance_s (config/ros/nodelets.yaml `leadership`).
@@ -26,6 +27,7 @@
 #include <pluginlib/class_list_macros.hpp>
 #include <ros/ros.h>
 
+#include "gesture_formation/WorkerDetection.h"
 #include "gesture_formation/WorkerState.h"
 #include "leadership_conversions.hpp"
 #include "param_loader.hpp"
@@ -62,6 +64,14 @@ class LeadershipNodelet : public nodelet::Nodelet {
           std::lock_guard<std::mutex> lock(mutex_);
           last_fused_s_ = m->last_fused.toSec();
         });
+    // Its own camera's detections (every UAV with a camera): a follower that sees the worker
+    // brings that freshness to an election (its estimator fuses this camera once it leads).
+    detection_sub_ = nh.subscribe<gesture_formation::WorkerDetection>(
+        "detection_in", 5, [this](const gesture_formation::WorkerDetection::ConstPtr& m) {
+          if (!m->detected) return;
+          std::lock_guard<std::mutex> lock(mutex_);
+          last_seen_s_ = std::max(last_seen_s_.value_or(-1e300), m->header.stamp.toSec());
+        });
     timer_ = nh.createTimer(ros::Duration(cfg.heartbeat_period_s / 4.0), [this](const ros::TimerEvent&) {
       std::lock_guard<std::mutex> lock(mutex_);
       const double t = now();
@@ -82,8 +92,13 @@ class LeadershipNodelet : public nodelet::Nodelet {
   }
 
   static double now() { return ros::Time::now().toSec(); }
+  /// The freshest worker evidence this UAV would lead with: its worker state's last fusion or its
+  /// own camera's last detection (docs/safety.md §1.2).
   double estimateAge(double t) const {
-    return last_fused_s_ ? std::max(0.0, t - *last_fused_s_) : std::numeric_limits<double>::infinity();
+    double age = std::numeric_limits<double>::infinity();
+    if (last_fused_s_) age = std::max(0.0, t - *last_fused_s_);
+    if (last_seen_s_) age = std::min(age, std::max(0.0, t - *last_seen_s_));
+    return age;
   }
 
   void onMessage(const gesture_formation::LeadershipMessage::ConstPtr& msg) {
@@ -126,12 +141,13 @@ class LeadershipNodelet : public nodelet::Nodelet {
   int uav_index_ = 0;
   std::optional<formation::Leadership> lead_;
   std::optional<double> last_fused_s_;  ///< the last worker state's last fusion (none: no estimate)
+  std::optional<double> last_seen_s_;   ///< its own camera's last detection of the worker (none: never)
   bool acting_ = false;
   std::uint32_t term_ = 0;
   int leader_ = -2;
   formation::LeadershipRole role_ = formation::LeadershipRole::kFollower;
   ros::Publisher out_pub_, state_pub_;
-  ros::Subscriber in_sub_, worker_sub_;
+  ros::Subscriber in_sub_, worker_sub_, detection_sub_;
   ros::Timer timer_;
 };
 

@@ -203,6 +203,9 @@ class MissionRun {
   std::unique_ptr<LeadershipNet> lead_;
   std::optional<HandoverRecorder> handover_;
   std::vector<bool> acting_;  ///< per UAV, at the current step
+  /// Per UAV: when its own camera last detected the worker (the leader's camera or its follower
+  /// view; −inf: never) — with its share, the freshness it brings to an election.
+  std::vector<double> own_seen_s_;
   int owner_ = 0;
   double took_over_s_ = -std::numeric_limits<double>::infinity();  ///< commands sent before are the previous leader's
   int silenced_ = -1;                                                ///< faults.leader_silence's UAV
@@ -298,6 +301,7 @@ void MissionRun::openHandoverLinks() {
   lead_ = std::make_unique<LeadershipNet>(lc, cfg_.link, std::move(rngs), cfg_.step_s);
   handover_.emplace(n_);
   acting_.assign(static_cast<std::size_t>(n_), false);
+  own_seen_s_.assign(static_cast<std::size_t>(n_), -std::numeric_limits<double>::infinity());
   const auto n = static_cast<std::size_t>(n_);
   operator_links_.resize(n);
   share_from_.resize(n);
@@ -353,8 +357,12 @@ void MissionRun::stepLeadership(double t) {
   std::vector<bool> up(static_cast<std::size_t>(n_), true);
   for (int i = 0; i < n_; ++i) {
     const UavRuntime& u = uav(i);
+    // The freshest worker evidence the UAV would lead with: the leader's own fusion; another UAV's
+    // share or its own camera's last detection (its estimator fuses that camera once it leads).
     const double fused = i == owner_ ? last_fused_s_ : (u.share ? u.share->worker.fused_s : std::nan(""));
     if (std::isfinite(fused)) age[static_cast<std::size_t>(i)] = std::max(0.0, t - fused);
+    const double seen = own_seen_s_[static_cast<std::size_t>(i)];
+    if (i != owner_ && std::isfinite(seen)) age[static_cast<std::size_t>(i)] = std::min(age[static_cast<std::size_t>(i)], std::max(0.0, t - seen));
     up[static_cast<std::size_t>(i)] = !silentAt(i, t) && !cfg_.faults.followerOffline(i, t);
   }
   lead_->step(t, age, up);
@@ -566,6 +574,10 @@ void MissionRun::cameraFrame(double t, const WorkerState& ws) {
     }
   }
   const SensorFrame& frame = cf.sensors;
+  if (frame.visible()) own_seen_s_[static_cast<std::size_t>(owner_)] = t;
+  for (std::size_t k = 0; k < cf.followers.size() && k + 1 < camera_uav.size(); ++k) {
+    if (cf.followers[k].visible) own_seen_s_[static_cast<std::size_t>(camera_uav[k + 1])] = t;
+  }
   M_.range_outliers += cf.range_outliers;
   (void)cam_model_.receive(cf.intrinsics);  // invalid intrinsics keep the model held (or none: no measurement)
   if (frame.visible() && cam_model_.model() != nullptr) {

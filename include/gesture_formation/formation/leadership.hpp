@@ -24,7 +24,7 @@
 ///   silent leader): a new term, its own vote, a request to the others. A member grants at most
 ///   one vote per term, only when not promised, and only to a candidate whose worker estimate is
 ///   not older than its own by more than estimate_tolerance_s (the freshest estimate wins over
-///   rank). A majority makes the candidate leader, its lease counted from the request's send time.
+///   rank; the callers pass the fresher of a UAV's worker state and its own camera's last detection). A majority makes the candidate leader, its lease counted from the request's send time.
 ///   The request is repeated every heartbeat_period_s against loss; no majority within
 ///   election_timeout_s: it stands again after its stagger in a new term.
 ///   Before that, a pre-vote: the candidate asks whether a majority *would* vote for it in the next
