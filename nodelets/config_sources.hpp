@@ -159,6 +159,7 @@ struct PlannerSettings {
   planning::PlannerConfig planner;
   planning::ReplanConfig replan;  ///< horizon, freshness, avoidance, search, brake, abort
   double replanning_period_s = 0.0;
+  double max_command_age_s = 5.0;  ///< a command kept through a lease gap is dropped when older at the resumption
   bool formation_loaded = false;
 };
 
@@ -176,14 +177,16 @@ inline void loadPlannerSettings(const ros::NodeHandle& pnh, ParamLoader& params,
     out.planner = mission.planner;
     out.replanning_period_s = mission.replanning_period_s;
     out.replan = mission.replan;
+    out.max_command_age_s = mission.max_command_age_s;
     params.note("from mission_file: replanning_period_s " + std::to_string(out.replanning_period_s) +
                 ", horizon_dt_s " + std::to_string(out.replan.dt_s) + ", horizon_steps " +
-                std::to_string(out.replan.steps) + ", faults.* limits, controller.brake_accel_mps2, abort.*, " +
+                std::to_string(out.replan.steps) + ", faults.* limits (max_command_age_s too), controller.brake_accel_mps2, abort.*, " +
                 "formation, planner");
     return;
   }
   std::string formation_file, planner_file;
   params.load("replanning_period_s", out.replanning_period_s, onboard::ranges::kReplanningPeriodS);
+  params.load("max_command_age_s", out.max_command_age_s, onboard::ranges::kMaxCommandAgeS);
   params.loadFields(planning::replanConfigFields(), out.replan);  // horizon_*, *_age_s, brake_accel_mps2, search_*
   params.load("avoid_all_plans", out.replan.rule.avoid_all_plans);
   loadAbortParams(pnh, params, out.replan.abort);

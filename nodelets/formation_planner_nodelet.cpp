@@ -4,7 +4,8 @@
 // (§2.4), the stage-1 reference on the worker's prediction, the request around the other UAVs'
 // received plans (planning::buildPlanRequest) and the verified plan or its fallback (flagged
 // `fallback`: every other UAV plans around it). The leader's instance owns the formation's parameters
-// (onboard::ParamsOwnership; commands in on formation_command_in, parameters out on formation_params_out).
+// (onboard::ParamsOwnership in planner_params_role.hpp; commands in on formation_command_in, parameters out on
+// formation_params_out; a leader whose lease lapsed applies the commands kept meanwhile if it resumes in its term).
 // With ~leadership true (optional, default false) the role, the slot flown and whose plan is the leader's
 // follow this UAV's own leadership_state_in (LeadershipState; docs/safety.md §1.2). With ~mapping_config
 // it plans on a live map of its depth camera (planner_live_map.hpp: depth_in, depth_info_in).
@@ -33,8 +34,7 @@
 #include "diagnostics.hpp"
 #include "planner_health.hpp"
 #include "planner_live_map.hpp"
-#include "gesture_formation/LeadershipState.h"
-#include "gesture_formation/onboard/formation_params_role.hpp"
+#include "planner_params_role.hpp"
 #include "gesture_formation/onboard/frame_check.hpp"
 #include "gesture_formation/onboard/wind_input.hpp"
 #include "gesture_formation/planning/replan_health.hpp"
@@ -77,7 +77,6 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
       return;
     }
     NODELET_INFO_STREAM("FormationPlanner (UAV " << uav_index_ << ") loaded:\n" << params.loaded());
-    own_.emplace(fcfg, uav_index_, leadership_);  // the config was validated by its loader
     rc.uav_index = uav_index_;
     rc.uav_count = uav_count_;
     rc.worker_heading = fcfg.worker_heading;
@@ -95,45 +94,11 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     abort_sub_ = nh.subscribe("abort_in", 20, &FormationPlannerNodelet::onAbort, this);
     abort_pub_ = nh.advertise<gesture_formation::AbortState>("abort_state_out", 5, true);
     abort_pub_.publish(toAbortState(step_->abort(), uav_index_, ros::Time::now().toSec(), "", -1, world_frame_));
-    setUpParamsRole(nh, params_rate_hz);
+    params_role_.setUp(nh, mutex_, fcfg, uav_index_, leadership_, params_rate_hz, settings.max_command_age_s, world_frame_);
     // Staggered replanning: UAV i plans at k·period + i·period/n (as in gfctl simulate).
     offset_s_ = period_s_ * uav_index_ / uav_count_;
     timer_ = nh.createTimer(ros::Duration(period_s_ / 8.0), &FormationPlannerNodelet::onTimer, this);
     diagnostics_.start(nh, 1.0, [this](double since_s) { return health(since_s); });
-  }
-
-  /// The parameter role's topics: the leader by index, or (~leadership) every UAV.
-  void setUpParamsRole(ros::NodeHandle& nh, double params_rate_hz) {
-    if (uav_index_ == formation::kLeader || leadership_) {
-      params_pub_ = nh.advertise<gesture_formation::FormationParams>("formation_params_out", 5, true);
-      command_sub_ = nh.subscribe("formation_command_in", 20, &FormationPlannerNodelet::onCommand, this);
-      ack_pub_ = nh.advertise<gesture_formation::CommandAck>("command_ack_out", 20);
-      assistance_pub_ = nh.advertise<gesture_formation::AssistanceState>("assistance_state_out", 5, true);
-      if (own_->owns()) assistance_pub_.publish(toMsg(own_->role().assistance().state(), ros::Time::now()));
-      assistance_sub_ = nh.subscribe("assistance_in", 20, &FormationPlannerNodelet::onAssistance, this);
-      params_timer_ = nh.createTimer(ros::Duration(1.0 / params_rate_hz), [this](const ros::TimerEvent&) {
-        std::lock_guard<std::mutex> lock(mutex_);
-        if (own_->owns()) publishParams();
-      });
-    }
-    if (uav_index_ != formation::kLeader || leadership_) params_sub_ = nh.subscribe("formation_params_in", 5, &FormationPlannerNodelet::onParams, this);
-    if (leadership_) leadership_sub_ = nh.subscribe("leadership_state_in", 5, &FormationPlannerNodelet::onLeadership, this);
-  }
-
-  // This UAV's leadership view (~leadership): starting to act, it takes the parameters over.
-  void onLeadership(const gesture_formation::LeadershipState::ConstPtr& msg) {
-    if (msg->uav_index != uav_index_) return;
-    std::lock_guard<std::mutex> lock(mutex_);
-    const auto change = own_->setActing(msg->acting, msg->header.stamp.toSec(), msg->leader);  // also the slot flown
-    if (change == onboard::ParamsOwnership::Change::kNone) return;
-    const bool started = change == onboard::ParamsOwnership::Change::kStarted;
-    NODELET_WARN_STREAM("FormationPlanner UAV " << uav_index_ << (started ? ": acts as leader (term " : ": no longer acts as leader (term ")
-                        << msg->term << (started ? ") from t = " + std::to_string(own_->tookOverS()) + " s: parameters version " +
-                                                       std::to_string(own_->version()) + " taken over; commands sent from now on applied"
-                                                 : "): parameters from the leader from now on"));
-    if (!started) return;
-    publishParams();
-    assistance_pub_.publish(toMsg(own_->role().assistance().state(), ros::Time::now()));
   }
 
   void onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
@@ -167,38 +132,6 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     auto& slot = received_[static_cast<std::size_t>(msg->uav_index)];
     if (!slot || plan->t0_s >= slot->plan.t0_s) slot = planning::ReceivedPlan{std::move(*plan), msg->fallback != 0};
   }
-  void onParams(const gesture_formation::FormationParams::ConstPtr& msg) {
-    auto p = fromMsg(*msg);
-    std::lock_guard<std::mutex> lock(mutex_);
-    const auto r = p ? own_->receive(*p, msg->version) : common::Result<bool>::fail(p.reason());
-    if (!r) NODELET_WARN_STREAM_THROTTLE(1.0, "FormationPlanner: formation parameters dropped: " << r.reason());
-  }
-  void onCommand(const gesture_formation::FormationCommand::ConstPtr& msg) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (!own_->takesCommand(msg->header.stamp.toSec())) return;
-    const auto& r = own_->role().apply(fromMsg(*msg), describe(*msg), msg->source, msg->header.stamp.toSec());
-    NODELET_INFO_STREAM("FormationPlanner: command " << r.text << " → " << r.outcome);
-    publishParams();
-    ack_pub_.publish(toAck(*msg, r.status, r.outcome, own_->version(), ros::Time::now()));  // to the operator
-  }
-  // The worker's request (GestureCommander) or the operator's acknowledgement (over LCM) → the latch.
-  void onAssistance(const gesture_formation::AssistanceState::ConstPtr& m) {
-    auto state = fromMsg(*m);
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (!own_->owns()) return;  // ~leadership: the acting UAV's latch
-    auto& latch = own_->role().assistance();
-    if (!state || !latch.receive(*state)) return;
-    NODELET_WARN_STREAM("FormationPlanner: assistance " << formation::toString(latch.state().phase) << " (requested at "
-                                                        << latch.state().requested_s << " s by " << latch.state().requested_by
-                                                        << "; the worker's gestures are refused while requested)");
-    assistance_pub_.publish(toMsg(latch.state(), ros::Time::now()));
-  }
-  void publishParams() {
-    auto m = toMsg(own_->role(), ros::Time::now(), world_frame_);
-    m.version = own_->version();
-    params_pub_.publish(m);
-  }
-
   // Every copy of an abort (operator over LCM, the leader's relay, the gesture commander): the
   // ReplanStep accepts the first that is fresh enough (planning::AbortPlanner::receive).
   void onAbort(const gesture_formation::AbortCommand::ConstPtr& msg) {
@@ -240,9 +173,9 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     in.state = *odom_;
     if (const auto w = wind_.at(t)) in.wind_estimate_mps = *w;
     in.worker = worker ? &*worker : nullptr;
-    in.params = &own_->role().params();
-    in.slot = own_->slot();  // ~leadership: the acting leader flies slot 0 (docs/safety.md §1.2)
-    in.leader_index = own_->leaderIndex();
+    in.params = &params_role_.own().role().params();
+    in.slot = params_role_.own().slot();  // ~leadership: the acting leader flies slot 0 (docs/safety.md §1.2)
+    in.leader_index = params_role_.own().leaderIndex();
     if (const auto& l = received_[static_cast<std::size_t>(in.leader_index)]) in.leader_plan = &l->plan;
     in.received = &received_;
     const planning::ReplanOutcome out = step_->step(in);
@@ -260,7 +193,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     }
     health_.record(out, t);
     logPlanProblems(out.result, uav_index_);
-    const auto msg = toMsg(out, uav_index_, t, own_->role().params(), own_->version(), world_frame_);
+    const auto msg = toMsg(out, uav_index_, t, params_role_.own().role().params(), params_role_.own().version(), world_frame_);
     plan_pub_.publish(msg);
     traj_pub_.publish(toMultiDof(msg, "uav" + std::to_string(uav_index_)));
   }
@@ -280,7 +213,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   std::string world_frame_;
   double period_s_ = 0.0, offset_s_ = 0.0, next_plan_s_ = -1.0;
   onboard::WindInput wind_;  ///< wind_estimate_in, checked and aged (docs/safety.md §4.7)
-  std::optional<onboard::ParamsOwnership> own_;  ///< the parameters' role, following the leadership or the index
+  PlannerParamsRole params_role_;  ///< the parameters' role, following the leadership or the index
   bool leadership_ = false;  ///< ~leadership: the parameters' role follows this UAV's leadership_state
   std::string mode_ = "track";             ///< track | hold | search | abort (logged on change)
   WorldMap world_;  ///< the map and field the planner and the abort's goal search use (live: live_map_'s)
@@ -288,11 +221,11 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   std::unique_ptr<planning::ReplanStep> step_;  ///< planner, hold / search, listening (shared with gfctl simulate)
   std::optional<planning::UavKinematicState> odom_;
   std::optional<gesture_formation::WorkerState> worker_;
-  std::vector<std::optional<planning::ReceivedPlan>> received_;  ///< by sender (the leader's: own_->leaderIndex())
+  std::vector<std::optional<planning::ReceivedPlan>> received_;  ///< by sender (the leader's: params_role_.own().leaderIndex())
   int abort_link_sender_ = -1;  ///< who delivered the accepted abort (LCM sender id; -1: ROS)
-  ros::Publisher plan_pub_, traj_pub_, params_pub_, abort_pub_, ack_pub_, assistance_pub_;
-  ros::Subscriber odom_sub_, worker_sub_, plans_sub_, params_sub_, command_sub_, wind_sub_, abort_sub_, assistance_sub_, leadership_sub_;
-  ros::Timer timer_, params_timer_;
+  ros::Publisher plan_pub_, traj_pub_, abort_pub_;
+  ros::Subscriber odom_sub_, worker_sub_, plans_sub_, wind_sub_, abort_sub_;
+  ros::Timer timer_;
 };
 
 }  // namespace gesture_formation::nodelets

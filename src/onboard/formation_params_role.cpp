@@ -51,12 +51,15 @@ ParamsOwnership::ParamsOwnership(const formation::FormationConfig& config, int u
   role_.emplace(config, uav_index);
 }
 
-ParamsOwnership::Change ParamsOwnership::setActing(bool acting, double t_s, int leader) {
+ParamsOwnership::Change ParamsOwnership::setActing(bool acting, double t_s, int leader, std::uint32_t term) {
   if (!follow_) return Change::kNone;
   leader_ = leader;
+  term_ = term;
   if (acting == acting_) return Change::kNone;
   acting_ = acting;
   if (!acting_) return Change::kStopped;
+  if (term != 0 && term == acted_term_) return Change::kResumed;  // nobody else acted since
+  acted_term_ = term;
   formation::FormationConfig cfg = config_;
   cfg.params = role_->params();
   base_version_ = version();

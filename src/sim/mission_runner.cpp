@@ -153,6 +153,7 @@ class MissionRun {
   void sampleTimeline(double t, const WorkerState& ws);
   void control(double t, double dt);
   void applyCommand(std::size_t record, const formation::FormationCommand& cmd, double t);
+  void applyOperatorMessage(const OperatorMessage& msg, double t);
   void setMode(int i, double t, const std::string& mode, const std::string& reason);
   void deliverAbort(double t);
   void receiveAbort(int i, const planning::AbortCommand& command, double t);
@@ -206,6 +207,11 @@ class MissionRun {
   /// Per UAV: when its own camera last detected the worker (the leader's camera or its follower
   /// view; −inf: never) — with its share, the freshness it brings to an election.
   std::vector<double> own_seen_s_;
+  /// Operator requests that reached the leader (owner_) while its lease had lapsed, and the term it
+  /// was in then: applied if it acts again in that term (onboard::ParamsOwnership::keepsCommand).
+  std::vector<OperatorMessage> kept_;
+  std::uint32_t kept_term_ = 0;
+  std::uint32_t owner_term_ = 0;  ///< the term in which owner_ last acted
   int owner_ = 0;
   double took_over_s_ = -std::numeric_limits<double>::infinity();  ///< commands sent before are the previous leader's
   int silenced_ = -1;                                                ///< faults.leader_silence's UAV
@@ -378,6 +384,8 @@ void MissionRun::takeOver(int k, double t) {
   // camera), the parameters and their version from that share, fresh gesture frames and filter.
   owner_ = k;
   took_over_s_ = t;
+  kept_.clear();  // its predecessor's
+  owner_term_ = lead_->member(k).term();
   const UavRuntime& u = uav(k);
   kf_ = estimation::HumanKalman(cfg_.estimator.filter);
   leader_knowledge_.reset();
@@ -483,23 +491,43 @@ void MissionRun::deliverOperatorMessages(double t) {
   // The operator's acknowledgement of an assistance request reaches the leader while it acts (the
   // ground station repeats it until then).
   if (acting_[static_cast<std::size_t>(owner_)] && !uav(owner_).offline) assistance_.acknowledgeDue(t);
+  // A leader whose lease lapsed keeps what reaches it meanwhile; acting again in the term in which it
+  // last acted (nobody else can have acted: a new leader needs a newer term) it applies those still
+  // within max_command_age_s of their sending — as the FormationPlanner's ParamsOwnership does.
+  const std::uint32_t owner_term = lead_->member(owner_).term();
+  if (acting_[static_cast<std::size_t>(owner_)]) {
+    if (owner_term == kept_term_ && owner_term == owner_term_) {
+      for (const OperatorMessage& msg : kept_) applyOperatorMessage(msg, t);
+    }
+    kept_.clear();
+    owner_term_ = owner_term;
+  }
   for (const auto& d : schedule_.due(t)) {
     const OperatorMessage msg{metrics_.addRequest(d.record), t, d.command};
     for (int i = 0; i < n_; ++i) operatorLink(i).send(t, msg);
   }
   for (int i = 0; i < n_; ++i) {
     for (const auto& msg : operatorLink(i).receive(t)) {
-      if (uav(i).offline || !acting_[static_cast<std::size_t>(i)] || i != owner_ || msg.sent_s < took_over_s_) continue;
-      RequestRecord& rec = metrics_.request(msg.record);
-      if (t - msg.sent_s > cfg_.faults.max_command_age_s) {  // never act on a command older than its age
-        ++M_.commands_stale;
-        if (rec.status == "lost") rec.status = "stale";
-        continue;
+      if (uav(i).offline || i != owner_ || msg.sent_s < took_over_s_) continue;
+      if (acting_[static_cast<std::size_t>(i)]) {
+        applyOperatorMessage(msg, t);
+      } else if (owner_term == owner_term_) {  // its lease lapsed in the term in which it acts
+        kept_.push_back(msg);
+        kept_term_ = owner_term;
       }
-      if (assistance_.refusal(formation::CommandSource::kOperator)) continue;  // never: the operator's pass (counted)
-      applyCommand(msg.record, msg.command, t);
     }
   }
+}
+
+void MissionRun::applyOperatorMessage(const OperatorMessage& msg, double t) {
+  RequestRecord& rec = metrics_.request(msg.record);
+  if (t - msg.sent_s > cfg_.faults.max_command_age_s) {  // never act on a command older than its age
+    ++M_.commands_stale;
+    if (rec.status == "lost") rec.status = "stale";
+    return;
+  }
+  if (assistance_.refusal(formation::CommandSource::kOperator)) return;  // never: the operator's pass (counted)
+  applyCommand(msg.record, msg.command, t);
 }
 
 void MissionRun::updateDropouts(double t) {

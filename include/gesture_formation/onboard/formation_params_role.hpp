@@ -64,10 +64,14 @@ class FormationParamsRole {
 /// while it acts as leader. A UAV that starts acting takes the parameters it holds (the last ones
 /// received) over with their version and from then on applies only the commands sent since it took
 /// over (older ones were its predecessor's, whose effect the parameters carry); while it does not
-/// act it takes the parameters it receives. Thread safety: none (the caller's lock).
+/// act it takes the parameters it receives. A leader whose lease lapses and that acts again *in the
+/// same term* resumes (nobody else can have acted: a new leader needs a newer term): it keeps its
+/// role, and the commands that reached it in between (keepsCommand) are its to apply then — under
+/// a lossy link the lease lapses for a fraction of a second many times a mission (docs/safety.md
+/// §1.2), and a command arriving in such a gap was dropped. Thread safety: none (the caller's lock).
 class ParamsOwnership {
  public:
-  enum class Change { kNone, kStarted, kStopped };
+  enum class Change { kNone, kStarted, kStopped, kResumed };
 
   /// `config` must be valid (its loader checked it).
   ParamsOwnership(const formation::FormationConfig& config, int uav_index, bool follow_leadership);
@@ -77,7 +81,9 @@ class ParamsOwnership {
   /// \brief Following the leadership: this UAV's acting state (its own LeadershipState) at `t_s`
   /// and the leader of its term as far as it knows (`leader`, −1: none). Starting to act, the role
   /// becomes the leader's from the parameters held, version carried on.
-  Change setActing(bool acting, double t_s, int leader = -1);
+  /// `term`: its leadership term (0: not known — never resumes). Acting again in the term in which
+  /// it last acted is kResumed: the role, its parameters and the take-over time are kept.
+  Change setActing(bool acting, double t_s, int leader = -1, std::uint32_t term = 0);
   /// \brief The formation slot this UAV flies (planning::ReplanInputs::slot), as gfctl simulate's
   /// hand-over assigns it: the acting leader flies the leader's (0); UAV 0, no longer acting,
   /// the slot its successor left (the successor's index; −1 before one is known: its own); every
@@ -88,6 +94,11 @@ class ParamsOwnership {
   int leaderIndex() const;
   /// \brief A command sent at `stamp_s` is this UAV's to apply.
   bool takesCommand(double stamp_s) const { return owns() && (!follow_ || stamp_s >= took_over_s_); }
+  /// \brief A command sent at `stamp_s` reached this UAV while its lease has lapsed in the term in
+  /// which it acts: keep it, to apply when it resumes (setActing → kResumed) if still fresh.
+  bool keepsCommand(double stamp_s) const {
+    return follow_ && !acting_ && acted_term_ != 0 && term_ == acted_term_ && stamp_s >= took_over_s_;
+  }
   /// \brief The owner's parameters as received; ignored (ok(false)) while this UAV owns them.
   common::Result<bool> receive(const formation::FormationParams& params, std::uint64_t version);
   /// The parameters' version: the one taken over plus this UAV's own applied commands.
@@ -104,6 +115,8 @@ class ParamsOwnership {
   int leader_ = -1;                 ///< the leader of this UAV's term as it knows it (−1: none)
   std::uint64_t base_version_ = 0;  ///< the version taken over (0: the role's own)
   double took_over_s_ = 0.0;        ///< when this UAV last started acting
+  std::uint32_t term_ = 0;          ///< its leadership term now (0: not known)
+  std::uint32_t acted_term_ = 0;    ///< the term in which it last acted (0: none known)
 };
 
 }  // namespace gesture_formation::onboard

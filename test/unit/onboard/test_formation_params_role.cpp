@@ -157,6 +157,46 @@ TEST(ParamsOwnershipTest, TheActingUavTakesTheParametersOverWithTheirVersion) {
   EXPECT_TRUE(by_index.takesCommand(0.0));
 }
 
+// A lease that lapses and comes back in the same term (a lossy link): nobody else can have acted, so
+// the role is resumed as it was and the commands that arrived in the gap are kept for it; back in a
+// newer term it is a take-over (the gap's commands may have been another leader's: none kept).
+TEST(ParamsOwnershipTest, ALeaderResumingInItsTermKeepsTheGapsCommands) {
+  using Change = onboard::ParamsOwnership::Change;
+  formation::FormationConfig config;
+  onboard::ParamsOwnership own(config, 0, true);
+  ASSERT_EQ(own.setActing(true, 1.0, 0, 1), Change::kStarted);
+  EXPECT_FALSE(own.keepsCommand(2.0)) << "acting: it takes commands, it does not keep them";
+  own.role().apply(common::Result<formation::FormationCommand>::ok(distancePlusOne(1)), "op #1", "operator", 2.0);
+  ASSERT_EQ(own.version(), 1u);
+  ASSERT_EQ(own.setActing(false, 3.0, 0, 1), Change::kStopped);
+  EXPECT_FALSE(own.takesCommand(3.2));
+  EXPECT_TRUE(own.keepsCommand(3.2)) << "its lease lapsed in the term in which it acts";
+  EXPECT_FALSE(own.keepsCommand(0.5)) << "sent before it took over: its predecessor's";
+  ASSERT_EQ(own.setActing(true, 3.4, 0, 1), Change::kResumed);
+  EXPECT_TRUE(own.owns());
+  EXPECT_EQ(own.version(), 1u) << "the role resumed as it was";
+  EXPECT_DOUBLE_EQ(own.tookOverS(), 1.0);
+  EXPECT_TRUE(own.takesCommand(3.2)) << "the gap's command is now its to apply";
+
+  // It learns a newer term (another UAV stands): nothing is kept any more, and acting again is a take-over.
+  ASSERT_EQ(own.setActing(false, 5.0, 0, 1), Change::kStopped);
+  EXPECT_EQ(own.setActing(false, 5.5, -1, 2), Change::kNone);
+  EXPECT_FALSE(own.keepsCommand(5.6)) << "a newer term: another UAV may act";
+  ASSERT_EQ(own.setActing(true, 8.0, 0, 3), Change::kStarted);
+  EXPECT_DOUBLE_EQ(own.tookOverS(), 8.0);
+  EXPECT_FALSE(own.takesCommand(5.6));
+
+  // Without the term (callers that do not know it): every start is a take-over, nothing kept.
+  onboard::ParamsOwnership no_term(config, 0, true);
+  ASSERT_EQ(no_term.setActing(true, 1.0, 0), Change::kStarted);
+  ASSERT_EQ(no_term.setActing(false, 2.0, 0), Change::kStopped);
+  EXPECT_FALSE(no_term.keepsCommand(2.5));
+  EXPECT_EQ(no_term.setActing(true, 3.0, 0), Change::kStarted);
+  // Not following the leadership: never kept.
+  onboard::ParamsOwnership by_index(config, 0, false);
+  EXPECT_FALSE(by_index.keepsCommand(1.0));
+}
+
 TEST(ParamsOwnershipTest, TheSlotAndTheLeadersPlanFollowTheLeadership) {
   formation::FormationConfig config;
   // Not following the leadership: by index, UAV 0 leads, every UAV flies its own slot.

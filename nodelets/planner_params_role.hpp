@@ -1,0 +1,139 @@
+#pragma once
+// The FormationPlanner's parameter role on ROS (onboard::ParamsOwnership; docs/safety.md §1.2, §2.9,
+// §2.10): the owner's — the leader by index, or with ~leadership the UAV acting as leader — commands
+// in (formation_command_in), parameters out (formation_params_out, latched, re-sent at
+// ~params_rate_hz), an acknowledgement per command handled (command_ack_out) and the assistance latch
+// (assistance_in → assistance_state_out); every other UAV's parameters in (formation_params_in); with
+// ~leadership its own LeadershipState (leadership_state_in). A leader whose lease lapses keeps the
+// commands that reach it meanwhile and applies them if it resumes in the same term within
+// max_command_age_s of their sending (ParamsOwnership::keepsCommand). Every callback takes the
+// nodelet's mutex.
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <ros/ros.h>
+
+#include "conversions.hpp"
+#include "gesture_formation/LeadershipState.h"
+#include "gesture_formation/onboard/formation_params_role.hpp"
+
+namespace gesture_formation::nodelets {
+
+class PlannerParamsRole {
+ public:
+  /// Creates the ownership and the topics of this UAV's role. `mutex` must outlive this.
+  void setUp(ros::NodeHandle& nh, std::mutex& mutex, const formation::FormationConfig& formation, int uav_index,
+             bool leadership, double params_rate_hz, double max_command_age_s, const std::string& world_frame) {
+    mutex_ = &mutex;
+    uav_index_ = uav_index;
+    max_command_age_s_ = max_command_age_s;
+    world_frame_ = world_frame;
+    own_.emplace(formation, uav_index, leadership);  // the config was validated by its loader
+    if (uav_index == formation::kLeader || leadership) {
+      params_pub_ = nh.advertise<gesture_formation::FormationParams>("formation_params_out", 5, true);
+      command_sub_ = nh.subscribe("formation_command_in", 20, &PlannerParamsRole::onCommand, this);
+      ack_pub_ = nh.advertise<gesture_formation::CommandAck>("command_ack_out", 20);
+      assistance_pub_ = nh.advertise<gesture_formation::AssistanceState>("assistance_state_out", 5, true);
+      if (own_->owns()) assistance_pub_.publish(toMsg(own_->role().assistance().state(), ros::Time::now()));
+      assistance_sub_ = nh.subscribe("assistance_in", 20, &PlannerParamsRole::onAssistance, this);
+      params_timer_ = nh.createTimer(ros::Duration(1.0 / params_rate_hz), [this](const ros::TimerEvent&) {
+        std::lock_guard<std::mutex> lock(*mutex_);
+        if (own_->owns()) publishParams();
+      });
+    }
+    if (uav_index != formation::kLeader || leadership) params_sub_ = nh.subscribe("formation_params_in", 5, &PlannerParamsRole::onParams, this);
+    if (leadership) leadership_sub_ = nh.subscribe("leadership_state_in", 5, &PlannerParamsRole::onLeadership, this);
+  }
+
+  /// The ownership (the caller holds the mutex).
+  const onboard::ParamsOwnership& own() const { return *own_; }
+
+ private:
+  // This UAV's leadership view (~leadership): starting to act, it takes the parameters over; resuming
+  // in the same term, it applies the commands kept while its lease had lapsed.
+  void onLeadership(const gesture_formation::LeadershipState::ConstPtr& msg) {
+    if (msg->uav_index != uav_index_) return;
+    std::lock_guard<std::mutex> lock(*mutex_);
+    using Change = onboard::ParamsOwnership::Change;
+    const auto change = own_->setActing(msg->acting, msg->header.stamp.toSec(), msg->leader, msg->term);  // also the slot flown
+    if (change == Change::kResumed) {
+      const double now = ros::Time::now().toSec();
+      std::size_t applied = 0;
+      for (const auto& m : kept_) {
+        if (now - m->header.stamp.toSec() > max_command_age_s_) continue;
+        applyCommand(*m);
+        ++applied;
+      }
+      if (!kept_.empty()) {
+        ROS_WARN_STREAM("FormationPlanner UAV " << uav_index_ << ": acts as leader again (term " << msg->term << "): " << applied
+                                                << " of " << kept_.size() << " commands kept since its lease lapsed applied");
+      }
+    }
+    if (change != Change::kStopped) kept_.clear();
+    if (change == Change::kNone || change == Change::kResumed) return;
+    const bool started = change == Change::kStarted;
+    ROS_WARN_STREAM("FormationPlanner UAV " << uav_index_ << (started ? ": acts as leader (term " : ": no longer acts as leader (term ")
+                                            << msg->term
+                                            << (started ? ") from t = " + std::to_string(own_->tookOverS()) + " s: parameters version " +
+                                                              std::to_string(own_->version()) + " taken over; commands sent from now on applied"
+                                                        : "): parameters from the leader from now on; commands kept until it resumes"));
+    if (!started) return;
+    publishParams();
+    assistance_pub_.publish(toMsg(own_->role().assistance().state(), ros::Time::now()));
+  }
+
+  void onParams(const gesture_formation::FormationParams::ConstPtr& msg) {
+    auto p = fromMsg(*msg);
+    std::lock_guard<std::mutex> lock(*mutex_);
+    const auto r = p ? own_->receive(*p, msg->version) : common::Result<bool>::fail(p.reason());
+    if (!r) ROS_WARN_STREAM_THROTTLE(1.0, "FormationPlanner: formation parameters dropped: " << r.reason());
+  }
+
+  void onCommand(const gesture_formation::FormationCommand::ConstPtr& msg) {
+    std::lock_guard<std::mutex> lock(*mutex_);
+    const double stamp = msg->header.stamp.toSec();
+    if (own_->keepsCommand(stamp)) kept_.push_back(msg);  // its lease lapsed: applied if it resumes in this term
+    if (own_->takesCommand(stamp)) applyCommand(*msg);
+  }
+
+  void applyCommand(const gesture_formation::FormationCommand& msg) {
+    const auto& r = own_->role().apply(fromMsg(msg), describe(msg), msg.source, msg.header.stamp.toSec());
+    ROS_INFO_STREAM("FormationPlanner: command " << r.text << " → " << r.outcome);
+    publishParams();
+    ack_pub_.publish(toAck(msg, r.status, r.outcome, own_->version(), ros::Time::now()));  // to the operator
+  }
+
+  // The worker's request (GestureCommander) or the operator's acknowledgement (over LCM) → the latch.
+  void onAssistance(const gesture_formation::AssistanceState::ConstPtr& m) {
+    auto state = fromMsg(*m);
+    std::lock_guard<std::mutex> lock(*mutex_);
+    if (!own_->owns()) return;  // ~leadership: the acting UAV's latch
+    auto& latch = own_->role().assistance();
+    if (!state || !latch.receive(*state)) return;
+    ROS_WARN_STREAM("FormationPlanner: assistance " << formation::toString(latch.state().phase) << " (requested at "
+                                                    << latch.state().requested_s << " s by " << latch.state().requested_by
+                                                    << "; the worker's gestures are refused while requested)");
+    assistance_pub_.publish(toMsg(latch.state(), ros::Time::now()));
+  }
+
+  void publishParams() {
+    auto m = toMsg(own_->role(), ros::Time::now(), world_frame_);
+    m.version = own_->version();
+    params_pub_.publish(m);
+  }
+
+  std::mutex* mutex_ = nullptr;
+  int uav_index_ = 0;
+  double max_command_age_s_ = 5.0;
+  std::string world_frame_;
+  std::optional<onboard::ParamsOwnership> own_;
+  std::vector<gesture_formation::FormationCommand::ConstPtr> kept_;  ///< reached it while its lease lapsed
+  ros::Publisher params_pub_, ack_pub_, assistance_pub_;
+  ros::Subscriber command_sub_, params_sub_, assistance_sub_, leadership_sub_;
+  ros::Timer params_timer_;
+};
+
+}  // namespace gesture_formation::nodelets
