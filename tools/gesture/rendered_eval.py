@@ -60,6 +60,8 @@ def render(gfctl, protocol, name, data, models=None):
         cmd += ["--models", models]
     if SKELETON != "movenet_lightning":
         cmd += ["--skeleton", SKELETON]
+    if spec.get("window_only"):  # training data: the skeleton network alone on the worker's window
+        cmd += ["--window-only"]
     with open(os.path.join(d, "render.log"), "w") as log:
         log.write(f"# {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC load {os.getloadavg()}\n")
         log.flush()
