@@ -23,9 +23,12 @@
 //   is never taken for a duplicate.
 // Leader hand-over (optional ~leadership, default false; docs/safety.md §1.2): the commander runs on
 // every UAV and follows this UAV's leadership_state_in (LeadershipState): only while it acts are
-// observations taken and commands sent; each time it starts acting the frames and the filter start
-// afresh (as gfctl simulate's new leader: no half-seen performance of the predecessor's fires).
+// observations taken and commands sent — and through a lapse of its lease in the term it acts in (the
+// FormationPlanner keeps those commands until the lease is back); each time it starts voting the frames
+// and the filter start afresh (as gfctl simulate's new leader: no half-seen performance of the
+// predecessor's fires).
 #include <algorithm>
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <mutex>
@@ -115,11 +118,15 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
       leadership_sub_ = nh.subscribe<gesture_formation::LeadershipState>(
           "leadership_state_in", 5, [this](const gesture_formation::LeadershipState::ConstPtr& m) {
             std::lock_guard<std::mutex> lock(mutex_);
-            if (m->acting == acting_) return;
-            acting_ = m->acting;
+            // It votes while it acts and through a lapse of its lease in the term it acted in (its
+            // commands then wait at the FormationPlanner: planner_params_role.hpp).
+            const bool votes = m->acting || (m->role == gesture_formation::LeadershipState::ROLE_LEADER && m->term == acted_term_);
+            if (m->acting) acted_term_ = m->term;
+            if (votes == acting_) return;
+            acting_ = votes;
             make_frames_();  // a new leader's vote and filter start afresh
             NODELET_WARN_STREAM("GestureCommander: " << (acting_ ? "acts as leader (term " + std::to_string(m->term) + "): votes from now on"
-                                                                 : std::string("no longer acts as leader: no vote")));
+                                                                 : std::string("no longer the leader of its term: no vote")));
           });
     }
     diagnostics_.start(nh, 1.0, [this](double since_s) { return health(since_s); });
@@ -235,7 +242,8 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
   double frame_wait_s_ = 0.0;
   std::optional<gesture::GestureFrames> frames_;  ///< vote, filter, mapping (shared with gfctl simulate)
   std::function<void()> make_frames_;             ///< (re)starts frames_ from the loaded settings
-  bool leadership_ = false, acting_ = false;      ///< ~leadership; this UAV acts as leader
+  bool leadership_ = false, acting_ = false;      ///< ~leadership; this UAV votes (acts, or its lease lapsed in its term)
+  std::uint32_t acted_term_ = 0;                 ///< the term in which it last acted
   std::uint64_t sequence_ = 0;
   std::string last_fired_;
   ros::Publisher command_pub_, status_pub_, abort_pub_, assistance_pub_;

@@ -6,8 +6,8 @@
 // (assistance_in → assistance_state_out); every other UAV's parameters in (formation_params_in); with
 // ~leadership its own LeadershipState (leadership_state_in). A leader whose lease lapses keeps the
 // commands that reach it meanwhile and applies them if it resumes in the same term within
-// max_command_age_s of their sending (ParamsOwnership::keepsCommand). Every callback takes the
-// nodelet's mutex.
+// max_command_age_s of their sending (ParamsOwnership::keepsCommand), and the assistance requests and
+// acknowledgements that reached it likewise. Every callback takes the nodelet's mutex.
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -67,12 +67,18 @@ class PlannerParamsRole {
         applyCommand(*m);
         ++applied;
       }
+      for (const auto& m : kept_assistance_) handleAssistance(*m);
       if (!kept_.empty()) {
         ROS_WARN_STREAM("FormationPlanner UAV " << uav_index_ << ": acts as leader again (term " << msg->term << "): " << applied
                                                 << " of " << kept_.size() << " commands kept since its lease lapsed applied");
       }
     }
-    if (change != Change::kStopped) kept_.clear();
+    const bool keeping = own_->keepsCommand(ros::Time::now().toSec());  // lapsed in the term it acted in
+    if (change == Change::kResumed || change == Change::kStarted || (!own_->owns() && !keeping)) {
+      // applied above, or its predecessor's, or a newer term's (they may be another leader's)
+      kept_.clear();
+      kept_assistance_.clear();
+    }
     if (change == Change::kNone || change == Change::kResumed) return;
     const bool started = change == Change::kStarted;
     ROS_WARN_STREAM("FormationPlanner UAV " << uav_index_ << (started ? ": acts as leader (term " : ": no longer acts as leader (term ")
@@ -108,9 +114,12 @@ class PlannerParamsRole {
 
   // The worker's request (GestureCommander) or the operator's acknowledgement (over LCM) → the latch.
   void onAssistance(const gesture_formation::AssistanceState::ConstPtr& m) {
-    auto state = fromMsg(*m);
     std::lock_guard<std::mutex> lock(*mutex_);
-    if (!own_->owns()) return;  // ~leadership: the acting UAV's latch
+    if (own_->keepsCommand(ros::Time::now().toSec())) kept_assistance_.push_back(m);  // its lease lapsed: on resuming
+    if (own_->owns()) handleAssistance(*m);  // ~leadership: the acting UAV's latch
+  }
+  void handleAssistance(const gesture_formation::AssistanceState& m) {
+    auto state = fromMsg(m);
     auto& latch = own_->role().assistance();
     if (!state || !latch.receive(*state)) return;
     ROS_WARN_STREAM("FormationPlanner: assistance " << formation::toString(latch.state().phase) << " (requested at "
@@ -131,6 +140,7 @@ class PlannerParamsRole {
   std::string world_frame_;
   std::optional<onboard::ParamsOwnership> own_;
   std::vector<gesture_formation::FormationCommand::ConstPtr> kept_;  ///< reached it while its lease lapsed
+  std::vector<gesture_formation::AssistanceState::ConstPtr> kept_assistance_;  ///< the same for the assistance latch
   ros::Publisher params_pub_, ack_pub_, assistance_pub_;
   ros::Subscriber command_sub_, params_sub_, assistance_sub_, leadership_sub_;
   ros::Timer params_timer_;

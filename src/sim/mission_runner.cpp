@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <optional>
 #include <sstream>
 
@@ -207,9 +208,10 @@ class MissionRun {
   /// Per UAV: when its own camera last detected the worker (the leader's camera or its follower
   /// view; −inf: never) — with its share, the freshness it brings to an election.
   std::vector<double> own_seen_s_;
-  /// Operator requests that reached the leader (owner_) while its lease had lapsed, and the term it
-  /// was in then: applied if it acts again in that term (onboard::ParamsOwnership::keepsCommand).
-  std::vector<OperatorMessage> kept_;
+  /// What the leader (owner_) received or fired while its lease had lapsed in the term it acts in —
+  /// operator requests, its gesture commands and assistance requests — and that term: each applied
+  /// (with the time then) if it acts again in that term (onboard::ParamsOwnership::keepsCommand).
+  std::vector<std::function<void(double)>> kept_;
   std::uint32_t kept_term_ = 0;
   std::uint32_t owner_term_ = 0;  ///< the term in which owner_ last acted
   int owner_ = 0;
@@ -497,7 +499,7 @@ void MissionRun::deliverOperatorMessages(double t) {
   const std::uint32_t owner_term = lead_->member(owner_).term();
   if (acting_[static_cast<std::size_t>(owner_)]) {
     if (owner_term == kept_term_ && owner_term == owner_term_) {
-      for (const OperatorMessage& msg : kept_) applyOperatorMessage(msg, t);
+      for (const auto& apply : kept_) apply(t);
     }
     kept_.clear();
     owner_term_ = owner_term;
@@ -512,7 +514,7 @@ void MissionRun::deliverOperatorMessages(double t) {
       if (acting_[static_cast<std::size_t>(i)]) {
         applyOperatorMessage(msg, t);
       } else if (owner_term == owner_term_) {  // its lease lapsed in the term in which it acts
-        kept_.push_back(msg);
+        kept_.push_back([this, msg](double now) { applyOperatorMessage(msg, now); });
         kept_term_ = owner_term;
       }
     }
@@ -688,16 +690,33 @@ void MissionRun::actOnFrames(double t, const std::vector<gesture::GestureFrame>&
     last_ratio_ = f.filter.dominant_ratio;
     if (!f.filter.fired) continue;
     const std::size_t record = metrics_.addRequest(firedGestureRecord(t, f.filter.dominant_id, cfg_.gesture_mapping));
-    if (!acting_[static_cast<std::size_t>(owner_)]) continue;  // no lease: the leader's commands wait for it
+    // Without a lease the leader's commands wait for it while it is still the leader of the term it
+    // acts in (applied if the lease comes back in that term: kept_); after a newer term they are dropped.
+    const bool acting = acting_[static_cast<std::size_t>(owner_)];
+    if (!acting && lead_->member(owner_).term() != owner_term_) continue;
+    const auto keepOrDo = [&](std::function<void(double)> apply) {
+      if (acting) return apply(t);
+      kept_.push_back(std::move(apply));
+      kept_term_ = owner_term_;
+    };
     if (f.action != nullptr && f.action->kind != gesture::GestureAction::Kind::kEvent) {
-      if (assistance_.refusal(formation::CommandSource::kGesture)) {  // the views are held until acknowledged
-        metrics_.requestOutcome(record, formation::toString(formation::CommandStatus::kRejected), t, 0, {});
-        continue;
-      }
-      applyCommand(record, gesture::toCommand(*f.action, ++gesture_seq_), t);
+      keepOrDo([this, record, fired_s = t, cmd = gesture::toCommand(*f.action, ++gesture_seq_)](double now) {
+        if (now - fired_s > cfg_.faults.max_command_age_s) {  // never act on a command older than its age
+          ++M_.commands_stale;
+          RequestRecord& rec = metrics_.request(record);
+          if (rec.status == "lost") rec.status = "stale";
+          return;
+        }
+        if (assistance_.refusal(formation::CommandSource::kGesture)) {  // the views are held until acknowledged
+          metrics_.requestOutcome(record, formation::toString(formation::CommandStatus::kRejected), now, 0, {});
+          return;
+        }
+        applyCommand(record, cmd, now);
+      });
     } else if (f.action != nullptr && f.action->event == gesture::GestureEvent::kAssistRequested) {
-      assistance_.request(t);
+      keepOrDo([this, fired_s = t](double) { assistance_.request(fired_s); });
     } else if (f.action != nullptr && f.action->event == gesture::GestureEvent::kAbort) {
+      // Every UAV acts on an abort on its own once received: sent at once, lease or not.
       receiveAbort(owner_, planning::AbortCommand{{"gesture", ++gesture_seq_}, planning::AbortSource::kGesture, t}, t);
     }
   }

@@ -11,7 +11,7 @@
 # from 250 s, the estimate error RMS <= 0.5 m, never two acting, no collision, mutual distance
 # >= Gamma_dis 2.5 m, worker distance >= 2.5 m, obstacle distance >= 0.5 m.
 # Then seed 23 to 45 s: an operator request arriving while the leader's lease has lapsed is applied
-# when it acts again in the same term (below).
+# when it acts again in the same term (below), and seed 2 to 90 s: so is a gesture command fired then.
 # Usage: gfctl_simulate_lossy_leadership.sh GFCTL SRC
 set -euo pipefail
 GFCTL=$1
@@ -63,5 +63,28 @@ if len(ops) < 2 or lost: problems.append(f"operator requests not applied: {lost}
 if l["steps_two_acting"] != 0: problems.append(f"steps with two acting {l['steps_two_acting']}")
 print(("FAIL " if problems else "ok   ") + "loss50 seed 23 to 45 s: " + (", ".join(problems) if problems else
       f"the request of 20 s arrived in the gap {gaps[0]['from_s']}-{gaps[0]['to_s']} s and was applied; {len(ops)}/{len(ops)} applied"))
+sys.exit(1 if problems else 0)
+PY
+# Seed 2 to 90 s: the worker's first gesture fires at 75.33 s while UAV 0's lease has lapsed
+# (75.14-76.82 s); the command waits and is applied when it acts again in the same term (at 093ec9f it
+# was lost; the filter re-arms only after the gesture is released, so it never fired again).
+"$GFCTL" simulate --scenario "$SRC/config/scenarios/power_towers.yaml" --fault-profile loss50 \
+  --out "$TMP/run2" --seed 2 --duration 90 --threads 1 --no-plot > "$TMP/run2.log" 2>&1 \
+  || { echo "FAIL: gfctl exited $?"; cat "$TMP/run2.log"; exit 1; }
+python3 - "$TMP/run2" <<'PY'
+import csv, json, sys
+d = sys.argv[1]
+g = [e for e in csv.DictReader(open(d + "/events.csv")) if e["source"] == "gesture"]
+l = json.load(open(d + "/metrics.json"))["leadership"]
+problems = []
+if len(g) != 1: problems.append(f"{len(g)} gesture commands fired (expected the one of ~75 s)")
+else:
+    t = float(g[0]["t"])
+    gap = [x for x in l["leaders"] if x["uav"] == -1 and x["from_s"] <= t <= x["to_s"]]
+    if not gap: problems.append(f"the gesture fired at {t} s with a leader acting: the case this checks did not occur")
+    if g[0]["status"] != "applied": problems.append(f"the gesture command fired at {t} s: {g[0]['status']}")
+if l["steps_two_acting"] != 0: problems.append(f"steps with two acting {l['steps_two_acting']}")
+print(("FAIL " if problems else "ok   ") + "loss50 seed 2 to 90 s: " + (", ".join(problems) if problems else
+      f"the gesture command fired at {g[0]['t']} s in a lease gap, applied at {g[0]['applied_t']} s"))
 sys.exit(1 if problems else 0)
 PY
