@@ -17,8 +17,10 @@ equality reference (--reference, default test/data/gesture/lstm_reference.csv).
 The skeleton network's systematic errors (docs/gestures.md §2, §9): --error-model FILE applies
 tools/gesture/error_model.py with the measured ranges of FILE (tools/gesture/error_model_movenet.yaml)
 to a share of the training and extra sequences (seeded by --error-model-seed; validation stays
-clean), and --rendered DIR,... adds the skeletons MoveNet extracted from a rendered TUNING set
-(`gfctl render-gestures`, all its views; sets of the held-out protocol's seed range are refused),
+clean), and --rendered DIR,... adds the skeletons MoveNet extracted from rendered sets — the
+training sets of protocol version 5 (seeds 3800-3899, `gfctl render-gestures --window-only`) or a
+tuning set (then no longer judged out-of-sample on it) — all their views; sets of the held-out
+protocol's seed range are refused,
 each window --rendered-repeat times. --init-onnx FILE fine-tunes from an exported model's weights
 (e.g. the shipped one) instead of a random start.
 """
@@ -83,7 +85,7 @@ def load_onnx_weights(model, path):
 
 
 def rendered_windows(dirs, repeat):
-    """Windows of the rendered tuning sets (every view's skeletons*.csv), each repeated `repeat` times."""
+    """Windows of rendered training or tuning sets (every view's skeletons*.csv), each repeated `repeat` times."""
     xs, ys, info = [], [], []
     for d in dirs:
         m = re.search(r"_seed(\d+)_", os.path.basename(os.path.normpath(d)) + "_")
@@ -139,7 +141,7 @@ def main():
     ap.add_argument("--error-model", default=None,
                     help="apply the skeleton network's errors (tools/gesture/error_model_movenet.yaml) to the training sets")
     ap.add_argument("--error-model-seed", type=int, default=11)
-    ap.add_argument("--rendered", default=None, help="rendered TUNING sets to train on, comma-separated directories")
+    ap.add_argument("--rendered", default=None, help="rendered training (3800-3899) or tuning sets to train on, comma-separated directories")
     ap.add_argument("--rendered-repeat", type=int, default=1)
     ap.add_argument("--reference", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "test", "data",
                                                        "gesture", "lstm_reference.csv"),
