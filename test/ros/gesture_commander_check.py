@@ -17,7 +17,7 @@ from geometry_msgs.msg import Pose
 from sensor_msgs.msg import CameraInfo
 
 import rospy
-from gesture_formation.msg import FormationCommand, GestureObservation, GestureStatus
+from gesture_formation.msg import FormationCommand, GestureObservation, GestureStatus, LeadershipState
 
 IN_ENVELOPE = (10.0, 11.0)    # distance [m], elevation [deg]: the leader's Table II geometry
 OUTSIDE = (30.0, 11.0)        # beyond the classifier's validated 5..20 m
@@ -88,7 +88,7 @@ def skeleton_fields(azimuth_deg, arm):
 def main():
     rospy.init_node("gesture_commander_check")
     pubs, commands, statuses = {}, {}, {}
-    for name in ("single", "voted", "confirm3d", "lagged", "nolag"):
+    for name in ("single", "voted", "confirm3d", "lagged", "nolag", "lead"):
         pubs[name] = (rospy.Publisher("/%s/observation" % name, GestureObservation, queue_size=50),
                       rospy.Publisher("/%s/peer_observations" % name, GestureObservation, queue_size=50))
         commands[name], statuses[name] = [], []
@@ -194,6 +194,27 @@ def main():
     check(len(commands["lagged"]) == 1 and len(fired) == 1 and fired[0].agreeing_views == 2,
           "fusion_lag_s 0.8, follower 1 0.47 s late: %d command(s)%s (expected 1, 2 agreeing)" % (
               len(commands["lagged"]), ", fired with %d agreeing" % fired[0].agreeing_views if fired else ""))
+    # ~leadership: acting in term 1, then its lease lapses (same term, still the term's leader): it
+    # votes on (the FormationPlanner keeps what it sends until the lease is back); a newer term with
+    # another leader: no vote; acting again in term 3: votes.
+    lead_pub = rospy.Publisher("/lead/leadership_state", LeadershipState, queue_size=5, latch=True)
+
+    def lead_state(term, leader, role, acting):
+        m = LeadershipState(uav_index=0, term=term, leader=leader, role=role, acting=acting)
+        m.header.stamp = rospy.Time.now()
+        lead_pub.publish(m)
+        time.sleep(0.5)
+
+    lead_state(1, 0, LeadershipState.ROLE_LEADER, True)
+    lead_state(1, 0, LeadershipState.ROLE_LEADER, False)
+    inject("lead", [0, 1], IN_ENVELOPE)
+    check(len(commands["lead"]) == 1, "~leadership, its lease lapsed in the term it acts in: %d command(s) (expected 1)" % len(commands["lead"]))
+    lead_state(2, 1, LeadershipState.ROLE_FOLLOWER, False)
+    inject("lead", [0, 1], IN_ENVELOPE)
+    check(len(commands["lead"]) == 1, "~leadership, a newer term led by UAV 1: %d command(s) in total (expected still 1)" % len(commands["lead"]))
+    lead_state(3, 0, LeadershipState.ROLE_LEADER, True)
+    inject("lead", [0, 1], IN_ENVELOPE)
+    check(len(commands["lead"]) == 2, "~leadership, acting again in term 3: %d command(s) in total (expected 2)" % len(commands["lead"]))
     return fails
 
 
