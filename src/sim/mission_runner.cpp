@@ -155,6 +155,8 @@ class MissionRun {
   void control(double t, double dt);
   void applyCommand(std::size_t record, const formation::FormationCommand& cmd, double t);
   void applyOperatorMessage(const OperatorMessage& msg, double t);
+  /// A command sent at `sent_s` is older than faults.max_command_age_s at `t`: counted, its record "stale".
+  bool staleAt(std::size_t record, double sent_s, double t);
   void setMode(int i, double t, const std::string& mode, const std::string& reason);
   void deliverAbort(double t);
   void receiveAbort(int i, const planning::AbortCommand& command, double t);
@@ -521,13 +523,16 @@ void MissionRun::deliverOperatorMessages(double t) {
   }
 }
 
+bool MissionRun::staleAt(std::size_t record, double sent_s, double t) {
+  if (t - sent_s <= cfg_.faults.max_command_age_s) return false;  // never act on a command older than its age
+  ++M_.commands_stale;
+  RequestRecord& rec = metrics_.request(record);
+  if (rec.status == "lost") rec.status = "stale";
+  return true;
+}
+
 void MissionRun::applyOperatorMessage(const OperatorMessage& msg, double t) {
-  RequestRecord& rec = metrics_.request(msg.record);
-  if (t - msg.sent_s > cfg_.faults.max_command_age_s) {  // never act on a command older than its age
-    ++M_.commands_stale;
-    if (rec.status == "lost") rec.status = "stale";
-    return;
-  }
+  if (staleAt(msg.record, msg.sent_s, t)) return;
   if (assistance_.refusal(formation::CommandSource::kOperator)) return;  // never: the operator's pass (counted)
   applyCommand(msg.record, msg.command, t);
 }
@@ -701,12 +706,7 @@ void MissionRun::actOnFrames(double t, const std::vector<gesture::GestureFrame>&
     };
     if (f.action != nullptr && f.action->kind != gesture::GestureAction::Kind::kEvent) {
       keepOrDo([this, record, fired_s = t, cmd = gesture::toCommand(*f.action, ++gesture_seq_)](double now) {
-        if (now - fired_s > cfg_.faults.max_command_age_s) {  // never act on a command older than its age
-          ++M_.commands_stale;
-          RequestRecord& rec = metrics_.request(record);
-          if (rec.status == "lost") rec.status = "stale";
-          return;
-        }
+        if (staleAt(record, fired_s, now)) return;
         if (assistance_.refusal(formation::CommandSource::kGesture)) {  // the views are held until acknowledged
           metrics_.requestOutcome(record, formation::toString(formation::CommandStatus::kRejected), now, 0, {});
           return;

@@ -18,9 +18,12 @@ GFCTL=$1
 SRC=$2
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
-"$GFCTL" simulate --scenario "$SRC/config/scenarios/power_towers.yaml" --fault-profile loss50 \
-  --out "$TMP/run" --seed 26 --duration 300 --threads 1 --no-plot > "$TMP/run.log" 2>&1 \
-  || { echo "FAIL: gfctl exited $?"; cat "$TMP/run.log"; exit 1; }
+simulate() {  # simulate SEED DURATION DIR: the power-tower mission under loss50
+  "$GFCTL" simulate --scenario "$SRC/config/scenarios/power_towers.yaml" --fault-profile loss50 \
+    --out "$3" --seed "$1" --duration "$2" --threads 1 --no-plot > "$3.log" 2>&1 \
+    || { echo "FAIL: gfctl exited $? (seed $1)"; cat "$3.log"; exit 1; }
+}
+simulate 26 300 "$TMP/run"
 python3 - "$TMP/run" <<'PY'
 import csv, json, sys
 d = sys.argv[1]
@@ -47,9 +50,7 @@ PY
 # arrives; it acts again in the same term a moment later. It keeps the request and applies it then
 # (onboard::ParamsOwnership::keepsCommand): every operator request of the run applied (at 093ec9f the
 # request of 20 s was lost).
-"$GFCTL" simulate --scenario "$SRC/config/scenarios/power_towers.yaml" --fault-profile loss50 \
-  --out "$TMP/run23" --seed 23 --duration 45 --threads 1 --no-plot > "$TMP/run23.log" 2>&1 \
-  || { echo "FAIL: gfctl exited $?"; cat "$TMP/run23.log"; exit 1; }
+simulate 23 45 "$TMP/run23"
 python3 - "$TMP/run23" <<'PY'
 import csv, json, sys
 d = sys.argv[1]
@@ -68,9 +69,7 @@ PY
 # Seed 2 to 90 s: the worker's first gesture fires at 75.33 s while UAV 0's lease has lapsed
 # (75.14-76.82 s); the command waits and is applied when it acts again in the same term (at 093ec9f it
 # was lost; the filter re-arms only after the gesture is released, so it never fired again).
-"$GFCTL" simulate --scenario "$SRC/config/scenarios/power_towers.yaml" --fault-profile loss50 \
-  --out "$TMP/run2" --seed 2 --duration 90 --threads 1 --no-plot > "$TMP/run2.log" 2>&1 \
-  || { echo "FAIL: gfctl exited $?"; cat "$TMP/run2.log"; exit 1; }
+simulate 2 90 "$TMP/run2"
 python3 - "$TMP/run2" <<'PY'
 import csv, json, sys
 d = sys.argv[1]
