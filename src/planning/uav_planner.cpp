@@ -155,6 +155,7 @@ void UavPlanner::reset() {
   flown_ = PlannedTrajectory{};
   tracking_deviation_m_ = 0.0;
   wind_speeds_.clear();
+  mean_wind_.setZero();
   sequence_ = 0;
 }
 
@@ -174,15 +175,21 @@ void UavPlanner::updateTrackingAllowance(const PlanRequest& req) {
 double UavPlanner::updateWindAllowance(const PlanRequest& req) {
   if (!std::isfinite(req.t_now_s)) return 0.0;
   // A clock that jumps back (a restarted simulation, a replayed bag) starts a new window.
-  if (!wind_speeds_.empty() && req.t_now_s < wind_speeds_.back().first) wind_speeds_.clear();
+  if (!wind_speeds_.empty() && req.t_now_s < wind_speeds_.back().t_s) wind_speeds_.clear();
   const Eigen::Vector3d& w = req.wind_estimate_mps;
-  if (w.head<2>().allFinite()) wind_speeds_.emplace_back(req.t_now_s, w.head<2>().norm());
-  while (!wind_speeds_.empty() && wind_speeds_.front().first < req.t_now_s - config_.wind_window_s) {
+  if (w.head<2>().allFinite()) wind_speeds_.push_back({req.t_now_s, w.head<2>()});
+  while (!wind_speeds_.empty() && wind_speeds_.front().t_s < req.t_now_s - config_.wind_window_s) {
     wind_speeds_.pop_front();
   }
+  mean_wind_.setZero();
   if (wind_speeds_.empty()) return 0.0;
   double peak = 0.0;
-  for (const auto& [t, v] : wind_speeds_) peak = std::max(peak, v);
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  for (const auto& e : wind_speeds_) {
+    peak = std::max(peak, e.horizontal_mps.norm());
+    sum += e.horizontal_mps;
+  }
+  mean_wind_.head<2>() = sum / static_cast<double>(wind_speeds_.size());
   return std::clamp(config_.wind_allowance_m_per_mps * (peak - config_.wind_allowance_from_mps), 0.0,
                     config_.wind_allowance_max_m);
 }
@@ -461,6 +468,8 @@ struct UavPlanner::PlanContext {
   const PlanRequest& req;
   Clock::time_point t_start;
   double allowance = 0.0;  ///< tracking + wind allowance added to the planning clearances
+  double wind_allowance = 0.0;  ///< the wind's part of it (PlanResult::wind_allowance_m)
+  Eigen::Vector3d downwind = Eigen::Vector3d::Zero();  ///< horizontal unit vector of the window's mean wind estimate
   double res = 0.0;        ///< map resolution
   double dt = 0.0;
   int N = 0;  ///< intervals of the horizon
@@ -539,6 +548,8 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
                              config_.tracking_allowance_max_m + wind_allowance);
   result.tracking_allowance_m = ctx.allowance;
   result.wind_allowance_m = wind_allowance;
+  ctx.wind_allowance = wind_allowance;
+  if (wind_allowance > 0.0 && mean_wind_.norm() > 1e-6) ctx.downwind = mean_wind_.normalized();
   const auto finish = [&](PlanResult r) {
     flown_ = r.trajectory;
     r.timings.total_ms = msSince(ctx.t_start);
@@ -833,12 +844,17 @@ void UavPlanner::addCorridorRows(PlanContext& c, PlanResult& result) const {
     const int s_prev = c.seg[static_cast<std::size_t>(k) - 1], s_cur = c.seg[static_cast<std::size_t>(k)];
     for (int s : {s_prev, s_cur}) {
       const Polytope& P = c.corridors[static_cast<std::size_t>(s)].polytope;
-      const double cap = std::min(c.allowance, c.corridors[static_cast<std::size_t>(s)].clearance_m - verify_clear);
+      // Not the wind's part: that is kept for the gust still to come (docs/safety.md §4.13).
+      const double cap = std::min(c.allowance - c.wind_allowance, c.corridors[static_cast<std::size_t>(s)].clearance_m - verify_clear);
       auto& rows_least = least[static_cast<std::size_t>(s)];
       if (rows_least.empty()) rows_least.resize(static_cast<std::size_t>(P.rows()));
       for (int r = 0; r < P.rows(); ++r) {
         const Eigen::Vector3d a = P.A.row(r).transpose();
         double b = P.b(r) - config_.corridor_margin_m;
+        // A plane downwind keeps the wind allowance once more: gusts push along the mean wind
+        // (docs/safety.md §4.13). A start already inside that band must only not get closer.
+        const double downwind = c.wind_allowance * std::max(0.0, a.dot(c.downwind));
+        if (downwind > 0.0) b = std::min(b, std::max(b - downwind, a.dot(c.p0)));
         if (a.dot(c.p0) + reach < b) continue;  // unreachable plane
         Reach& lr = rows_least[static_cast<std::size_t>(r)];
         if (lr.full.empty()) lr.full = leastReach(a, c.p0, qp.v0, qp.a0, qp.velocity, qp.acceleration, 1.0, c.dt, c.N);

@@ -232,8 +232,14 @@ class UavPlanner {
   PlannedTrajectory flown_;
   double tracking_deviation_m_ = 0.0;
   double allowance_t_s_ = 0.0;
-  /// Horizontal wind-estimate speeds (t, m/s) of the last wind_window_s, for the wind allowance.
-  std::deque<std::pair<double, double>> wind_speeds_;
+  /// Horizontal wind estimates of the last wind_window_s: their peak speed sizes the wind
+  /// allowance, their mean gives the downwind direction (docs/safety.md §4.7, §4.13).
+  struct WindSample {
+    double t_s = 0.0;
+    Eigen::Vector2d horizontal_mps = Eigen::Vector2d::Zero();
+  };
+  std::deque<WindSample> wind_speeds_;
+  Eigen::Vector3d mean_wind_ = Eigen::Vector3d::Zero();  ///< horizontal mean of the window (z = 0)
   std::uint32_t sequence_ = 0;
   bool keep_last_qp_ = false;
   std::unique_ptr<TrajectoryQpProblem> last_qp_;
