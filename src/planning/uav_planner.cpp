@@ -632,6 +632,7 @@ void UavPlanner::projectReferences(PlanContext& c, PlanResult& result) const {
         moved = true;
       }
     }
+    if (c.has_worker && aroundSilentUavs(c, k, r)) moved = true;
     const auto proj = projectToClearance(*field_, *map_, r, c.path_clear, config_.max_projection_m);
     if (proj) {
       moved = moved || (*proj - r).norm() > 1e-9;
@@ -643,6 +644,46 @@ void UavPlanner::projectReferences(PlanContext& c, PlanResult& result) const {
     if (moved) ++result.projected_references;
     c.ref[static_cast<std::size_t>(k)] = r;
   }
+}
+
+bool UavPlanner::aroundSilentUavs(const PlanContext& c, int k, Eigen::Vector3d& r) const {
+  // A UAV silent for as long as its keep-out's bound (docs/safety.md §1.3) hovers where its last
+  // plan ended, and a reference there can never be reached: the UAV would press against the
+  // keep-out wherever the QP leaves it (a new leader whose slot the silent old leader still holds:
+  // 16 m from the worker at his feet's height, outside the cameras' envelope; §1.2). Such a
+  // reference turns about the vertical through the worker — distance and elevation kept, so the
+  // view stays in the envelope — by the least angle (5° steps, the side the UAV is on first) that
+  // takes it out of every silent UAV's keep-out + buffer.
+  const double t = c.req.t_now_s + k * c.dt;
+  const double bound = uavKeepOutDistance(config_, std::numeric_limits<double>::infinity());
+  std::vector<std::pair<Eigen::Vector3d, double>> silent;  // position at t, distance kept
+  for (const auto& other : c.req.higher_priority_plans) {
+    if (other.empty() || !(uavKeepOutDistance(config_, c.req.t_now_s - other.t0_s) >= bound - 1e-9)) continue;
+    silent.emplace_back(evaluateTrajectory(other, t).p, bound + config_.qp_distance_buffer_m);
+  }
+  const auto clear = [&](const Eigen::Vector3d& q) {
+    for (const auto& [o, d] : silent) {
+      if ((q - o).norm() < d) return false;
+    }
+    return true;
+  };
+  if (silent.empty() || clear(r)) return false;
+  const Eigen::Vector3d w = c.req.worker.p_world.col(k);
+  const Eigen::Vector3d d = r - w;
+  const Eigen::Vector2d from_w(c.p0.x() - w.x(), c.p0.y() - w.y());
+  const double side = d.x() * from_w.y() - d.y() * from_w.x() >= 0.0 ? 1.0 : -1.0;  // towards the UAV's azimuth
+  constexpr double kStep = 5.0 * M_PI / 180.0;
+  for (int i = 1; i * kStep <= M_PI + 1e-9; ++i) {
+    for (double sgn : {side, -side}) {
+      const double a = sgn * i * kStep;
+      const Eigen::Vector3d q = w + Eigen::Vector3d(std::cos(a) * d.x() - std::sin(a) * d.y(), std::sin(a) * d.x() + std::cos(a) * d.y(), d.z());
+      if (clear(q)) {
+        r = q;
+        return true;
+      }
+    }
+  }
+  return false;  // nowhere around the worker: the QP's rows keep it out
 }
 
 void UavPlanner::planPath(PlanContext& c, PlanResult& result) const {

@@ -1464,6 +1464,33 @@ TEST(UavPlannerTest, KeepOutOfAnOldPlanStopsGrowingAtItsBound) {
 // A UAV silent for 60 s (its last plan ended 52 s ago: it hovers at the plan's end) is kept out of
 // its hover point by Γ_dis + age_margin_max_m — not of a 300-m ball (Γ_dis + 5 m/s · 60 s), which
 // the unbounded rule asked and which pushed the formation 30 m off (leader_dropout_60s seed 2).
+// docs/safety.md §1.2: a UAV silent for longer than its keep-out's bound hovers where its last plan
+// ended; a reference there (the new leader's slot, still held by the silent old leader) turns about
+// the vertical through the worker out of its keep-out, so the view keeps its distance and height.
+// Without the turn the UAV stays where the keep-out stops it, 17.5 m from the worker (horizontal).
+TEST(UavPlannerTest, AReferenceHeldByASilentUavTurnsAboutTheWorker) {
+  const World& w = towers();
+  const double t = 60.0;
+  const Eigen::Vector3d worker(25, -12, 1), to(25, -2, 6), from(25, 6, 6);  // open ground between the towers
+  const PlannerConfig cfg = testConfig();
+  const double keep = uavKeepOutDistance(cfg, t);
+  UavPlanner p(cfg, w.map, w.field);
+  auto req = straightRequest(1, t, stateAt(from, t), to, to, 1.5, worker);
+  req.higher_priority_plans = {standingPlan(0, to, 0.0)};  // silent for 60 s, hovering at the reference
+  PlanResult r;
+  for (int i = 0; i < 4; ++i) {  // 4 replannings, the UAV on its plan
+    r = p.plan(req);
+    ASSERT_EQ(r.status, PlanStatus::kOptimized) << r.reason;
+    req.t_now_s += 2.0;
+    req.state = stateAt(evaluateTrajectory(r.trajectory, req.t_now_s).p, req.t_now_s);
+  }
+  const Eigen::Vector3d end = r.trajectory.samples.back().p_world;
+  EXPECT_NEAR((end - worker).head<2>().norm(), 10.0, 1.0) << end.transpose();
+  EXPECT_NEAR(end.z(), to.z(), 0.5) << end.transpose();
+  EXPECT_GT(r.projected_references, 0);
+  for (const auto& s : r.trajectory.samples) EXPECT_GE((s.p_world - to).norm(), keep - 1e-3);
+}
+
 TEST(UavPlannerTest, UavSilentFor60sIsKeptOutOfItsHoverPointOnly) {
   const World& w = towers();
   const double t = 60.0;
