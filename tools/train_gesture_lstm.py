@@ -21,7 +21,7 @@ clean), and --rendered DIR,... adds the skeletons MoveNet extracted from rendere
 training sets of protocol version 5 (seeds 3800-3899, `gfctl render-gestures --window-only`) or a
 tuning set (then no longer judged out-of-sample on it) — all their views; sets of the held-out
 protocol's seed range are refused,
-each window --rendered-repeat times. --init-onnx FILE fine-tunes from an exported model's weights
+each window --rendered-repeat times (those labelled none --rendered-none-repeat times more). --init-onnx FILE fine-tunes from an exported model's weights
 (e.g. the shipped one) instead of a random start.
 """
 import re
@@ -84,8 +84,9 @@ def load_onnx_weights(model, path):
         model.head.bias.copy_(torch.from_numpy(np.array(init[gemm.input[2]])))
 
 
-def rendered_windows(dirs, repeat):
-    """Windows of rendered training or tuning sets (every view's skeletons*.csv), each repeated `repeat` times."""
+def rendered_windows(dirs, repeat, none_repeat=1):
+    """Windows of rendered training or tuning sets (every view's skeletons*.csv), each repeated `repeat` times,
+    those labelled none `repeat` x `none_repeat` times."""
     xs, ys, info = [], [], []
     for d in dirs:
         m = re.search(r"_seed(\d+)_", os.path.basename(os.path.normpath(d)) + "_")
@@ -95,8 +96,8 @@ def rendered_windows(dirs, repeat):
             raise ValueError(f"--rendered {d}: seed {m.group(1)} belongs to the held-out protocol (9000-9999)")
         for f in sorted(n for n in os.listdir(d) if re.fullmatch(r"skeletons(_view\d+)?\.csv", n)):
             x, y, _ = gesture_data.windows(gesture_data.load_frames(d, f))
-            xs += [x] * repeat
-            ys += [y] * repeat
+            xs += [x] * repeat + [x[y == 0]] * (repeat * (none_repeat - 1))
+            ys += [y] * repeat + [y[y == 0]] * (repeat * (none_repeat - 1))
             info.append({"dir": os.path.basename(os.path.normpath(d)), "file": f, "windows": int(len(x))})
     return np.concatenate(xs), np.concatenate(ys), info
 
@@ -143,6 +144,8 @@ def main():
     ap.add_argument("--error-model-seed", type=int, default=11)
     ap.add_argument("--rendered", default=None, help="rendered training (3800-3899) or tuning sets to train on, comma-separated directories")
     ap.add_argument("--rendered-repeat", type=int, default=1)
+    ap.add_argument("--rendered-none-repeat", type=int, default=1,
+                    help="the rendered windows labelled none (work motions, the moves into and out of a gesture) this many times more")
     ap.add_argument("--reference", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "test", "data",
                                                        "gesture", "lstm_reference.csv"),
                     help="where the C++/OpenCV equality reference is written")
@@ -166,7 +169,9 @@ def main():
         xtr, ytr, changed = np.concatenate([xtr, xex]), np.concatenate([ytr, yex]), changed + changed_ex
     rendered_info = []
     if a.rendered:
-        xre, yre, rendered_info = rendered_windows(a.rendered.split(","), a.rendered_repeat)
+        if a.rendered_none_repeat < 1:
+            sys.exit(f"--rendered-none-repeat must be >= 1, got {a.rendered_none_repeat}")
+        xre, yre, rendered_info = rendered_windows(a.rendered.split(","), a.rendered_repeat, a.rendered_none_repeat)
         xtr, ytr = np.concatenate([xtr, xre]), np.concatenate([ytr, yre])
     xva, yva, _ = gesture_data.windows(gesture_data.load_frames(val_dir))
     print(f"windows: train {len(xtr)} {np.bincount(ytr, minlength=5).tolist()}, val {len(xva)} "
@@ -232,7 +237,8 @@ def main():
         "learning_rate": a.lr, "threads": a.threads,
         "error_model": ({"file": os.path.basename(a.error_model), "sha256": sha256(a.error_model), "seed": a.error_model_seed,
                          "sequences_changed": int(changed)} if em_cfg else None),
-        "rendered": ({"sets": rendered_info, "repeat": a.rendered_repeat} if a.rendered else None),
+        "rendered": ({"sets": rendered_info, "repeat": a.rendered_repeat, "none_repeat": a.rendered_none_repeat}
+                     if a.rendered else None),
         "validation": {"seed": a.val_seed, "sequences": a.val_count, "windows": int(len(xva)),
                        "accuracy": history[-1]["val_accuracy"]},
         "torch_seed": a.torch_seed, "epochs": a.epochs, "hidden": a.hidden, "torch": torch.__version__,
