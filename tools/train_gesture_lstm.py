@@ -21,8 +21,9 @@ clean), and --rendered DIR,... adds the skeletons MoveNet extracted from rendere
 training sets of protocol version 5 (seeds 3800-3899, `gfctl render-gestures --window-only`) or a
 tuning set (then no longer judged out-of-sample on it) — all their views; sets of the held-out
 protocol's seed range are refused,
-each window --rendered-repeat times (those labelled none --rendered-none-repeat times more). --init-onnx FILE fine-tunes from an exported model's weights
-(e.g. the shipped one) instead of a random start.
+each window --rendered-repeat times (those labelled none --rendered-none-repeat times more).
+--init-onnx FILE fine-tunes from an exported model's weights (e.g. the shipped one) instead of a
+random start.
 """
 import re
 import argparse

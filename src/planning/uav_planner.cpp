@@ -8,6 +8,8 @@
 #include <cmath>
 #include <sstream>
 
+#include <Eigen/Geometry>
+
 #include "gesture_formation/common/angles.hpp"
 #include "gesture_formation/planning/camera_tracking.hpp"
 #include "gesture_formation/planning/corridor_builder.hpp"
@@ -616,6 +618,12 @@ std::string UavPlanner::runStages(PlanContext& ctx, PlanResult& result) {
 void UavPlanner::projectReferences(PlanContext& c, PlanResult& result) const {
   const PlanRequest& req = c.req;
   c.ref.assign(static_cast<std::size_t>(c.N) + 1, c.p0);
+  // The UAVs silent for as long as their keep-out's bound (aroundSilentUavs).
+  std::vector<const PlannedTrajectory*> silent;
+  const double bound = uavKeepOutDistance(config_, std::numeric_limits<double>::infinity());
+  for (const auto& other : req.higher_priority_plans) {
+    if (!other.empty() && uavKeepOutDistance(config_, req.t_now_s - other.t0_s) >= bound - 1e-9) silent.push_back(&other);
+  }
   for (int k = 1; k <= c.N; ++k) {
     Eigen::Vector3d r = req.reference.p_world.col(k);
     bool moved = false;
@@ -632,7 +640,7 @@ void UavPlanner::projectReferences(PlanContext& c, PlanResult& result) const {
         moved = true;
       }
     }
-    if (c.has_worker && aroundSilentUavs(c, k, r)) moved = true;
+    if (c.has_worker && aroundSilentUavs(c, silent, k, r)) moved = true;
     const auto proj = projectToClearance(*field_, *map_, r, c.path_clear, config_.max_projection_m);
     if (proj) {
       moved = moved || (*proj - r).norm() > 1e-9;
@@ -646,7 +654,8 @@ void UavPlanner::projectReferences(PlanContext& c, PlanResult& result) const {
   }
 }
 
-bool UavPlanner::aroundSilentUavs(const PlanContext& c, int k, Eigen::Vector3d& r) const {
+bool UavPlanner::aroundSilentUavs(const PlanContext& c, const std::vector<const PlannedTrajectory*>& silent, int k,
+                                  Eigen::Vector3d& r) const {
   // A UAV silent for as long as its keep-out's bound (docs/safety.md §1.3) hovers where its last
   // plan ended, and a reference there can never be reached: the UAV would press against the
   // keep-out wherever the QP leaves it (a new leader whose slot the silent old leader still holds:
@@ -654,20 +663,15 @@ bool UavPlanner::aroundSilentUavs(const PlanContext& c, int k, Eigen::Vector3d& 
   // reference turns about the vertical through the worker — distance and elevation kept, so the
   // view stays in the envelope — by the least angle (5° steps, the side the UAV is on first) that
   // takes it out of every silent UAV's keep-out + buffer.
+  if (silent.empty()) return false;
   const double t = c.req.t_now_s + k * c.dt;
-  const double bound = uavKeepOutDistance(config_, std::numeric_limits<double>::infinity());
-  std::vector<std::pair<Eigen::Vector3d, double>> silent;  // position at t, distance kept
-  for (const auto& other : c.req.higher_priority_plans) {
-    if (other.empty() || !(uavKeepOutDistance(config_, c.req.t_now_s - other.t0_s) >= bound - 1e-9)) continue;
-    silent.emplace_back(evaluateTrajectory(other, t).p, bound + config_.qp_distance_buffer_m);
-  }
+  const double keep = uavKeepOutDistance(config_, std::numeric_limits<double>::infinity()) + config_.qp_distance_buffer_m;
+  std::vector<Eigen::Vector3d> at_t;
+  for (const PlannedTrajectory* other : silent) at_t.push_back(evaluateTrajectory(*other, t).p);
   const auto clear = [&](const Eigen::Vector3d& q) {
-    for (const auto& [o, d] : silent) {
-      if ((q - o).norm() < d) return false;
-    }
-    return true;
+    return std::all_of(at_t.begin(), at_t.end(), [&](const Eigen::Vector3d& o) { return (q - o).norm() >= keep; });
   };
-  if (silent.empty() || clear(r)) return false;
+  if (clear(r)) return false;
   const Eigen::Vector3d w = c.req.worker.p_world.col(k);
   const Eigen::Vector3d d = r - w;
   const Eigen::Vector2d from_w(c.p0.x() - w.x(), c.p0.y() - w.y());
@@ -675,8 +679,7 @@ bool UavPlanner::aroundSilentUavs(const PlanContext& c, int k, Eigen::Vector3d& 
   constexpr double kStep = 5.0 * M_PI / 180.0;
   for (int i = 1; i * kStep <= M_PI + 1e-9; ++i) {
     for (double sgn : {side, -side}) {
-      const double a = sgn * i * kStep;
-      const Eigen::Vector3d q = w + Eigen::Vector3d(std::cos(a) * d.x() - std::sin(a) * d.y(), std::sin(a) * d.x() + std::cos(a) * d.y(), d.z());
+      const Eigen::Vector3d q = w + Eigen::AngleAxisd(sgn * i * kStep, Eigen::Vector3d::UnitZ()) * d;
       if (clear(q)) {
         r = q;
         return true;

@@ -210,9 +210,10 @@ class UavPlanner {
   std::optional<PlannedTrajectory> separateHoldPoint(const PlanRequest& request, const PlannedTrajectory& hold,
                                                      std::string& why) const;
   void aimCamera(const PlanRequest& request, PlannedTrajectory& trajectory) const;
-  /// Reference step k turned about the worker out of the keep-out of every UAV silent for as long
-  /// as its keep-out's bound (docs/safety.md §1.2); true when it moved.
-  bool aroundSilentUavs(const PlanContext& c, int k, Eigen::Vector3d& r) const;
+  /// Reference step k turned about the worker out of the keep-out of the `silent` UAVs' plans
+  /// (silent for as long as their keep-out's bound; docs/safety.md §1.2); true when it moved.
+  bool aroundSilentUavs(const PlanContext& c, const std::vector<const PlannedTrajectory*>& silent, int k,
+                        Eigen::Vector3d& r) const;
   void updateTrackingAllowance(const PlanRequest& request);
   /// Records request.wind_estimate_mps; returns the wind allowance (PlannerConfig::wind_allowance_*).
   double updateWindAllowance(const PlanRequest& request);
