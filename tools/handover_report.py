@@ -16,7 +16,8 @@ seeds both stores hold, the medians and extremes of the tracking and safety figu
 (e.g. before / after a planner change).
 
   tools/handover_report.py --store FILE [--out docs/results/leader_handover.md] [--commit PREFIX]
-                           [--load "1-min load 8-12 on 2 cores"] [--baseline FILE --baseline-commit PREFIX]
+                           [--load "2 workers at a time, 1-min load 8-12 on 2 cores"]
+                           [--baseline FILE --baseline-commit PREFIX]
 """
 import argparse
 import datetime
@@ -133,7 +134,8 @@ def main(argv=None):
     ap.add_argument("--store", required=True)
     ap.add_argument("--out", default="docs/results/leader_handover.md")
     ap.add_argument("--commit", default="", help="only missions of source commits starting with this")
-    ap.add_argument("--load", default="not recorded", help="the machine load while the missions ran")
+    ap.add_argument("--load", default="not recorded",
+                    help="the machine load while the missions ran (and how many ran at a time, niced or not)")
     ap.add_argument("--baseline", default="", help="a store to compare with (its leader_dropout missions)")
     ap.add_argument("--baseline-commit", default="", help="only baseline missions of source commits starting with this")
     a = ap.parse_args(argv)
@@ -151,8 +153,8 @@ def main(argv=None):
         f"`{os.path.basename(a.store)}`, commit(s) {', '.join(commits) or 'none'}; missions finished "
         f"{times[0] if times else '-'} .. {times[-1] if times else '-'}. Mission: `config/scenarios/power_towers.yaml` with "
         "`config/faults/leader_dropout_{5s,60s,for_good}.yaml` (at 60 s the acting leader's radio dies for 5 s, 60 s, "
-        "for good), run to 240 s (`config/campaigns/mission_safety.yaml`, `gfctl simulate --threads 1`, one mission at a "
-        f"time, nice). Machine load: {a.load}. Failed attempts stored: {len(fails)}. What the UAVs do: "
+        "for good), run to 240 s (`config/campaigns/mission_safety.yaml`, `gfctl simulate --threads 1`). "
+        f"Machine load: {a.load}. Failed attempts stored: {len(fails)}. What the UAVs do: "
         "[safety.md](../safety.md) §1.2.",
         "",
         f"Limit for a new leader: silence_limit_s + candidacy_stagger_s + 2 election_timeout_s = {LIMIT_S:.1f} s "
