@@ -62,6 +62,7 @@ void ReplanStep::restart(std::unique_ptr<Planner> planner) {
   flown_ = PlannedTrajectory{};
   listen_since_s_ = std::numeric_limits<double>::quiet_NaN();
   listening_ = true;
+  flying_backoff_ = false;
 }
 
 std::string ReplanStep::listeningHold(double t_s, const std::vector<std::optional<ReceivedPlan>>* received) {
@@ -208,9 +209,17 @@ ReplanOutcome ReplanStep::step(const ReplanInputs& in) {
   req_in.hold_reference = choice.given ? &choice.reference : nullptr;  // also: avoid every received plan
   if (choice.camera_target.cols() > 0) req_in.camera_target = &choice.camera_target;
   req_in.rule = config_.rule;
-  const PlanRequest request = buildPlanRequest(req_in);
+  PlanRequest request = buildPlanRequest(req_in);
+  // A back-off is for an unseen worker's reach; once the UAV tracks (or holds) again, a failed plan
+  // brakes where it is rather than flying the back-off on, away from the worker and out of view.
+  request.reuse_previous = !flying_backoff_ || out.backing_off;
   out.reference = request.reference;
   out.result = planner_->plan(request);
+  if (out.backing_off) {
+    flying_backoff_ = !out.result.trajectory.empty();
+  } else if (out.result.status == PlanStatus::kOptimized) {
+    flying_backoff_ = false;
+  }
   // Holding and aborting UAVs have right of way: nobody counts on them to dodge.
   out.fallback = out.result.status != PlanStatus::kOptimized || choice.given;
   flown_ = out.result.trajectory;  // empty: the controller brakes to hover on its own

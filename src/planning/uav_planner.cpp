@@ -360,6 +360,8 @@ PlanResult UavPlanner::fallback(const PlanRequest& req, PlanResult result, const
   std::string why_not;
   if (last_verified_.empty()) {
     why_not = "no previous plan";
+  } else if (!req.reuse_previous) {
+    why_not = "previous plan is a back-off no longer needed";
   } else if (!std::isfinite(req.t_now_s) || last_verified_.tEnd() < req.t_now_s + config_.fallback_min_horizon_s) {
     std::ostringstream os;
     os << "previous plan ends at " << last_verified_.tEnd() << " s, before t_now + " << config_.fallback_min_horizon_s << " s";

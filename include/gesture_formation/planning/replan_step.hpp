@@ -221,6 +221,9 @@ class ReplanStep {
   std::optional<Eigen::Vector3d> home_;  ///< the take-off point (ReplanConfig::home_world or the first position)
   double listen_since_s_ = std::numeric_limits<double>::quiet_NaN();  ///< the first replanning since the (re)start
   bool listening_ = true;
+  /// The plan flown is a back-off's (since the last optimized plan of another mode): a UAV that no
+  /// longer backs off does not fall back to it (PlanRequest::reuse_previous).
+  bool flying_backoff_ = false;
 };
 
 }  // namespace gesture_formation::planning

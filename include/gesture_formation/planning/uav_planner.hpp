@@ -62,6 +62,10 @@ struct PlanRequest {
   /// `wind_estimation`); non-finite: none. Feeds the wind allowance
   /// (PlannerConfig::wind_allowance_*).
   Eigen::Vector3d wind_estimate_mps = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  /// False: a failed request brakes to hover instead of reusing the last verified plan — set by
+  /// planning::ReplanStep while that plan is a back-off from the worker's reach the UAV no longer
+  /// needs (it tracks again: flying the back-off on would carry it out of the camera's view).
+  bool reuse_previous = true;
 };
 
 enum class PlanStatus {

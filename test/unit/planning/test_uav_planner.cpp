@@ -388,6 +388,27 @@ TEST(UavPlannerTest, NanReferenceFallsBackToPreviousPlanThenBrake) {
   EXPECT_NE(n.reason.find("state.p_world"), std::string::npos) << n.reason;
 }
 
+// PlanRequest::reuse_previous false (ReplanStep: the plan flown is a back-off the UAV no longer
+// needs): the same failure brakes to hover instead of flying the previous plan on.
+TEST(UavPlannerTest, AFailedRequestThatMayNotReuseThePreviousPlanBrakes) {
+  const World& w = towers();
+  UavPlanner planner(testConfig(), w.map, w.field);
+  const Eigen::Vector3d from(-8, -12, 10), to(-2, -12, 10), worker(-5, -3, 1);
+  const PlanResult first = planner.plan(straightRequest(0, 0.0, stateAt(from), from, to, 1.5, worker));
+  ASSERT_EQ(first.status, PlanStatus::kOptimized) << first.reason;
+  PlanRequest bad = straightRequest(0, 0.4, advance(first.trajectory, 0.4), from, to, 1.5, worker);
+  bad.reference.p_world(1, 7) = std::numeric_limits<double>::quiet_NaN();
+  bad.reuse_previous = false;
+  const PlanResult r = planner.plan(bad);
+  EXPECT_EQ(r.status, PlanStatus::kFallbackBrake) << r.reason;
+  EXPECT_NE(r.reason.find("back-off no longer needed"), std::string::npos) << r.reason;
+  ASSERT_FALSE(r.trajectory.empty());
+  // It stops near where it is, not where the previous plan was going.
+  const Eigen::Vector3d stop = r.trajectory.samples.back().p_world;
+  EXPECT_LT((stop - bad.state.p_world).norm(), (evaluateTrajectory(first.trajectory, first.trajectory.tEnd()).p - bad.state.p_world).norm());
+  EXPECT_LT(r.trajectory.samples.back().v_world.norm(), 1e-6);
+}
+
 // A catch-up plan ends moving (the reference is far; the terminal velocity is only penalised).
 // Re-timed for a fallback it used to hover after its end — a velocity step of ~4 m/s within one
 // interval, which failed verification ("acceleration 26 m/s^2"), so a failed replanning braked

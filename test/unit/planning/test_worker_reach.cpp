@@ -302,6 +302,28 @@ TEST(ReplanStepReachTest, AHoldingFollowerBacksOffFromTheGrowingReachAlongAnOrdi
   EXPECT_TRUE(back.backoff.empty());
 }
 
+// Power towers, leader_dropout seed 51: a follower backing off became the leader and tracked again,
+// its track plans failed for 5.6 s and each failure flew the back-off on — 10 m further and 7 m
+// lower, out of the camera's view of the worker, who was then lost for the rest of the mission. A
+// back-off is not the fallback of a UAV that no longer backs off: its failed plans brake.
+TEST(ReplanStepReachTest, AUavThatNoLongerBacksOffDoesNotFallBackToTheBackOff) {
+  HoldingFollower f(reachConfig());
+  const Eigen::Vector3d p(0.0, -8.0, 1.9);
+  f.at(0.0, p);
+  f.at(2.0, p);
+  EXPECT_TRUE(f.log->back().reuse_previous);  // tracking: the previous plan is an ordinary fallback
+  ASSERT_TRUE(f.at(3.2, p).backing_off);
+  EXPECT_TRUE(f.log->back().reuse_previous);  // backing off: its own plan may be flown on
+  ASSERT_TRUE(f.at(3.6, p).backing_off);
+  EXPECT_TRUE(f.log->back().reuse_previous);
+  f.w.stamp_s = f.w.fused_s = 4.0;
+  ASSERT_EQ(f.at(4.0, p).mode, pl::ReplanMode::kTrack);
+  EXPECT_FALSE(f.log->back().reuse_previous);  // the plan flown is the back-off: a failure brakes
+  f.w.stamp_s = f.w.fused_s = 4.4;
+  ASSERT_EQ(f.at(4.4, p).mode, pl::ReplanMode::kTrack);
+  EXPECT_TRUE(f.log->back().reuse_previous);  // an optimized track plan since: ordinary again
+}
+
 TEST(ReplanStepReachTest, WithAWalkingSpeedOfZeroTheHoldKeepsItsPoint) {
   pl::ReachConfig still = reachConfig();
   still.walking_speed_mps = 0.0;
