@@ -33,6 +33,8 @@ ArmMeasures measureArm(const Skeleton3D& s, const BodyFrame& f, bool left, const
   a.horizontal_abduction_deg = common::radToDeg(std::atan2(outward, std::abs(upper.x())));
   a.elbow_deg = angleDeg(s.p_world[sh] - s.p_world[el], s.p_world[wr] - s.p_world[el]);
   a.shoulder_wrist_elevation_deg = angleDeg(upper + fore, -Eigen::Vector3d::UnitZ());
+  const Eigen::Vector3d line = upper + fore;
+  a.shoulder_wrist_horizontal_deg = common::radToDeg(std::atan2(line.y() * (left ? 1.0 : -1.0), std::abs(line.x())));
   a.forearm_from_horizontal_deg = std::abs(common::radToDeg(std::asin(std::clamp(fore.normalized().z(), -1.0, 1.0))));
   a.wrist_height_H = height_H(s.p_world[wr]);
   a.wrist_body = R_body_world * (s.p_world[wr] - f.p_world_origin);
@@ -75,15 +77,16 @@ bool wristsNearMidline(const PoseMeasures& m, double max_offset_H) {
 Test palmsTolerant(const PoseMeasures& m, const GestureGeometryNumbers& n) {
   const TolerantGeometryNumbers& t = n.tolerant;
   if (!m.left.valid || !m.right.valid || m.wrist_separation_H > t.palms_max_separation_H ||
-      !wristsNearMidline(m, t.max_midline_offset_H)) {
+      !wristsNearMidline(m, t.max_midline_offset_H) ||
+      std::abs(0.5 * (m.left.wrist_body.y() + m.right.wrist_body.y())) > t.palms_max_centre_offset_H * m.height_m) {
     return Test::kOut;
   }
   const double mean = 0.5 * (m.left.wrist_height_H + m.right.wrist_height_H);
   if (mean <= t.tool_max_height_H) return Test::kNearMiss;  // a tool held in both hands, low
   if (mean < t.palms_min_height_H) return Test::kBand;
   const bool in_front = m.left.wrist_body.x() > 0.0 && m.right.wrist_body.x() > 0.0;
-  const bool level = m.left.forearm_from_horizontal_deg <= n.palms_forearm_max_from_horizontal_deg &&
-                     m.right.forearm_from_horizontal_deg <= n.palms_forearm_max_from_horizontal_deg;
+  const bool level = m.left.forearm_from_horizontal_deg <= t.palms_forearm_max_deg &&
+                     m.right.forearm_from_horizontal_deg <= t.palms_forearm_max_deg;
   return mean <= t.palms_max_height_H && in_front && level ? Test::kInside : Test::kOut;
 }
 
@@ -132,6 +135,24 @@ Test raiseTolerant(const ArmMeasures& a, const TolerantGeometryNumbers& t) {
   return Test::kOut;
 }
 
+/// Extend an arm read on the line shoulder → wrist (a sideways upper arm reads low, its elbow bent).
+Test extendTolerant(const ArmMeasures& a, const TolerantGeometryNumbers& t, double hanging_max_deg) {
+  if (!a.valid || a.shoulder_wrist_elevation_deg <= hanging_max_deg) return Test::kOut;
+  const double line = a.shoulder_wrist_elevation_deg, side = a.shoulder_wrist_horizontal_deg;
+  if (line >= 180.0 - t.pointing_max_shoulder_wrist_deg) return Test::kOut;  // an arm up: raise's business
+  if (line <= t.pointing_max_shoulder_wrist_deg || side <= t.pointing_max_shoulder_wrist_deg) return Test::kNearMiss;
+  if (line >= t.extend_min_shoulder_wrist_deg && line <= t.extend_max_shoulder_wrist_deg && side >= t.extend_min_horizontal_deg) {
+    return a.elbow_deg >= t.extend_min_elbow_deg ? Test::kInside : Test::kOut;
+  }
+  return Test::kBand;
+}
+
+/// Standing upright enough for a one-arm gesture (TolerantGeometryNumbers: unknown stance is not).
+bool upright(const PoseMeasures& m, const TolerantGeometryNumbers& t) {
+  return m.stance.valid && m.stance.trunk_tilt_deg <= t.one_arm_max_trunk_tilt_deg &&
+         m.stance.foot_offset_torso <= t.one_arm_max_foot_offset_torso;
+}
+
 }  // namespace
 
 const char* toString(GeometryRules r) {
@@ -172,6 +193,7 @@ PoseMeasures measurePose(const Skeleton3D& s, const GestureGeometryNumbers& n) {
   m.height_m = torso_m / span_H;
   m.left = measureArm(s, *frame, true, height_H);
   m.right = measureArm(s, *frame, false, height_H);
+  m.stance = stanceOf(s);
   if (m.left.valid && m.right.valid) {
     m.wrist_separation_H = (m.left.wrist_body - m.right.wrist_body).norm() / m.height_m;
     m.wrists_crossed = m.left.wrist_body.y() < 0.0 && m.right.wrist_body.y() > 0.0;
@@ -185,9 +207,15 @@ PoseVerdict classifyPose(const PoseMeasures& m, const GestureGeometryNumbers& n)
   const bool tolerant = n.rules == GeometryRules::kNetworkTolerant;
   const Test palms = tolerant ? palmsTolerant(m, n) : palmsTogether(m, n);
   const Test cross = tolerant ? crossTolerant(m, n) : crossArms(m, n);
-  const Test extend[2] = {extendArm(m.left, n), extendArm(m.right, n)};
-  const Test raise[2] = {tolerant ? raiseTolerant(m.left, n.tolerant) : raiseArm(m.left, n),
-                         tolerant ? raiseTolerant(m.right, n.tolerant) : raiseArm(m.right, n)};
+  Test extend[2] = {tolerant ? extendTolerant(m.left, n.tolerant, n.hanging_max_elevation_deg) : extendArm(m.left, n),
+                    tolerant ? extendTolerant(m.right, n.tolerant, n.hanging_max_elevation_deg) : extendArm(m.right, n)};
+  Test raise[2] = {tolerant ? raiseTolerant(m.left, n.tolerant) : raiseArm(m.left, n),
+                   tolerant ? raiseTolerant(m.right, n.tolerant) : raiseArm(m.right, n)};
+  if (tolerant && !upright(m, n.tolerant)) {  // a lunge's or a kick's arm: at most the band
+    for (Test* t : {&extend[0], &extend[1], &raise[0], &raise[1]}) {
+      if (*t == Test::kInside) *t = Test::kBand;
+    }
+  }
   // Gesture regions: each (gesture, arm) inside counts once; a one-arm gesture needs exactly one arm.
   std::multiset<int> inside;
   if (palms == Test::kInside) inside.insert(kPalmsTogether);

@@ -40,17 +40,33 @@ const common::FieldTable<ViewFusionConfig>& fields() {
       {"view_fusion.tolerant_3d.tool_max_height_H", Range::closed(0.0, 1.2), [](C& c) { return &c.geometry.tolerant.tool_max_height_H; }},
       {"view_fusion.tolerant_3d.max_midline_offset_H", Range::openClosed(0.0, 0.5),
        [](C& c) { return &c.geometry.tolerant.max_midline_offset_H; }},
+      {"view_fusion.tolerant_3d.palms_max_centre_offset_H", Range::openClosed(0.0, 0.5),
+       [](C& c) { return &c.geometry.tolerant.palms_max_centre_offset_H; }},
+      {"view_fusion.tolerant_3d.palms_forearm_max_deg", Range::closed(0.0, 90.0), [](C& c) { return &c.geometry.tolerant.palms_forearm_max_deg; }},
       {"view_fusion.tolerant_3d.cross_max_midline_offset_H", Range::openClosed(0.0, 0.5),
        [](C& c) { return &c.geometry.tolerant.cross_max_midline_offset_H; }},
       {"view_fusion.tolerant_3d.cross_min_height_H", Range::closed(0.0, 1.2), [](C& c) { return &c.geometry.tolerant.cross_min_height_H; }},
       {"view_fusion.tolerant_3d.cross_max_height_H", Range::closed(0.0, 1.2), [](C& c) { return &c.geometry.tolerant.cross_max_height_H; }},
       {"view_fusion.tolerant_3d.folded_max_height_H", Range::closed(0.0, 1.2), [](C& c) { return &c.geometry.tolerant.folded_max_height_H; }},
+      {"view_fusion.tolerant_3d.extend_min_shoulder_wrist_deg", Range::closed(0.0, 180.0),
+       [](C& c) { return &c.geometry.tolerant.extend_min_shoulder_wrist_deg; }},
+      {"view_fusion.tolerant_3d.extend_max_shoulder_wrist_deg", Range::closed(0.0, 180.0),
+       [](C& c) { return &c.geometry.tolerant.extend_max_shoulder_wrist_deg; }},
+      {"view_fusion.tolerant_3d.extend_min_horizontal_deg", Range::closed(0.0, 90.0),
+       [](C& c) { return &c.geometry.tolerant.extend_min_horizontal_deg; }},
+      {"view_fusion.tolerant_3d.extend_min_elbow_deg", Range::closed(90.0, 180.0), [](C& c) { return &c.geometry.tolerant.extend_min_elbow_deg; }},
+      {"view_fusion.tolerant_3d.pointing_max_shoulder_wrist_deg", Range::closed(0.0, 90.0),
+       [](C& c) { return &c.geometry.tolerant.pointing_max_shoulder_wrist_deg; }},
       {"view_fusion.tolerant_3d.raise_min_shoulder_wrist_deg", Range::closed(90.0, 180.0),
        [](C& c) { return &c.geometry.tolerant.raise_min_shoulder_wrist_deg; }},
       {"view_fusion.tolerant_3d.raise_min_elbow_deg", Range::closed(90.0, 180.0), [](C& c) { return &c.geometry.tolerant.raise_min_elbow_deg; }},
       {"view_fusion.tolerant_3d.reach_max_shoulder_wrist_deg", Range::closed(90.0, 180.0),
        [](C& c) { return &c.geometry.tolerant.reach_max_shoulder_wrist_deg; }},
       {"view_fusion.tolerant_3d.reach_max_elbow_deg", Range::closed(90.0, 180.0), [](C& c) { return &c.geometry.tolerant.reach_max_elbow_deg; }},
+      {"view_fusion.tolerant_3d.one_arm_max_trunk_tilt_deg", Range::openClosed(0.0, 90.0),
+       [](C& c) { return &c.geometry.tolerant.one_arm_max_trunk_tilt_deg; }},
+      {"view_fusion.tolerant_3d.one_arm_max_foot_offset_torso", Range::openClosed(0.0, 5.0),
+       [](C& c) { return &c.geometry.tolerant.one_arm_max_foot_offset_torso; }},
   }};
   return t;
 }
@@ -72,6 +88,17 @@ std::vector<common::ConfigError> problems(const ViewFusionConfig& c) {
                     "must exceed " + k + "cross_min_height_H " + common::formatDouble(t.cross_min_height_H));
   common::checkRule(e, t.folded_max_height_H <= t.cross_min_height_H, k + "folded_max_height_H", t.folded_max_height_H,
                     "must not exceed " + k + "cross_min_height_H " + common::formatDouble(t.cross_min_height_H));
+  common::checkRule(e, t.extend_max_shoulder_wrist_deg > t.extend_min_shoulder_wrist_deg, k + "extend_max_shoulder_wrist_deg",
+                    t.extend_max_shoulder_wrist_deg,
+                    "must exceed " + k + "extend_min_shoulder_wrist_deg " + common::formatDouble(t.extend_min_shoulder_wrist_deg));
+  common::checkRule(e, t.extend_max_shoulder_wrist_deg < 180.0 - t.pointing_max_shoulder_wrist_deg, k + "extend_max_shoulder_wrist_deg",
+                    t.extend_max_shoulder_wrist_deg,
+                    "must be below 180 - " + k + "pointing_max_shoulder_wrist_deg " + common::formatDouble(t.pointing_max_shoulder_wrist_deg) +
+                        " (an arm that high is raise's)");
+  common::checkRule(e, t.pointing_max_shoulder_wrist_deg <= std::min(t.extend_min_shoulder_wrist_deg, t.extend_min_horizontal_deg),
+                    k + "pointing_max_shoulder_wrist_deg", t.pointing_max_shoulder_wrist_deg,
+                    "must not exceed " + k + "extend_min_shoulder_wrist_deg " + common::formatDouble(t.extend_min_shoulder_wrist_deg) +
+                        " nor " + k + "extend_min_horizontal_deg " + common::formatDouble(t.extend_min_horizontal_deg));
   common::checkRule(e, t.reach_max_shoulder_wrist_deg <= t.raise_min_shoulder_wrist_deg, k + "reach_max_shoulder_wrist_deg",
                     t.reach_max_shoulder_wrist_deg,
                     "must not exceed " + k + "raise_min_shoulder_wrist_deg " + common::formatDouble(t.raise_min_shoulder_wrist_deg));
