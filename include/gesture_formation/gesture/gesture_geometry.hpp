@@ -68,7 +68,7 @@ namespace gesture_formation::gesture {
 /// \brief Which regions classifyPose() tests (file comment).
 enum class GeometryRules : int {
   kDesign = 0,         ///< design.md §2's regions as written
-  kNetworkTolerant,    ///< palms, cross and raise allowing for the skeleton network's systematic errors
+  kNetworkTolerant,    ///< every region allowing for the skeleton network's systematic errors (one-arm: upright)
 };
 const char* toString(GeometryRules r);
 
