@@ -626,6 +626,10 @@ void UavPlanner::projectReferences(PlanContext& c, PlanResult& result) const {
   for (const auto& other : req.higher_priority_plans) {
     if (!other.empty() && uavKeepOutDistance(config_, req.t_now_s - other.t0_s) >= bound - 1e-9) silent.push_back(&other);
   }
+  for (auto it = silent_turn_side_.begin(); it != silent_turn_side_.end();) {  // forget UAVs heard again
+    const bool still = std::any_of(silent.begin(), silent.end(), [&](const PlannedTrajectory* p) { return p->uav_index == it->first; });
+    it = still ? std::next(it) : silent_turn_side_.erase(it);
+  }
   for (int k = 1; k <= c.N; ++k) {
     Eigen::Vector3d r = req.reference.p_world.col(k);
     bool moved = false;
@@ -676,11 +680,24 @@ bool UavPlanner::aroundSilentUavs(const PlanContext& c, const std::vector<const 
   if (clear(r)) return false;
   const Eigen::Vector3d w = c.req.worker.p_world.col(k);
   const Eigen::Vector3d d = r - w;
+  // The side: latched per silent UAV from the UAV's position when its first turn happens (towards the
+  // UAV's azimuth), so that the reference neither crosses over the worker nor swaps sides later.
+  int blocker = -1;
+  for (std::size_t j = 0; j < at_t.size(); ++j) {
+    if ((r - at_t[j]).norm() < keep) {
+      blocker = silent[j]->uav_index;
+      break;
+    }
+  }
   const Eigen::Vector2d from_w(c.p0.x() - w.x(), c.p0.y() - w.y());
-  const double side = d.x() * from_w.y() - d.y() * from_w.x() >= 0.0 ? 1.0 : -1.0;  // towards the UAV's azimuth
+  auto latched = silent_turn_side_.find(blocker);
+  if (latched == silent_turn_side_.end()) {
+    latched = silent_turn_side_.emplace(blocker, d.x() * from_w.y() - d.y() * from_w.x() >= 0.0 ? 1.0 : -1.0).first;
+  }
+  const double side = latched->second;
   constexpr double kStep = 5.0 * M_PI / 180.0;
-  for (int i = 1; i * kStep <= M_PI + 1e-9; ++i) {
-    for (double sgn : {side, -side}) {
+  for (double sgn : {side, -side}) {
+    for (int i = 1; i * kStep <= M_PI + 1e-9; ++i) {
       const Eigen::Vector3d q = w + Eigen::AngleAxisd(sgn * i * kStep, Eigen::Vector3d::UnitZ()) * d;
       if (clear(q)) {
         r = q;

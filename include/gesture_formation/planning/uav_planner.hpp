@@ -22,6 +22,7 @@
 #include <cstdint>
 #include <deque>
 #include <limits>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -232,6 +233,9 @@ class UavPlanner {
   std::unique_ptr<GridPathSearch> search_;
   std::unique_ptr<TrajectoryQp> qp_;
   PlannedTrajectory last_verified_;
+  /// aroundSilentUavs: the side (+1/-1 about the vertical) a reference turns round each silent UAV,
+  /// chosen from the UAV's position when the turn first happens and kept while that UAV stays silent.
+  mutable std::map<int, double> silent_turn_side_;
   /// The brake plan being flown while replanning keeps failing (verified or not): its stop
   /// point is kept instead of braking anew from each state (empty when not braking).
   PlannedTrajectory brake_;

@@ -1512,6 +1512,36 @@ TEST(UavPlannerTest, AReferenceHeldByASilentUavTurnsAboutTheWorker) {
   for (const auto& s : r.trajectory.samples) EXPECT_GE((s.p_world - to).norm(), keep - 1e-3);
 }
 
+// The turn goes round the silent UAV on the side the UAV is on, even where the other side is the
+// smaller turn, and keeps that side (power towers leader_dropout_for_good seed 97: the least turn sent
+// the new leader over the tower to the far side, where it pushed the other follower round; the two
+// views ended 81 degrees apart and the 2-of-2 vote missed every gesture).
+TEST(UavPlannerTest, TheTurnAboutTheWorkerKeepsTheSideTheUavIsOn) {
+  const World& w = towers();
+  const double t = 60.0;
+  const Eigen::Vector3d worker(25, -12, 1);
+  const auto around = [&](double az_deg) {  // 10 m from the worker, 6 m up, at an azimuth about him
+    const double a = az_deg * M_PI / 180.0;
+    return Eigen::Vector3d(worker.x() + 10.0 * std::cos(a), worker.y() + 10.0 * std::sin(a), 6.0);
+  };
+  const Eigen::Vector3d to = around(90.0), hover = around(95.0), from = around(130.0);
+  const auto azimuth = [&](const Eigen::Vector3d& p) { return std::atan2(p.y() - worker.y(), p.x() - worker.x()) * 180.0 / M_PI; };
+  UavPlanner p(testConfig(), w.map, w.field);
+  auto req = straightRequest(1, t, stateAt(from, t), to, to, 1.5, worker);
+  req.higher_priority_plans = {standingPlan(0, hover, 0.0)};  // silent for 60 s, 5 degrees past the reference
+  PlanResult r;
+  for (int i = 0; i < 4; ++i) {
+    r = p.plan(req);
+    ASSERT_EQ(r.status, PlanStatus::kOptimized) << r.reason;
+    req.t_now_s += 2.0;
+    req.state = stateAt(evaluateTrajectory(r.trajectory, req.t_now_s).p, req.t_now_s);
+  }
+  const Eigen::Vector3d end = r.trajectory.samples.back().p_world;
+  EXPECT_GT(azimuth(end), azimuth(hover) + 30.0) << end.transpose();  // the UAV's side (the least turn: below 60 deg)
+  EXPECT_NEAR((end - worker).head<2>().norm(), 10.0, 1.0) << end.transpose();
+  EXPECT_GT(r.projected_references, 0);
+}
+
 TEST(UavPlannerTest, UavSilentFor60sIsKeptOutOfItsHoverPointOnly) {
   const World& w = towers();
   const double t = 60.0;
