@@ -667,8 +667,8 @@ bool UavPlanner::aroundSilentUavs(const PlanContext& c, const std::vector<const 
   // keep-out wherever the QP leaves it (a new leader whose slot the silent old leader still holds:
   // 16 m from the worker at his feet's height, outside the cameras' envelope; §1.2). Such a
   // reference turns about the vertical through the worker — distance and elevation kept, so the
-  // view stays in the envelope — by the least angle (5° steps, the side the UAV is on first) that
-  // takes it out of every silent UAV's keep-out + buffer.
+  // view stays in the envelope — on the side the UAV is on (latched per silent UAV) by the least angle
+  // in 5° steps that takes it out of every silent UAV's keep-out + buffer.
   if (silent.empty()) return false;
   const double t = c.req.t_now_s + k * c.dt;
   const double keep = uavKeepOutDistance(config_, std::numeric_limits<double>::infinity()) + config_.qp_distance_buffer_m;
@@ -677,18 +677,13 @@ bool UavPlanner::aroundSilentUavs(const PlanContext& c, const std::vector<const 
   const auto clear = [&](const Eigen::Vector3d& q) {
     return std::all_of(at_t.begin(), at_t.end(), [&](const Eigen::Vector3d& o) { return (q - o).norm() >= keep; });
   };
-  if (clear(r)) return false;
+  const auto inside = std::find_if(at_t.begin(), at_t.end(), [&](const Eigen::Vector3d& o) { return (r - o).norm() < keep; });
+  if (inside == at_t.end()) return false;
+  const int blocker = silent[static_cast<std::size_t>(inside - at_t.begin())]->uav_index;
   const Eigen::Vector3d w = c.req.worker.p_world.col(k);
   const Eigen::Vector3d d = r - w;
   // The side: latched per silent UAV from the UAV's position when its first turn happens (towards the
   // UAV's azimuth), so that the reference neither crosses over the worker nor swaps sides later.
-  int blocker = -1;
-  for (std::size_t j = 0; j < at_t.size(); ++j) {
-    if ((r - at_t[j]).norm() < keep) {
-      blocker = silent[j]->uav_index;
-      break;
-    }
-  }
   const Eigen::Vector2d from_w(c.p0.x() - w.x(), c.p0.y() - w.y());
   auto latched = silent_turn_side_.find(blocker);
   if (latched == silent_turn_side_.end()) {

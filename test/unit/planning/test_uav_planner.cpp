@@ -358,14 +358,30 @@ TEST(UavPlannerTest, StartInsideObstacleFallsBackToBrake) {
   for (const auto& smp : r.trajectory.samples) EXPECT_EQ(smp.p_world, ground);  // at rest: hover in place
 }
 
+namespace {
+
+/// One optimized plan from (-8, -12, 10) towards (-2, -12, 10), then the request 0.4 s later on it,
+/// which fails: its reference step 7 is NaN.
+struct PlanThenFailingRequest {
+  PlanResult first;
+  PlanRequest bad;
+};
+PlanThenFailingRequest planThenFailingRequest(UavPlanner& planner) {
+  const Eigen::Vector3d from(-8, -12, 10), to(-2, -12, 10), worker(-5, -3, 1);
+  PlanThenFailingRequest out;
+  out.first = planner.plan(straightRequest(0, 0.0, stateAt(from), from, to, 1.5, worker));
+  out.bad = straightRequest(0, 0.4, advance(out.first.trajectory, 0.4), from, to, 1.5, worker);
+  out.bad.reference.p_world(1, 7) = std::numeric_limits<double>::quiet_NaN();
+  return out;
+}
+
+}  // namespace
+
 TEST(UavPlannerTest, NanReferenceFallsBackToPreviousPlanThenBrake) {
   const World& w = towers();
   UavPlanner planner(testConfig(), w.map, w.field);
-  const Eigen::Vector3d from(-8, -12, 10), to(-2, -12, 10), worker(-5, -3, 1);
-  const PlanResult first = planner.plan(straightRequest(0, 0.0, stateAt(from), from, to, 1.5, worker));
+  const auto [first, bad] = planThenFailingRequest(planner);
   ASSERT_EQ(first.status, PlanStatus::kOptimized) << first.reason;
-  PlanRequest bad = straightRequest(0, 0.4, advance(first.trajectory, 0.4), from, to, 1.5, worker);
-  bad.reference.p_world(1, 7) = std::numeric_limits<double>::quiet_NaN();
   const PlanResult r = planner.plan(bad);
   EXPECT_EQ(r.status, PlanStatus::kFallbackPrevious) << r.reason;
   EXPECT_NE(r.reason.find("reference step 7"), std::string::npos) << r.reason;
@@ -393,11 +409,8 @@ TEST(UavPlannerTest, NanReferenceFallsBackToPreviousPlanThenBrake) {
 TEST(UavPlannerTest, AFailedRequestThatMayNotReuseThePreviousPlanBrakes) {
   const World& w = towers();
   UavPlanner planner(testConfig(), w.map, w.field);
-  const Eigen::Vector3d from(-8, -12, 10), to(-2, -12, 10), worker(-5, -3, 1);
-  const PlanResult first = planner.plan(straightRequest(0, 0.0, stateAt(from), from, to, 1.5, worker));
+  auto [first, bad] = planThenFailingRequest(planner);
   ASSERT_EQ(first.status, PlanStatus::kOptimized) << first.reason;
-  PlanRequest bad = straightRequest(0, 0.4, advance(first.trajectory, 0.4), from, to, 1.5, worker);
-  bad.reference.p_world(1, 7) = std::numeric_limits<double>::quiet_NaN();
   bad.reuse_previous = false;
   const PlanResult r = planner.plan(bad);
   EXPECT_EQ(r.status, PlanStatus::kFallbackBrake) << r.reason;
