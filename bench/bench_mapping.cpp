@@ -136,7 +136,7 @@ double cpuMs() {
 }
 
 struct Sections {
-  Stats points, raycast, map, field, total, cpu, rays, map_changes, field_written;
+  Stats points, raycast, map, field, total, cpu, rays, map_changes, field_written, tree_nodes;
 };
 
 void print(const char* name, const Sections& s) {
@@ -154,6 +154,7 @@ void print(const char* name, const Sections& s) {
   row("rays cast (one per end voxel)", s.rays, "");
   row("map voxels changed", s.map_changes, "");
   row("field voxels recomputed", s.field_written, "");
+  row("OctoMap nodes after the frame", s.tree_nodes, "");
 }
 
 
@@ -170,6 +171,7 @@ void markdownRows(std::FILE* f, const char* section, const Sections& s) {
   row("rays cast (one per end voxel)", s.rays, 0);
   row("map voxels changed", s.map_changes, 0);
   row("field values recomputed", s.field_written, 0);
+  row("OctoMap nodes after the frame (pruned in batches)", s.tree_nodes, 0);
 }
 
 struct Run {
@@ -222,6 +224,7 @@ void record(Sections& s, const mapping::FrameUpdate& u, double cpu_ms) {
   s.rays.add(u.rays_cast);
   s.map_changes.add(u.map_changes);
   s.field_written.add(static_cast<double>(u.field.voxels_written));
+  s.tree_nodes.add(static_cast<double>(u.tree_nodes));
 }
 
 /// Section 4: the construction site. Returns false (with a message) when the scenario cannot be

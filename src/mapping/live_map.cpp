@@ -114,7 +114,9 @@ void LiveMap::updateVoxel(const octomap::OcTreeKey& key, std::ptrdiff_t index, b
   // saturated_ remembers that per grid voxel, so those voxels are not even searched.
   const std::uint8_t skip = hit ? kSaturatedOccupied : kSaturatedFree;
   if (index >= 0 && saturated_[static_cast<std::size_t>(index)] == skip) return;
-  const octomap::OcTreeNode* node = tree_->updateNode(key, hit, /*lazy_eval=*/false);
+  // lazy_eval: the inner nodes' occupancy is not kept up to date (nothing here reads it) and the
+  // tree is pruned in batches (pruneWhenGrown), not at every update: the same leaves, less work.
+  const octomap::OcTreeNode* node = tree_->updateNode(key, hit, /*lazy_eval=*/true);
   if (index < 0 || node == nullptr) return;
   const float l = node->getLogOdds();
   saturated_[static_cast<std::size_t>(index)] = l <= tree_->getClampingThresMinLog()   ? kSaturatedFree
@@ -168,7 +170,17 @@ int LiveMap::castRays(const DepthPoints& points) {
   for (const auto& [key, index] : occupied_cells) updateVoxel(key, index, true);
   for (const auto& key : occupied_outside) updateVoxel(key, -1, true);
   for (const std::size_t index : touched) mark_[index] = 0;
+  pruneWhenGrown();
   return static_cast<int>(ends.size());
+}
+
+void LiveMap::pruneWhenGrown() {
+  // Collapses clamped, uniform octants once the tree has doubled since the last pass: linear in
+  // the tree's size, so the cost per update stays bounded and the memory within twice the pruned tree.
+  constexpr std::size_t kMinNodes = 1 << 16;
+  if (tree_->size() < std::max(kMinNodes, 2 * nodes_after_prune_)) return;
+  tree_->prune();
+  nodes_after_prune_ = tree_->size();
 }
 
 planning::VoxelIndex LiveMap::voxelOfIndex(std::size_t index) const {
@@ -267,6 +279,7 @@ common::Result<FrameUpdate> LiveMap::integrate(const DepthFrame& frame) {
 
   const auto t1 = std::chrono::steady_clock::now();
   out.rays_cast = castRays(*points);
+  out.tree_nodes = tree_->size();
   out.raycast_ms = msSince(t1);
 
   const auto t2 = std::chrono::steady_clock::now();

@@ -54,6 +54,7 @@ struct FrameUpdate {
   int rays_cast = 0;        ///< rays after merging returns that end in the same voxel
   int observed_changes = 0; ///< OctoMap voxels created or flipped by this frame
   int map_changes = 0;      ///< voxels of the planner's map that changed (fused with the prior)
+  std::size_t tree_nodes = 0;  ///< the observed OctoMap's nodes after the frame (pruned in batches)
   planning::FieldUpdateStats field;
   double points_ms = 0.0;   ///< decimation, back-projection, merging
   double raycast_ms = 0.0;  ///< OctoMap insertPointCloud
@@ -129,7 +130,9 @@ class LiveMap {
 
   /// \brief The observed state of the voxel containing p (world, m): the OctoMap alone.
   Observed observed(const Eigen::Vector3d& p_world) const;
-  /// \brief The observed OctoMap (log-odds, pruned); not to be read while integrate() runs.
+  /// \brief The observed OctoMap (log-odds per voxel; pruned in batches, inner nodes' occupancy
+  /// not maintained: call updateInnerOccupancy() on a copy before reading coarser depths); not to
+  /// be read while integrate() runs.
   const octomap::OcTree& observedTree() const { return *tree_; }
   const MappingConfig& config() const { return config_; }
 
@@ -146,6 +149,8 @@ class LiveMap {
     if (i < 0 || j < 0 || k < 0 || i >= grid_size_.x() || j >= grid_size_.y() || k >= grid_size_.z()) return -1;
     return i + static_cast<std::ptrdiff_t>(grid_size_.x()) * (j + static_cast<std::ptrdiff_t>(grid_size_.y()) * k);
   }
+  /// Prunes tree_ when it has doubled since the last pruning (updates are lazy: see updateVoxel).
+  void pruneWhenGrown();
   /// One hit or miss of a voxel (index −1: outside the grid), skipped when OctoMap would abort it.
   void updateVoxel(const octomap::OcTreeKey& key, std::ptrdiff_t index, bool hit);
   /// The changed OctoMap voxels, and the voxels of this frame that held a received class, as
@@ -167,6 +172,7 @@ class LiveMap {
   std::shared_ptr<const planning::OccupancyMap> prior_;
   std::shared_ptr<planning::SeenSpace> seen_;
   std::unique_ptr<octomap::OcTree> tree_;
+  std::size_t nodes_after_prune_ = 0;  ///< tree_'s size after its last pruning
   octomap::KeyRay keyray_;  ///< castRays' scratch
   std::vector<std::pair<octomap::OcTreeKey, std::ptrdiff_t>> free_cells_, occupied_cells_;  ///< castRays' scratch
   std::vector<std::size_t> touched_;                                                          ///< castRays' scratch
