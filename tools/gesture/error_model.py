@@ -3,7 +3,8 @@ augmentation for tools/train_gesture_lstm.py --error-model; docs/gestures.md §2
 
 The generator's keypoints are the true joints plus random noise; MoveNet's keypoints on rendered
 frames err systematically (measured on the rendered TUNING set only, docs/gestures.md §9): hands
-named by image side, crossed wrists pulled together, palms reported apart, a raised arm read lower,
+named by image side, crossed wrists pulled together, palms reported apart, the wrists of an object
+held between the hands pulled together (optional `gap_deflation`), a raised arm read lower,
 straight arms read bent, wrists with low confidence and poor positions. `apply` reproduces these
 on one sequence, with the ranges of an error-model YAML (tools/gesture/error_model_movenet.yaml)
 drawn once per sequence from a seeded generator. Labels are not changed.
@@ -98,6 +99,25 @@ def _gaps(kp, h, cfg, motion, rng, side):
         f = _draw(rng, cfg["crossed_gap_factor"])
         kp[crossed, LW, :2] = mid[crossed] + f * (lw[crossed] - mid[crossed])
         kp[crossed, RW, :2] = mid[crossed] + f * (rw[crossed] - mid[crossed])
+    if motion in cfg.get("gap_deflation", {}):
+        # wrists apart (an object between the hands) reported pulled together towards their midpoint:
+        # the gap times the drawn factor, never below min_gap (box heights); with min_offset, only
+        # where the wrists' midpoint lies at least that many shoulder widths aside of the shoulders'
+        # (frontal views only: side-on, aside is not decided)
+        spec = cfg["gap_deflation"][motion]
+        spec = spec if isinstance(spec, dict) else {"factor": spec}
+        f = _draw(rng, spec["factor"])
+        both = _present(kp, LW, RW)
+        if "min_offset" in spec:
+            width = np.abs(kp[:, LS, 0] - kp[:, RS, 0])
+            aside = np.abs(mid[:, 0] - 0.5 * (kp[:, LS, 0] + kp[:, RS, 0]))
+            both &= (side != 0) & (aside >= spec["min_offset"] * np.maximum(width, 1e-9))
+        gap = np.linalg.norm(lw - rw, axis=1)
+        target = np.maximum(f * gap, spec.get("min_gap", 0.0) * h)
+        scale = np.where(gap > target, target / np.maximum(gap, 1e-12), 1.0)
+        kp[both, LW, :2] = mid[both] + scale[both, None] * (lw[both] - mid[both])
+        kp[both, RW, :2] = mid[both] + scale[both, None] * (rw[both] - mid[both])
+        lw, rw = kp[:, LW, :2].copy(), kp[:, RW, :2].copy()
     if motion in cfg["gap_inflation"]:
         target = _draw(rng, cfg["gap_inflation"][motion]) * h
         gap = np.linalg.norm(lw - rw, axis=1)
