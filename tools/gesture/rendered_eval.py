@@ -498,7 +498,7 @@ def rules_lines(rules):
 
 
 def report(protocol, protocol_path, tuning_errors, tuning_eval, heldout_eval, out, load_start, v1_runs=(), trained=(),
-           rules=None, title=None):
+           rules=None, title=None, note=None):
     lines = [f"# {title or 'Gestures on rendered frames through the real networks (protocol version 2)'}", "",
              f"Written by `tools/gesture/rendered_eval.py report` on "
              f"{datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC, commit {he.git('rev-parse', '--short', 'HEAD')}"
@@ -516,6 +516,9 @@ def report(protocol, protocol_path, tuning_errors, tuning_eval, heldout_eval, ou
                 text = [ln.strip() for ln in f if ln.startswith("#") or ln.startswith("gfctl render-gestures")]
             lines.append(f"Render of {name} (its log): " + " / ".join(t.lstrip("# ") for t in text) + ".")
     lines.append("")
+    if note:
+        with open(note) as f:
+            lines += ["## What was decided, and on what", "", f.read().strip(), ""]
     if trained:
         lines += ["## Candidate models (not shipped unless third_party_models/gesture_lstm says so)", ""] + training_lines(trained) + [""]
     if tuning_errors:
@@ -562,6 +565,8 @@ def main():
     ap.add_argument("--trained", default=None, help="report: candidate models' training.json, comma-separated, each as LABEL=PATH")
     ap.add_argument("--rules", default=None, help="report: tools/gesture/geometry_rules.py's JSON (tuning set)")
     ap.add_argument("--title", default=None, help="report: the page's title")
+    ap.add_argument("--note", default=None, help="report: a markdown file with the decision and the checks outside this tool "
+                    "(unit tests, photos), placed after the header")
     ap.add_argument("--label", default="", help="evaluate: what this run is (model / rule), written into its JSON")
     ap.add_argument("--gfctl")
     ap.add_argument("--set", default=None)
@@ -597,7 +602,7 @@ def main():
                 ap.error(f"--trained {item}: expected LABEL=PATH")
             trained.append((label, path))
         report(protocol, a.protocol, load(a.tuning_errors), loads(a.tuning_eval), loads(a.heldout_eval), out, os.getloadavg(),
-               v1, trained, load(a.rules), a.title)
+               v1, trained, load(a.rules), a.title, a.note)
         print(f"wrote {out}")
         return
     if not a.set:
