@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Rewrites the `## gesture_lstm (ours)` section of third_party_models/MODELS.md (from that
-heading to the end of the file) from the trained file's sha256,
+heading to the next `## ` heading; the sections after it are kept) from the trained file's sha256,
 third_party_models/gesture_lstm/training.json and evaluation.json. Run after
 tools/train_gesture_lstm.py and tools/gesture/evaluate_gesture_lstm.py."""
 import hashlib
@@ -59,9 +59,11 @@ def main():
     ]
     with open(MD) as f:
         text = f.read()
-    head = text.split(HEADING)[0].rstrip("\n") + "\n\n"
+    head, _, rest = text.partition(HEADING)
+    # the sections after this one (e.g. the mannequin's) stay as they are
+    following = rest[rest.find("\n## ") + 1:] if "\n## " in rest else ""
     with open(MD, "w") as f:
-        f.write(head + "\n".join(lines))
+        f.write(head.rstrip("\n") + "\n\n" + "\n".join(lines) + ("\n" + following if following else ""))
     print("wrote", MD)
 
 
