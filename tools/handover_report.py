@@ -71,6 +71,9 @@ def profile_section(name, rows):
     req = sum(l.get("requests_after", 0) for l in ls)
     req_ok = sum(l.get("requests_after_applied", 0) for l in ls)
     incomplete = sum(1 for l in ls if l.get("requests_after_applied", 0) != l.get("requests_after", 0))
+    performed = sum(m.get("gestures_performed", 0) for m in ms)
+    fired = sum(m.get("gesture_requests_applied", 0) for m in ms)
+    missed = [str(r["seed"]) for r, m in zip(rows, ms) if m.get("gesture_requests_applied", 0) < m.get("gestures_performed", 0)]
     out += [
         "| figure | value |",
         "|---|---|",
@@ -81,6 +84,8 @@ def profile_section(name, rows):
         f"| steps with two acting (sum over seeds) | {sum(l.get('steps_two_acting', 0) for l in ls)} |",
         f"| the silent leader's last acting step after the silence [s] (max) | {max((l['silenced_last_acting_s'] - l['silent_from_s']) for l in ls if l.get('silenced_last_acting_s') is not None):.2f} |",
         f"| operator requests sent after the hand-over: applied / sent (missions with one not applied) | {req_ok} / {req} ({incomplete}) |",
+        f"| the worker's gestures (whole mission): applied / performed (seeds with one not applied) | {fired} / {performed} "
+        f"({', '.join(missed) if missed else 'none'}) |",
         f"| collisions (sum) | {sum(m['collisions'] for m in ms)} |",
         f"| min mutual distance [m] (min / median / 95 % / max over seeds; Γ_dis {GAMMA_DIS_M}) | {dist([m['min_mutual_distance_m'] for m in ms])} |",
         f"| seeds with mutual distance < Γ_dis | {sum(1 for m in ms if m['min_mutual_distance_m'] < GAMMA_DIS_M)} |",
