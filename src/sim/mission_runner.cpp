@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <map>
 #include <optional>
 #include <sstream>
 
@@ -147,6 +148,8 @@ class MissionRun {
                                        const std::optional<Eigen::Vector3d>& worker_est);
   std::vector<gesture::GestureFrame> aggregateViews(double t, const LeaderCameraFrame& cf);
   void actOnFrames(double t, const std::vector<gesture::GestureFrame>& closed);
+  /// One closed frame into votes_ (the readings noted for its stamp, the vote, the filter).
+  void recordVote(const gesture::GestureFrame& f);
   void replanDue(double t);
   void replan(int i, double t);
   void sendPlan(int i, double t, const planning::ReplanOutcome& out, const formation::FormationParams& params,
@@ -195,6 +198,8 @@ class MissionRun {
   MetricsAccumulator metrics_;
   MissionMetrics& M_;
   std::vector<ModeChange> modes_;
+  std::map<double, std::vector<int>> frame_views_;  ///< per open frame stamp: each UAV's reading that reached the vote
+  std::vector<VoteRecord> votes_;                   ///< votes.csv
   std::uint64_t gesture_seq_ = 0;
   OperatorSchedule schedule_;
   int last_class_ = -1;
@@ -407,6 +412,7 @@ void MissionRun::takeOver(int k, double t) {
     }
   }
   frames_ = gesture::GestureFrames(cfg_.gesture_filter, cfg_.view_fusion, cfg_.gesture_mapping, n_, 0.0);
+  frame_views_.clear();
   assistance_.leaderChanged();
   modes_.push_back(ModeChange{t, k, uav(k).mode, "acting as leader (term " + std::to_string(lead_->member(k).term()) +
                                                      "): estimator, gestures, parameters and share taken over"});
@@ -471,6 +477,7 @@ MissionOutput MissionRun::run(double duration_s, std::chrono::steady_clock::time
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   MissionOutput out = metrics_.finish(worker_.episodes(), static_cast<double>(steps) * dt, wall_s);
   out.modes = std::move(modes_);
+  out.votes = std::move(votes_);
   if (abort_record_) out.metrics.abort = abort_record_->summary();
   if (approach_record_) out.metrics.worker_approach = approach_record_->summary();
   out.metrics.assistance = assistance_.summary();
@@ -629,6 +636,26 @@ void MissionRun::cameraFrame(double t, const WorkerState& ws) {
   metrics_.cameraFrame(frame.visible(), kf_.confirmed() ? &estimate : nullptr, ws.p_world);
 }
 
+void MissionRun::recordVote(const gesture::GestureFrame& f) {
+  VoteRecord v;
+  v.t_s = f.t_s;
+  v.leader = owner_;
+  const auto it = frame_views_.find(f.t_s);
+  v.view_ids = it != frame_views_.end() ? it->second : std::vector<int>(static_cast<std::size_t>(n_), -1);
+  frame_views_.erase(frame_views_.begin(), frame_views_.upper_bound(f.t_s));  // this frame and any older one
+  v.fused_id = f.fused.gesture_id;
+  v.voting_views = f.fused.voting_views;
+  v.agreeing_views = f.fused.agreeing_views;
+  v.confirmed_3d = f.fused.confirmed_3d;
+  v.checked_3d = f.fused.checked_3d;
+  v.rejected_3d = f.fused.rejected_3d;
+  v.frames_3d = f.fused.frames_3d;
+  v.dominant_id = f.filter.dominant_id;
+  v.dominant_ratio = f.filter.dominant_ratio;
+  v.fired = f.filter.fired;
+  votes_.push_back(std::move(v));
+}
+
 gesture::ViewObservation MissionRun::observation(int uav_index, int view, double t, const gesture::Classification& c,
                                                  const gesture::CalibratedSkeleton& cal,
                                                  const std::optional<Eigen::Vector3d>& worker_est) {
@@ -672,7 +699,15 @@ std::vector<gesture::GestureFrame> MissionRun::aggregateViews(double t, const Le
   };
   // Views are numbered by UAV (one camera only: the leader's is view 0).
   const int own_view = follower_views_ ? owner_ : 0;
-  if (cf.classification) take(frames_.observe(observation(owner_, own_view, t, *cf.classification, cf.calibrated, worker_est)));
+  const auto noteReading = [this](const gesture::ViewObservation& o) {
+    auto& ids = frame_views_.try_emplace(o.t_s, static_cast<std::size_t>(n_), -1).first->second;
+    if (o.view >= 0 && o.view < n_) ids[static_cast<std::size_t>(o.view)] = o.gesture_id;
+  };
+  if (cf.classification) {
+    const gesture::ViewObservation o = observation(owner_, own_view, t, *cf.classification, cf.calibrated, worker_est);
+    noteReading(o);
+    take(frames_.observe(o));
+  }
   for (std::size_t f = 0; f < cf.followers.size(); ++f) {
     const int i = static_cast<int>(f) < owner_ ? static_cast<int>(f) : static_cast<int>(f) + 1;  // the UAV of view f
     if (cf.followers[f].classification && !uav(i).offline) {
@@ -682,7 +717,9 @@ std::vector<gesture::GestureFrame> MissionRun::aggregateViews(double t, const Le
   for (int i = 0; follower_views_ && i < n_; ++i) {
     if (i == owner_) continue;
     for (const auto& o : voteLink(i, owner_)->receive(t)) {
-      if (!uav(owner_).offline) take(frames_.observe(o));  // a dead radio drops what arrives
+      if (uav(owner_).offline) continue;  // a dead radio drops what arrives
+      noteReading(o);
+      take(frames_.observe(o));
     }
   }
   take(frames_.closeDue(t));
@@ -691,6 +728,7 @@ std::vector<gesture::GestureFrame> MissionRun::aggregateViews(double t, const Le
 
 void MissionRun::actOnFrames(double t, const std::vector<gesture::GestureFrame>& closed) {
   for (const gesture::GestureFrame& f : closed) {
+    recordVote(f);
     last_class_ = f.fused.gesture_id;
     last_ratio_ = f.filter.dominant_ratio;
     if (!f.filter.fired) continue;

@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # gfctl simulate: a short mission per scenario with the safety assertions of issue 7:
 # min mutual distance >= Gamma_dis 2.5 m, obstacle clearance >= the planner's verification
-# clearance 0.5 m (distance field: to voxel centres), no collisions; every output file written.
+# clearance 0.5 m (distance field: to voxel centres), no collisions; every output file written;
+# votes.csv has a fired row for each gesture command of events.csv (its frame at most 0.5 s before
+# the command, the same id).
 # Usage: gfctl_simulate_missions.sh GFCTL SRC
 set -euo pipefail
 GFCTL=$1
@@ -14,9 +16,25 @@ for spec in power_towers:60 open_field:84 dense_pillars:30; do
   dur=${spec##*:}
   "$GFCTL" simulate --scenario "$SRC/config/scenarios/$name.yaml" --out "$TMP/$name" --seed 3 --duration "$dur" --no-plot \
     > "$TMP/$name.log" 2>&1 || { echo "FAIL $name: gfctl exited $?"; cat "$TMP/$name.log"; fail=1; continue; }
-  for f in metrics.json timeline.csv events.csv scene.json; do
+  for f in metrics.json timeline.csv events.csv scene.json votes.csv; do
     [ -s "$TMP/$name/$f" ] || { echo "FAIL $name: $f missing"; fail=1; }
   done
+  python3 - "$TMP/$name" "$name" <<'PY' || fail=1
+import csv, sys
+d, name = sys.argv[1], sys.argv[2]
+votes = list(csv.DictReader(open(f"{d}/votes.csv")))
+fired = [(float(v["t"]), v["dominant_id"]) for v in votes if v["fired"] == "1"]
+commands = [(float(e["t"]), e["gesture_id"]) for e in csv.DictReader(open(f"{d}/events.csv")) if e["source"] == "gesture"]
+problems = []
+if not votes or any(v["id_L"] == "" or v["fused_id"] == "" for v in votes):
+    problems.append(f"votes.csv: {len(votes)} rows, or an empty id")
+# a frame is stamped when its images were taken and closed (and acted on) a little later
+if len(fired) != len(commands) or any(g != h or not 0 <= t - s <= 0.5 for (s, g), (t, h) in zip(fired, commands)):
+    problems.append(f"votes.csv fired {fired} but events.csv has the gesture commands {commands}")
+print(("FAIL " if problems else "ok   ") + name + " votes.csv: " + (", ".join(problems) if problems else
+      f"{len(votes)} frames, {len(fired)} fired = the gesture commands"))
+sys.exit(1 if problems else 0)
+PY
   python3 - "$TMP/$name/metrics.json" "$name" <<'PY' || fail=1
 import json, sys
 m = json.load(open(sys.argv[1]))

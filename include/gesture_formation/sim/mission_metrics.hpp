@@ -175,6 +175,24 @@ struct PlanRecord {
   std::string reason;        ///< empty when optimised
 };
 
+/// \brief One gesture frame the acting leader's vote closed (votes.csv): what each camera read for
+/// it, the vote and the filter — why a gesture fired or did not (docs/simulation.md §3).
+struct VoteRecord {
+  double t_s = 0.0;            ///< the frame's stamp
+  int leader = 0;              ///< the UAV whose vote it is
+  std::vector<int> view_ids;   ///< per UAV: the gesture id its camera read for the frame (−1: none reached the vote)
+  int fused_id = 0;            ///< gesture::FusedGesture: the id that went to the filter
+  int voting_views = 0;
+  int agreeing_views = 0;
+  bool confirmed_3d = false;
+  bool checked_3d = false;
+  bool rejected_3d = false;
+  int frames_3d = 0;
+  int dominant_id = -1;        ///< gesture::GestureFilterOutput
+  double dominant_ratio = 0.0;
+  bool fired = false;
+};
+
 /// \brief Everything a mission produces (the files of docs/simulation.md §3).
 struct MissionOutput {
   MissionMetrics metrics;
@@ -184,6 +202,7 @@ struct MissionOutput {
   std::vector<RequestRecord> requests;
   std::vector<GestureEpisode> gestures;  ///< performed by the worker
   std::vector<PerceptionRecord> perception;  ///< rendered camera: per frame and UAV (perception.csv)
+  std::vector<VoteRecord> votes;             ///< every gesture frame the vote closed (votes.csv)
 };
 
 /// \brief The obstacle-distance metric (docs/simulation.md §4): within
