@@ -530,6 +530,24 @@ bool writePlansCsv(const std::string& path, const MissionOutput& out, std::strin
   });
 }
 
+bool writeVotesCsv(const std::string& path, const MissionOutput& out, int uav_count, std::string* error) {
+  return writeTextFile(path, error, [&](std::ostream& f) {
+    f << "t,leader";
+    for (int i = 0; i < uav_count; ++i) f << ",id_" << formation::uavLabel(i);
+    f << ",fused_id,voting_views,agreeing_views,confirmed_3d,checked_3d,rejected_3d,frames_3d,dominant_id,dominant_ratio,fired\n";
+    for (const VoteRecord& v : out.votes) {
+      f << formatDouble(v.t_s) << ',' << formation::uavLabel(v.leader);
+      for (int i = 0; i < uav_count; ++i) {
+        f << ',' << (static_cast<std::size_t>(i) < v.view_ids.size() ? v.view_ids[static_cast<std::size_t>(i)] : -1);
+      }
+      const gesture::FusedGesture& g = v.fused;
+      f << ',' << g.gesture_id << ',' << g.voting_views << ',' << g.agreeing_views << ',' << g.confirmed_3d << ','
+        << g.checked_3d << ',' << g.rejected_3d << ',' << g.frames_3d << ',' << v.dominant_id << ','
+        << formatDouble(v.dominant_ratio) << ',' << v.fired << '\n';
+    }
+  });
+}
+
 bool writeMissionFiles(const std::string& dir, const MissionOutput& out, int uav_count, bool with_modes,
                        std::string* error) {
   if (!writeTimelineCsv(dir + "/timeline.csv", out, uav_count, error) || !writeEventsCsv(dir + "/events.csv", out, error) ||
@@ -541,23 +559,7 @@ bool writeMissionFiles(const std::string& dir, const MissionOutput& out, int uav
       })) {
     return false;
   }
-  if (!out.votes.empty() && !writeTextFile(dir + "/votes.csv", error, [&](std::ostream& f) {
-        f << "t,leader";
-        for (int i = 0; i < uav_count; ++i) f << ",id_" << formation::uavLabel(i);
-        f << ",fused_id,voting_views,agreeing_views,confirmed_3d,checked_3d,rejected_3d,frames_3d,dominant_id,"
-             "dominant_ratio,fired\n";
-        for (const VoteRecord& v : out.votes) {
-          f << formatDouble(v.t_s) << ',' << formation::uavLabel(v.leader);
-          for (int i = 0; i < uav_count; ++i) {
-            f << ',' << (static_cast<std::size_t>(i) < v.view_ids.size() ? v.view_ids[static_cast<std::size_t>(i)] : -1);
-          }
-          f << ',' << v.fused_id << ',' << v.voting_views << ',' << v.agreeing_views << ',' << v.confirmed_3d << ','
-            << v.checked_3d << ',' << v.rejected_3d << ',' << v.frames_3d << ',' << v.dominant_id << ','
-            << formatDouble(v.dominant_ratio) << ',' << v.fired << '\n';
-        }
-      })) {
-    return false;
-  }
+  if (!out.votes.empty() && !writeVotesCsv(dir + "/votes.csv", out, uav_count, error)) return false;
   const std::string tmp = dir + "/metrics.json.tmp", path = dir + "/metrics.json";
   {
     std::ofstream f(tmp);

@@ -643,13 +643,7 @@ void MissionRun::recordVote(const gesture::GestureFrame& f) {
   const auto it = frame_views_.find(f.t_s);
   v.view_ids = it != frame_views_.end() ? it->second : std::vector<int>(static_cast<std::size_t>(n_), -1);
   frame_views_.erase(frame_views_.begin(), frame_views_.upper_bound(f.t_s));  // this frame and any older one
-  v.fused_id = f.fused.gesture_id;
-  v.voting_views = f.fused.voting_views;
-  v.agreeing_views = f.fused.agreeing_views;
-  v.confirmed_3d = f.fused.confirmed_3d;
-  v.checked_3d = f.fused.checked_3d;
-  v.rejected_3d = f.fused.rejected_3d;
-  v.frames_3d = f.fused.frames_3d;
+  v.fused = f.fused;
   v.dominant_id = f.filter.dominant_id;
   v.dominant_ratio = f.filter.dominant_ratio;
   v.fired = f.filter.fired;

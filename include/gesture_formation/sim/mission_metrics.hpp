@@ -36,6 +36,7 @@
 #include "gesture_formation/formation/formation_commands.hpp"
 #include "gesture_formation/formation/formation_params.hpp"
 #include "gesture_formation/gesture/gesture_mapping.hpp"
+#include "gesture_formation/gesture/view_fusion.hpp"
 #include "gesture_formation/planning/shapes.hpp"
 #include "gesture_formation/planning/uav_planner.hpp"
 #include "gesture_formation/sim/assistance_drill.hpp"
@@ -181,13 +182,7 @@ struct VoteRecord {
   double t_s = 0.0;            ///< the frame's stamp
   int leader = 0;              ///< the UAV whose vote it is
   std::vector<int> view_ids;   ///< per UAV: the gesture id its camera read for the frame (−1: none reached the vote)
-  int fused_id = 0;            ///< gesture::FusedGesture: the id that went to the filter
-  int voting_views = 0;
-  int agreeing_views = 0;
-  bool confirmed_3d = false;
-  bool checked_3d = false;
-  bool rejected_3d = false;
-  int frames_3d = 0;
+  gesture::FusedGesture fused;  ///< the vote (the id that went to the filter, views, 3-D check)
   int dominant_id = -1;        ///< gesture::GestureFilterOutput
   double dominant_ratio = 0.0;
   bool fired = false;
@@ -382,8 +377,10 @@ bool writeModesCsv(const std::string& path, const MissionOutput& out, std::strin
 /// \brief Writes plans.csv: `t,uav,status,params_version,planning_ms,reason`, one row per
 /// replanning (commas in the reason become ';').
 bool writePlansCsv(const std::string& path, const MissionOutput& out, std::string* error);
+/// \brief Writes votes.csv: one row per VoteRecord (columns: docs/simulation.md §3).
+bool writeVotesCsv(const std::string& path, const MissionOutput& out, int uav_count, std::string* error);
 /// \brief Writes a mission's files into `dir`: timeline.csv, events.csv, modes.csv (if
-/// `with_modes`), plans.csv and metrics.json last, atomically (written to a temporary name, then renamed:
+/// `with_modes`), plans.csv, votes.csv (when there are votes) and metrics.json last, atomically (written to a temporary name, then renamed:
 /// its appearance tells a watching script that the files are complete).
 bool writeMissionFiles(const std::string& dir, const MissionOutput& out, int uav_count, bool with_modes,
                        std::string* error);
