@@ -41,8 +41,9 @@ remaps = ["odometry_in:=odometry", "worker_state_in:=worker_state", "plans_in:=l
           "formation_params_out:=formation_params", "formation_command_in:=formation_command",
           "abort_in:=abort", "abort_state_out:=abort_state"]
 env = dict(os.environ, ROS_NAMESPACE="/uav2")
+loader = open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "reload.log"), "w")
 subprocess.Popen(["rosrun", "nodelet", "nodelet", "load", "gesture_formation/FormationPlanner", "manager",
-                  "__name:=formation_planner"] + remaps, env=env)
+                  "__name:=formation_planner"] + remaps, env=env, stdout=loader, stderr=subprocess.STDOUT)
 print("loaded /uav2/formation_planner again at %.2f s" % rospy.get_time(), flush=True)
 rospy.spin()
 PY
@@ -100,6 +101,7 @@ exit \$rc
 INNER
 timeout 100 unshare -n bash "$T/inner.sh"
 rc=$?
-[ $rc -eq 0 ] || { echo "--- launch.log (errors, warnings, follower 2; not the parameter dump)"
-  grep -aE "ERROR|WARN|refuses|uav2|UAV 2" "$T/launch.log" | grep -avE '^ \* /' | head -40; }
+[ $rc -eq 0 ] || { echo "--- the reloading loader's output (reload.log)"; cat "$T/reload.log"
+  echo "--- launch.log: errors, warnings and follower 2's planner, the last 40 (not the parameter dump)"
+  grep -aE "ERROR|WARN|refuses|formation_planner|UAV 2" "$T/launch.log" | grep -avE '^ \* /' | tail -40; }
 exit $rc
