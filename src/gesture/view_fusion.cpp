@@ -319,8 +319,10 @@ bool ViewFusion::confirmedIn3D(int g, const std::vector<Skeleton3D>& frames3d) c
     return n >= config_.confirm_3d_min_frames &&
            static_cast<double>(framesInRegion(g, frames3d)) >= config_.confirm_3d_min_fraction * n;
   }
+  const auto half = static_cast<std::size_t>(std::max(0, (config_.require_3d_median_frames - 1) / 2));
   int frames = 0, hits = 0;
-  for (const Skeleton3D& s : frames3d) {
+  for (std::size_t k = 0; k < frames3d.size(); ++k) {
+    const Skeleton3D s = half == 0 ? frames3d[k] : medianSkeleton(frames3d, k >= half ? k - half : 0, k + half);
     if (!bodyFrameOf(s)) continue;
     ++frames;
     if (oneArmGesture3D(s) == g) ++hits;

@@ -195,9 +195,9 @@ class ViewFusion {
   /// read on the median of require_3d_median_frames around it (require_3d).
   bool holdsIn3D(int g, const std::vector<Skeleton3D>& frames) const;
   /// Whether the triangulated frames show gesture g (confirm_3d): a one-arm gesture in
-  /// confirm_3d_min_fraction of the frames with a body frame (oneArmGesture3D, with its upright
-  /// stance); with scope all a two-arm gesture on its geometry_3d region read as holdsIn3D reads it
-  /// (medians), same fraction.
+  /// confirm_3d_min_fraction of the frames with a body frame, each read on the median of
+  /// require_3d_median_frames around it (oneArmGesture3D, with its upright stance); with scope all a
+  /// two-arm gesture on its geometry_3d region read as holdsIn3D reads it (medians), same fraction.
   bool confirmedIn3D(int g, const std::vector<Skeleton3D>& frames) const;
   /// How many of the frames, each read on the median of require_3d_median_frames around it, fall in
   /// gesture g's geometry_3d region.
