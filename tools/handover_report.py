@@ -7,7 +7,7 @@ from each mission's metrics.json `leadership` section and its safety figures: th
 silence to a new acting leader (distribution, and against the limit silence_limit_s +
 candidacy_stagger_s + 2 election_timeout_s), which UAV took over, the most UAVs acting at one step
 (must be 1) and the steps with two acting (must be 0), the operator requests sent after the
-hand-over and how many were applied, collisions, the least mutual distance (Gamma_dis 2.5 m), the
+hand-over and how many were applied, the worker's gestures applied and the false adaptations, collisions, the least mutual distance (Gamma_dis 2.5 m), the
 least worker distance (Gamma_dis) and obstacle distance (0.5 m), the tracking errors, the wall time
 per mission.
 
@@ -16,7 +16,7 @@ seeds both stores hold, the medians and extremes of the tracking and safety figu
 (e.g. before / after a planner change).
 
   tools/handover_report.py --store FILE [--out docs/results/leader_handover.md] [--commit PREFIX]
-                           [--load "2 workers at a time, 1-min load 8-12 on 2 cores"]
+                           [--seeds A..B] [--title TEXT] [--load "2 workers at a time, 1-min load 8-12 on 2 cores"]
                            [--baseline FILE --baseline-commit PREFIX]
 """
 import argparse
@@ -41,7 +41,20 @@ def dist(values, fmt="{:.2f}"):
     return " / ".join(fmt.format(v) for v in (vals[0], pick(0.5), pick(0.95), vals[-1]))
 
 
-def load(store, commit):
+def parse_seeds(text):
+    """'A..B' -> (A, B) inclusive; '' -> None (every seed)."""
+    if not text:
+        return None
+    try:
+        a, b = (int(x) for x in text.split(".."))
+    except ValueError:
+        raise SystemExit(f"handover_report.py: --seeds {text!r}: expected A..B, e.g. 101..200")
+    if a > b:
+        raise SystemExit(f"handover_report.py: --seeds {text!r}: the first seed is after the last")
+    return a, b
+
+
+def load(store, commit, seeds=None):
     con = sqlite3.connect(f"file:{store}?mode=ro", uri=True)
     con.row_factory = sqlite3.Row
     q = "SELECT profile, seed, source_commit, finished_utc, mission_s, metrics_json FROM missions WHERE profile LIKE 'leader_dropout%'"
@@ -49,6 +62,9 @@ def load(store, commit):
     if commit:
         q += " AND source_commit LIKE ?"
         params = (commit + "%",)
+    if seeds:
+        q += " AND seed BETWEEN ? AND ?"
+        params += seeds
     rows = [dict(r) for r in con.execute(q + " ORDER BY profile, seed", params)]
     fails = [dict(r) for r in con.execute(
         "SELECT profile, seed, status, exit_code FROM failures WHERE profile LIKE 'leader_dropout%'")]
@@ -86,6 +102,8 @@ def profile_section(name, rows):
         f"| operator requests sent after the hand-over: applied / sent (missions with one not applied) | {req_ok} / {req} ({incomplete}) |",
         f"| the worker's gestures (whole mission): applied / performed (seeds with one not applied) | {fired} / {performed} "
         f"({', '.join(missed) if missed else 'none'}) |",
+        f"| false adaptations: commands no gesture asked for (sum; seeds with one) | {sum(m.get('false_adaptations', 0) for m in ms)} "
+        f"({', '.join(str(r['seed']) for r, m in zip(rows, ms) if m.get('false_adaptations', 0)) or 'none'}) |",
         f"| collisions (sum) | {sum(m['collisions'] for m in ms)} |",
         f"| min mutual distance [m] (min / median / 95 % / max over seeds; Γ_dis {GAMMA_DIS_M}) | {dist([m['min_mutual_distance_m'] for m in ms])} |",
         f"| seeds with mutual distance < Γ_dis | {sum(1 for m in ms if m['min_mutual_distance_m'] < GAMMA_DIS_M)} |",
@@ -107,6 +125,7 @@ COMPARED = [("distance error rms [m]", "distance_error_rms_m", "{:.2f}"),
             ("min worker distance [m]", "min_human_distance_m", "{:.2f}"),
             ("min obstacle distance [m]", "min_obstacle_distance_m", "{:.2f}"),
             ("collisions", "collisions", "{:.0f}"),
+            ("false adaptations", "false_adaptations", "{:.0f}"),
             ("brake fallbacks per mission", "plans_fallback_brake", "{:.0f}"),
             ("gesture requests applied per mission", "gesture_requests_applied", "{:.0f}"),
             ("operator requests applied per mission", "operator_requests_applied", "{:.0f}")]
@@ -139,6 +158,8 @@ def main(argv=None):
     ap.add_argument("--store", required=True)
     ap.add_argument("--out", default="docs/results/leader_handover.md")
     ap.add_argument("--commit", default="", help="only missions of source commits starting with this")
+    ap.add_argument("--seeds", default="", help="only these seeds, A..B (e.g. a held-out range)")
+    ap.add_argument("--title", default="Leader hand-over: the leader_dropout profiles", help="the page's heading")
     ap.add_argument("--load", default="not recorded",
                     help="the machine load while the missions ran (and how many ran at a time, niced or not)")
     ap.add_argument("--baseline", default="", help="a store to compare with (its leader_dropout missions)")
@@ -147,12 +168,13 @@ def main(argv=None):
     if not os.path.exists(a.store):
         print(f"handover_report.py: --store {a.store}: no such file", file=sys.stderr)
         return 2
-    rows, fails = load(a.store, a.commit)
+    seeds = parse_seeds(a.seeds)
+    rows, fails = load(a.store, a.commit, seeds)
     commits = sorted({r["source_commit"][:10] for r in rows})
     times = sorted(r["finished_utc"] for r in rows if r["finished_utc"])
     now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     lines = [
-        "# Leader hand-over: the leader_dropout profiles",
+        f"# {a.title}",
         "",
         f"Written by `tools/handover_report.py` (do not edit by hand) on {now} from the campaign store "
         f"`{os.path.basename(a.store)}`, commit(s) {', '.join(commits) or 'none'}; missions finished "
@@ -172,7 +194,7 @@ def main(argv=None):
         if not os.path.exists(a.baseline):
             print(f"handover_report.py: --baseline {a.baseline}: no such file", file=sys.stderr)
             return 2
-        base_rows, _ = load(a.baseline, a.baseline_commit)
+        base_rows, _ = load(a.baseline, a.baseline_commit, seeds)
         base_commits = sorted({r["source_commit"][:10] for r in base_rows})
         lines += baseline_section(rows, base_rows, f"store `{os.path.basename(a.baseline)}`, commit(s) {', '.join(base_commits) or 'none'}")
     os.makedirs(os.path.dirname(a.out) or ".", exist_ok=True)
