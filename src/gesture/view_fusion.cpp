@@ -110,6 +110,13 @@ std::vector<common::ConfigError> problems(const ViewFusionConfig& c) {
   return e;
 }
 
+/// Frame k of a window of triangulated frames as the 3-D tests read it: the per-keypoint median of the
+/// median_frames (odd) frames centred on it, clamped to the window; 1: the frame itself.
+Skeleton3D frameOnMedian(const std::vector<Skeleton3D>& frames, std::size_t k, int median_frames) {
+  const auto half = static_cast<std::size_t>(std::max(0, (median_frames - 1) / 2));
+  return half == 0 ? frames[k] : medianSkeleton(frames, k >= half ? k - half : 0, k + half);
+}
+
 }  // namespace
 
 std::vector<std::string> ViewFusionConfig::validate() const { return common::problemLines(problems(*this)); }
@@ -297,10 +304,9 @@ std::vector<Skeleton3D> ViewFusion::framesIn3D(double t_now) const {
 }
 
 std::size_t ViewFusion::framesInRegion(int g, const std::vector<Skeleton3D>& frames) const {
-  const auto half = static_cast<std::size_t>(std::max(0, (config_.require_3d_median_frames - 1) / 2));
   std::size_t holds = 0;
   for (std::size_t k = 0; k < frames.size(); ++k) {
-    const Skeleton3D s = half == 0 ? frames[k] : medianSkeleton(frames, k >= half ? k - half : 0, k + half);
+    const Skeleton3D s = frameOnMedian(frames, k, config_.require_3d_median_frames);
     if (classifyPose3D(s, config_.geometry).gesture_id == g) ++holds;
   }
   return holds;
@@ -319,10 +325,9 @@ bool ViewFusion::confirmedIn3D(int g, const std::vector<Skeleton3D>& frames3d) c
     return n >= config_.confirm_3d_min_frames &&
            static_cast<double>(framesInRegion(g, frames3d)) >= config_.confirm_3d_min_fraction * n;
   }
-  const auto half = static_cast<std::size_t>(std::max(0, (config_.require_3d_median_frames - 1) / 2));
   int frames = 0, hits = 0;
   for (std::size_t k = 0; k < frames3d.size(); ++k) {
-    const Skeleton3D s = half == 0 ? frames3d[k] : medianSkeleton(frames3d, k >= half ? k - half : 0, k + half);
+    const Skeleton3D s = frameOnMedian(frames3d, k, config_.require_3d_median_frames);
     if (!bodyFrameOf(s)) continue;
     ++frames;
     if (oneArmGesture3D(s) == g) ++hits;
