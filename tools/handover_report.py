@@ -48,9 +48,9 @@ def parse_seeds(text):
     try:
         a, b = (int(x) for x in text.split(".."))
     except ValueError:
-        raise SystemExit(f"handover_report.py: --seeds {text!r}: expected A..B, e.g. 101..200")
+        raise ValueError(f"--seeds {text!r}: expected A..B, e.g. 101..200")
     if a > b:
-        raise SystemExit(f"handover_report.py: --seeds {text!r}: the first seed is after the last")
+        raise ValueError(f"--seeds {text!r}: the first seed is after the last")
     return a, b
 
 
@@ -168,7 +168,11 @@ def main(argv=None):
     if not os.path.exists(a.store):
         print(f"handover_report.py: --store {a.store}: no such file", file=sys.stderr)
         return 2
-    seeds = parse_seeds(a.seeds)
+    try:
+        seeds = parse_seeds(a.seeds)
+    except ValueError as e:
+        print(f"handover_report.py: {e}", file=sys.stderr)
+        return 2
     rows, fails = load(a.store, a.commit, seeds)
     commits = sorted({r["source_commit"][:10] for r in rows})
     times = sorted(r["finished_utc"] for r in rows if r["finished_utc"])
