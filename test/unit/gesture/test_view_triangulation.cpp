@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 #include <random>
 
 #include <Eigen/Geometry>
@@ -340,11 +341,15 @@ TEST(ViewTriangulationTest, ThreeNoisyViewsTellExtendAndRaiseFromTheirNearMisses
 // does not; the triangulated skeletons of the vote window decide whether it counts.
 namespace {
 
+/// Changes observation `o` of frame k before it is observed (e.g. a view's keypoints moved).
+using ObservationEdit = std::function<void(int k, gf::gesture::ViewObservation& o)>;
+
 /// 1.2 s of observations at 15 Hz from two cameras (leader at 0°, follower at +60°) of one body;
-/// view 0 reads `id0`, view 1 `id1`. Returns the fused verdict at the end.
+/// view 0 reads `id0`, view 1 `id1`; `edit`, if given, changes each observation first. Returns the
+/// fused verdict at the end.
 gf::gesture::FusedGesture fuseTwoViews(const gf::gesture::Body3D& body, int id0, int id1,
                                        const gf::gesture::ViewFusionConfig& config, bool with_skeletons = true,
-                                       int frames = 18) {
+                                       int frames = 18, const ObservationEdit& edit = {}) {
   gf::gesture::ViewFusion fusion(config, 3, 4);
   std::vector<CalibratedSkeleton> cams{cameraAt(10.0, 20.0, 0.0, 1.0), cameraAt(9.0, 25.0, 60.0, 1.0)};
   for (auto& c : cams) projectInto(body, c);
@@ -359,6 +364,7 @@ gf::gesture::FusedGesture fuseTwoViews(const gf::gesture::Body3D& body, int id0,
       o.distance_m = 10.0;
       o.elevation_deg = 20.0;
       if (with_skeletons) o.calibrated = cams[static_cast<std::size_t>(v)];
+      if (edit) edit(k, o);
       EXPECT_TRUE(fusion.observe(o));
     }
   }
@@ -416,30 +422,13 @@ namespace {
 /// five frames is the arm itself.
 gf::gesture::FusedGesture fuseTwoJitteryViews(const gf::gesture::Body3D& body, int id0, int id1,
                                               const gf::gesture::ViewFusionConfig& config, double jitter_px) {
-  gf::gesture::ViewFusion fusion(config, 3, 4);
-  std::vector<CalibratedSkeleton> cams{cameraAt(10.0, 20.0, 0.0, 1.0), cameraAt(9.0, 25.0, 60.0, 1.0)};
-  for (auto& c : cams) projectInto(body, c);
-  double t = 0.0;
-  for (int k = 0; k < 18; ++k) {
-    t = 10.0 + k / 15.0;
-    for (int v = 0; v < 2; ++v) {
-      gf::gesture::ViewObservation o;
-      o.view = v;
-      o.t_s = t;
-      o.gesture_id = v == 0 ? id0 : id1;
-      o.distance_m = 10.0;
-      o.elevation_deg = 20.0;
-      o.calibrated = cams[static_cast<std::size_t>(v)];
-      if (v == 1 && k % 3 != 0) {
-        const double dy = k % 3 == 1 ? jitter_px : -jitter_px;
-        for (const auto w : {gf::gesture::Keypoint::kLeftWrist, gf::gesture::Keypoint::kRightWrist}) {
-          o.calibrated->skeleton.y[static_cast<std::size_t>(w)] += dy;
-        }
-      }
-      EXPECT_TRUE(fusion.observe(o));
+  return fuseTwoViews(body, id0, id1, config, true, 18, [jitter_px](int k, gf::gesture::ViewObservation& o) {
+    if (o.view != 1 || k % 3 == 0) return;
+    const double dy = k % 3 == 1 ? jitter_px : -jitter_px;
+    for (const auto w : {gf::gesture::Keypoint::kLeftWrist, gf::gesture::Keypoint::kRightWrist}) {
+      o.calibrated->skeleton.y[static_cast<std::size_t>(w)] += dy;
     }
-  }
-  return fusion.fuse(t);
+  });
 }
 
 }  // namespace
