@@ -27,6 +27,9 @@ import sqlite3
 import statistics
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from campaign import BadInput, parse_seeds  # noqa: E402  the campaign file's seeds rule ("A..B")
+
 PROFILES = ["leader_dropout_5s", "leader_dropout_60s", "leader_dropout_for_good"]
 GAMMA_DIS_M = 2.5
 CLEARANCE_M = 0.5
@@ -41,19 +44,6 @@ def dist(values, fmt="{:.2f}"):
     return " / ".join(fmt.format(v) for v in (vals[0], pick(0.5), pick(0.95), vals[-1]))
 
 
-def parse_seeds(text):
-    """'A..B' -> (A, B) inclusive; '' -> None (every seed)."""
-    if not text:
-        return None
-    try:
-        a, b = (int(x) for x in text.split(".."))
-    except ValueError:
-        raise ValueError(f"--seeds {text!r}: expected A..B, e.g. 101..200")
-    if a > b:
-        raise ValueError(f"--seeds {text!r}: the first seed is after the last")
-    return a, b
-
-
 def load(store, commit, seeds=None):
     con = sqlite3.connect(f"file:{store}?mode=ro", uri=True)
     con.row_factory = sqlite3.Row
@@ -63,8 +53,8 @@ def load(store, commit, seeds=None):
         q += " AND source_commit LIKE ?"
         params = (commit + "%",)
     if seeds:
-        q += " AND seed BETWEEN ? AND ?"
-        params += seeds
+        q += f" AND seed IN ({','.join('?' * len(seeds))})"
+        params += tuple(seeds)
     rows = [dict(r) for r in con.execute(q + " ORDER BY profile, seed", params)]
     fails = [dict(r) for r in con.execute(
         "SELECT profile, seed, status, exit_code FROM failures WHERE profile LIKE 'leader_dropout%'")]
@@ -169,9 +159,9 @@ def main(argv=None):
         print(f"handover_report.py: --store {a.store}: no such file", file=sys.stderr)
         return 2
     try:
-        seeds = parse_seeds(a.seeds)
-    except ValueError as e:
-        print(f"handover_report.py: {e}", file=sys.stderr)
+        seeds = parse_seeds(a.seeds) if a.seeds else None
+    except BadInput as e:
+        print(f"handover_report.py: --{e}", file=sys.stderr)
         return 2
     rows, fails = load(a.store, a.commit, seeds)
     commits = sorted({r["source_commit"][:10] for r in rows})
