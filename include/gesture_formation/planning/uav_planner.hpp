@@ -234,7 +234,8 @@ class UavPlanner {
   std::unique_ptr<TrajectoryQp> qp_;
   PlannedTrajectory last_verified_;
   /// aroundSilentUavs: the side (+1/-1 about the vertical) a reference turns round each silent UAV,
-  /// chosen from the UAV's position when the turn first happens and kept while that UAV stays silent.
+  /// the side of that silent UAV the UAV is on (seen from the worker) when the turn first happens,
+  /// kept while that UAV stays silent.
   mutable std::map<int, double> silent_turn_side_;
   /// The brake plan being flown while replanning keeps failing (verified or not): its stop
   /// point is kept instead of braking anew from each state (empty when not braking).

@@ -1555,6 +1555,42 @@ TEST(UavPlannerTest, TheTurnAboutTheWorkerKeepsTheSideTheUavIsOn) {
   EXPECT_GT(r.projected_references, 0);
 }
 
+// The side is the side of the silent UAV the UAV is on, also when the first reference turned is the
+// UAV's own slot on its own azimuth (the side of that reference is then a coin toss): the next
+// reference, the slot the silent UAV holds, turns towards the UAV, not round the far side
+// (leader_dropout_for_good seed 157: latched on the own slot, the new leader's slot turned 35 degrees
+// away from it, over the tower top, where the UAV stuck above the worker for 60 s).
+TEST(UavPlannerTest, TheTurnSideIsTheSideOfTheSilentUavTheUavIsOn) {
+  const World& w = towers();
+  const double t = 60.0;
+  const Eigen::Vector3d worker(25, -12, 1);
+  const auto around = [&](double az_deg) {  // 10 m from the worker, 6 m up
+    const double a = az_deg * M_PI / 180.0;
+    return Eigen::Vector3d(worker.x() + 10.0 * std::cos(a), worker.y() + 10.0 * std::sin(a), 6.0);
+  };
+  const auto azimuth = [&](const Eigen::Vector3d& p) { return std::atan2(p.y() - worker.y(), p.x() - worker.x()) * 180.0 / M_PI; };
+  const Eigen::Vector3d own = around(0.0), hover = around(40.0), slot = around(45.0);
+  const PlannerConfig cfg = testConfig();
+  ASSERT_LT((own - hover).norm(), uavKeepOutDistance(cfg, t));  // the own slot just inside the keep-out
+  UavPlanner p(cfg, w.map, w.field);
+  auto req = straightRequest(1, t, stateAt(own, t), own, own, 1.5, worker);  // at its own slot, on its azimuth
+  req.higher_priority_plans = {standingPlan(0, hover, 0.0)};                 // silent for 60 s
+  PlanResult r = p.plan(req);
+  ASSERT_EQ(r.status, PlanStatus::kOptimized) << r.reason;
+  ASSERT_GT(r.projected_references, 0);  // the own slot turned: the side is latched here
+  for (int i = 0; i < 4; ++i) {  // now the reference is the slot the silent UAV holds
+    req.t_now_s += 2.0;
+    req.state = stateAt(evaluateTrajectory(r.trajectory, req.t_now_s).p, req.t_now_s);
+    req.reference = straightRequest(1, req.t_now_s, req.state, slot, slot, 1.5, worker).reference;
+    r = p.plan(req);
+    ASSERT_EQ(r.status, PlanStatus::kOptimized) << r.reason;
+  }
+  const Eigen::Vector3d end = r.trajectory.samples.back().p_world;
+  EXPECT_LT(azimuth(end), 10.0) << end.transpose();  // the UAV's side of the silent UAV (the far side: beyond 80 deg)
+  EXPECT_GT(azimuth(end), -45.0) << end.transpose();
+  EXPECT_NEAR((end - worker).head<2>().norm(), 10.0, 1.0) << end.transpose();
+}
+
 TEST(UavPlannerTest, UavSilentFor60sIsKeptOutOfItsHoverPointOnly) {
   const World& w = towers();
   const double t = 60.0;
