@@ -667,8 +667,8 @@ bool UavPlanner::aroundSilentUavs(const PlanContext& c, const std::vector<const 
   // keep-out wherever the QP leaves it (a new leader whose slot the silent old leader still holds:
   // 16 m from the worker at his feet's height, outside the cameras' envelope; §1.2). Such a
   // reference turns about the vertical through the worker — distance and elevation kept, so the
-  // view stays in the envelope — on the side of the silent UAV the UAV is on (latched per silent UAV) by the least angle
-  // in 5° steps that takes it out of every silent UAV's keep-out + buffer.
+  // view stays in the envelope — on the side of the silent UAV the UAV is on (latched per silent
+  // UAV) by the least angle in 5° steps that takes it out of every silent UAV's keep-out + buffer.
   if (silent.empty()) return false;
   const double t = c.req.t_now_s + k * c.dt;
   const double keep = uavKeepOutDistance(config_, std::numeric_limits<double>::infinity()) + config_.qp_distance_buffer_m;
@@ -682,12 +682,10 @@ bool UavPlanner::aroundSilentUavs(const PlanContext& c, const std::vector<const 
   const int blocker = silent[static_cast<std::size_t>(inside - at_t.begin())]->uav_index;
   const Eigen::Vector3d w = c.req.worker.p_world.col(k);
   const Eigen::Vector3d d = r - w;
-  // The side: the side of the silent UAV the UAV is on (seen from the worker), latched per silent UAV
-  // when its first turn happens, so that the reference neither crosses over the worker nor swaps
-  // sides later. Taken from the silent UAV's azimuth, not the reference's: the first reference turned
-  // may be the UAV's own slot on its own azimuth, where that side is a coin toss, and the latch then
-  // sends the next one, the slot the silent UAV holds, round the far side over the tower
-  // (leader_dropout_for_good seed 157: the new leader stuck 4 m above the worker for 60 s).
+  // Latched so that the reference neither crosses over the worker nor swaps sides later; taken from
+  // the silent UAV's azimuth, not the reference's: the first reference turned may be the UAV's own
+  // slot on its own azimuth, where that side is a coin toss, and the latch then sent the slot the
+  // silent UAV holds round the far side, over the tower (leader_dropout_for_good seed 157).
   const Eigen::Vector2d from_w(c.p0.x() - w.x(), c.p0.y() - w.y());
   const Eigen::Vector3d b = *inside - w;
   auto latched = silent_turn_side_.find(blocker);
