@@ -78,7 +78,7 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     transport_ = std::move(started->transport);
     link_ = std::move(started->link);
     marks_ = lcm_bridge::HighWaterMarkSaver(cfg.marks_file);
-    link_->setHandler([this](const comm::Envelope& e) { onEnvelope(e); });
+    link_->setHandler([this](const comm::Envelope& e) { onEnvelopeGuarded(e); });
     link_->setRejectHandler([this](const comm::VerifyResult& r, std::optional<std::uint16_t> claimed) {
       onRejected(r, claimed);
     });
@@ -196,7 +196,21 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     if (msg->phase != gesture_formation::AbortState::PHASE_NONE && a) relay_ = *a;
   }
 
-  // Called from drain() (mutex held). What to hand on: comm::LinkInbox.
+  // Called from drain() (mutex held). An authenticated payload that the decoders let through and a
+  // conversion still refuses (e.g. a time ros::Time cannot hold: the decoders refuse those) is
+  // dropped with an error, never thrown into roscpp's timer, which would end the whole manager.
+  void onEnvelopeGuarded(const comm::Envelope& e) {
+    try {
+      onEnvelope(e);
+    } catch (const std::exception& ex) {
+      ++conversion_failures_;
+      NODELET_ERROR_STREAM_THROTTLE(1.0, "LcmBridge: from sender " << e.sender_id << ", " << comm::toString(e.type)
+                                                                   << " dropped (" << conversion_failures_
+                                                                   << " so far): " << ex.what());
+    }
+  }
+
+  // What to hand on: comm::LinkInbox.
   void onEnvelope(const comm::Envelope& e) {
     if (e.type == comm::MessageType::kMapUpdate) return onMapUpdate(e);  // not an inbox item
     const comm::InboxItem item = inbox_.take(e);
@@ -276,6 +290,7 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
   std::unique_ptr<lcm_bridge::SecureLink> link_;
   comm::LinkInbox inbox_;  ///< decoding, peers' heartbeats, first command copies, refused observations
   comm::Heartbeat heartbeat_;
+  std::uint64_t conversion_failures_ = 0;  ///< envelopes dropped because a conversion to ROS threw
   int command_repeats_ = 1;
   double command_repeat_period_s_ = 0.1;
   comm::OutgoingRepeats repeats_;  ///< copies of single events still to send

@@ -36,7 +36,7 @@ const char* toString(EnvelopeError e) {
     case EnvelopeError::kBadType: return "bad message type";
     case EnvelopeError::kBadFlags: return "reserved flags set";
     case EnvelopeError::kLengthMismatch: return "length field does not match size";
-    case EnvelopeError::kBadStamp: return "stamp not finite";
+    case EnvelopeError::kBadStamp: return "stamp not a time in [0, 4e9) s";
   }
   return "unknown";
 }
@@ -71,7 +71,7 @@ EnvelopeError parseEnvelope(const std::uint8_t* data, std::size_t size, Envelope
   const std::size_t expected = kHeaderBytes + static_cast<std::size_t>(length) + tag_bytes;
   if (size < expected) return EnvelopeError::kTruncated;
   if (size > expected) return EnvelopeError::kLengthMismatch;
-  if (!std::isfinite(stamp)) return EnvelopeError::kBadStamp;
+  if (!isWireTime(stamp)) return EnvelopeError::kBadStamp;
 
   view.version = version;
   view.type = static_cast<MessageType>(type);
@@ -97,7 +97,9 @@ SealResult serialiseSigned(const Envelope& envelope, std::uint8_t version) {
     return SealResult::fail("payload of " + std::to_string(envelope.payload.size()) + " bytes exceeds " +
                             std::to_string(kMaxPayloadBytes));
   }
-  if (!std::isfinite(envelope.stamp_s)) return SealResult::fail("stamp_s is not finite");
+  if (!isWireTime(envelope.stamp_s)) {
+    return SealResult::fail("stamp_s must be a time in [0, 4e9) s, got " + std::to_string(envelope.stamp_s));
+  }
   if (!isKnownMessageType(static_cast<std::uint8_t>(envelope.type))) return SealResult::fail("unknown message type");
   ByteWriter w;
   w.u8(kMagic0);

@@ -51,8 +51,8 @@ InboxItem LinkInbox::decodeOne(const Envelope& e) {
     case MessageType::kGestureObservation: {
       GestureObservationMessage o;
       if (!decoder_.decode(e, o)) return {};
-      // A UAV votes for its own camera only; the frame time must be a ROS time.
-      if (o.uav_index != e.sender_id || !(o.t_s >= 0.0 && o.t_s < 4.0e9)) {
+      // A UAV votes for its own camera only (its time, a wire time, is checked by the decoder).
+      if (o.uav_index != e.sender_id) {
         ++observations_refused_;
         std::ostringstream os;
         os << "gesture observation refused (" << observations_refused_ << " so far): sender " << e.sender_id
@@ -70,7 +70,7 @@ InboxItem LinkInbox::decodeOne(const Envelope& e) {
     case MessageType::kCommandAck: {
       CommandAckMessage a;
       if (!decoder_.decode(e, a)) return {};
-      auto key = std::make_pair(a.id.sender, a.id.sequence);
+      AckKey key{e.sender_id, a.id.sender, a.id.sequence};
       if (!acks_seen_.insert(key).second) return {};  // a later copy
       acks_order_.push_back(std::move(key));
       if (acks_order_.size() > kAckMemory) {

@@ -71,6 +71,12 @@ bool allFinite(std::initializer_list<double> values) {
   return true;
 }
 
+/// What an encoder says of a time that is not a wire time (empty when it is one).
+std::string timeProblem(double t_s, const char* field) {
+  if (isWireTime(t_s)) return "";
+  return std::string(field) + " must be a time in [0, 4e9) s, got " + std::to_string(t_s);
+}
+
 void putVector(ByteWriter& w, const Eigen::Vector3d& v) {
   w.f64(v.x());
   w.f64(v.y());
@@ -104,6 +110,11 @@ class Decoder {
     if (!std::isfinite(x)) return fail(PayloadError::kNonFinite, field);
     v = x;
     return true;
+  }
+  /// A wire time (isWireTime).
+  bool time(double& v, const std::string& field) {
+    if (!f64(v, field)) return false;
+    return isWireTime(v) || fail(PayloadError::kOutOfRange, field);
   }
   bool vec3(Eigen::Vector3d& v, const std::string& field) {
     return f64(v.x(), field + ".x") && f64(v.y(), field + ".y") && f64(v.z(), field + ".z");
@@ -166,8 +177,9 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, Heartbeat
 //      u8 flags(bit0 lost) -------------------------------------------------------------------
 
 EncodeResult encodePayload(const WorkerStateMessage& m) {
-  if (!std::isfinite(m.t_s)) return EncodeResult::fail("worker_state.t_s not finite");
-  if (!std::isfinite(m.last_fused_t_s)) return EncodeResult::fail("worker_state.last_fused_t_s not finite");
+  for (const auto& [t, field] : {std::pair{m.t_s, "worker_state.t_s"}, std::pair{m.last_fused_t_s, "worker_state.last_fused_t_s"}}) {
+    if (const std::string e = timeProblem(t, field); !e.empty()) return EncodeResult::fail(e);
+  }
   if (m.last_fused_t_s > m.t_s) return EncodeResult::fail("worker_state.last_fused_t_s after t_s");
   if (!m.p_world.allFinite()) return EncodeResult::fail("worker_state.p_world not finite");
   if (!m.v_world.allFinite()) return EncodeResult::fail("worker_state.v_world not finite");
@@ -188,8 +200,8 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, WorkerSta
   Decoder d(data, size);
   WorkerStateMessage m;
   std::uint8_t flags = 0;
-  d.f64(m.t_s, "worker_state.t_s");
-  if (d.f64(m.last_fused_t_s, "worker_state.last_fused_t_s") && m.last_fused_t_s > m.t_s) {
+  d.time(m.t_s, "worker_state.t_s");
+  if (d.time(m.last_fused_t_s, "worker_state.last_fused_t_s") && m.last_fused_t_s > m.t_s) {
     d.fail(PayloadError::kOutOfRange, "worker_state.last_fused_t_s");
   }
   d.vec3(m.p_world, "worker_state.p_world");
@@ -211,7 +223,7 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, WorkerSta
 
 EncodeResult encodePayload(const planning::PlannedTrajectory& m) {
   if (!validUavIndex(m.uav_index)) return EncodeResult::fail("planned_trajectory.uav_index " + std::to_string(m.uav_index) + " outside [0, " + std::to_string(kMaxUavIndex) + "]");
-  if (!std::isfinite(m.t0_s)) return EncodeResult::fail("planned_trajectory.t0_s not finite");
+  if (const std::string e = timeProblem(m.t0_s, "planned_trajectory.t0_s"); !e.empty()) return EncodeResult::fail(e);
   if (!(std::isfinite(m.dt_s) && m.dt_s > 0)) return EncodeResult::fail("planned_trajectory.dt_s must be finite and > 0");
   if (m.samples.size() > kMaxTrajectorySamples) {
     return EncodeResult::fail("planned_trajectory.samples has " + std::to_string(m.samples.size()) + " entries, at most " + std::to_string(kMaxTrajectorySamples));
@@ -246,7 +258,7 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, planning:
   std::uint16_t uav = 0, count = 0;
   if (d.u16(uav, "planned_trajectory.uav_index") && !validUavIndex(uav)) d.fail(PayloadError::kOutOfRange, "planned_trajectory.uav_index");
   d.u32(m.sequence, "planned_trajectory.sequence");
-  d.f64(m.t0_s, "planned_trajectory.t0_s");
+  d.time(m.t0_s, "planned_trajectory.t0_s");
   if (d.f64(m.dt_s, "planned_trajectory.dt_s") && !(m.dt_s > 0)) d.fail(PayloadError::kOutOfRange, "planned_trajectory.dt_s");
   if (d.u16(count, "planned_trajectory.count")) {
     if (count > kMaxTrajectorySamples) {
@@ -494,7 +506,7 @@ void getSkeleton(Decoder& d, ObservedSkeleton& o) {
 
 EncodeResult encodePayload(const GestureObservationMessage& m) {
   if (!validUavIndex(m.uav_index)) return EncodeResult::fail("gesture_observation.uav_index " + std::to_string(m.uav_index) + " outside [0, " + std::to_string(kMaxUavIndex) + "]");
-  if (!std::isfinite(m.t_s)) return EncodeResult::fail("gesture_observation.t_s not finite");
+  if (const std::string e = timeProblem(m.t_s, "gesture_observation.t_s"); !e.empty()) return EncodeResult::fail(e);
   if (m.gesture_id > kMaxGestureId) return EncodeResult::fail("gesture_observation.gesture_id " + std::to_string(m.gesture_id) + " > " + std::to_string(kMaxGestureId));
   if (m.probabilities.size() > kMaxGestureClasses) return EncodeResult::fail("gesture_observation.probabilities has " + std::to_string(m.probabilities.size()) + " entries, at most " + std::to_string(kMaxGestureClasses));
   for (double p : m.probabilities) {
@@ -526,7 +538,7 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, GestureOb
   if (d.u16(m.uav_index, "gesture_observation.uav_index") && !validUavIndex(m.uav_index)) {
     d.fail(PayloadError::kOutOfRange, "gesture_observation.uav_index");
   }
-  d.f64(m.t_s, "gesture_observation.t_s");
+  d.time(m.t_s, "gesture_observation.t_s");
   if (d.u8(m.gesture_id, "gesture_observation.gesture_id") && m.gesture_id > kMaxGestureId) {
     d.fail(PayloadError::kOutOfRange, "gesture_observation.gesture_id");
   }
@@ -624,7 +636,7 @@ EncodeResult encodePayload(const CommandAckMessage& m) {
     return EncodeResult::fail("command_ack.id.sender must be 1.." + std::to_string(kMaxSenderNameBytes) +
                               " printable ASCII characters without spaces");
   }
-  if (!std::isfinite(m.command_stamp_s)) return EncodeResult::fail("command_ack.command_stamp_s must be finite");
+  if (const std::string e = timeProblem(m.command_stamp_s, "command_ack.command_stamp_s"); !e.empty()) return EncodeResult::fail(e);
   if (!validOutcomeText(m.outcome)) {
     return EncodeResult::fail("command_ack.outcome must be at most " + std::to_string(kMaxAckOutcomeBytes) +
                               " bytes without control characters (" + std::to_string(m.outcome.size()) + " bytes)");
@@ -658,7 +670,7 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, CommandAc
   if (d.u8(source, "command_ack.source") && source > 1) d.fail(PayloadError::kOutOfRange, "command_ack.source");
   if (d.u8(status, "command_ack.status") && status > 2) d.fail(PayloadError::kOutOfRange, "command_ack.status");
   d.u64(m.params_version, "command_ack.params_version");
-  d.f64(m.command_stamp_s, "command_ack.command_stamp_s");
+  d.time(m.command_stamp_s, "command_ack.command_stamp_s");
   if (d.u8(outcome_len, "command_ack.outcome_length") && outcome_len > kMaxAckOutcomeBytes) {
     d.fail(PayloadError::kOversizeArray, "command_ack.outcome_length");
   }
@@ -686,8 +698,8 @@ bool validOptionalName(const std::string& s) { return s.empty() || validSenderNa
 
 EncodeResult encodePayload(const AssistanceMessage& m) {
   const auto& a = m.state;
-  if (!std::isfinite(a.requested_s) || !std::isfinite(a.acknowledged_s)) {
-    return EncodeResult::fail("assistance.requested_s / acknowledged_s must be finite");
+  for (const auto& [t, field] : {std::pair{a.requested_s, "assistance.requested_s"}, std::pair{a.acknowledged_s, "assistance.acknowledged_s"}}) {
+    if (const std::string e = timeProblem(t, field); !e.empty()) return EncodeResult::fail(e);
   }
   if (!validOptionalName(a.requested_by) || !validOptionalName(a.acknowledged_by)) {
     return EncodeResult::fail("assistance.requested_by / acknowledged_by must be 0.." + std::to_string(kMaxSenderNameBytes) +
@@ -710,7 +722,7 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, Assistanc
   auto& a = m.state;
   std::uint8_t phase = 0;
   if (d.u8(phase, "assistance.phase") && phase > 2) d.fail(PayloadError::kOutOfRange, "assistance.phase");
-  d.f64(a.requested_s, "assistance.requested_s");
+  d.time(a.requested_s, "assistance.requested_s");
   auto name = [&d](std::string& into, const char* length_field, const char* field) {
     std::uint8_t n = 0;
     if (d.u8(n, length_field) && n > kMaxSenderNameBytes) d.fail(PayloadError::kOversizeArray, length_field);
@@ -721,7 +733,7 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, Assistanc
     }
   };
   name(a.requested_by, "assistance.requested_by_length", "assistance.requested_by");
-  d.f64(a.acknowledged_s, "assistance.acknowledged_s");
+  d.time(a.acknowledged_s, "assistance.acknowledged_s");
   name(a.acknowledged_by, "assistance.acknowledged_by_length", "assistance.acknowledged_by");
   if (d.finish()) {
     a.phase = static_cast<formation::AssistancePhase>(phase);

@@ -44,6 +44,12 @@ constexpr std::size_t kMaxTagBytes = kEd25519SignatureBytes;
 constexpr std::size_t tagBytes(std::uint8_t version) {
   return version == kEnvelopeVersionHmac ? kTagBytes : version == kEnvelopeVersionEd25519 ? kEd25519SignatureBytes : 0;
 }
+/// Absolute times on the wire (envelope stamps and the payloads' times, s: since the epoch onboard,
+/// since the start in simulation) lie in [0, kMaxWireTimeS): what a ROS time holds (2^32 s), with
+/// margin. Encoders and decoders refuse any other, naming the field — a receiver turns them into
+/// ros::Time, which throws outside that range.
+constexpr double kMaxWireTimeS = 4.0e9;
+inline bool isWireTime(double t_s) { return t_s >= 0.0 && t_s < kMaxWireTimeS; }
 /// Largest payload [bytes]: fits a planned trajectory of kMaxTrajectorySamples samples and
 /// stays below LCM's 64 KiB single-datagram limit with the header and tag.
 constexpr std::size_t kMaxPayloadBytes = 60000;
@@ -98,7 +104,7 @@ enum class EnvelopeError {
   kBadType,
   kBadFlags,
   kLengthMismatch,  ///< longer than the length field says (trailing bytes)
-  kBadStamp,        ///< stamp not finite
+  kBadStamp,        ///< stamp not a wire time (isWireTime: finite, in [0, kMaxWireTimeS))
 };
 const char* toString(EnvelopeError e);
 

@@ -18,6 +18,7 @@
 #include <map>
 #include <set>
 #include <string>
+#include <tuple>
 #include <variant>
 
 #include "gesture_formation/comm/command_intake.hpp"
@@ -60,10 +61,13 @@ class LinkInbox {
   PayloadDecoder decoder_;
   CommandIntake intake_;
   std::map<std::uint16_t, Heartbeat> peers_;  ///< each sender's last heartbeat
-  /// The ids of the last kAckMemory acknowledgements handed on (later copies are dropped).
+  /// The last kAckMemory acknowledgements handed on, by (link sender, command id): later copies
+  /// from the same sender are dropped; another sender's ack of the same id is its own (one UAV
+  /// cannot silence another's acknowledgement by sending it first).
   static constexpr std::size_t kAckMemory = 256;
-  std::set<std::pair<std::string, std::uint64_t>> acks_seen_;
-  std::deque<std::pair<std::string, std::uint64_t>> acks_order_;
+  using AckKey = std::tuple<std::uint16_t, std::string, std::uint64_t>;
+  std::set<AckKey> acks_seen_;
+  std::deque<AckKey> acks_order_;
   std::uint64_t observations_refused_ = 0;
   std::uint64_t leadership_refused_ = 0;
   std::string last_refusal_;

@@ -122,12 +122,14 @@ TEST(CommEnvelopeTest, StructuralErrorsAreNamed) {
   b[24] = 0x7F;  // length 2 GB
   check(b, EnvelopeError::kOversize);
   check(std::vector<std::uint8_t>(kMaxEnvelopeBytes + 1, 0), EnvelopeError::kOversize);
-  b = good;
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  std::uint64_t bits = 0;
-  std::memcpy(&bits, &nan, 8);
-  for (int i = 0; i < 8; ++i) b[16 + i] = static_cast<std::uint8_t>(bits >> (56 - 8 * i));
-  check(b, EnvelopeError::kBadStamp);
+  // The stamp must be a wire time (a ROS time can hold it): finite, in [0, kMaxWireTimeS).
+  for (const double stamp : {std::numeric_limits<double>::quiet_NaN(), -1.0, -1e-9, kMaxWireTimeS, 5.0e9}) {
+    b = good;
+    std::uint64_t bits = 0;
+    std::memcpy(&bits, &stamp, 8);
+    for (int i = 0; i < 8; ++i) b[16 + i] = static_cast<std::uint8_t>(bits >> (56 - 8 * i));
+    check(b, EnvelopeError::kBadStamp);
+  }
   EXPECT_EQ(parseEnvelope(nullptr, 100, v), EnvelopeError::kTruncated);
 }
 
@@ -142,8 +144,12 @@ TEST(CommEnvelopeTest, SealRefusesWhatReceiversWouldRefuse) {
   EXPECT_EQ(max->size(), kHeaderBytes + kMaxPayloadBytes + kTagBytes);  // version 1
   EXPECT_EQ(kMaxEnvelopeBytes, kHeaderBytes + kMaxPayloadBytes + kEd25519SignatureBytes);
   e.payload.clear();
-  e.stamp_s = std::numeric_limits<double>::infinity();
-  EXPECT_FALSE(sealEnvelope(e, k.data(), k.size()));
+  for (const double stamp : {std::numeric_limits<double>::infinity(), -1.0, kMaxWireTimeS}) {
+    e.stamp_s = stamp;
+    const auto sealed = sealEnvelope(e, k.data(), k.size());
+    ASSERT_FALSE(sealed) << stamp;
+    EXPECT_NE(sealed.reason().find("stamp_s must be a time in [0, 4e9) s"), std::string::npos) << sealed.reason();
+  }
   e.stamp_s = 0;
   e.type = static_cast<MessageType>(kMaxMessageType + 1);  // the first unknown type
   EXPECT_FALSE(sealEnvelope(e, k.data(), k.size()));

@@ -2,6 +2,7 @@
 // copies of single events): what each envelope yields, and when each copy falls due.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <variant>
 
 #include "gesture_formation/comm/link_inbox.hpp"
@@ -79,9 +80,70 @@ TEST(LinkInboxTest, ObservationsOfAnotherCameraOrWithABadTimeAreRefused) {
   EXPECT_NE(inbox.lastRefusal().find("gesture observation refused (1 so far): sender 1, uav_index 2"), std::string::npos)
       << inbox.lastRefusal();
   EXPECT_FALSE(inbox.lastWasDecodeFailure());
-  o.t_s = 5.0e9;  // not a ROS time
-  EXPECT_TRUE(std::holds_alternative<std::monostate>(inbox.take(envelopeOf(o, 2))));
-  EXPECT_EQ(inbox.observationsRefused(), 2u);
+}
+
+namespace {
+
+/// `e` with the big-endian double at payload byte `offset` replaced by `value`.
+Envelope withDoubleAt(Envelope e, std::size_t offset, double value) {
+  std::uint64_t bits = 0;
+  std::memcpy(&bits, &value, sizeof bits);
+  for (int i = 0; i < 8; ++i) e.payload.at(offset + static_cast<std::size_t>(i)) = static_cast<std::uint8_t>(bits >> (56 - 8 * i));
+  return e;
+}
+
+}  // namespace
+
+// Every time a receiver turns into ros::Time (which throws outside [0, 2^32) s, and a throw in the
+// bridge's timer ends the whole nodelet manager) is a wire time: an authenticated payload with a
+// negative or too large one is a decode failure naming the field, and no encoder writes one.
+TEST(LinkInboxTest, TimesOutsideTheWireRangeAreDecodeFailuresNamingTheField) {
+  WorkerStateMessage w;
+  w.t_s = 12.0;
+  w.last_fused_t_s = 0.0;  // ≤ t_s whatever t_s is patched to below
+  GestureObservationMessage o;
+  o.uav_index = 2;
+  o.t_s = 12.0;
+  o.probabilities = {0.5, 0.5};
+  CommandAckMessage a;
+  a.id = {"op@100", 4};
+  a.command_stamp_s = 12.0;
+  AssistanceMessage s;
+  s.state.requested_s = 12.0;
+  s.state.acknowledged_s = 12.0;
+  struct Case {
+    Envelope e;
+    std::size_t offset;
+    const char* field;
+  };
+  const std::vector<Case> cases{
+      {envelopeOf(w, 0), 0, "worker_state.t_s"},
+      {envelopeOf(w, 0), 8, "worker_state.last_fused_t_s"},
+      {envelopeOf(plan(3), 1), 6, "planned_trajectory.t0_s"},
+      {envelopeOf(o, 2), 2, "gesture_observation.t_s"},
+      {envelopeOf(a, 0), 1 + 6 + 8 + 1 + 1 + 8, "command_ack.command_stamp_s"},
+      {envelopeOf(s, 0), 1, "assistance.requested_s"},
+  };
+  for (const Case& c : cases) {
+    LinkInbox inbox;
+    ASSERT_FALSE(std::holds_alternative<std::monostate>(inbox.take(c.e))) << c.field << ": the unpatched payload";
+    for (const double bad : {-1.0, -1e-9, 5.0e9, kMaxWireTimeS}) {
+      EXPECT_TRUE(std::holds_alternative<std::monostate>(inbox.take(withDoubleAt(c.e, c.offset, bad)))) << c.field << " = " << bad;
+      EXPECT_TRUE(inbox.lastWasDecodeFailure()) << c.field << " = " << bad;
+      EXPECT_NE(inbox.lastRefusal().find(std::string("out_of_range: ") + c.field), std::string::npos) << inbox.lastRefusal();
+    }
+    LinkInbox fresh;  // (the first take above made an acknowledgement's copies repeats)
+    EXPECT_FALSE(std::holds_alternative<std::monostate>(fresh.take(withDoubleAt(c.e, c.offset, 0.0)))) << c.field << " = 0";
+  }
+  // The encoders refuse the same, naming the field and the value.
+  w.t_s = -1.0;
+  auto bytes = encodePayload(w);
+  ASSERT_FALSE(bytes);
+  EXPECT_NE(bytes.reason().find("worker_state.t_s must be a time in [0, 4e9) s, got -1"), std::string::npos) << bytes.reason();
+  s.state.acknowledged_s = 5.0e9;
+  bytes = encodePayload(s);
+  ASSERT_FALSE(bytes);
+  EXPECT_NE(bytes.reason().find("assistance.acknowledged_s"), std::string::npos) << bytes.reason();
 }
 
 TEST(LinkInboxTest, EveryAbortCopyIsHandedOnStampedWithItsEnvelope) {
@@ -141,6 +203,22 @@ TEST(LinkInboxTest, AnAcknowledgementIsHandedOnOncePerCommandId) {
   EXPECT_TRUE(std::holds_alternative<CommandAckMessage>(inbox.take(envelopeOf(a, 0, 22.0))));
   a.id.sequence = 100 + 255;
   EXPECT_TRUE(std::holds_alternative<std::monostate>(inbox.take(envelopeOf(a, 0, 22.1))));  // still remembered
+}
+
+// An acknowledgement is a repeat only of the same link sender's: another member sending an ack of
+// the same command id first (a captured follower) does not silence the leader's.
+TEST(LinkInboxTest, AnotherSendersAcknowledgementDoesNotSilenceTheLeaders) {
+  LinkInbox inbox;
+  CommandAckMessage forged;
+  forged.id = {"operator@100", 7};
+  forged.status = formation::CommandStatus::kRejected;
+  ASSERT_TRUE(std::holds_alternative<CommandAckMessage>(inbox.take(envelopeOf(forged, 2, 30.0))));
+  CommandAckMessage real = forged;
+  real.status = formation::CommandStatus::kApplied;
+  const auto item = inbox.take(envelopeOf(real, 0, 30.1));
+  ASSERT_TRUE(std::holds_alternative<CommandAckMessage>(item));
+  EXPECT_EQ(std::get<CommandAckMessage>(item).status, formation::CommandStatus::kApplied);
+  EXPECT_TRUE(std::holds_alternative<std::monostate>(inbox.take(envelopeOf(real, 0, 30.2))));  // the leader's own repeat
 }
 
 TEST(LinkInboxTest, AnUndecodablePayloadIsADecodeFailureNamingTheField) {

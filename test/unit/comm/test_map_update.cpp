@@ -122,6 +122,8 @@ TEST(MapUpdateTest, EveryMalformedPayloadIsRefusedNamingItsField) {
   const Case cases[] = {
       {"map_update.uav_index", PayloadError::kOutOfRange, [](MapUpdate& m) { m.uav_index = 32; }},
       {"map_update.stamp_s", PayloadError::kNonFinite, [](MapUpdate& m) { m.delta.stamp_s = std::nan(""); }},
+      {"map_update.stamp_s must be a time in [0, 4e9) s, got -1", PayloadError::kOutOfRange, [](MapUpdate& m) { m.delta.stamp_s = -1.0; }},
+      {"map_update.stamp_s must be a time in [0, 4e9) s", PayloadError::kOutOfRange, [](MapUpdate& m) { m.delta.stamp_s = 5.0e9; }},
       {"map_update.resolution_m", PayloadError::kNonFinite,
        [](MapUpdate& m) { m.delta.resolution_m = std::numeric_limits<double>::infinity(); }},
       {"map_update.resolution_m", PayloadError::kOutOfRange, [](MapUpdate& m) { m.delta.resolution_m = 0.0; }},
