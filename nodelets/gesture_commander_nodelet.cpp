@@ -124,7 +124,9 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
             if (m->acting) acted_term_ = m->term;
             if (votes == acting_) return;
             acting_ = votes;
-            make_frames_();  // a new leader's vote and filter start afresh
+            make_frames_();  // a new leader's vote and filter start afresh,
+            // waiting for the gesture in progress to be released (its predecessor may have fired)
+            if (acting_) frames_->awaitRelease();
             NODELET_WARN_STREAM("GestureCommander: " << (acting_ ? "acts as leader (term " + std::to_string(m->term) + "): votes from now on"
                                                                  : std::string("no longer the leader of its term: no vote")));
           });

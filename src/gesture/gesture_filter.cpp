@@ -110,7 +110,12 @@ void GestureFilter::popFront() {
   --size_;
 }
 
-GestureFilterOutput GestureFilter::update(double t_s, double gesture_id) {
+void GestureFilter::awaitRelease() {
+  armed_ = config_.rearm == RearmMode::kRepeat;
+  none_since_s_ = std::numeric_limits<double>::quiet_NaN();
+}
+
+GestureFilterOutput GestureFilter::update(double t_s, double gesture_id, bool none_seen) {
   GestureFilterOutput out;
   out.window_count = size_;
   if (!std::isfinite(t_s)) {
@@ -159,8 +164,9 @@ GestureFilterOutput GestureFilter::update(double t_s, double gesture_id) {
     }
   }
   out.dominant_ratio = static_cast<double>(best_count) / static_cast<double>(size_);
-  // Release: "none" dominating (no tie) for release_s re-arms; anything else restarts the run.
-  if (!tie && best == kGestureNone) {
+  // Release: "none" dominating (no tie) for release_s re-arms; anything else restarts the run,
+  // and so does a measurement of none that saw no release (a vote that fell short).
+  if (!tie && best == kGestureNone && (id != kGestureNone || none_seen)) {
     if (std::isnan(none_since_s_)) none_since_s_ = t_s;
     if (t_s - none_since_s_ >= config_.release_s) armed_ = true;
   } else {

@@ -54,7 +54,10 @@ GestureFrame GestureFrames::process(double t_s, const Pending& p) {
     f.fused.gesture_id = p.own_id;
     f.fused.voting_views = f.fused.agreeing_views = 1;
   }
-  f.filter = filter_.update(t_s, f.fused.gesture_id);
+  // Release evidence: as many views see none as a gesture needs to agree (a view lost while the
+  // worker holds a gesture leaves the vote short: id 0, but no release); one camera: its own none.
+  const bool none_seen = views_ > 1 ? f.fused.none_views >= fusion_.config().min_agreeing_views : p.own_id == kGestureNone;
+  f.filter = filter_.update(t_s, f.fused.gesture_id, none_seen);
   if (f.filter.fired) f.action = mapping_.find(f.filter.dominant_id);
   return f;
 }

@@ -240,6 +240,7 @@ FusedGesture ViewFusion::fuse(double t_now) const {
     }
   }
   out.agreeing_views = best_votes;
+  out.none_views = votes[0];
   const bool one_short = config_.confirm_3d && unique && best_votes + 1 == config_.min_agreeing_views &&
                          (config_.confirm_3d_scope == ViewFusionConfig::ConfirmScope::kAll || best == kExtendArmSide ||
                           best == kRaiseArmUp);
@@ -254,7 +255,10 @@ FusedGesture ViewFusion::fuse(double t_now) const {
     out.gesture_id = best;
     out.confirmed_3d = true;
   }
-  if (out.gesture_id != 0 && config_.require_3d && out.frames_3d > 0) {
+  // Two calibrated views in the window make the geometry the judge even when none of their
+  // observations pair up in time (frames_3d 0 < require_3d_min_frames: refused) — a missing
+  // triangulation is no licence to skip the check.
+  if (out.gesture_id != 0 && config_.require_3d && (out.frames_3d > 0 || calibratedViews(t_now) >= 2)) {
     out.checked_3d = true;
     if (out.frames_3d < config_.require_3d_min_frames || !holdsIn3D(best, frames)) {
       out.gesture_id = 0;
@@ -265,15 +269,25 @@ FusedGesture ViewFusion::fuse(double t_now) const {
   return out;
 }
 
+bool ViewFusion::usableFor3D(const ViewObservation& o, double t_now) const {
+  return o.calibrated && o.t_s > t_now - config_.vote_window_s && o.t_s <= t_now + config_.max_age_s &&
+         inEnvelope(o.distance_m, o.elevation_deg);
+}
+
+int ViewFusion::calibratedViews(double t_now) const {
+  int n = 0;
+  for (const auto& h : history_) {
+    n += std::any_of(h.begin(), h.end(), [&](const ViewObservation& o) { return usableFor3D(o, t_now); }) ? 1 : 0;
+  }
+  return n;
+}
+
 std::vector<Skeleton3D> ViewFusion::framesIn3D(double t_now) const {
   // One 3-D frame per observation of the most observed view inside the window and the envelope:
   // with it, every other view's observation nearest in time (≤ confirm_3d_max_dt_s) that carries a
   // calibrated skeleton; triangulated when at least two views take part.
   std::vector<Skeleton3D> out;
-  const auto usable = [&](const ViewObservation& o) {
-    return o.calibrated && o.t_s > t_now - config_.vote_window_s && o.t_s <= t_now + config_.max_age_s &&
-           inEnvelope(o.distance_m, o.elevation_deg);
-  };
+  const auto usable = [&](const ViewObservation& o) { return usableFor3D(o, t_now); };
   std::size_t ref = 0, ref_count = 0;
   for (std::size_t i = 0; i < history_.size(); ++i) {
     const auto c = static_cast<std::size_t>(std::count_if(history_[i].begin(), history_[i].end(), usable));

@@ -390,7 +390,8 @@ void MissionRun::stepLeadership(double t) {
 
 void MissionRun::takeOver(int k, double t) {
   // A new leader: its estimator starts from the last share it received (then fuses its own
-  // camera), the parameters and their version from that share, fresh gesture frames and filter.
+  // camera), the parameters and their version from that share, fresh gesture frames and filter
+  // that wait for the gesture in progress to be released.
   owner_ = k;
   took_over_s_ = t;
   kept_.clear();  // its predecessor's
@@ -412,6 +413,7 @@ void MissionRun::takeOver(int k, double t) {
     }
   }
   frames_ = gesture::GestureFrames(cfg_.gesture_filter, cfg_.view_fusion, cfg_.gesture_mapping, n_, 0.0);
+  frames_.awaitRelease();  // its predecessor may have fired for the performance in progress
   frame_views_.clear();
   assistance_.leaderChanged();
   modes_.push_back(ModeChange{t, k, uav(k).mode, "acting as leader (term " + std::to_string(lead_->member(k).term()) +

@@ -113,6 +113,19 @@ def main():
             rate.sleep()
         time.sleep(0.5)
 
+    def idle(name, views, geometry, frames=38):
+        """views read "none" for `frames` frames at 15 Hz (~2.5 s): the worker seen not gesturing."""
+        rate = rospy.Rate(15)
+        for _ in range(frames):
+            stamp = rospy.Time.now()
+            for uav in sorted(views, reverse=True):  # the leader's last: it closes the frame
+                o = GestureObservation(uav_index=uav, gesture_id=0, probabilities=[1.0, 0.0, 0.0, 0.0, 0.0],
+                                       geometry_known=True, distance_m=geometry[0], elevation_deg=geometry[1])
+                o.header.stamp = stamp
+                pubs[name][0 if uav == 0 else 1].publish(o)
+            rate.sleep()
+        time.sleep(0.5)
+
     def inject_late_follower(names, delay_frames=7):
         """The leader reads gesture 2 at once; follower 1 reads it too, its observations published
         delay_frames frames (at 15 Hz) after their stamp."""
@@ -196,7 +209,9 @@ def main():
               len(commands["lagged"]), ", fired with %d agreeing" % fired[0].agreeing_views if fired else ""))
     # ~leadership: acting in term 1, then its lease lapses (same term, still the term's leader): it
     # votes on (the FormationPlanner keeps what it sends until the lease is back); a newer term with
-    # another leader: no vote; acting again in term 3: votes.
+    # another leader: no vote; acting again in term 3: votes. A UAV that starts acting fires only
+    # once it has seen the worker release the gesture in progress (its predecessor may have fired for
+    # it): the worker is seen idle first, and a gesture already held when it took over does not fire.
     lead_pub = rospy.Publisher("/lead/leadership_state", LeadershipState, queue_size=5, latch=True)
 
     def lead_state(term, leader, role, acting):
@@ -207,6 +222,7 @@ def main():
 
     lead_state(1, 0, LeadershipState.ROLE_LEADER, True)
     lead_state(1, 0, LeadershipState.ROLE_LEADER, False)
+    idle("lead", [0, 1], IN_ENVELOPE)
     inject("lead", [0, 1], IN_ENVELOPE)
     check(len(commands["lead"]) == 1, "~leadership, its lease lapsed in the term it acts in: %d command(s) (expected 1)" % len(commands["lead"]))
     lead_state(2, 1, LeadershipState.ROLE_FOLLOWER, False)
@@ -214,7 +230,12 @@ def main():
     check(len(commands["lead"]) == 1, "~leadership, a newer term led by UAV 1: %d command(s) in total (expected still 1)" % len(commands["lead"]))
     lead_state(3, 0, LeadershipState.ROLE_LEADER, True)
     inject("lead", [0, 1], IN_ENVELOPE)
-    check(len(commands["lead"]) == 2, "~leadership, acting again in term 3: %d command(s) in total (expected 2)" % len(commands["lead"]))
+    check(len(commands["lead"]) == 1,
+          "~leadership, acting again in term 3, the gesture held since before: %d command(s) in total (expected still 1)" % len(commands["lead"]))
+    idle("lead", [0, 1], IN_ENVELOPE)
+    inject("lead", [0, 1], IN_ENVELOPE)
+    check(len(commands["lead"]) == 2,
+          "~leadership, acting in term 3, released and performed again: %d command(s) in total (expected 2)" % len(commands["lead"]))
     return fails
 
 

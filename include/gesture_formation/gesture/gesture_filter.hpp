@@ -19,9 +19,11 @@
 ///     cooldown) or t − t_last_fired ≥ t_d (cooldown_s; an elapsed time exactly t_d may fire).
 /// Re-arming (`rearm`): with `release` (the default: one performance, one command) a fired
 /// command disarms the filter until the gesture has been released — the dominant id of every
-/// evaluation has been 0 (none; no tie) for at least release_s (from the first such evaluation;
-/// any other evaluation restarts it), or every earlier entry of G has expired (nothing seen for
-/// t_c: a new performance). A gesture held, or misread and held, for longer than t_d thus fires
+/// evaluation has been 0 (none; no tie) *and the measurement itself saw none* (update's
+/// `none_seen`: the views agreed on none, not merely failed to agree on a gesture) for at least
+/// release_s (from the first such evaluation; any other evaluation restarts it), or every earlier
+/// entry of G has expired (nothing seen for t_c: a new performance). A view lost while the worker
+/// holds a gesture makes the vote fall short (id 0) but is no release. A gesture held, or misread and held, for longer than t_d thus fires
 /// once. With `repeat` (the paper) the filter is always armed: a held gesture fires again
 /// every t_d. Firing does not clear G. Rejected and unevaluated measurements do not count
 /// toward anything.
@@ -108,8 +110,14 @@ class GestureFilter {
   static common::Result<GestureFilter> create(const GestureFilterConfig& config);
 
   /// \brief Processes one classifier output at time `t_s` [s] with id `gesture_id`.
-  /// `gesture_id` is a double so that non-integer input can be rejected here.
-  GestureFilterOutput update(double t_s, double gesture_id);
+  /// `gesture_id` is a double so that non-integer input can be rejected here. `none_seen`: for
+  /// id 0, whether the input saw the worker not gesturing (release evidence) rather than a vote
+  /// that fell short (lost or disagreeing views, a 3-D refusal); ignored for other ids.
+  GestureFilterOutput update(double t_s, double gesture_id, bool none_seen = true);
+
+  /// \brief Disarms the filter until the gesture in progress (if any) is released — what a new
+  /// leader's filter does, since its predecessor may have fired for the performance it now sees.
+  void awaitRelease();
 
   /// \brief Forgets every measurement and the last fired time.
   void reset();

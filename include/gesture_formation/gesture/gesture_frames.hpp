@@ -53,6 +53,12 @@ class GestureFrames {
   /// \brief Closes every pending frame stamped at or before t_s − closeAfterS(), in time order.
   std::vector<GestureFrame> closeDue(double t_now_s);
 
+  /// \brief A new leader's frames: the filter waits for the gesture in progress (if any) to be
+  /// released before it fires (GestureFilter::awaitRelease) — its predecessor may already have
+  /// fired for that performance, and its parameters, which the new leader took over, hold that
+  /// command. Call right after constructing the frames of a take-over.
+  void awaitRelease() { filter_.awaitRelease(); }
+
   /// Cameras that vote: uav_count, or 1 with min_agreeing_views ≤ 1.
   int views() const { return views_; }
   /// max(frame_wait_s, fusion_lag_s when several views vote).

@@ -149,6 +149,7 @@ struct FusedGesture {
   int gesture_id = 0;      ///< what goes to the GestureFilter
   int voting_views = 0;    ///< fresh views inside the envelope
   int agreeing_views = 0;  ///< votes for gesture_id (for 0: votes of the best gesture, which fell short)
+  int none_views = 0;      ///< fresh views inside the envelope that vote none
   bool confirmed_3d = false;  ///< gesture_id passed with the 3-D confirmation as its last vote
   bool checked_3d = false;    ///< require_3d: the vote's gesture was checked in 3-D (two or more calibrated views)
   bool rejected_3d = false;   ///< require_3d: the vote's gesture failed its 3-D geometry (gesture_id is then 0)
@@ -191,6 +192,10 @@ class ViewFusion {
   /// calibrated observations, with every other view's nearest (≤ confirm_3d_max_dt_s); only frames
   /// two or more views took part in.
   std::vector<Skeleton3D> framesIn3D(double t_now) const;
+  /// An observation the 3-D tests may use at t_now: calibrated, inside the vote window and the envelope.
+  bool usableFor3D(const ViewObservation& o, double t_now) const;
+  /// Views with at least one observation usableFor3D at t_now.
+  int calibratedViews(double t_now) const;
   /// Whether design.md §2's geometry of gesture g holds in require_3d_min_fraction of the frames, each
   /// read on the median of require_3d_median_frames around it (require_3d).
   bool holdsIn3D(int g, const std::vector<Skeleton3D>& frames) const;

@@ -306,6 +306,53 @@ TEST(GestureFilterReleaseTest, ReleasedForReleaseSThenTheSameGestureFiresAgain) 
   EXPECT_EQ(run(2, 6.0).size(), 1u);   // a new performance fires once
 }
 
+// A measurement of none that saw no release (the vote fell short: a view lost while the worker
+// holds the gesture) neither counts toward the release nor lets a held gesture fire again; the
+// same measurements seeing none do.
+TEST(GestureFilterReleaseTest, NoneThatSawNoReleaseDoesNotReArm) {
+  GestureFilterConfig c;
+  c.release_s = 1.0;
+  GestureFilter f(c);
+  double t = 0.0;
+  const auto run = [&](int id, double seconds, bool none_seen) {
+    std::vector<double> fired;
+    for (double end = t + seconds; t < end - 1e-9; t += 0.1) {
+      if (f.update(t, id, none_seen).fired) fired.push_back(t);
+    }
+    return fired;
+  };
+  EXPECT_EQ(run(2, 3.0, true).size(), 1u);
+  EXPECT_TRUE(run(0, 4.0, false).empty());  // 4 s of a vote that fell short: "none" dominates, no release
+  EXPECT_FALSE(f.armed());
+  EXPECT_TRUE(run(2, 6.0, true).empty());  // the views return: the same performance, nothing more
+  EXPECT_TRUE(run(0, 3.0, true).empty());   // released
+  EXPECT_TRUE(f.armed());
+  EXPECT_EQ(run(2, 6.0, true).size(), 1u);
+}
+
+// A new leader's filter (awaitRelease) does not fire for a gesture in progress until it has been
+// released: its predecessor may have fired for that performance already.
+TEST(GestureFilterReleaseTest, AfterAwaitReleaseAHeldGestureFiresOnlyOnceReleased) {
+  GestureFilterConfig c;
+  c.release_s = 1.0;
+  GestureFilter f(c);
+  f.awaitRelease();
+  EXPECT_FALSE(f.armed());
+  double t = 0.0;
+  int fired = 0;
+  for (; t < 6.0; t += 0.1) fired += f.update(t, 2).fired ? 1 : 0;
+  EXPECT_EQ(fired, 0);
+  for (; t < 9.0; t += 0.1) fired += f.update(t, 0).fired ? 1 : 0;
+  EXPECT_TRUE(f.armed());
+  for (; t < 12.0; t += 0.1) fired += f.update(t, 2).fired ? 1 : 0;
+  EXPECT_EQ(fired, 1);
+  // rearm: repeat (the paper) stays armed.
+  c.rearm = RearmMode::kRepeat;
+  GestureFilter repeat(c);
+  repeat.awaitRelease();
+  EXPECT_TRUE(repeat.armed());
+}
+
 TEST(GestureFilterReleaseTest, BothModesFireTwiceForTwoPerformancesAndOnlyRepeatRefiresAHold) {
   for (const RearmMode mode : {RearmMode::kRelease, RearmMode::kRepeat}) {
     SCOPED_TRACE(toString(mode));

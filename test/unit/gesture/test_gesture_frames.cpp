@@ -110,3 +110,56 @@ TEST(GestureFramesTest, AHeldGestureFiresOnceWithItsActionThenCoolsDown) {
   ASSERT_NE(action, nullptr);
   EXPECT_EQ(action, frames.mapping().find(1));
 }
+
+// Three views, 2 of 3 to agree: the leader and follower 1 read gesture 1, follower 2 none. The
+// command fires; follower 1 is then lost for 3 s (the vote falls short: id 0, but only one view sees
+// none) and returns while the worker still holds the gesture: no second command. Once two views see
+// none for release_s, the next performance fires.
+TEST(GestureFramesTest, AViewLostWhileTheGestureIsHeldIsNoRelease) {
+  gg::GestureFilterConfig fc = filter();
+  fc.release_s = 1.0;
+  gg::GestureFrames frames(fc, fusion(2), gg::GestureMapping::paperDefault(), 3, 0.0);
+  std::vector<double> fired;
+  double t = 0.0;
+  const auto step = [&](int id0, int id1, int id2, bool view1) {
+    std::vector<gg::ViewObservation> os{obs(0, t, id0), obs(2, t, id2)};
+    if (view1) os.push_back(obs(1, t, id1));
+    for (const auto& o : os) {
+      for (const auto& f : frames.observe(o)) {
+        if (f.filter.fired) fired.push_back(f.t_s);
+      }
+    }
+    for (const auto& f : frames.closeDue(t + 1.0)) {
+      if (f.filter.fired) fired.push_back(f.t_s);
+    }
+    t += 0.1;
+  };
+  while (t < 2.0) step(1, 1, 0, true);
+  ASSERT_EQ(fired.size(), 1u);
+  while (t < 5.0) step(1, 1, 0, false);  // follower 1 lost: the vote falls short
+  while (t < 12.0) step(1, 1, 0, true);  // back, the gesture still held (past the 5 s cool-down)
+  EXPECT_EQ(fired.size(), 1u) << "fired again at " << fired.back() << " s";
+  while (t < 14.0) step(0, 0, 0, true);  // released
+  while (t < 16.0) step(1, 1, 0, true);
+  EXPECT_EQ(fired.size(), 2u);
+}
+
+// A new leader's frames (awaitRelease) wait for the gesture in progress to be released.
+TEST(GestureFramesTest, ANewLeadersFramesWaitForTheGestureInProgressToBeReleased) {
+  gg::GestureFilterConfig fc = filter();
+  fc.release_s = 1.0;
+  gg::GestureFrames frames(fc, fusion(1), gg::GestureMapping::paperDefault(), 3, 0.0);
+  frames.awaitRelease();
+  int fired = 0;
+  double t = 0.0;
+  const auto run = [&](int id, double until) {
+    for (; t < until - 1e-9; t += 0.1) {
+      for (const auto& f : frames.observe(obs(0, t, id))) fired += f.filter.fired ? 1 : 0;
+    }
+  };
+  run(1, 4.0);
+  EXPECT_EQ(fired, 0);
+  run(0, 6.0);
+  run(1, 9.0);
+  EXPECT_EQ(fired, 1);
+}

@@ -555,6 +555,25 @@ TEST(ViewFusionRequire3DTest, WithoutTwoCalibratedViewsTheVoteDecidesAloneWithTw
   EXPECT_EQ(fuseTwoViews(tool, 3, 3, require3d(true), true, 5).gesture_id, 0);
 }
 
+// Two calibrated views whose calibrated observations never pair up in time (each view's skeleton
+// arrives only in the frames the other's does not — a follower's pose lookup failing every other
+// frame): no triangulated frame, which does not skip the 3-D check — refused like too few frames
+// (before, the vote alone decided then).
+TEST(ViewFusionRequire3DTest, TwoCalibratedViewsThatNeverPairAreRefused) {
+  SkeletonSynthesizer synth(SynthConfig{}, 10);
+  const auto palms = synth.pose(Motion::kPalmsTogether, 1.0, 0.0, true);
+  const gf::gesture::ViewFusionConfig c = require3d(true);
+  const auto shifted = fuseTwoViews(palms, 3, 3, c, true, 18, [&](int k, gf::gesture::ViewObservation& o) {
+    if ((k + o.view) % 2 == 1) o.calibrated.reset();  // 1/15 s apart > confirm_3d_max_dt_s
+  });
+  EXPECT_EQ(shifted.frames_3d, 0);
+  EXPECT_TRUE(shifted.checked_3d);
+  EXPECT_TRUE(shifted.rejected_3d);
+  EXPECT_EQ(shifted.gesture_id, 0);
+  // The same views paired: the geometry holds.
+  EXPECT_EQ(fuseTwoViews(palms, 3, 3, c, true, 18).gesture_id, 3);
+}
+
 TEST(ViewFusionRequire3DTest, AConfirmedOneArmGestureMustAlsoHoldItsGeometry) {
   SkeletonSynthesizer synth(SynthConfig{}, 11);
   gf::gesture::ViewFusionConfig c = require3d(true);
