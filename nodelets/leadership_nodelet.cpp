@@ -118,16 +118,32 @@ class LeadershipNodelet : public nodelet::Nodelet {
     for (const auto& m : out) out_pub_.publish(toMsg(m));
   }
 
-  /// Publishes the state when the view changed; a lapsed lease is stamped with its end.
+  /// Publishes the state when the view changed; a lapsed lease is stamped with its end (the end
+  /// known while it acted: a leader deposed by a newer term has none left, it stops now). While it
+  /// acts, a one-shot timer at the lease's end publishes the stop then — not at the next tick, up to
+  /// a quarter heartbeat later, while its successor may already act.
   void update(double t) {
     const bool acting = lead_->acting(t);
+    if (acting) armLeaseEnd(lead_->leaseUntil(), t);
     if (acting == acting_ && lead_->term() == term_ && lead_->leader() == leader_ && lead_->role() == role_) return;
-    const double stamp = (acting_ && !acting && lead_->leaseUntil() <= t) ? lead_->leaseUntil() : t;
+    const double stamp = (acting_ && !acting && lease_end_ <= t) ? lease_end_ : t;
     if (acting != acting_) {
       NODELET_WARN_STREAM("Leadership UAV " << uav_index_ << ": " << (acting ? "acts as leader" : "no longer acts")
                                             << " (term " << lead_->term() << ", t = " << stamp << " s)");
     }
     publishState(stamp);
+  }
+  void armLeaseEnd(double lease_until, double t) {
+    if (lease_until == lease_end_ && lease_timer_.isValid()) return;
+    lease_end_ = lease_until;
+    if (!std::isfinite(lease_until)) return;
+    lease_timer_ = getNodeHandle().createTimer(
+        ros::Duration(std::max(lease_until - t, 1e-4) + 1e-4),
+        [this](const ros::TimerEvent&) {
+          std::lock_guard<std::mutex> lock(mutex_);
+          update(now());
+        },
+        true);
   }
   void publishState(double stamp) {
     acting_ = lead_->acting(stamp);
@@ -143,6 +159,8 @@ class LeadershipNodelet : public nodelet::Nodelet {
   std::optional<double> last_fused_s_;  ///< the last worker state's last fusion (none: no estimate)
   std::optional<double> last_seen_s_;   ///< its own camera's last detection of the worker (none: never)
   bool acting_ = false;
+  double lease_end_ = -std::numeric_limits<double>::infinity();  ///< the lease's end while it acted
+  ros::Timer lease_timer_;                                          ///< one-shot at lease_end_
   std::uint32_t term_ = 0;
   int leader_ = -2;
   formation::LeadershipRole role_ = formation::LeadershipRole::kFollower;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <stdexcept>
 
 namespace gesture_formation::formation {
@@ -90,8 +91,12 @@ Leadership::Leadership(const LeadershipConfig& config, int self, Start start, do
   }
 }
 
-void Leadership::adoptTerm(std::uint32_t term) {
+void Leadership::adoptTerm(std::uint32_t term, double now_s) {
   term_ = term;
+  // A newer term is news of a leader or a candidate: the silence before standing starts again
+  // (a recovered old leader that learns of its successor waits for its heartbeats instead of
+  // standing at once).
+  last_heard_s_ = std::max(last_heard_s_, now_s);
   voted_for_ = -1;
   leader_ = -1;
   last_heartbeat_sent_s_ = kNever;
@@ -159,6 +164,11 @@ void Leadership::standForElection(double now_s, double estimate_age_s, std::vect
 }
 
 void Leadership::startTerm(double now_s, double estimate_age_s, std::vector<LeadershipMessage>& out) {
+  if (term_ == std::numeric_limits<std::uint32_t>::max()) {  // a wrap to 0 would make every message of it stale
+    ++counters_.terms_exhausted;
+    becomeFollower();
+    return;
+  }
   ++term_;
   ++counters_.elections_started;
   role_ = LeadershipRole::kCandidate;
@@ -247,7 +257,7 @@ std::vector<LeadershipMessage> Leadership::receive(double now_s, const Leadershi
     if (m.granted) {
       onAnswer(now_s, m, out);
     } else if (m.term > term_) {
-      adoptTerm(m.term);
+      adoptTerm(m.term, now_s);
     }
     return out;
   }
@@ -264,7 +274,7 @@ std::vector<LeadershipMessage> Leadership::receive(double now_s, const Leadershi
     out.push_back(reply(answer, m, false));
     return out;
   }
-  if (m.term > term_) adoptTerm(m.term);
+  if (m.term > term_) adoptTerm(m.term, now_s);
   switch (m.kind) {
     case LeadershipMessageKind::kHeartbeat: onHeartbeat(now_s, m, out); break;
     case LeadershipMessageKind::kVoteRequest: onVoteRequest(now_s, m, estimate_age_s, out); break;
@@ -278,6 +288,13 @@ std::vector<LeadershipMessage> Leadership::receive(double now_s, const Leadershi
 
 void Leadership::onHeartbeat(double now_s, const LeadershipMessage& m, std::vector<LeadershipMessage>& out) {
   if (role_ == LeadershipRole::kLeader) return;  // another leader of this very term: impossible with one vote per term
+  // It backs one leader per term: the one it follows or voted for. A second leader of the same
+  // term — possible only after a member that lost its state (restart) voted twice — gets no ack
+  // from it, so that leader's lease lapses instead of two acting on the same members' acks.
+  if ((leader_ >= 0 && leader_ != m.from) || (voted_for_ >= 0 && voted_for_ != self_ && voted_for_ != m.from)) {
+    ++counters_.rival_heartbeats_refused;
+    return;
+  }
   if (role_ == LeadershipRole::kCandidate) becomeFollower();
   leader_ = m.from;
   silent_leader_ = m.from;
@@ -295,6 +312,10 @@ void Leadership::onHeartbeat(double now_s, const LeadershipMessage& m, std::vect
 
 void Leadership::onAnswer(double now_s, const LeadershipMessage& m, std::vector<LeadershipMessage>& out) {
   if (!m.granted || m.to != self_) return;
+  if (m.echo_s > now_s) {  // it never sent that: a lease from it would have no end
+    ++counters_.answers_from_the_future;
+    return;
+  }
   const auto j = static_cast<std::size_t>(m.from);
   if (m.kind == LeadershipMessageKind::kPreVoteReply) {
     if (role_ != LeadershipRole::kCandidate || !pre_vote_ || m.echo_s != request_sent_s_ || m.term != term_ + 1) return;

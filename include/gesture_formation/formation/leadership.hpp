@@ -113,6 +113,11 @@ struct LeadershipCounters {
   std::uint64_t votes_refused = 0;
   std::uint64_t stale_term_messages = 0;  ///< messages of an older term (answered with a refusal)
   std::uint64_t terms_adopted = 0;        ///< newer terms learnt from others
+  /// heartbeats of its current term from another UAV than the one it follows or voted for in that
+  /// term (a second leader of one term: it gets no ack, so its lease lapses)
+  std::uint64_t rival_heartbeats_refused = 0;
+  std::uint64_t answers_from_the_future = 0;  ///< acks/replies echoing a send time after its own clock (ignored)
+  std::uint64_t terms_exhausted = 0;          ///< candidacies refused because the term counter is at its maximum
 };
 
 /// \brief One UAV's view of the leadership (see the file comment).
@@ -147,7 +152,7 @@ class Leadership {
   int majority() const { return config_.uav_count / 2 + 1; }
 
  private:
-  void adoptTerm(std::uint32_t term);
+  void adoptTerm(std::uint32_t term, double now_s);
   void becomeFollower();
   void standForElection(double now_s, double estimate_age_s, std::vector<LeadershipMessage>& out);
   void updateLease();

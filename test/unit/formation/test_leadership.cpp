@@ -315,3 +315,93 @@ TEST(LeadershipTest, StaleTermsAreRefusedWithTheNewerTerm) {
   EXPECT_EQ(l.term(), 3u);
   EXPECT_EQ(l.leader(), 2);
 }
+
+// A member backs one leader per term. After a restart a member may vote a second time in a term it
+// already voted in (it forgot that vote), so two members can hold the same term as leaders; a
+// member that voted for (or follows) one of them never acks the other, so the other's lease lapses.
+TEST(LeadershipTest, AHeartbeatOfTheSameTermFromAnotherLeaderIsNotAcked) {
+  const LeadershipConfig c;
+  Leadership l(c, 0, Leadership::Start::kRestart, 0.0);
+  LeadershipMessage rq;
+  rq.kind = LeadershipMessageKind::kVoteRequest;
+  rq.term = 2;
+  rq.from = 2;
+  rq.sent_s = 50.0;
+  rq.estimate_age_s = 0.1;
+  auto out = l.receive(10.0, rq, 0.1);  // past the quiet time: it votes for 2 in term 2
+  ASSERT_EQ(out.size(), 1u);
+  ASSERT_TRUE(out[0].granted);
+  LeadershipMessage hb;
+  hb.kind = LeadershipMessageKind::kHeartbeat;
+  hb.term = 2;
+  hb.from = 1;  // elected in term 2 before member 2 restarted and voted again
+  hb.sent_s = 60.0;
+  EXPECT_TRUE(l.receive(10.5, hb, 0.1).empty());
+  EXPECT_EQ(l.counters().rival_heartbeats_refused, 1u);
+  hb.from = 2;
+  out = l.receive(10.6, hb, 0.1);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_TRUE(out[0].granted);
+  EXPECT_EQ(l.leader(), 2);
+  hb.from = 1;  // and it still refuses 1 while it follows 2
+  EXPECT_TRUE(l.receive(10.7, hb, 0.1).empty());
+  EXPECT_EQ(l.counters().rival_heartbeats_refused, 2u);
+}
+
+// The scenario of the review: UAV 0 leads term 1 and is cut off; UAV 1 is elected in term 2 with
+// UAV 2's vote; UAV 2 then restarts (forgets its vote) while UAV 1 is cut off and UAV 0 comes back;
+// UAV 2 wins term 2 again with UAV 0's vote; UAV 1 reconnects. Never two acting.
+TEST(LeadershipTest, ARestartedVoterCannotMakeTwoLeadersActInOneTerm) {
+  const LeadershipConfig c;
+  for (std::uint32_t seed = 1; seed <= 20; ++seed) {
+    Formation f(c, seed);
+    f.link_ = [](int from, int to, double t) {
+      const bool zero_cut = t >= 5.0 && t < 20.0 && (from == 0 || to == 0);
+      const bool one_cut = t >= 20.0 && t < 22.6 && (from == 1 || to == 1);
+      return !zero_cut && !one_cut;
+    };
+    f.runUntil(20.0);
+    ASSERT_EQ(f.acting(f.now()), 1) << "seed " << seed;
+    f.restart(2, f.now());
+    f.runUntil(40.0);
+    EXPECT_EQ(f.violations, 0) << "seed " << seed << " at t = " << f.violation_t;
+    EXPECT_GE(f.acting(f.now()), 0) << "seed " << seed << ": someone leads in the end";
+  }
+}
+
+// A recovered old leader that learns a newer term waits the silence limit for its successor's
+// heartbeats instead of standing at once (it did, before: its last_heard was from its own term).
+TEST(LeadershipTest, ARecoveredOldLeaderDoesNotStandBeforeTheSilenceLimit) {
+  const LeadershipConfig c;
+  for (std::uint32_t seed = 1; seed <= 20; ++seed) {
+    Formation f(c, seed);
+    f.link_ = [](int from, int to, double t) { return t < 10.0 || t >= 15.0 || (from != 0 && to != 0); };
+    f.runUntil(14.99);
+    const auto before = f.at(0).counters().pre_votes_started;
+    f.runUntil(25.0);
+    EXPECT_EQ(f.at(0).counters().pre_votes_started, before) << "seed " << seed;
+    EXPECT_EQ(f.at(0).role(), LeadershipRole::kFollower) << "seed " << seed;
+    EXPECT_EQ(f.violations, 0) << "seed " << seed << " at t = " << f.violation_t;
+  }
+}
+
+// An ack echoing a send time after the leader's own clock (which it never sent) gives no lease.
+TEST(LeadershipTest, AnAnswerFromTheFutureGivesNoLease) {
+  const LeadershipConfig c;
+  Leadership l(c, 0, Leadership::Start::kMissionStart, 0.0);
+  l.tick(0.0, 0.1);
+  LeadershipMessage ack;
+  ack.kind = LeadershipMessageKind::kHeartbeatAck;
+  ack.term = l.term();
+  ack.from = 1;
+  ack.to = 0;
+  ack.granted = true;
+  ack.echo_s = 1.0e6;
+  l.receive(0.05, ack, 0.1);
+  EXPECT_FALSE(l.acting(0.1));
+  EXPECT_EQ(l.counters().answers_from_the_future, 1u);
+  ack.echo_s = 0.0;
+  l.receive(0.06, ack, 0.1);
+  EXPECT_TRUE(l.acting(0.1));
+  EXPECT_LE(l.leaseUntil(), c.lease_s + 1e-12);
+}
