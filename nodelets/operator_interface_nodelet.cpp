@@ -46,6 +46,10 @@ class OperatorInterfaceNodelet : public nodelet::Nodelet {
     params.load("sender_name", sender_);
     params.load("uav_count", uav_count_, 1, comm::kMaxUavIndex + 1);
     if (sender_.empty() || sender_.find(' ') != std::string::npos) params.addError("sender_name: must be non-empty without spaces");
+    if (sender_.size() > comm::kMaxOperatorNameBytes) {  // NAME@ID must fit the wire's name (the leader's ack)
+      params.addError("sender_name: '" + sender_ + "' has " + std::to_string(sender_.size()) + " characters, at most " +
+                      std::to_string(comm::kMaxOperatorNameBytes));
+    }
     std::string mission_file;
     params.loadOptional("mission_file", mission_file, "");
     onboard::OnboardSettings mission;

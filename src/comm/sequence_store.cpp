@@ -80,6 +80,13 @@ Result<bool> writeStateFile(const std::string& path, const std::string& text) {
     ::unlink(tmp.c_str());
     return fail(std::string("rename failed: ") + std::strerror(err));
   }
+  // The rename is durable only once the directory is: without this a power cut soon after a start
+  // can bring the old boot counter back, and the next boot reuses the crashed run's sequence numbers.
+  const std::size_t slash = path.find_last_of('/');
+  const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
+  const Fd d{::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC)};
+  if (d.fd < 0) return fail(std::string("cannot open its directory '") + dir + "': " + std::strerror(errno));
+  if (::fsync(d.fd) != 0) return fail(std::string("fsync of its directory failed: ") + std::strerror(errno));
   return Result<bool>::ok(true);
 }
 

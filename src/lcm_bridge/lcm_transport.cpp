@@ -246,10 +246,10 @@ common::Result<std::unique_ptr<LcmTransport>> LcmTransport::create(const std::st
     t->impl_->fd = fd.value();
     return R::ok(std::move(t));
   }
-  // One regex subscription for our channels (LCM anchors it with ^...$).
-  lcm::Subscription* sub = t->impl_->lcm.subscribe(
-      channel_prefix + "(HEARTBEAT|WORKER_STATE|PLANNED_TRAJECTORY|FORMATION_PARAMS|FORMATION_COMMAND|GESTURE_OBSERVATION|ABORT_COMMAND|COMMAND_ACK|ASSISTANCE)",
-      &Impl::onMessage, t->impl_.get());
+  // One regex subscription for our channels, every one of kChannels (LCM anchors it with ^...$).
+  std::string pattern = channel_prefix + "(";
+  for (const ChannelSuffix& c : kChannels) pattern += std::string(c.suffix) + (&c == std::end(kChannels) - 1 ? ")" : "|");
+  lcm::Subscription* sub = t->impl_->lcm.subscribe(pattern, &Impl::onMessage, t->impl_.get());
   // LCM's default holds 30 undispatched messages and drops the rest unseen: room for a burst.
   if (sub != nullptr) sub->setQueueCapacity(kQueueCapacity);
   return R::ok(std::move(t));

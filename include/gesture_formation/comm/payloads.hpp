@@ -41,6 +41,9 @@ constexpr std::size_t kMaxFollowers = kMaxUavIndex;
 constexpr std::size_t kMaxCommandTargets = kMaxUavIndex + 1;
 /// Largest command sender name [bytes]; printable ASCII without spaces (0x21..0x7e).
 constexpr std::size_t kMaxSenderNameBytes = 64;
+/// Longest operator name: the leader hands an operator's command on (and acknowledges it) as
+/// NAME@ID, ID the link sender (≤ 65535), which must fit kMaxSenderNameBytes.
+constexpr std::size_t kMaxOperatorNameBytes = kMaxSenderNameBytes - 6;
 
 /// \brief Liveness of one UAV, sent periodically (e.g. 5 Hz).
 struct Heartbeat {

@@ -69,6 +69,19 @@ TEST(CommLcmTransportTest, RefusesABadUrl) {
   EXPECT_NE(tr.reason().find("nosuchprovider://"), std::string::npos);
 }
 
+// memq:// (in-process: tests, the simulator's links) subscribes to every message type's channel —
+// it listed all but leadership and map updates, which in-process links then never received.
+TEST(CommLcmTransportTest, MemqReceivesEveryMessageType) {
+  auto tr = memq();
+  int received = 0;
+  tr->setHandler([&](comm::MessageType, const std::vector<std::uint8_t>&) { ++received; });
+  for (int type = 1; type <= comm::kMaxMessageType; ++type) {
+    ASSERT_TRUE(tr->publish(static_cast<comm::MessageType>(type), {1, 2, 3})) << type;
+    EXPECT_EQ(tr->drain(), 1) << comm::toString(static_cast<comm::MessageType>(type));
+  }
+  EXPECT_EQ(received, comm::kMaxMessageType);
+}
+
 TEST(CommLcmTransportTest, SecureLinkCarriesAPlannedTrajectoryOverMemq) {
   auto tr = memq();
   double now = 10.0;
