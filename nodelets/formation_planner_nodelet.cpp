@@ -59,6 +59,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     wind_ = onboard::WindInput(max_wind_age_s);
     double params_rate_hz = 0.0;
     params.load("params_rate_hz", params_rate_hz, 0.1, 50.0);
+    params.load("max_odometry_age_s", max_odometry_age_s_, 0.01, 10.0);
     getPrivateNodeHandle().param("leadership", leadership_, false);  // optional: see the file comment
     PlannerSettings settings;  // from ~mission_file (simulation) or the parameters (config_sources.hpp)
     loadPlannerSettings(getPrivateNodeHandle(), params, mission_file, settings);
@@ -109,6 +110,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     }
     std::lock_guard<std::mutex> lock(mutex_);
     odom_ = toKinematicState(*msg);
+    odom_stamp_s_ = msg->header.stamp.toSec();
   }
   void onWind(const geometry_msgs::TwistWithCovarianceStamped::ConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -118,6 +120,12 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
                                                                                << " rejected so far");
   }
   void onWorker(const gesture_formation::WorkerState::ConstPtr& msg) {
+    // A non-finite estimate (a diverged filter) is no worker knowledge: every distance to it would
+    // be NaN, which the reach and the verifier's comparisons would read as "far".
+    if (!toEigen(msg->position).allFinite() || !toEigen(msg->velocity).allFinite()) {
+      NODELET_ERROR_STREAM_THROTTLE(1.0, "FormationPlanner UAV " << uav_index_ << ": worker state with a non-finite position or velocity dropped");
+      return;
+    }
     std::lock_guard<std::mutex> lock(mutex_);
     worker_ = *msg;
   }
@@ -163,6 +171,15 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
 
   void replan(double t) {
     if (!odom_) return;
+    // A plan starts from the UAV's state: from an old one it would be verified from where the UAV
+    // was, and the relay would pull the UAV back along a path nobody checked. No new plan then —
+    // the relay flies the last verified one to its end and holds, as in a planner outage.
+    if (!(t - odom_stamp_s_ <= max_odometry_age_s_)) {
+      NODELET_ERROR_STREAM_THROTTLE(1.0, "FormationPlanner UAV " << uav_index_ << ": no replanning: the odometry is "
+                                                                 << t - odom_stamp_s_ << " s old (max_odometry_age_s "
+                                                                 << max_odometry_age_s_ << ")");
+      return;
+    }
     const auto map_lock = live_map_.readLock();  // a live map's updates wait for this replanning
     // The replanning step gfctl simulate's UAVs run too (planning::ReplanStep): freshness and
     // hold, listen before moving, the worker's extrapolation, hold / search, the request.
@@ -220,6 +237,8 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   PlannerLiveMap live_map_;  ///< ~mapping_config: the depth camera's live map
   std::unique_ptr<planning::ReplanStep> step_;  ///< planner, hold / search, listening (shared with gfctl simulate)
   std::optional<planning::UavKinematicState> odom_;
+  double odom_stamp_s_ = 0.0;         ///< odom_'s stamp (ROS time)
+  double max_odometry_age_s_ = 0.5;   ///< ~max_odometry_age_s: older odometry stops replanning
   std::optional<gesture_formation::WorkerState> worker_;
   std::vector<std::optional<planning::ReceivedPlan>> received_;  ///< by sender (the leader's: params_role_.own().leaderIndex())
   int abort_link_sender_ = -1;  ///< who delivered the accepted abort (LCM sender id; -1: ROS)

@@ -270,7 +270,7 @@ VerificationReport TrajectoryVerifier::verify(const PlannedTrajectory& tr, doubl
         const double d = (x.p - evaluateTrajectory(others[j], t).p).norm();
         const double req = recoveringDistance(config_, required[j], start_dist[j], t - tr.t0_s);
         rep.min_uav_margin_m = std::min(rep.min_uav_margin_m, d - required[j]);
-        if (d < req - tol) {
+        if (!(d >= req - tol)) {  // a NaN plan sample fails (a NaN compares false)
           os << "verify: " << d << " m from UAV " << others[j].uav_index << "'s plan at t=" << t << " (need " << req << " m)";
           return fail(os.str());
         }
@@ -278,7 +278,7 @@ VerificationReport TrajectoryVerifier::verify(const PlannedTrajectory& tr, doubl
           const double de = distanceToPolyline(envelope[j], x.p);
           const double req_e = recoveringDistance(config_, config_.mutual_distance_m, start_envelope[j], t - tr.t0_s);
           rep.min_uav_margin_m = std::min(rep.min_uav_margin_m, de - config_.mutual_distance_m);
-          if (de < req_e - tol) {
+          if (!(de >= req_e - tol)) {
             os << "verify: " << de << " m from UAV " << others[j].uav_index << "'s braking envelope at t=" << t << " (need "
                << req_e << " m)";
             return fail(os.str());
@@ -291,7 +291,7 @@ VerificationReport TrajectoryVerifier::verify(const PlannedTrajectory& tr, doubl
         rep.min_worker_distance_m = std::min(rep.min_worker_distance_m, d);
         const double limit = config_.worker_safety_distance_m;
         const double req = recoveringDistance(config_, limit, start_worker, t - tr.t0_s);
-        if (d < req - tol) {
+        if (!(d >= req - tol)) {  // a NaN worker prediction fails
           os << "verify: " << d << " m from the worker at t=" << t << " (need " << req << " m)";
           return fail(os.str());
         }

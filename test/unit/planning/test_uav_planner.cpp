@@ -1638,3 +1638,28 @@ TEST(UavPlannerTest, UavSilentFor60sIsKeptOutOfItsHoverPointOnly) {
   EXPECT_FALSE(near.ok);
   EXPECT_NE(near.reason.find("UAV 0's plan"), std::string::npos) << near.reason;
 }
+
+// The verifier fails closed: a NaN in another UAV's plan or in the worker's prediction is no
+// distance (a NaN compares false with any limit, which read as "far enough" before).
+TEST(TrajectoryVerifierTest, ANonFiniteOtherPlanOrWorkerPredictionFailsVerification) {
+  const World& w = towers();
+  const PlannerConfig cfg = testConfig();
+  const TrajectoryVerifier verifier(*w.map, *w.field, cfg);
+  const double t = 10.0;
+  const Eigen::Vector3d own(-8, -12, 10), far = own + Eigen::Vector3d(0, 20, 0);
+  const PlannedTrajectory mine = standingPlan(1, own, t);
+  const VerificationReport ok = verifier.verify(mine, t, {standingPlan(0, far, t)}, {}, t, 0.2);
+  ASSERT_TRUE(ok.ok) << ok.reason;
+  PlannedTrajectory bad = standingPlan(0, far, t);
+  bad.samples[5].p_world.x() = std::numeric_limits<double>::quiet_NaN();
+  const VerificationReport with_nan_plan = verifier.verify(mine, t, {bad}, {}, t, 0.2);
+  EXPECT_FALSE(with_nan_plan.ok);
+  EXPECT_NE(with_nan_plan.reason.find("UAV 0's plan"), std::string::npos) << with_nan_plan.reason;
+  const auto worker = gesture_formation::formation::constantVelocityHorizon(far, Eigen::Vector3d::Zero(), 0.0, 41, 0.2);
+  ASSERT_TRUE(verifier.verify(mine, t, {}, worker, t, 0.2).ok);
+  const auto nan_worker = gesture_formation::formation::constantVelocityHorizon(
+      Eigen::Vector3d(std::numeric_limits<double>::quiet_NaN(), 0.0, 1.0), Eigen::Vector3d::Zero(), 0.0, 41, 0.2);
+  const VerificationReport with_nan_worker = verifier.verify(mine, t, {}, nan_worker, t, 0.2);
+  EXPECT_FALSE(with_nan_worker.ok);
+  EXPECT_NE(with_nan_worker.reason.find("from the worker"), std::string::npos) << with_nan_worker.reason;
+}
