@@ -153,12 +153,17 @@ common::Result<Eigen::Vector3d> chooseRetreatGoal(int uav_index, int uav_count, 
                                                   const AbortConfig& c) {
   using R = common::Result<Eigen::Vector3d>;
   if (space.field == nullptr) return R::fail("no map to choose a retreat goal in");
-  const double z = space.ground_height_m + c.retreat_height_m + uav_index * c.layer_spacing_m;
+  // The UAV's layer, kept inside the map by goal_clearance_m: a map lower than the layers (the
+  // construction site's 16 m) puts the upper layers at its top. The goals stay apart anyway — each
+  // UAV's rings lie layer_spacing_m further out than the previous UAV's, so two goals are at least
+  // that far apart horizontally — the layers only add height between their climbs.
   const Aabb& b = space.bounds;
-  if (!(z >= b.min_world.z() + c.goal_clearance_m && z <= b.max_world.z() - c.goal_clearance_m)) {
-    return R::fail("retreat layer of UAV " + std::to_string(uav_index) + " at " + common::formatNumber(z) +
-                   " m lies outside the map by goal_clearance_m (abort.retreat_height_m, abort.layer_spacing_m)");
+  const double z_low = b.min_world.z() + c.goal_clearance_m, z_high = b.max_world.z() - c.goal_clearance_m;
+  if (!(z_low <= z_high)) {
+    return R::fail("the map is " + common::formatNumber(b.max_world.z() - b.min_world.z()) +
+                   " m high, less than twice abort.goal_clearance_m: no retreat layer fits");
   }
+  const double z = std::clamp(space.ground_height_m + c.retreat_height_m + uav_index * c.layer_spacing_m, z_low, z_high);
   const Eigen::Vector2d away = (p_uav_world - p_worker_world).head<2>();
   // Straight above or below the worker: a bearing per UAV index (golden angle), still deterministic.
   const double bearing0 = away.norm() > 1e-6 ? std::atan2(away.y(), away.x()) : uav_index * 2.399963229728653;

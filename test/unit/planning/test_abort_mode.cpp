@@ -137,12 +137,35 @@ TEST(RetreatGoalTest, AUavFacingTheWallTurnsAsideAndAUavInTheOpenGoesStraightOut
   EXPECT_NEAR(west->y(), 0.0, 1e-9);
 }
 
-TEST(RetreatGoalTest, FailsNamingWhyWhenNothingFitsOrTheLayerIsOutsideTheMap) {
+// A map lower than the layers (the construction site's 16 m, the pillars' 14 m): the upper layers
+// are put at the map's top less goal_clearance_m instead of leaving those UAVs without a goal
+// (they stayed in formation beside the worker); the goals still keep layer_spacing_m horizontally.
+TEST(RetreatGoalTest, LayersAboveTheMapAreKeptInsideItAndTheGoalsStillApart) {
   pl::AbortConfig c;
-  c.retreat_height_m = 28.0;  // UAV 0 at 28 m: within 3 m of the map's top (30 m)
-  const auto high = pl::chooseRetreatGoal(0, 3, kWorker + Eigen::Vector3d(-8, 0, 5), kWorker, world().space(), c);
-  ASSERT_FALSE(high);
-  EXPECT_NE(high.reason().find("outside the map"), std::string::npos) << high.reason();
+  c.retreat_height_m = 25.0;  // layers at 25, 29, 33 m: the map's top is 30 m
+  const Eigen::Vector3d p_uav = kWorker + Eigen::Vector3d(-8, 0, 5);
+  std::vector<Eigen::Vector3d> goals;
+  for (int uav = 0; uav < 3; ++uav) {
+    const auto g = pl::chooseRetreatGoal(uav, 3, p_uav, kWorker, world().space(), c);
+    ASSERT_TRUE(g) << "UAV " << uav << ": " << g.reason();
+    goals.push_back(*g);
+  }
+  EXPECT_NEAR(goals[0].z(), 25.0, 1e-9);
+  EXPECT_NEAR(goals[1].z(), 30.0 - c.goal_clearance_m, 1e-9);
+  EXPECT_NEAR(goals[2].z(), 30.0 - c.goal_clearance_m, 1e-9);
+  for (std::size_t i = 0; i < goals.size(); ++i) {
+    for (std::size_t j = i + 1; j < goals.size(); ++j) {
+      EXPECT_GE((goals[i] - goals[j]).head<2>().norm(), c.layer_spacing_m - 1e-9) << i << " " << j;
+    }
+  }
+}
+
+TEST(RetreatGoalTest, FailsNamingWhyWhenNothingFitsOrTheMapIsTooThin) {
+  pl::AbortConfig c;
+  c.goal_clearance_m = 16.0;  // 2 × 16 m > the 30 m map: no height is 16 m inside it
+  const auto thin = pl::chooseRetreatGoal(0, 3, kWorker + Eigen::Vector3d(-8, 0, 5), kWorker, world().space(), c);
+  ASSERT_FALSE(thin);
+  EXPECT_NE(thin.reason().find("no retreat layer fits"), std::string::npos) << thin.reason();
   c = pl::AbortConfig{};
   c.retreat_distance_m = 40.0;  // every point ≥ 40 m away lies outside the 60 m map
   c.max_distance_m = 45.0;
