@@ -107,8 +107,10 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
     status_pub_ = nh.advertise<gesture_formation::GestureStatus>("gesture_status_out", 10);
     abort_pub_ = nh.advertise<gesture_formation::AbortCommand>("abort_out", 10);
     assistance_pub_ = nh.advertise<gesture_formation::AssistanceState>("assistance_out", 10);
-    own_sub_ = nh.subscribe("observation_in", 50, &GestureCommanderNodelet::onObservation, this);
-    peer_sub_ = nh.subscribe("peer_observations_in", 100, &GestureCommanderNodelet::onObservation, this);
+    own_sub_ = nh.subscribe<gesture_formation::GestureObservation>(
+        "observation_in", 50, [this](const gesture_formation::GestureObservation::ConstPtr& m) { onObservation(m, true); });
+    peer_sub_ = nh.subscribe<gesture_formation::GestureObservation>(
+        "peer_observations_in", 100, [this](const gesture_formation::GestureObservation::ConstPtr& m) { onObservation(m, false); });
     timer_ = nh.createTimer(ros::Duration(0.01), [this](const ros::TimerEvent&) {
       std::lock_guard<std::mutex> lock(mutex_);
       if (!acts()) return;
@@ -158,11 +160,16 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
 
   bool acts() const { return !leadership_ || acting_; }
 
-  void onObservation(const gesture_formation::GestureObservation::ConstPtr& msg) {
+  /// `own`: this UAV's camera (observation_in). With one camera voting, that camera is the vote's
+  /// view 0 whichever UAV this is — after a hand-over the acting UAV's own camera, not UAV 0's
+  /// relayed one (as gfctl simulate does) — and the others' are ignored.
+  void onObservation(const gesture_formation::GestureObservation::ConstPtr& msg, bool own) {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!acts() || msg->uav_index >= frames_->views()) return;  // single camera: the followers do not vote
+    const bool single = frames_->views() == 1;
+    if (!acts() || (single ? !own : msg->uav_index >= frames_->views())) return;
     std::string skeleton_problem;
-    const gesture::ViewObservation o = toViewObservation(*msg, &skeleton_problem);
+    gesture::ViewObservation o = toViewObservation(*msg, &skeleton_problem);
+    if (single) o.view = 0;
     if (!skeleton_problem.empty()) {
       NODELET_WARN_STREAM_THROTTLE(5.0, "GestureCommander: skeleton of UAV " << int(msg->uav_index)
                                             << " left out of the 3-D confirmation: " << skeleton_problem);
@@ -171,7 +178,7 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
     std::string reason;
     const auto closed = frames_->observe(o, &accepted, &reason);
     ++observations_since_report_;
-    if (accepted) last_seen_s_[msg->uav_index] = ros::Time::now().toSec();
+    if (accepted) last_seen_s_[static_cast<std::size_t>(o.view)] = ros::Time::now().toSec();
     else ++rejected_since_report_;
     if (!accepted) {
       NODELET_WARN_STREAM_THROTTLE(1.0, "GestureCommander: observation of UAV " << int(msg->uav_index) << " rejected: " << reason);
