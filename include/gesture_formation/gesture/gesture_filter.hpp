@@ -19,9 +19,10 @@
 ///     cooldown) or t − t_last_fired ≥ t_d (cooldown_s; an elapsed time exactly t_d may fire).
 /// Re-arming (`rearm`): with `release` (the default: one performance, one command) a fired
 /// command disarms the filter until the gesture has been released — the dominant id of every
-/// evaluation has been 0 (none; no tie) *and the measurement itself saw none* (update's
-/// `none_seen`: the views agreed on none, not merely failed to agree on a gesture) for at least
-/// release_s (from the first such evaluation; any other evaluation restarts it), or every earlier
+/// evaluation has been 0 (none; no tie), none of its measurements of 0 a vote that merely fell
+/// short (update's `none_seen` false: the views failed to agree on a gesture rather than agreed on
+/// none), for at least release_s (from the first such evaluation; any other evaluation restarts
+/// it), or every earlier
 /// entry of G has expired (nothing seen for t_c: a new performance). A view lost while the worker
 /// holds a gesture makes the vote fall short (id 0) but is no release. A gesture held, or misread and held, for longer than t_d thus fires
 /// once. With `repeat` (the paper) the filter is always armed: a held gesture fires again
