@@ -119,6 +119,16 @@ class Formation {
   double t_ = 0.0;
 };
 
+/// A leadership message of `kind` in `term` from `from`, sent at `sent_s` (the sender's clock).
+LeadershipMessage message(LeadershipMessageKind kind, std::uint32_t term, int from, double sent_s) {
+  LeadershipMessage m;
+  m.kind = kind;
+  m.term = term;
+  m.from = from;
+  m.sent_s = sent_s;
+  return m;
+}
+
 }  // namespace
 
 TEST(LeadershipTest, DesignatedLeaderActsOnceAMajorityAckedAndKeepsLeading) {
@@ -286,11 +296,7 @@ TEST(LeadershipTest, ConfigProblemsNameTheKeyAndValue) {
 TEST(LeadershipTest, StaleTermsAreRefusedWithTheNewerTerm) {
   const LeadershipConfig c;
   Leadership l(c, 1, Leadership::Start::kMissionStart, 0.0);
-  LeadershipMessage hb;
-  hb.kind = LeadershipMessageKind::kHeartbeat;
-  hb.term = 3;
-  hb.from = 2;
-  hb.sent_s = 100.0;
+  LeadershipMessage hb = message(LeadershipMessageKind::kHeartbeat, 3, 2, 100.0);
   auto out = l.receive(1.0, hb, 0.1);
   ASSERT_EQ(out.size(), 1u);
   EXPECT_TRUE(out[0].granted);
@@ -304,12 +310,7 @@ TEST(LeadershipTest, StaleTermsAreRefusedWithTheNewerTerm) {
   EXPECT_EQ(out[0].term, 3u);
   EXPECT_EQ(out[0].to, 0);
   // A vote request while promised to the leader is refused and changes nothing.
-  LeadershipMessage rq;
-  rq.kind = LeadershipMessageKind::kVoteRequest;
-  rq.term = 4;
-  rq.from = 0;
-  rq.sent_s = 5.0;
-  out = l.receive(1.2, rq, 0.1);
+  out = l.receive(1.2, message(LeadershipMessageKind::kVoteRequest, 4, 0, 5.0), 0.1);
   ASSERT_EQ(out.size(), 1u);
   EXPECT_FALSE(out[0].granted);
   EXPECT_EQ(l.term(), 3u);
@@ -322,20 +323,13 @@ TEST(LeadershipTest, StaleTermsAreRefusedWithTheNewerTerm) {
 TEST(LeadershipTest, AHeartbeatOfTheSameTermFromAnotherLeaderIsNotAcked) {
   const LeadershipConfig c;
   Leadership l(c, 0, Leadership::Start::kRestart, 0.0);
-  LeadershipMessage rq;
-  rq.kind = LeadershipMessageKind::kVoteRequest;
-  rq.term = 2;
-  rq.from = 2;
-  rq.sent_s = 50.0;
+  LeadershipMessage rq = message(LeadershipMessageKind::kVoteRequest, 2, 2, 50.0);
   rq.estimate_age_s = 0.1;
   auto out = l.receive(10.0, rq, 0.1);  // past the quiet time: it votes for 2 in term 2
   ASSERT_EQ(out.size(), 1u);
   ASSERT_TRUE(out[0].granted);
-  LeadershipMessage hb;
-  hb.kind = LeadershipMessageKind::kHeartbeat;
-  hb.term = 2;
-  hb.from = 1;  // elected in term 2 before member 2 restarted and voted again
-  hb.sent_s = 60.0;
+  // From UAV 1, elected in term 2 before member 2 restarted and voted again.
+  LeadershipMessage hb = message(LeadershipMessageKind::kHeartbeat, 2, 1, 60.0);
   EXPECT_TRUE(l.receive(10.5, hb, 0.1).empty());
   EXPECT_EQ(l.counters().rival_heartbeats_refused, 1u);
   hb.from = 2;
@@ -390,10 +384,7 @@ TEST(LeadershipTest, AnAnswerFromTheFutureGivesNoLease) {
   const LeadershipConfig c;
   Leadership l(c, 0, Leadership::Start::kMissionStart, 0.0);
   l.tick(0.0, 0.1);
-  LeadershipMessage ack;
-  ack.kind = LeadershipMessageKind::kHeartbeatAck;
-  ack.term = l.term();
-  ack.from = 1;
+  LeadershipMessage ack = message(LeadershipMessageKind::kHeartbeatAck, l.term(), 1, 0.0);
   ack.to = 0;
   ack.granted = true;
   ack.echo_s = 1.0e6;
