@@ -1,4 +1,5 @@
 #include "gesture_formation/comm/envelope.hpp"
+#include "gesture_formation/comm/wire_time.hpp"
 
 #include <cmath>
 #include <string>
@@ -97,9 +98,7 @@ SealResult serialiseSigned(const Envelope& envelope, std::uint8_t version) {
     return SealResult::fail("payload of " + std::to_string(envelope.payload.size()) + " bytes exceeds " +
                             std::to_string(kMaxPayloadBytes));
   }
-  if (!isWireTime(envelope.stamp_s)) {
-    return SealResult::fail("stamp_s must be a time in [0, 4e9) s, got " + std::to_string(envelope.stamp_s));
-  }
+  if (const std::string e = wireTimeProblem(envelope.stamp_s, "stamp_s"); !e.empty()) return SealResult::fail(e);
   if (!isKnownMessageType(static_cast<std::uint8_t>(envelope.type))) return SealResult::fail("unknown message type");
   ByteWriter w;
   w.u8(kMagic0);
@@ -138,6 +137,11 @@ SealResult sealEnvelopeEd25519(const Envelope& envelope, const std::uint8_t* see
   if (!ed25519Sign(seed, out.data(), out.size(), signature)) return SealResult::fail("Ed25519 signing failed (OpenSSL)");
   out.insert(out.end(), signature.begin(), signature.end());
   return SealResult::ok(std::move(out));
+}
+
+std::string wireTimeProblem(double t_s, const std::string& field) {
+  if (isWireTime(t_s)) return "";
+  return field + " must be a time in [0, 4e9) s, got " + std::to_string(t_s);
 }
 
 }  // namespace gesture_formation::comm

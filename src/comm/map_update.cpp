@@ -1,4 +1,5 @@
 #include "gesture_formation/comm/map_update.hpp"
+#include "gesture_formation/comm/wire_time.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -42,9 +43,7 @@ PayloadError structureProblem(const MapUpdate& m, std::string* reason) {
                                                         std::to_string(m.uav_index));
   }
   if (!std::isfinite(m.delta.stamp_s)) return fail(PayloadError::kNonFinite, reason, "stamp_s must be finite");
-  if (!isWireTime(m.delta.stamp_s)) {
-    return fail(PayloadError::kOutOfRange, reason, "stamp_s must be a time in [0, 4e9) s, got " + std::to_string(m.delta.stamp_s));
-  }
+  if (const std::string e = wireTimeProblem(m.delta.stamp_s, "stamp_s"); !e.empty()) return fail(PayloadError::kOutOfRange, reason, e);
   if (!std::isfinite(m.delta.resolution_m)) return fail(PayloadError::kNonFinite, reason, "resolution_m must be finite");
   if (!(m.delta.resolution_m > 0.0 && m.delta.resolution_m <= kMaxMapResolutionM)) {
     return fail(PayloadError::kOutOfRange, reason, "resolution_m must be in (0, " + std::to_string(kMaxMapResolutionM) +

@@ -1,4 +1,5 @@
 #include "gesture_formation/comm/payloads.hpp"
+#include "gesture_formation/comm/wire_time.hpp"
 
 #include <cmath>
 #include <initializer_list>
@@ -69,12 +70,6 @@ bool allFinite(std::initializer_list<double> values) {
     if (!std::isfinite(v)) return false;
   }
   return true;
-}
-
-/// What an encoder says of a time that is not a wire time (empty when it is one).
-std::string timeProblem(double t_s, const char* field) {
-  if (isWireTime(t_s)) return "";
-  return std::string(field) + " must be a time in [0, 4e9) s, got " + std::to_string(t_s);
 }
 
 void putVector(ByteWriter& w, const Eigen::Vector3d& v) {
@@ -178,7 +173,7 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, Heartbeat
 
 EncodeResult encodePayload(const WorkerStateMessage& m) {
   for (const auto& [t, field] : {std::pair{m.t_s, "worker_state.t_s"}, std::pair{m.last_fused_t_s, "worker_state.last_fused_t_s"}}) {
-    if (const std::string e = timeProblem(t, field); !e.empty()) return EncodeResult::fail(e);
+    if (const std::string e = wireTimeProblem(t, field); !e.empty()) return EncodeResult::fail(e);
   }
   if (m.last_fused_t_s > m.t_s) return EncodeResult::fail("worker_state.last_fused_t_s after t_s");
   if (!m.p_world.allFinite()) return EncodeResult::fail("worker_state.p_world not finite");
@@ -223,7 +218,7 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, WorkerSta
 
 EncodeResult encodePayload(const planning::PlannedTrajectory& m) {
   if (!validUavIndex(m.uav_index)) return EncodeResult::fail("planned_trajectory.uav_index " + std::to_string(m.uav_index) + " outside [0, " + std::to_string(kMaxUavIndex) + "]");
-  if (const std::string e = timeProblem(m.t0_s, "planned_trajectory.t0_s"); !e.empty()) return EncodeResult::fail(e);
+  if (const std::string e = wireTimeProblem(m.t0_s, "planned_trajectory.t0_s"); !e.empty()) return EncodeResult::fail(e);
   if (!(std::isfinite(m.dt_s) && m.dt_s > 0)) return EncodeResult::fail("planned_trajectory.dt_s must be finite and > 0");
   if (m.samples.size() > kMaxTrajectorySamples) {
     return EncodeResult::fail("planned_trajectory.samples has " + std::to_string(m.samples.size()) + " entries, at most " + std::to_string(kMaxTrajectorySamples));
@@ -506,7 +501,7 @@ void getSkeleton(Decoder& d, ObservedSkeleton& o) {
 
 EncodeResult encodePayload(const GestureObservationMessage& m) {
   if (!validUavIndex(m.uav_index)) return EncodeResult::fail("gesture_observation.uav_index " + std::to_string(m.uav_index) + " outside [0, " + std::to_string(kMaxUavIndex) + "]");
-  if (const std::string e = timeProblem(m.t_s, "gesture_observation.t_s"); !e.empty()) return EncodeResult::fail(e);
+  if (const std::string e = wireTimeProblem(m.t_s, "gesture_observation.t_s"); !e.empty()) return EncodeResult::fail(e);
   if (m.gesture_id > kMaxGestureId) return EncodeResult::fail("gesture_observation.gesture_id " + std::to_string(m.gesture_id) + " > " + std::to_string(kMaxGestureId));
   if (m.probabilities.size() > kMaxGestureClasses) return EncodeResult::fail("gesture_observation.probabilities has " + std::to_string(m.probabilities.size()) + " entries, at most " + std::to_string(kMaxGestureClasses));
   for (double p : m.probabilities) {
@@ -636,7 +631,7 @@ EncodeResult encodePayload(const CommandAckMessage& m) {
     return EncodeResult::fail("command_ack.id.sender must be 1.." + std::to_string(kMaxSenderNameBytes) +
                               " printable ASCII characters without spaces");
   }
-  if (const std::string e = timeProblem(m.command_stamp_s, "command_ack.command_stamp_s"); !e.empty()) return EncodeResult::fail(e);
+  if (const std::string e = wireTimeProblem(m.command_stamp_s, "command_ack.command_stamp_s"); !e.empty()) return EncodeResult::fail(e);
   if (!validOutcomeText(m.outcome)) {
     return EncodeResult::fail("command_ack.outcome must be at most " + std::to_string(kMaxAckOutcomeBytes) +
                               " bytes without control characters (" + std::to_string(m.outcome.size()) + " bytes)");
@@ -699,7 +694,7 @@ bool validOptionalName(const std::string& s) { return s.empty() || validSenderNa
 EncodeResult encodePayload(const AssistanceMessage& m) {
   const auto& a = m.state;
   for (const auto& [t, field] : {std::pair{a.requested_s, "assistance.requested_s"}, std::pair{a.acknowledged_s, "assistance.acknowledged_s"}}) {
-    if (const std::string e = timeProblem(t, field); !e.empty()) return EncodeResult::fail(e);
+    if (const std::string e = wireTimeProblem(t, field); !e.empty()) return EncodeResult::fail(e);
   }
   if (!validOptionalName(a.requested_by) || !validOptionalName(a.acknowledged_by)) {
     return EncodeResult::fail("assistance.requested_by / acknowledged_by must be 0.." + std::to_string(kMaxSenderNameBytes) +
