@@ -1,8 +1,8 @@
 // LcmBridge nodelet: the only code that touches LCM (lcm_bridge::SecureLink: signed envelopes with
 // sender id, sequence and stamp; docs/security.md); a thin adapter between ROS topics and the link
 // (topics, parameters, defaults: docs/ros.md "LcmBridge"). ROS → LCM: the share, plans (their
-// fallback flag in a heartbeat sent just before), parameters, gesture observations, aborts (the
-// leader's accepted abort also after every share), single events repeated like a command
+// fallback flag in a heartbeat sent just before), parameters, gesture observations, aborts (this
+// UAV's accepted abort also after every plan it sends), single events repeated like a command
 // (~command_repeats copies, comm::OutgoingRepeats: commands, the leader's acknowledgements and
 // assistance state — also with every share while requested —, the ground's acknowledgement of it),
 // leadership messages (docs/safety.md §1.2) and live-map changes (docs/mapping.md §8), both from UAVs
@@ -165,7 +165,6 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     std::lock_guard<std::mutex> lock(mutex_);
     heartbeat_.worker_visible = !msg->lost;
     send(toWire(*msg), "worker state");
-    if (relay_) send(*relay_, "abort (relay)");  // the leader's accepted abort travels with every share
     if (assistance_ && assistance_->state.phase == formation::AssistancePhase::kRequested) send(*assistance_, "assistance");
   }
   void onPlan(const gesture_formation::PlannedTrajectory::ConstPtr& msg) {
@@ -176,6 +175,7 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     heartbeat_.last_plan_sequence = msg->sequence;
     send(heartbeat_, "heartbeat");  // before the plan: it carries the plan's fallback flag
     send(*plan, "plan");
+    if (relay_) send(*relay_, "abort (relay)");  // this UAV's accepted abort travels with every plan it sends
   }
   // An abort to send (the ground station's copies: the OperatorInterface repeats it).
   void onAbort(const gesture_formation::AbortCommand::ConstPtr& msg) { sendChecked(toWire(*msg), "abort"); }
@@ -189,7 +189,7 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     send(*m, what, copies, period_s);
     if constexpr (std::is_same_v<T, comm::AssistanceMessage>) assistance_ = *m;  // re-sent while requested
   }
-  // The leader's abort state: once it accepted an abort, the command is relayed (docs/safety.md §2.8).
+  // This UAV's abort state: once it accepted an abort, the command is relayed (docs/safety.md §2.8).
   void onAbortState(const gesture_formation::AbortState::ConstPtr& msg) {
     auto a = toWire(msg->command);
     std::lock_guard<std::mutex> lock(mutex_);
@@ -295,7 +295,7 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
   double command_repeat_period_s_ = 0.1;
   comm::OutgoingRepeats repeats_;  ///< copies of single events still to send
   std::optional<comm::AssistanceMessage> assistance_;  ///< the last assistance state sent (leader: re-sent while requested)
-  std::optional<comm::AbortMessage> relay_;  ///< the leader's accepted abort, sent after every worker state
+  std::optional<comm::AbortMessage> relay_;  ///< this UAV's accepted abort, sent after every plan
   /// LCM messages handled per 5 ms drain: bounded, so a flood cannot keep the mutex from heartbeats.
   static constexpr int kMaxDrainPerTick = 2000;
   lcm_bridge::HighWaterMarkSaver marks_;  ///< high_water_file, saved when the marks changed

@@ -56,11 +56,13 @@ class OperatorInterfaceNodelet : public nodelet::Nodelet {
     if (!mission_file.empty() && loadOnboard(mission_file, params, mission)) {
       abort_repeats_ = mission.replan.abort.repeats;
       abort_period_s_ = mission.replan.abort.repeat_period_s;
+      abort_resend_period_s_ = mission.replan.abort.resend_period_s;
       params.note("from mission_file: abort.repeats " + std::to_string(abort_repeats_) + ", abort.repeat_period_s " +
-                  std::to_string(abort_period_s_));
+                  std::to_string(abort_period_s_) + ", abort.resend_period_s " + std::to_string(abort_resend_period_s_));
     } else if (mission_file.empty()) {
       params.load("abort_repeats", abort_repeats_, 1, 100);
       params.load("abort_repeat_period_s", abort_period_s_, 0.01, 10.0);
+      params.load("abort_resend_period_s", abort_resend_period_s_, 0.1, 60.0);
     }
     if (!params.ok()) {
       NODELET_ERROR_STREAM("OperatorInterface refuses to start; fix these parameters:\n" << params.report());
@@ -156,21 +158,33 @@ class OperatorInterfaceNodelet : public nodelet::Nodelet {
     abort_.sequence = ++sequence_;
     abort_.link_sender = -1;
     abort_copies_left_ = abort_repeats_;
+    abort_resend_at_ = ros::Time(0);
     sendAbortCopy();
     res.accepted = true;
     res.sequence = abort_.sequence;
     res.copies = abort_repeats_;
     res.message = "sent";
     NODELET_WARN_STREAM("OperatorInterface: abort #" << abort_.sequence << " sent (" << abort_repeats_ << " copies, "
-                                                     << abort_period_s_ << " s apart)");
+                                                     << abort_period_s_ << " s apart, then one every "
+                                                     << abort_resend_period_s_ << " s while this node runs)");
     return true;
   }
-  // Mutex held. One copy, stamped now (its age at each UAV is this copy's).
+  // Mutex held. One copy, stamped now (its age at each UAV is this copy's): the burst's, then one
+  // every abort_resend_period_s for as long as this node runs — a UAV out of reach for the whole
+  // burst (a link outage, a reboot) still gets it when it is back (docs/safety.md §2.8).
   void sendAbortCopy() {
-    if (abort_copies_left_ <= 0) return;
-    abort_.stamp = ros::Time::now();
+    if (abort_.sequence == 0) return;  // no abort sent
+    const ros::Time now = ros::Time::now();
+    if (abort_copies_left_ > 0) {
+      --abort_copies_left_;
+      if (abort_copies_left_ == 0) abort_resend_at_ = now + ros::Duration(abort_resend_period_s_);
+    } else if (now < abort_resend_at_) {
+      return;
+    } else {
+      abort_resend_at_ = now + ros::Duration(abort_resend_period_s_);
+    }
+    abort_.stamp = now;
     abort_pub_.publish(abort_);
-    --abort_copies_left_;
   }
   void repeatAbort(const ros::TimerEvent&) {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -235,6 +249,8 @@ class OperatorInterfaceNodelet : public nodelet::Nodelet {
   std::uint64_t sequence_ = 0;
   int abort_repeats_ = 1;
   double abort_period_s_ = 0.2;
+  double abort_resend_period_s_ = 1.0;
+  ros::Time abort_resend_at_;  ///< after the burst: when the next copy falls due
   int abort_copies_left_ = 0;  ///< copies of abort_ still to send
   gesture_formation::AbortCommand abort_;
   static constexpr double kAckTimeoutS = 5.0;  ///< a command of ours unacknowledged this long is reported

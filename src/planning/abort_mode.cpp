@@ -74,6 +74,7 @@ const common::FieldTable<AbortConfig>& abortConfigFields() {
       {"max_command_age_s", Range::positive(), [](C& c) { return &c.max_command_age_s; }},
       {"repeats", Range::closed(1, 100), [](C& c) { return &c.repeats; }},
       {"repeat_period_s", Range::openClosed(0.0, 10.0), [](C& c) { return &c.repeat_period_s; }},
+      {"resend_period_s", Range::openClosed(0.0, 60.0), [](C& c) { return &c.resend_period_s; }},
   }};
   return t;
 }
@@ -196,14 +197,32 @@ common::Result<Eigen::Vector3d> chooseRetreatGoal(int uav_index, int uav_count, 
   return R::fail(os.str());
 }
 
-common::Result<Eigen::Vector3d> chooseLandingPoint(const Eigen::Vector3d& goal_world, const Eigen::Vector3d& home_world,
+common::Result<Eigen::Vector3d> chooseLandingPoint(const Eigen::Vector3d& goal_world,
+                                                   const std::optional<Eigen::Vector3d>& home_world,
                                                    const RetreatSpace& space, const AbortConfig& c) {
   using R = common::Result<Eigen::Vector3d>;
   if (space.field == nullptr) return R::fail("no map to verify a landing spot in");
-  for (const Eigen::Vector3d& top : {goal_world, home_world}) {
+  std::vector<Eigen::Vector3d> tops{goal_world};
+  if (home_world) tops.push_back(*home_world);
+  for (const Eigen::Vector3d& top : tops) {
     if (columnClear(top, space, c)) return R::ok(Eigen::Vector3d(top.x(), top.y(), space.ground_height_m + c.land_height_m));
   }
-  return R::fail("neither the column below the retreat goal nor the one below the take-off point is clear");
+  return R::fail(home_world ? "neither the column below the retreat goal nor the one below the take-off point is clear"
+                            : "the column below the retreat goal is not clear");
+}
+
+std::string homeProblem(const Eigen::Vector3d& home_world, const Eigen::Vector3d& worker_world,
+                        const RetreatSpace& space, const AbortConfig& c) {
+  if (!home_world.allFinite()) return "the take-off point is not known";
+  if (!insideBy(space.bounds, home_world, c.goal_clearance_m)) {
+    return "the take-off point lies less than goal_clearance_m inside the map";
+  }
+  const double d = (home_world - worker_world).head<2>().norm();
+  if (!(d >= c.retreat_distance_m)) {  // NaN (no worker estimate) refuses too
+    return "the take-off point is " + common::formatNumber(d) + " m from the worker estimate, less than retreat_distance_m " +
+           common::formatNumber(c.retreat_distance_m);
+  }
+  return "";
 }
 
 formation::ReferenceTrajectory approachReference(const Eigen::Vector3d& p_from_world, const Eigen::Vector3d& goal_world,
@@ -255,13 +274,19 @@ void AbortPlanner::advance(const Situation& s, Decision& d) {
   if (!arrived || settled(phase_)) return;
   d.phase_changed = true;
   if (phase_ == AbortPhase::kRetreat) {
+    const std::string home_problem = homeProblem(s.home_world, s.worker_world, space_, config_);
     if (config_.after == AbortAfter::kHover) {
       phase_ = AbortPhase::kAtRetreat;
+    } else if (config_.after == AbortAfter::kReturnHome && !home_problem.empty()) {
+      phase_ = AbortPhase::kAtRetreat;  // the take-off point is not a safe place now: it stays at the retreat goal
+      goal_note_ = home_problem + "; staying at the retreat goal";
     } else if (config_.after == AbortAfter::kReturnHome) {
       phase_ = AbortPhase::kReturnHome;
       goal_ = s.home_world;
     } else {
-      const auto spot = chooseLandingPoint(*goal_, s.home_world, space_, config_);
+      std::optional<Eigen::Vector3d> home;
+      if (home_problem.empty()) home = s.home_world;
+      const auto spot = chooseLandingPoint(*goal_, home, space_, config_);
       if (spot) {
         phase_ = AbortPhase::kLanding;
         goal_ = *spot;

@@ -29,12 +29,17 @@ planning::AbortCommand AbortSender::command() const {
   return c;
 }
 
+double AbortSender::dueAt(int k) const {
+  if (k < repeats_) return event_->t_s + k * period_s_;
+  return event_->t_s + (repeats_ - 1) * period_s_ + (k - repeats_ + 1) * resend_period_s_;
+}
+
 std::vector<planning::AbortCommand> AbortSender::due(double t_s) {
   std::vector<planning::AbortCommand> out;
   if (!event_ || event_->source != planning::AbortSource::kOperator) return out;
-  while (sent_ < repeats_ && event_->t_s + sent_ * period_s_ <= t_s + 1e-9) {
+  while (dueAt(sent_) <= t_s + 1e-9) {
     planning::AbortCommand c = command();
-    c.sent_s = event_->t_s + sent_ * period_s_;  // each copy is stamped when it is sent
+    c.sent_s = dueAt(sent_);  // each copy is stamped when it is sent
     out.push_back(c);
     ++sent_;
   }

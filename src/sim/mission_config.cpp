@@ -75,6 +75,7 @@ std::vector<std::string> FaultConfig::validate(const std::string& prefix) const 
   };
   entries(planner_outages, plannerOutageFields(), "planner_outages");
   entries(follower_dropouts, uavDropoutFields(), "follower_dropouts");
+  entries(operator_outages, plannerOutageFields(), "operator_outages");
   auto outliers = rangeOutlierFields().rangeProblems(range_outliers);
   common::checkRule(outliers, range_outliers.max_error_m >= range_outliers.min_error_m, "max_error_m",
                     range_outliers.max_error_m, "must be >= min_error_m");
@@ -87,6 +88,13 @@ std::vector<std::string> FaultConfig::validate(const std::string& prefix) const 
 
 bool FaultConfig::followerOffline(int uav, double t_s) const {
   for (const auto& o : follower_dropouts) {
+    if (o.uav == uav && t_s >= o.from_s && t_s < o.to_s) return true;
+  }
+  return false;
+}
+
+bool FaultConfig::operatorLinkDown(int uav, double t_s) const {
+  for (const auto& o : operator_outages) {
     if (o.uav == uav && t_s >= o.from_s && t_s < o.to_s) return true;
   }
   return false;
@@ -316,6 +324,20 @@ void readPlannerOutages(ConfigReader& r, const std::string& fk, std::vector<Plan
   }
 }
 
+void readOperatorOutages(ConfigReader& r, const std::string& fk, std::vector<PlannerOutage>& out) {
+  const YAML::Node oo = r.node(fk + "operator_outages");
+  if (oo.IsDefined() && oo.IsSequence()) {
+    for (std::size_t i = 0; i < oo.size(); ++i) {
+      const std::string k = fk + "operator_outages[" + std::to_string(i) + "].";
+      PlannerOutage o;
+      plannerOutageFields().readRequiredFields(r, k, o, "an outage names its UAV and window");
+      out.push_back(o);
+    }
+  } else if (oo.IsDefined()) {
+    r.addError(fk + "operator_outages", "must be a list of {uav, from_s, to_s}");
+  }
+}
+
 void readFollowerDropouts(ConfigReader& r, const std::string& fk, std::vector<UavDropout>& out) {
   const YAML::Node fd = r.node(fk + "follower_dropouts");
   if (fd.IsDefined() && fd.IsSequence()) {
@@ -331,7 +353,7 @@ void readFollowerDropouts(ConfigReader& r, const std::string& fk, std::vector<Ua
 }
 
 /// mission.faults: link and wind overlays (key by key over mission.links.* / mission.wind),
-/// sensor windows, planner outages, follower dropouts, range outliers.
+/// sensor windows, planner outages, follower dropouts, operator-link outages, range outliers.
 void readFaults(ConfigReader& r, const std::string& m, MissionConfig& c) {
   const std::string fk = m + "faults.";
   for (auto [name, lc] : std::initializer_list<std::pair<const char*, LinkConfig*>>{{"link", &c.link},
@@ -344,6 +366,7 @@ void readFaults(ConfigReader& r, const std::string& m, MissionConfig& c) {
   readWindows(r, fk + "stereo_dropouts", c.faults.stereo_dropouts);
   readPlannerOutages(r, fk, c.faults.planner_outages);
   readFollowerDropouts(r, fk, c.faults.follower_dropouts);
+  readOperatorOutages(r, fk, c.faults.operator_outages);
   readAbortEvent(r, fk + "abort", c.faults.abort);
   readWorkerApproach(r, fk + "worker_approach", c.faults.worker_approach);
   readLeaderSilence(r, fk + "leader_silence", c.faults.leader_silence);
@@ -368,6 +391,9 @@ void checkUavCount(ConfigReader& r, const std::string& m, const MissionConfig& c
   }
   for (const auto& o : c.faults.follower_dropouts) {
     if (o.uav >= n_uavs) r.addError(fk + "follower_dropouts", "uav " + std::to_string(o.uav) + " does not exist");
+  }
+  for (const auto& o : c.faults.operator_outages) {
+    if (o.uav >= n_uavs) r.addError(fk + "operator_outages", "uav " + std::to_string(o.uav) + " does not exist");
   }
 }
 

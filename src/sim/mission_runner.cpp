@@ -45,15 +45,18 @@ struct LeaderShare {
   formation::FormationParams params;
   std::uint64_t params_version = 0;
   planning::PlannedTrajectory plan;
-  /// The abort the leader accepted, relayed in every share from then on (the repetition that
-  /// reaches a follower across losses; docs/safety.md §2.8).
-  std::optional<planning::AbortCommand> abort;
   int from = 0;  ///< the sending (acting) leader
 };
 
-/// A follower's plan with its planner status: a UAV that could not plan (braking or on its
-/// previous plan) is avoided by every other UAV, also higher-priority ones (right of way).
-using PlanMessage = planning::ReceivedPlan;
+/// A UAV's plan as every other receives it (the ROS PlannedTrajectory over LCM).
+struct PlanMessage {
+  /// The plan with its planner status: a UAV that could not plan (braking or on its previous plan)
+  /// is avoided by every other UAV, also higher-priority ones (right of way).
+  planning::ReceivedPlan plan;
+  /// The abort this UAV accepted, relayed with every plan it sends from then on (the repetition
+  /// that reaches a UAV across losses, outages and restarts; docs/safety.md §2.8).
+  std::optional<planning::AbortCommand> abort;
+};
 
 struct OperatorMessage {
   std::size_t record = 0;
@@ -74,7 +77,7 @@ struct UavRuntime {
   WindEstimate wind_estimate;  ///< the flight stack's wind estimate (planning's wind allowance)
   double next_plan_s = 0.0;
   std::optional<LeaderShare> share;                           ///< followers: last received from the leader
-  std::vector<std::optional<PlanMessage>> received;  ///< plans received from the followers
+  std::vector<std::optional<planning::ReceivedPlan>> received;  ///< plans received from the other UAVs
   bool offline = false;                                      ///< follower dropout in progress
   std::string mode = "start";                                ///< last mode recorded (ModeChange)
 };
@@ -138,7 +141,7 @@ class MissionRun {
   Link<LeaderShare>& shareLink(int from, int to);
   Link<gesture::ViewObservation>* voteLink(int from, int to);
   Link<OperatorMessage>& operatorLink(int to);
-  void receiveShare(int i, LeaderShare s, double t);
+  void receiveShare(int i, LeaderShare s);
   void deliverOperatorMessages(double t);
   void updateDropouts(double t);
   void deliverUavMessages(double t);
@@ -190,7 +193,8 @@ class MissionRun {
   std::vector<std::vector<std::unique_ptr<Link<PlanMessage>>>> plan_links_;  // [i][j]: i → j
   std::vector<std::unique_ptr<Link<gesture::ViewObservation>>> vote_links_;  // [i]: follower i → leader
   std::vector<std::unique_ptr<Link<planning::AbortCommand>>> abort_links_;   // [i]: ground station → UAV i
-  AbortSender abort_sender_{cfg_.faults.abort, cfg_.replan.abort.repeats, cfg_.replan.abort.repeat_period_s};
+  AbortSender abort_sender_{cfg_.faults.abort, cfg_.replan.abort.repeats, cfg_.replan.abort.repeat_period_s,
+                            cfg_.replan.abort.resend_period_s};
   std::optional<AbortRecorder> abort_record_;
   std::optional<ApproachRecorder> approach_record_;  ///< faults.worker_approach
   AssistanceDrill assistance_{cfg_.assistance_acks_s};  ///< the acting leader's latch (docs/safety.md §2.10)
@@ -517,7 +521,9 @@ void MissionRun::deliverOperatorMessages(double t) {
   }
   for (const auto& d : schedule_.due(t)) {
     const OperatorMessage msg{metrics_.addRequest(d.record), t, d.command};
-    for (int i = 0; i < n_; ++i) operatorLink(i).send(t, msg);
+    for (int i = 0; i < n_; ++i) {
+      if (!cfg_.faults.operatorLinkDown(i, t)) operatorLink(i).send(t, msg);
+    }
   }
   for (int i = 0; i < n_; ++i) {
     for (const auto& msg : operatorLink(i).receive(t)) {
@@ -573,26 +579,26 @@ void MissionRun::deliverUavMessages(double t) {
   for (int i = 0; i < n_; ++i) {
     for (int from = 0; from < n_; ++from) {
       if (from == i) continue;
-      for (auto& s : shareLink(from, i).receive(t)) receiveShare(i, std::move(s), t);
+      for (auto& s : shareLink(from, i).receive(t)) receiveShare(i, std::move(s));
     }
   }
   for (int i = 0; i < n_; ++i) {
     UavRuntime& u = uav(i);
     for (int j = 0; j < n_; ++j) {
       if (j == i) continue;
-      for (auto& p : plan_links_[static_cast<std::size_t>(j)][static_cast<std::size_t>(i)]->receive(t)) {
+      for (auto& m : plan_links_[static_cast<std::size_t>(j)][static_cast<std::size_t>(i)]->receive(t)) {
         if (u.offline) continue;
+        if (m.abort) receiveAbort(i, *m.abort, t);  // a relayed abort counts whatever the plan's age
         auto& slot = u.received[static_cast<std::size_t>(j)];
-        if (!slot || p.plan.t0_s > slot->plan.t0_s) slot = std::move(p);  // duplicates and late copies ignored
+        if (!slot || m.plan.plan.t0_s > slot->plan.t0_s) slot = std::move(m.plan);  // duplicates and late copies ignored
       }
     }
   }
 }
 
-void MissionRun::receiveShare(int i, LeaderShare s, double t) {
+void MissionRun::receiveShare(int i, LeaderShare s) {
   UavRuntime& u = uav(i);
   if (u.offline) return;
-  if (s.abort) receiveAbort(i, *s.abort, t);  // a relayed abort counts whatever the share's age
   if (!u.share || s.worker.stamp_s > u.share->worker.stamp_s) u.share = std::move(s);
 }
 
@@ -853,8 +859,6 @@ void MissionRun::sendPlan(int i, double t, const planning::ReplanOutcome& out, c
     s.params = params;
     s.params_version = version;
     s.plan = out.result.trajectory;
-    s.abort = uav(i).step->abort().command();
-    if (s.abort) s.abort->sent_s = t;  // each relayed copy is stamped when it is sent (its age: the share's)
     s.from = i;
     for (int j = 0; j < n_; ++j) {
       if (j != i) shareLink(i, j).send(t, s);
@@ -862,7 +866,8 @@ void MissionRun::sendPlan(int i, double t, const planning::ReplanOutcome& out, c
   }
   // Every UAV's plan to every other (the leader's too, as the ROS PlannedTrajectory): after a
   // hand-over the others still know the old leader's last plan.
-  const PlanMessage msg{out.result.trajectory, out.fallback};
+  PlanMessage msg{planning::ReceivedPlan{out.result.trajectory, out.fallback}, uav(i).step->abort().command()};
+  if (msg.abort) msg.abort->sent_s = t;  // each relayed copy is stamped when it is sent
   for (int j = 0; j < n_; ++j) {
     if (j != i) plan_links_[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)]->send(t, msg);
   }
@@ -923,7 +928,9 @@ void MissionRun::deliverAbort(double t) {
     receiveAbort(owner_, planning::AbortCommand{{"gesture", ++gesture_seq_}, planning::AbortSource::kGesture, event->t_s}, t);
   }
   for (const auto& c : abort_sender_.due(t)) {
-    for (auto& link : abort_links_) link->send(t, c);
+    for (std::size_t i = 0; i < abort_links_.size(); ++i) {
+      if (!cfg_.faults.operatorLinkDown(static_cast<int>(i), t)) abort_links_[i]->send(t, c);
+    }
   }
   for (int i = 0; i < static_cast<int>(abort_links_.size()); ++i) {
     for (const auto& c : abort_links_[static_cast<std::size_t>(i)]->receive(t)) {

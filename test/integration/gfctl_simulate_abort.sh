@@ -10,8 +10,11 @@
 # with mission.abort.after: land (to 150 s): every UAV at its landing approach point (2 m above
 # the ground), the spots >= Gamma_dis apart; and from search / hold (the leader's camera blind from
 # 90 s: at 100 s it searches, the followers hold) the same as the first; and with follower 2's
-# computer down 95-112 s (it misses every copy from the ground station) it aborts from the leader's
-# relay once back (listening first) and settles too (to 150 s).
+# computer down 95-112 s (it misses every copy from the ground station) it aborts from the others'
+# relay once back (listening first) and settles too (to 150 s). Link outages (docs/safety.md §2.8):
+# the ground station's link to the leader down 95-115 s — the leader aborts from the followers'
+# relay within a second, as the others; to every UAV down 95-103.9 s (the whole burst, 100-101.8 s,
+# and the first resends lost) — every UAV aborts from the resend at 104.8 s within a second.
 # Usage: gfctl_simulate_abort.sh GFCTL SRC
 set -euo pipefail
 GFCTL=$1
@@ -22,16 +25,20 @@ fail=0
 printf 'faults:\n  abort: {t_s: 100, source: gesture}\n' > "$TMP/gesture_abort.yaml"
 printf 'faults:\n  camera_blackouts: [[90, 130]]\n  abort: {t_s: 100, source: operator}\n' > "$TMP/search_abort.yaml"
 printf 'faults:\n  follower_dropouts: [{uav: 2, from_s: 95, to_s: 112}]\n  abort: {t_s: 100, source: operator}\n' > "$TMP/dropout_abort.yaml"
+printf 'faults:\n  operator_outages: [{uav: 0, from_s: 95, to_s: 115}]\n  abort: {t_s: 100, source: operator}\n' > "$TMP/leader_outage.yaml"
+printf 'faults:\n  operator_outages: [{uav: 0, from_s: 95, to_s: 103.9}, {uav: 1, from_s: 95, to_s: 103.9}, {uav: 2, from_s: 95, to_s: 103.9}]\n  abort: {t_s: 100, source: operator}\n' > "$TMP/all_outage.yaml"
 # The power-tower mission with abort.after: land (the model path made absolute for the copy).
 sed -e "s|gesture_model: \.\./\.\./|gesture_model: $SRC/|" -e 's|^  worker:$|  abort: {after: land}\n  worker:|' \
   "$SRC/config/scenarios/power_towers.yaml" > "$TMP/power_towers_land.yaml"
-for run in operator gesture land search dropout; do
+for run in operator gesture land search dropout leader_outage all_outage; do
   faults=(--fault-profile abort_mid_mission)
   scenario="$SRC/config/scenarios/power_towers.yaml"
   duration=135
   [ "$run" = gesture ] && faults=(--faults "$TMP/gesture_abort.yaml")
   [ "$run" = search ] && faults=(--faults "$TMP/search_abort.yaml")
   [ "$run" = dropout ] && { faults=(--faults "$TMP/dropout_abort.yaml"); duration=150; }
+  [ "$run" = leader_outage ] && faults=(--faults "$TMP/leader_outage.yaml")
+  [ "$run" = all_outage ] && { faults=(--faults "$TMP/all_outage.yaml"); duration=150; }
   [ "$run" = land ] && { faults=(--faults "$SRC/config/faults/abort_mid_mission.yaml"); scenario="$TMP/power_towers_land.yaml"; duration=150; }
   "$GFCTL" simulate --scenario "$scenario" "${faults[@]}" --out "$TMP/$run" \
     --seed 1 --duration "$duration" --threads 1 --no-plot > "$TMP/$run.log" 2>&1 \
@@ -56,8 +63,10 @@ worker = [float(last[k]) for k in ("worker_x", "worker_y", "worker_z")]
 zs = []
 for u in a["uavs"]:
     i, name = u["uav"], ("L" if u["uav"] == 0 else str(u["uav"]))
-    late = run == "dropout" and i == 2  # offline 95-112 s: from the leader's relay once back
-    if u["accepted_s"] is None or u["accepted_s"] - (112.0 if late else a["issued_s"]) > 1.0 or u["accepted_s"] < a["issued_s"]:
+    # When it can first hear of the abort: follower 2 offline 95-112 s (from the others' relay once
+    # back); every ground link down until 103.9 s (the resend at 104.8 s); otherwise at once.
+    first = 112.0 if run == "dropout" and i == 2 else 104.8 if run == "all_outage" else a["issued_s"]
+    if u["accepted_s"] is None or u["accepted_s"] - first > 1.0 or u["accepted_s"] < first:
         problems.append(f"uav {i} accepted at {u['accepted_s']}")
     if u["phase"] != final or u["settled_s"] is None: problems.append(f"uav {i} phase {u['phase']}")
     if u["min_uav_distance_m"] < 2.5: problems.append(f"uav {i} min mutual {u['min_uav_distance_m']:.2f} < 2.5")

@@ -5,8 +5,9 @@ At sim t = ABORT_AT_S it runs `tools/gf_command.py abort`, then checks: every UA
 abort_state (gesture_formation/AbortState) shows the command accepted and reaches the settled
 phase of the mission's abort.after (hover: PHASE_AT_RETREAT) within SETTLE_LIMIT_S; each settled
 UAV's goal is in its own layer (abort.retreat_height_m + i * layer_spacing_m) and the goals are at
-least layer_spacing_m apart; the ground station sent abort.repeats copies of one id and each
-follower also received the leader's relay; from settling to the end every UAV's true position keeps the worker's
+least layer_spacing_m apart; the ground station sent abort.repeats copies of one id, then one every
+abort.resend_period_s; every UAV also received the relay of each other UAV (each relays the abort it
+accepted with its plans); from settling to the end every UAV's true position keeps the worker's
 true position at least abort.retreat_distance_m - arrival_tolerance_m away (the goal is >=
 retreat_distance_m from the worker estimate, the UAV within arrival_tolerance_m of its goal);
 SimWorld's metrics.json: no collision, the least mutual distance >= the planner's Γ_dis.
@@ -31,7 +32,8 @@ HOVER_AFTER_SETTLE_S = 3.0  # then the distances are judged over what was record
 UAVS = 3
 # planning::AbortConfig's defaults (a mission without `abort:` runs with them).
 ABORT_DEFAULTS = {"retreat_distance_m": 15.0, "retreat_height_m": 10.0, "layer_spacing_m": 4.0,
-                  "arrival_tolerance_m": 1.0, "repeats": 10, "after": "hover"}
+                  "arrival_tolerance_m": 1.0, "repeats": 10, "repeat_period_s": 0.2, "resend_period_s": 1.0,
+                  "after": "hover"}
 SETTLED_PHASE = {"hover": AbortState.PHASE_AT_RETREAT, "return_home": AbortState.PHASE_AT_HOME,
                  "land": AbortState.PHASE_LANDED}
 fails = 0
@@ -55,9 +57,9 @@ def main():
     truth = {i: [] for i in range(UAVS)}       # (sim time, x, y, z)
     worker = []
     sent = []                                  # the OperatorInterface's copies (/operator/abort)
-    copies = {i: [] for i in range(1, UAVS)}   # every copy a follower's LcmBridge received
+    copies = {i: [] for i in range(UAVS)}      # every copy a UAV's LcmBridge received
     rospy.Subscriber("/operator/abort", AbortCommand, lambda m: sent.append(m))
-    for i in range(1, UAVS):
+    for i in range(UAVS):
         rospy.Subscriber(f"/uav{i}/abort", AbortCommand, lambda m, i=i: copies[i].append(m))
     for i in range(UAVS):
         rospy.Subscriber(f"/uav{i}/abort_state", AbortState, lambda m, i=i: states[i].append((rospy.get_time(), m)))
@@ -125,12 +127,21 @@ def main():
         check(len(after) > 10 and dmin >= limit,
               f"{names[i]}: from settling to the end ({len(after)} true positions) the worker >= {limit:.1f} m away "
               f"(least {dmin:.2f} m)")
-    n_sent = len(sent)
-    check(n_sent == cfg["repeats"] and len(set((m.sender, m.sequence) for m in sent)) == 1, f"the ground station sent {n_sent} copies of one id "
-          f"({len(set((m.sender, m.sequence) for m in sent))} id(s)), stamps {sent[0].stamp.to_sec():.2f} .. {sent[-1].stamp.to_sec():.2f} s")
-    for i in range(1, UAVS):
-        relayed = [m for m in copies[i] if m.link_sender == 0 and m.sequence == sent[0].sequence]
-        check(len(relayed) > 0, f"{names[i]}: also received the leader's relay ({len(relayed)} copies from sender 0, "
+    n_burst = cfg["repeats"]
+    burst, resends = sent[:n_burst], sent[n_burst:]
+    ids = set((m.sender, m.sequence) for m in sent)
+    span = burst[-1].stamp.to_sec() - burst[0].stamp.to_sec()
+    check(len(burst) == n_burst and len(ids) == 1 and span <= (n_burst - 1) * cfg["repeat_period_s"] + 0.1,
+          f"the ground station sent {len(burst)} copies of one id ({len(ids)} id(s) in all) within {span:.2f} s")
+    # Then one copy every resend_period_s (its timer ticks every repeat_period_s: a copy is up to one tick late).
+    gaps = [b.stamp.to_sec() - a.stamp.to_sec() for a, b in zip(sent[n_burst - 1:], resends)]
+    low, high = cfg["resend_period_s"] - 0.05, cfg["resend_period_s"] + cfg["repeat_period_s"] + 0.1
+    check(len(resends) >= 3 and all(low <= g <= high for g in gaps),
+          f"then {len(resends)} resends, gaps {', '.join(f'{g:.2f}' for g in gaps[:6])} s (want {low:.2f} .. {high:.2f})")
+    for i in range(UAVS):
+        by = {j: len([m for m in copies[i] if m.link_sender == j and m.sequence == sent[0].sequence]) for j in range(UAVS)}
+        check(all(by[j] > 0 for j in range(UAVS) if j != i),
+              f"{names[i]}: received every other UAV's relay ({', '.join(f'{n} from {j}' for j, n in by.items() if j != i)}; "
               f"{len([m for m in copies[i] if m.link_sender == 100])} from the ground station)")
     pairs = [(a, b) for a in goals for b in goals if a < b]
     least = min((math.dist(goals[a], goals[b]) for a, b in pairs), default=math.nan)

@@ -75,6 +75,9 @@ struct AbortConfig {
   double max_command_age_s = 10.0;
   int repeats = 10;                   ///< the sender sends each abort command this many times, ≥ 1
   double repeat_period_s = 0.2;       ///< … this far apart [s], > 0
+  /// … and then one copy this often for as long as it runs [s], (0, 60]: a UAV out of reach for
+  /// the whole burst (link outage, reboot) still receives it when it is back.
+  double resend_period_s = 1.0;
   AbortAfter after = AbortAfter::kHover;  ///< `after: hover | return_home | land`
 
   /// \brief Every problem, each {key, "must be …, got v"} (keys as in the file, without prefix).
@@ -131,11 +134,20 @@ common::Result<Eigen::Vector3d> chooseRetreatGoal(int uav_index, int uav_count, 
                                                   const AbortConfig& config);
 
 /// \brief The landing approach point above the first verified spot of {below `goal_world`, below
-/// `home_world`}: the column from the candidate's height down to land_height_m above the ground
-/// keeps, at every 0.5 m, a clearance ≥ min(goal_clearance_m, height above the ground − 2·resolution)
-/// (nothing closer beside or under it than the ground itself). Fails when neither is clear.
-common::Result<Eigen::Vector3d> chooseLandingPoint(const Eigen::Vector3d& goal_world, const Eigen::Vector3d& home_world,
+/// `home_world` (none: the goal only)}: the column from the candidate's height down to land_height_m
+/// above the ground keeps, at every 0.5 m, a clearance ≥ min(goal_clearance_m, height above the
+/// ground − 2·resolution) (nothing closer beside or under it than the ground itself). Fails when
+/// no candidate is clear.
+common::Result<Eigen::Vector3d> chooseLandingPoint(const Eigen::Vector3d& goal_world,
+                                                   const std::optional<Eigen::Vector3d>& home_world,
                                                    const RetreatSpace& space, const AbortConfig& config);
+
+/// \brief Why the take-off point `home_world` may not be flown back to or landed below now ("" when
+/// it may): it must be finite, inside the map by goal_clearance_m and ≥ retreat_distance_m
+/// horizontally from the worker estimate `worker_world` — a planner restarted mid-mission takes its
+/// first position, its slot beside the worker, for its take-off point.
+std::string homeProblem(const Eigen::Vector3d& home_world, const Eigen::Vector3d& worker_world,
+                        const RetreatSpace& space, const AbortConfig& config);
 
 /// \brief Steps k = 0..steps−1 from `p_from_world` towards `goal_world` at `speed_mps` (dt_s per
 /// step; at the goal once there), camera towards `worker_world` (heading `heading_rad` when

@@ -34,20 +34,25 @@ struct AbortEvent {
 void readAbortEvent(common::ConfigReader& r, const std::string& key, std::optional<AbortEvent>& out);
 
 /// \brief The operator's copies of the abort as they fall due: one command (id "operator-abort" #1),
-/// sent `repeats` times `period_s` apart from the event's time.
+/// sent `repeats` times `period_s` apart from the event's time, then once every `resend_period_s`
+/// for the rest of the mission (a UAV out of reach for the whole burst still receives it).
 class AbortSender {
  public:
-  AbortSender(const std::optional<AbortEvent>& event, int repeats, double period_s)
-      : event_(event), repeats_(repeats), period_s_(period_s) {}
-  /// \brief The copies due at or before t_s not returned before (each copy the same command).
+  AbortSender(const std::optional<AbortEvent>& event, int repeats, double period_s, double resend_period_s)
+      : event_(event), repeats_(repeats), period_s_(period_s), resend_period_s_(resend_period_s) {}
+  /// \brief The copies due at or before t_s not returned before (each copy the same command,
+  /// stamped when it falls due).
   std::vector<planning::AbortCommand> due(double t_s);
   /// \brief The command (no copy sent yet: still the same).
   planning::AbortCommand command() const;
 
  private:
+  /// When copy k (0-based) falls due.
+  double dueAt(int k) const;
   std::optional<AbortEvent> event_;
   int repeats_ = 1;
   double period_s_ = 0.2;
+  double resend_period_s_ = 1.0;
   int sent_ = 0;
 };
 

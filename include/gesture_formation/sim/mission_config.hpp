@@ -92,6 +92,9 @@ struct FaultConfig {
   std::vector<std::pair<double, double>> camera_blackouts;  ///< [from, to] s: the leader sees no worker
   std::vector<PlannerOutage> planner_outages;
   std::vector<UavDropout> follower_dropouts;               ///< uav ≥ 1
+  /// The ground station's link to UAV `uav` is down in [from_s, to_s) (`operator_outages:
+  /// [{uav, from_s, to_s}]`): the operator's commands and abort copies sent to it then are lost.
+  std::vector<PlannerOutage> operator_outages;
   std::vector<std::pair<double, double>> uwb_dropouts;     ///< [from, to] s: no UWB range
   std::vector<std::pair<double, double>> stereo_dropouts;  ///< [from, to] s: no stereo range
   RangeOutlierConfig range_outliers;
@@ -110,10 +113,12 @@ struct FaultConfig {
   std::vector<std::string> validate(const std::string& prefix = "") const;
   /// \brief Whether follower `uav`'s computer is down at `t_s` (a follower_dropouts window).
   bool followerOffline(int uav, double t_s) const;
+  /// \brief Whether the ground station's link to UAV `uav` is down at `t_s` (an operator_outages window).
+  bool operatorLinkDown(int uav, double t_s) const;
 };
 
 /// \brief The one range of each number of the fault section's entries: range_outliers.*,
-/// planner_outages[i].*, follower_dropouts[i].*.
+/// planner_outages[i].* (and operator_outages[i].*), follower_dropouts[i].*.
 const common::FieldTable<RangeOutlierConfig>& rangeOutlierFields();
 const common::FieldTable<PlannerOutage>& plannerOutageFields();
 const common::FieldTable<UavDropout>& uavDropoutFields();

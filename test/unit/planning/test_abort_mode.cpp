@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -185,6 +186,20 @@ TEST(LandingPointTest, BelowTheGoalWhenItsColumnIsClearElseBelowHomeElseNone) {
   ASSERT_TRUE(b) << b.reason();
   EXPECT_EQ(*b, Eigen::Vector3d(-10.0, -10.0, c.land_height_m));  // the pillar is under the goal: home
   EXPECT_FALSE(pl::chooseLandingPoint(above_pillar, above_pillar, world().space(), c));
+  EXPECT_FALSE(pl::chooseLandingPoint(above_pillar, std::nullopt, world().space(), c));  // no home to fall back on
+}
+
+TEST(LandingPointTest, ATakeOffPointBesideTheWorkerOrOutsideTheMapIsRefusedNamingWhy) {
+  const pl::AbortConfig c;  // retreat_distance_m 15
+  EXPECT_EQ(pl::homeProblem(Eigen::Vector3d(-12.0, -12.0, 6.0), kWorker, world().space(), c), "");
+  const std::string beside = pl::homeProblem(Eigen::Vector3d(5.0, 3.0, 6.0), kWorker, world().space(), c);
+  EXPECT_NE(beside.find("retreat_distance_m"), std::string::npos) << beside;
+  EXPECT_NE(beside.find("5.83"), std::string::npos) << beside;  // its distance from the worker estimate
+  const Eigen::Vector3d nan = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  EXPECT_NE(pl::homeProblem(nan, kWorker, world().space(), c), "");
+  EXPECT_NE(pl::homeProblem(Eigen::Vector3d(-12.0, -12.0, 6.0), nan, world().space(), c), "");  // no worker estimate
+  EXPECT_NE(pl::homeProblem(Eigen::Vector3d(500.0, 0.0, 6.0), kWorker, world().space(), c).find("inside the map"),
+            std::string::npos);
 }
 
 // ---- the phases ---------------------------------------------------------------------------
@@ -199,7 +214,7 @@ pl::AbortPlanner::Situation at(double t, const Eigen::Vector3d& p, const Eigen::
   s.p_world = p;
   s.v_world = v;
   s.worker_world = kWorker;
-  s.home_world = Eigen::Vector3d(-10.0, -10.0, 6.0);
+  s.home_world = Eigen::Vector3d(-12.0, -12.0, 6.0);  // 17 m from the worker: a take-off point it may return to
   return s;
 }
 
@@ -257,6 +272,29 @@ TEST(AbortPlannerTest, RetreatsThenReturnsHome) {
   EXPECT_EQ(*a.currentGoal(), at(0, goal).home_world);
   EXPECT_EQ(a.decide(at(15.0, goal)).phase, pl::AbortPhase::kReturnHome);  // not there yet
   EXPECT_EQ(a.decide(at(20.0, at(0, goal).home_world)).phase, pl::AbortPhase::kAtHome);
+}
+
+TEST(AbortPlannerTest, ATakeOffPointBesideTheWorkerIsNotReturnedToNorLandedBelow) {
+  // A planner restarted mid-mission took its slot beside the worker for its take-off point.
+  for (const auto after : {pl::AbortAfter::kReturnHome, pl::AbortAfter::kLand}) {
+    pl::AbortConfig c;
+    c.after = after;
+    pl::AbortPlanner a(0, 3, c, world().space());
+    a.receive(command(0.0), 0.0);
+    a.decide(at(0.0, Eigen::Vector3d(-8.0, 0.0, 6.0)));
+    const Eigen::Vector3d goal = *a.retreatGoal();
+    auto s = at(9.0, goal);
+    s.home_world = Eigen::Vector3d(-6.0, 2.0, 5.0);  // 6.3 m from the worker
+    const auto d = a.decide(s);
+    if (after == pl::AbortAfter::kReturnHome) {
+      EXPECT_EQ(d.phase, pl::AbortPhase::kAtRetreat) << d.reason;
+      EXPECT_NE(d.reason.find("retreat_distance_m"), std::string::npos) << d.reason;
+      EXPECT_EQ(*a.currentGoal(), goal);
+    } else {  // the column below the goal is clear: it lands there, never below the take-off point
+      EXPECT_EQ(d.phase, pl::AbortPhase::kLanding) << d.reason;
+      EXPECT_EQ(*a.currentGoal(), Eigen::Vector3d(goal.x(), goal.y(), c.land_height_m));
+    }
+  }
 }
 
 TEST(AbortPlannerTest, RetreatsThenApproachesAVerifiedLandingSpot) {

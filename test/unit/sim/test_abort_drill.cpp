@@ -29,19 +29,26 @@ TEST(AbortEventTest, TheFaultKeyIsReadAndBadValuesAreNamed) {
   EXPECT_NE(all.find("radio"), std::string::npos) << all;
 }
 
-TEST(AbortSenderTest, SendsTheSameCommandRepeatsTimesPeriodApart) {
-  gf::sim::AbortSender s(gf::sim::AbortEvent{10.0, gf::planning::AbortSource::kOperator}, 3, 0.2);
+TEST(AbortSenderTest, SendsTheSameCommandRepeatsTimesPeriodApartThenEveryResendPeriod) {
+  gf::sim::AbortSender s(gf::sim::AbortEvent{10.0, gf::planning::AbortSource::kOperator}, 3, 0.2, 1.0);
   EXPECT_TRUE(s.due(9.9).empty());
   const auto first = s.due(10.0);
   ASSERT_EQ(first.size(), 1u);
   EXPECT_DOUBLE_EQ(first[0].sent_s, 10.0);
   const auto rest = s.due(11.0);
-  ASSERT_EQ(rest.size(), 2u);
+  ASSERT_EQ(rest.size(), 2u);  // the burst's 10.2 and 10.4; the first resend falls due at 11.4
   EXPECT_DOUBLE_EQ(rest[1].sent_s, 10.4);
   EXPECT_EQ(rest[1].id.sender, first[0].id.sender);
   EXPECT_EQ(rest[1].id.sequence, first[0].id.sequence);  // one command: the copies are repeats
-  EXPECT_TRUE(s.due(20.0).empty());
-  gf::sim::AbortSender g(gf::sim::AbortEvent{10.0, gf::planning::AbortSource::kGesture}, 3, 0.2);
+  EXPECT_TRUE(s.due(11.3).empty());
+  // After the burst, one copy per resend period for the rest of the mission, each stamped when sent.
+  const auto later = s.due(20.0);
+  ASSERT_EQ(later.size(), 9u);  // 11.4, 12.4, ..., 19.4
+  EXPECT_DOUBLE_EQ(later.front().sent_s, 11.4);
+  EXPECT_DOUBLE_EQ(later.back().sent_s, 19.4);
+  EXPECT_EQ(later.back().id.sequence, first[0].id.sequence);
+  EXPECT_EQ(s.due(20.0).size(), 0u);  // nothing twice
+  gf::sim::AbortSender g(gf::sim::AbortEvent{10.0, gf::planning::AbortSource::kGesture}, 3, 0.2, 1.0);
   EXPECT_TRUE(g.due(20.0).empty());  // a gesture is the leader's, not the ground station's
 }
 

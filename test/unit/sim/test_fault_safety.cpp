@@ -116,6 +116,9 @@ mission:
       - {uav: 1, from_s: 20, to_s: 10}
       - {uav: 7, from_s: 1, to_s: 2}
     uwb_dropouts: [[5, 3]]
+    operator_outages:
+      - {uav: 9, from_s: 4, to_s: 2}
+      - {uav: 0, from_s: 1}
     range_outliers: {probability: 2.0}
     max_worker_age_s: -1
     bogus_fault: 1
@@ -125,6 +128,8 @@ mission:
   const std::string e = m.reason();
   for (const char* needle : {"mission.faults.link.loss", "1.5", "mission.faults.link.reorder", "follower_dropouts[0]",
                              "from_s 20", "uav 7 does not exist", "uwb_dropouts[0]", "[5, 3]",
+                             "operator_outages[0] needs from_s < to_s", "uav 9 does not exist",
+                             "operator_outages[1].to_s",
                              "mission.faults.range_outliers.probability", "mission.faults.max_worker_age_s",
                              "mission.faults.bogus_fault: unknown key"}) {
     EXPECT_NE(e.find(needle), std::string::npos) << needle << "\n" << e;
