@@ -13,6 +13,7 @@
 #include "gesture_formation/gesture/gesture_filter.hpp"
 #include "gesture_formation/gesture/gesture_mapping.hpp"
 #include "gesture_formation/gesture/view_fusion.hpp"
+#include "gesture_formation/planning/brake_horizon.hpp"
 #include "gesture_formation/planning/distance_field.hpp"
 #include "gesture_formation/planning/occupancy_map.hpp"
 #include "gesture_formation/planning/planner_config.hpp"
@@ -199,6 +200,9 @@ inline void loadPlannerSettings(const ros::NodeHandle& pnh, ParamLoader& params,
     for (const auto& e : planning::abortPlannerProblems(out.replan.abort, out.planner.mutual_distance_m,
                                                         out.planner.limits.max_speed_mps, "abort/")) {
       params.addError(e.key + ": " + e.message);
+    }
+    for (const auto& e : planning::brakeHorizonProblems(out.planner.limits, out.replan.dt_s, out.replan.steps, "")) {
+      params.addError(pnh.resolveName(e.key) + ": " + e.message);
     }
   }
 }

@@ -140,7 +140,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     auto& slot = received_[static_cast<std::size_t>(msg->uav_index)];
     if (!slot || plan->t0_s >= slot->plan.t0_s) slot = planning::ReceivedPlan{std::move(*plan), msg->fallback != 0};
   }
-  // Every copy of an abort (operator over LCM, the leader's relay, the gesture commander): the
+  // Every copy of an abort (operator over LCM, the other UAVs' relay, the gesture commander): the
   // ReplanStep accepts the first that is fresh enough (planning::AbortPlanner::receive).
   void onAbort(const gesture_formation::AbortCommand::ConstPtr& msg) {
     auto c = fromMsg(*msg);

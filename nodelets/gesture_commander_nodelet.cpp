@@ -18,7 +18,8 @@
 //   {event: assist_requested}; to the leader's FormationPlanner), gesture_status_out (GestureStatus,
 //   one per fused frame).
 // Parameters (required): ~gesture_config (config/gestures.yaml: filter, mapping, view_fusion.*)
-//   or ~mission_file (a scenario's mission.gestures), ~uav_count, ~sender_name, ~frame_wait_s.
+//   or ~mission_file (a scenario's mission.gestures), ~uav_count, ~sender_name, ~frame_wait_s,
+//   ~frame_merge_s (unsynchronised cameras: one observation per view per frame, gesture::GestureFrames).
 //   Command sequence numbers start at the wall clock in microseconds, so a restarted commander
 //   is never taken for a duplicate.
 // Leader hand-over (optional ~leadership, default false; docs/safety.md §1.2): the commander runs on
@@ -59,6 +60,7 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
     params.load("uav_count", uav_count, 1, comm::kMaxUavIndex + 1);
     params.load("sender_name", sender_);
     params.load("frame_wait_s", frame_wait_s_, 0.0, 1.0);
+    params.load("frame_merge_s", frame_merge_s_, 0.0, 1.0);
     params.loadOptional("mission_file", mission_file, "");
     gesture::GestureFilterConfig fcfg;
     gesture::ViewFusionConfig vcfg;
@@ -91,7 +93,7 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
       return;
     }
     getPrivateNodeHandle().param("leadership", leadership_, false);  // optional: see the file comment
-    make_frames_ = [=] { frames_.emplace(fcfg, vcfg, mapping, uav_count, frame_wait_s_); };
+    make_frames_ = [=] { frames_.emplace(fcfg, vcfg, mapping, uav_count, frame_wait_s_, frame_merge_s_); };
     make_frames_();
     last_seen_s_.assign(static_cast<std::size_t>(frames_->views()), -1e9);
     NODELET_INFO_STREAM("GestureCommander loaded:\n"
@@ -249,6 +251,7 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
   std::vector<double> last_seen_s_;  ///< per camera: ROS time of its last accepted observation
   std::string sender_;
   double frame_wait_s_ = 0.0;
+  double frame_merge_s_ = 0.0;  ///< observations of different views this close in time form one frame (0: exact stamps)
   std::optional<gesture::GestureFrames> frames_;  ///< vote, filter, mapping (shared with gfctl simulate)
   std::function<void()> make_frames_;             ///< (re)starts frames_ from the loaded settings
   bool leadership_ = false, acting_ = false;      ///< ~leadership; this UAV votes (acts, or its lease lapsed in its term)

@@ -2,7 +2,7 @@
 // sender id, sequence and stamp; docs/security.md); a thin adapter between ROS topics and the link
 // (topics, parameters, defaults: docs/ros.md "LcmBridge"). ROS → LCM: the share, plans (their
 // fallback flag in a heartbeat sent just before), parameters, gesture observations, aborts (this
-// UAV's accepted abort also after every plan it sends), single events repeated like a command
+// UAV's accepted abort also with every timed heartbeat, whether or not its planner plans), single events repeated like a command
 // (~command_repeats copies, comm::OutgoingRepeats: commands, the leader's acknowledgements and
 // assistance state — also with every share while requested —, the ground's acknowledgement of it),
 // leadership messages (docs/safety.md §1.2) and live-map changes (docs/mapping.md §8), both from UAVs
@@ -132,6 +132,9 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     heartbeat_timer_ = nh.createTimer(ros::Duration(1.0 / heartbeat_hz), [this](const ros::TimerEvent&) {
       std::lock_guard<std::mutex> lock(mutex_);
       send(heartbeat_, "heartbeat");
+      // This UAV's accepted abort, with every timed heartbeat (heartbeat_rate_hz): also while its
+      // planner publishes nothing (stale odometry, no worker estimate, an outage).
+      if (relay_) send(*relay_, "abort (relay)");
     });
   }
 
@@ -175,7 +178,6 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     heartbeat_.last_plan_sequence = msg->sequence;
     send(heartbeat_, "heartbeat");  // before the plan: it carries the plan's fallback flag
     send(*plan, "plan");
-    if (relay_) send(*relay_, "abort (relay)");  // this UAV's accepted abort travels with every plan it sends
   }
   // An abort to send (the ground station's copies: the OperatorInterface repeats it).
   void onAbort(const gesture_formation::AbortCommand::ConstPtr& msg) { sendChecked(toWire(*msg), "abort"); }
@@ -295,7 +297,7 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
   double command_repeat_period_s_ = 0.1;
   comm::OutgoingRepeats repeats_;  ///< copies of single events still to send
   std::optional<comm::AssistanceMessage> assistance_;  ///< the last assistance state sent (leader: re-sent while requested)
-  std::optional<comm::AbortMessage> relay_;  ///< this UAV's accepted abort, sent after every plan
+  std::optional<comm::AbortMessage> relay_;  ///< this UAV's accepted abort, sent with every timed heartbeat
   /// LCM messages handled per 5 ms drain: bounded, so a flood cannot keep the mutex from heartbeats.
   static constexpr int kMaxDrainPerTick = 2000;
   lcm_bridge::HighWaterMarkSaver marks_;  ///< high_water_file, saved when the marks changed

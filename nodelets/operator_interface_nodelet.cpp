@@ -8,7 +8,9 @@
 // Abort (docs/safety.md §2.8): the service send_abort (gesture_formation/SendAbort; tools/gf_command.py
 // abort) publishes one AbortCommand (source operator, the next sequence number) on abort_out — to
 // the ground station's LcmBridge, which sends every copy to every UAV — ~abort_repeats times,
-// ~abort_repeat_period_s apart, each copy stamped when sent (as gfctl simulate's AbortSender).
+// ~abort_repeat_period_s apart, then once every ~abort_resend_period_s for as long as this node runs
+// (clearing an abort takes restarting this node and every UAV), each copy stamped when sent (as
+// gfctl simulate's AbortSender).
 // Acknowledgements (docs/safety.md §2.9): the leader's CommandAck for every command it handled
 // arrives on command_ack_in (the ground LcmBridge); each is logged — the operator's own commands with
 // the time since sending, the worker's gesture commands as such — and republished on command_ack_out
@@ -19,8 +21,9 @@
 // latched on assistance_state_out (for the operator's displays); the service acknowledge_assistance
 // (AcknowledgeAssistance; tools/gf_command.py ack-assist) sends the acknowledgement of the pending
 // request on assistance_ack_out (to the ground LcmBridge → the leader's planner).
-// Parameters (required): ~sender_name, ~uav_count, ~abort_repeats, ~abort_repeat_period_s; with
-// ~mission_file (simulation; optional ~faults_file) the mission's abort.repeats / repeat_period_s win.
+// Parameters (required): ~sender_name, ~uav_count, ~abort_repeats, ~abort_repeat_period_s,
+// ~abort_resend_period_s; with ~mission_file (simulation; optional ~faults_file) the mission's
+// abort.repeats / repeat_period_s / resend_period_s win.
 #include <map>
 #include <mutex>
 #include <optional>
@@ -63,6 +66,10 @@ class OperatorInterfaceNodelet : public nodelet::Nodelet {
       params.load("abort_repeats", abort_repeats_, 1, 100);
       params.load("abort_repeat_period_s", abort_period_s_, 0.01, 10.0);
       params.load("abort_resend_period_s", abort_resend_period_s_, 0.1, 60.0);
+      if (abort_resend_period_s_ < abort_period_s_) {
+        params.addError("abort_resend_period_s: value " + std::to_string(abort_resend_period_s_) +
+                        " must be >= abort_repeat_period_s " + std::to_string(abort_period_s_));
+      }
     }
     if (!params.ok()) {
       NODELET_ERROR_STREAM("OperatorInterface refuses to start; fix these parameters:\n" << params.report());
@@ -171,7 +178,8 @@ class OperatorInterfaceNodelet : public nodelet::Nodelet {
   }
   // Mutex held. One copy, stamped now (its age at each UAV is this copy's): the burst's, then one
   // every abort_resend_period_s for as long as this node runs — a UAV out of reach for the whole
-  // burst (a link outage, a reboot) still gets it when it is back (docs/safety.md §2.8).
+  // burst (a link outage, a reboot) still gets it when it is back (docs/safety.md §2.8). The timer
+  // ticks every abort_repeat_period_s: a resend falls on the first tick at or after its time.
   void sendAbortCopy() {
     if (abort_.sequence == 0) return;  // no abort sent
     const ros::Time now = ros::Time::now();
@@ -180,8 +188,9 @@ class OperatorInterfaceNodelet : public nodelet::Nodelet {
       if (abort_copies_left_ == 0) abort_resend_at_ = now + ros::Duration(abort_resend_period_s_);
     } else if (now < abort_resend_at_) {
       return;
-    } else {
-      abort_resend_at_ = now + ros::Duration(abort_resend_period_s_);
+    } else {  // on schedule, not from this tick (no drift); after a stall, from now
+      abort_resend_at_ += ros::Duration(abort_resend_period_s_);
+      if (abort_resend_at_ <= now) abort_resend_at_ = now + ros::Duration(abort_resend_period_s_);
     }
     abort_.stamp = now;
     abort_pub_.publish(abort_);

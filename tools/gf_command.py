@@ -8,7 +8,7 @@ a view adaptation (gesture_formation/SendCommand) or an abort (gesture_formation
     AMOUNT     increment (default) or, with --set, the new value ([deg] or [m])
   tools/gf_command.py abort [--service /operator/send_abort]
     every UAV that accepts it flies to its own retreat goal (docs/safety.md §2.8); the ground
-    station sends it abort.repeats times
+    station sends it abort.repeats times, then once every abort.resend_period_s while it runs
   tools/gf_command.py ack-assist [--service /operator/acknowledge_assistance]
     acknowledges the worker's pending request for assistance (docs/safety.md §2.10): the leader
     then accepts the worker's gesture commands again
@@ -103,7 +103,7 @@ def main():
         spec = (SendCommand, (a.target, a.parameter, "set" if a.set else "increment", a.amount),
                 lambda r: f"sent #{r.sequence}: {a.target}.{a.parameter} {op} {a.amount:g}")
     elif kind == "abort":
-        spec = (SendAbort, (), lambda r: f"abort sent #{r.sequence} ({r.copies} copies)")
+        spec = (SendAbort, (), lambda r: f"abort sent #{r.sequence} ({r.copies} copies, then resent until the ground station restarts)")
     else:
         spec = (AcknowledgeAssistance, (), lambda r: f"assistance request of {r.requested_at.to_sec():.2f} s acknowledged")
     srv_type, args, accepted = spec

@@ -1,17 +1,40 @@
 #include "gesture_formation/gesture/gesture_frames.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <utility>
 
 namespace gesture_formation::gesture {
 
 GestureFrames::GestureFrames(const GestureFilterConfig& filter, const ViewFusionConfig& fusion, GestureMapping mapping,
-                             int uav_count, double frame_wait_s)
+                             int uav_count, double frame_wait_s, double merge_window_s)
     : filter_(filter),
       fusion_(fusion, fusion.min_agreeing_views > 1 ? std::max(1, uav_count) : 1, filter.max_gesture_id),
       mapping_(std::move(mapping)),
       views_(fusion.min_agreeing_views > 1 ? std::max(1, uav_count) : 1),
-      close_after_s_(std::max(frame_wait_s, views_ > 1 ? fusion.fusion_lag_s : 0.0)) {}
+      close_after_s_(std::max(frame_wait_s, views_ > 1 ? fusion.fusion_lag_s : 0.0)),
+      merge_window_s_(std::max(0.0, merge_window_s)) {}
+
+GestureFrames::Pending& GestureFrames::frameOf(const ViewObservation& o) {
+  const auto view = static_cast<std::size_t>(o.view);
+  for (Pending& p : pending_) {
+    const bool joins = merge_window_s_ > 0.0 ? std::abs(o.t_s - p.t_s) <= merge_window_s_ && !p.seen[view]
+                                             : o.t_s == p.t_s;  // exact stamps: every copy counts (as reported)
+    if (joins) {
+      p.t_s = std::max(p.t_s, o.t_s);
+      return p;
+    }
+  }
+  // A new frame, kept in stamp order (exact stamps) / opening order (merging).
+  Pending fresh;
+  fresh.t_s = o.t_s;
+  fresh.seen.assign(static_cast<std::size_t>(views_), false);
+  auto at = pending_.end();
+  if (merge_window_s_ <= 0.0) {
+    at = std::find_if(pending_.begin(), pending_.end(), [&](const Pending& p) { return p.t_s > o.t_s; });
+  }
+  return *pending_.insert(at, std::move(fresh));
+}
 
 std::vector<GestureFrame> GestureFrames::observe(const ViewObservation& o, bool* accepted, std::string* reason) {
   if (accepted != nullptr) *accepted = false;
@@ -22,11 +45,12 @@ std::vector<GestureFrame> GestureFrames::observe(const ViewObservation& o, bool*
   const bool ok = fusion_.observe(o, reason);
   if (accepted != nullptr) *accepted = ok;
   if (o.t_s <= last_closed_s_) return {};  // its frame is closed: it votes in the next ones
-  Pending& p = pending_[o.t_s];
+  Pending& p = frameOf(o);
   ++p.reported;
+  p.seen[static_cast<std::size_t>(o.view)] = true;
   p.accepted = p.accepted || ok;
   if (ok && o.view == 0) p.own_id = o.gesture_id;
-  if (p.reported >= views_) return closeUpTo(o.t_s);
+  if (p.reported >= views_) return closeUpTo(p.t_s);
   return {};
 }
 
@@ -34,17 +58,18 @@ std::vector<GestureFrame> GestureFrames::closeDue(double t_now_s) { return close
 
 std::vector<GestureFrame> GestureFrames::closeUpTo(double t_s) {
   std::vector<GestureFrame> out;
-  while (!pending_.empty() && pending_.begin()->first <= t_s) {
-    const double t = pending_.begin()->first;
-    const Pending p = pending_.begin()->second;
+  while (!pending_.empty() && pending_.front().t_s <= t_s) {
+    const Pending p = std::move(pending_.front());
     pending_.erase(pending_.begin());
-    last_closed_s_ = t;
-    if (p.accepted) out.push_back(process(t, p));
+    last_closed_s_ = std::max(last_closed_s_, p.t_s);
+    if (p.accepted) out.push_back(process(p));
   }
   return out;
 }
 
-GestureFrame GestureFrames::process(double t_s, const Pending& p) {
+GestureFrame GestureFrames::process(const Pending& p) {
+  const double t_s = std::max(p.t_s, last_filtered_s_);
+  last_filtered_s_ = t_s;
   GestureFrame f;
   f.t_s = t_s;
   f.reported = p.reported;

@@ -7,6 +7,7 @@
 
 #include "gesture_formation/common/config_fields.hpp"
 #include "gesture_formation/formation/formation_geometry.hpp"
+#include "gesture_formation/planning/brake_horizon.hpp"
 
 namespace gesture_formation::onboard {
 
@@ -41,6 +42,7 @@ void readOnboardSettings(ConfigReader& r, const std::string& m, OnboardSettings&
                         [&](ConfigReader& s) { c.replan.abort = planning::readAbortConfig(s); });
   common::addProblems(r, "", planning::abortPlannerProblems(c.replan.abort, c.planner.mutual_distance_m,
                                                             c.planner.limits.max_speed_mps, m + "abort."));
+  common::addProblems(r, "", planning::brakeHorizonProblems(c.planner.limits, c.replan.dt_s, c.replan.steps, m));
 }
 
 namespace {

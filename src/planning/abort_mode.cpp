@@ -74,7 +74,7 @@ const common::FieldTable<AbortConfig>& abortConfigFields() {
       {"max_command_age_s", Range::positive(), [](C& c) { return &c.max_command_age_s; }},
       {"repeats", Range::closed(1, 100), [](C& c) { return &c.repeats; }},
       {"repeat_period_s", Range::openClosed(0.0, 10.0), [](C& c) { return &c.repeat_period_s; }},
-      {"resend_period_s", Range::openClosed(0.0, 60.0), [](C& c) { return &c.resend_period_s; }},
+      {"resend_period_s", Range::closed(0.1, 60.0), [](C& c) { return &c.resend_period_s; }},
   }};
   return t;
 }
@@ -86,6 +86,8 @@ std::vector<common::ConfigError> ruleProblems(const AbortConfig& c) {
   std::vector<common::ConfigError> e;
   common::checkRule(e, c.max_distance_m >= c.retreat_distance_m, "max_distance_m", c.max_distance_m,
                     "must be >= retreat_distance_m (" + common::formatNumber(c.retreat_distance_m) + ")");
+  common::checkRule(e, c.resend_period_s >= c.repeat_period_s, "resend_period_s", c.resend_period_s,
+                    "must be >= repeat_period_s (" + common::formatNumber(c.repeat_period_s) + ")");
   return e;
 }
 
@@ -214,8 +216,13 @@ common::Result<Eigen::Vector3d> chooseLandingPoint(const Eigen::Vector3d& goal_w
 std::string homeProblem(const Eigen::Vector3d& home_world, const Eigen::Vector3d& worker_world,
                         const RetreatSpace& space, const AbortConfig& c) {
   if (!home_world.allFinite()) return "the take-off point is not known";
-  if (!insideBy(space.bounds, home_world, c.goal_clearance_m)) {
-    return "the take-off point lies less than goal_clearance_m inside the map";
+  // Horizontally only: a take-off point on the pad lies at the map's floor.
+  const Aabb& b = space.bounds;
+  const Eigen::Vector2d lo = b.min_world.head<2>().array() + c.goal_clearance_m;
+  const Eigen::Vector2d hi = b.max_world.head<2>().array() - c.goal_clearance_m;
+  const Eigen::Vector2d xy = home_world.head<2>();
+  if (!((xy.array() >= lo.array()).all() && (xy.array() <= hi.array()).all())) {
+    return "the take-off point lies less than goal_clearance_m inside the map horizontally";
   }
   const double d = (home_world - worker_world).head<2>().norm();
   if (!(d >= c.retreat_distance_m)) {  // NaN (no worker estimate) refuses too
@@ -292,7 +299,7 @@ void AbortPlanner::advance(const Situation& s, Decision& d) {
         goal_ = *spot;
       } else {
         phase_ = AbortPhase::kAtRetreat;  // nothing verified to land on: it stays at the retreat goal
-        goal_note_ = spot.reason();
+        goal_note_ = spot.reason() + (home_problem.empty() ? "" : " (" + home_problem + ")");
       }
     }
   } else if (phase_ == AbortPhase::kReturnHome) {

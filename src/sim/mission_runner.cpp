@@ -48,13 +48,15 @@ struct LeaderShare {
   int from = 0;  ///< the sending (acting) leader
 };
 
-/// A UAV's plan as every other receives it (the ROS PlannedTrajectory over LCM).
+/// What a UAV sends every replanning period (the ROS PlannedTrajectory and the LcmBridge's
+/// heartbeat over LCM).
 struct PlanMessage {
   /// The plan with its planner status: a UAV that could not plan (braking or on its previous plan)
-  /// is avoided by every other UAV, also higher-priority ones (right of way).
-  planning::ReceivedPlan plan;
-  /// The abort this UAV accepted, relayed with every plan it sends from then on (the repetition
-  /// that reaches a UAV across losses, outages and restarts; docs/safety.md §2.8).
+  /// is avoided by every other UAV, also higher-priority ones (right of way). None: its planner
+  /// did not run (an outage), only the abort below goes out.
+  std::optional<planning::ReceivedPlan> plan;
+  /// The abort this UAV accepted, relayed every period from then on, planner or not (the
+  /// repetition that reaches a UAV across losses, outages and restarts; docs/safety.md §2.8).
   std::optional<planning::AbortCommand> abort;
 };
 
@@ -155,6 +157,8 @@ class MissionRun {
   void recordVote(const gesture::GestureFrame& f);
   void replanDue(double t);
   void replan(int i, double t);
+  /// UAV i's accepted abort, alone, to every other UAV (its planner did not run).
+  void relayAbort(int i, double t);
   void sendPlan(int i, double t, const planning::ReplanOutcome& out, const formation::FormationParams& params,
                 std::uint64_t version);
   void sampleTimeline(double t, const WorkerState& ws);
@@ -588,9 +592,10 @@ void MissionRun::deliverUavMessages(double t) {
       if (j == i) continue;
       for (auto& m : plan_links_[static_cast<std::size_t>(j)][static_cast<std::size_t>(i)]->receive(t)) {
         if (u.offline) continue;
-        if (m.abort) receiveAbort(i, *m.abort, t);  // a relayed abort counts whatever the plan's age
+        if (m.abort) receiveAbort(i, *m.abort, t);  // a relayed abort counts whatever the message's age
+        if (!m.plan) continue;
         auto& slot = u.received[static_cast<std::size_t>(j)];
-        if (!slot || m.plan.plan.t0_s > slot->plan.t0_s) slot = std::move(m.plan);  // duplicates and late copies ignored
+        if (!slot || m.plan->plan.t0_s > slot->plan.t0_s) slot = std::move(m.plan);  // duplicates and late copies ignored
       }
     }
   }
@@ -783,6 +788,7 @@ void MissionRun::replan(int i, double t) {
     if (o.uav == i && t >= o.from_s && t < o.to_s) {
       ++M_.plans_skipped;
       setMode(i, t, "outage", "planner outage: the loaded plan is flown to its end and held");
+      relayAbort(i, t);  // the link (the ROS LcmBridge) still relays an accepted abort
       return;
     }
   }
@@ -849,6 +855,15 @@ void MissionRun::replan(int i, double t) {
     u.ctl.setPlan(res.trajectory);
   }
   sendPlan(i, t, out, *params, version);
+}
+
+void MissionRun::relayAbort(int i, double t) {
+  PlanMessage msg{std::nullopt, uav(i).step->abort().command()};
+  if (!msg.abort) return;
+  msg.abort->sent_s = t;
+  for (int j = 0; j < n_; ++j) {
+    if (j != i) plan_links_[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)]->send(t, msg);
+  }
 }
 
 void MissionRun::sendPlan(int i, double t, const planning::ReplanOutcome& out, const formation::FormationParams& params,

@@ -7,7 +7,7 @@ phase of the mission's abort.after (hover: PHASE_AT_RETREAT) within SETTLE_LIMIT
 UAV's goal is in its own layer (abort.retreat_height_m + i * layer_spacing_m) and the goals are at
 least layer_spacing_m apart; the ground station sent abort.repeats copies of one id, then one every
 abort.resend_period_s; every UAV also received the relay of each other UAV (each relays the abort it
-accepted with its plans); from settling to the end every UAV's true position keeps the worker's
+accepted with its heartbeats); from settling to the end every UAV's true position keeps the worker's
 true position at least abort.retreat_distance_m - arrival_tolerance_m away (the goal is >=
 retreat_distance_m from the worker estimate, the UAV within arrival_tolerance_m of its goal);
 SimWorld's metrics.json: no collision, the least mutual distance >= the planner's Γ_dis.

@@ -2,7 +2,7 @@
 # The operator's abort through the ROS system (docs/safety.md §2.8, docs/ros.md "Abort"):
 # simulation.launch (3 UAV managers + world, LCM inside a private network namespace), at sim
 # t = 12 s `tools/gf_command.py abort` (OperatorInterface → the ground station's LcmBridge → every
-# UAV's LcmBridge → its FormationPlanner's ReplanStep; every UAV relays the abort it accepted with its plans). Checks
+# UAV's LcmBridge → its FormationPlanner's ReplanStep; every UAV relays the abort it accepted with its heartbeats). Checks
 # (test/ros/abort_check.py): every UAV accepts it and its latched abort_state reaches at_retreat
 # (the mission's abort.after: hover) within the limit; after settling each keeps the worker at
 # least abort.retreat_distance_m − arrival_tolerance_m away and its goal's layer; SimWorld's

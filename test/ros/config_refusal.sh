@@ -25,8 +25,8 @@ run fp_bad FormationPlanner _uav_index:=0 _uav_count:=3 _world_frame:=world \
   _scenario_file:="$CFG/scenarios/power_towers.yaml" _formation_config:="$T/formation_broken.yaml" \
   _planner_config:="$CFG/planner.yaml" _replanning_period_s:=99.0 _horizon_dt_s:=0.2 _horizon_steps:=40 \
   _params_rate_hz:=2.0 _max_odometry_age_s:=0.5 plan_out:=fp_bad_plan
-run gc_bad GestureCommander _uav_count:=3 _sender_name:=gesture _frame_wait_s:=0.1 _gesture_config:="$T/gestures_broken.yaml"
-run gc_vf GestureCommander _uav_count:=3 _sender_name:=gesture _frame_wait_s:=0.1 _gesture_config:="$T/gestures_vf_broken.yaml" \
+run gc_bad GestureCommander _uav_count:=3 _sender_name:=gesture _frame_wait_s:=0.1 _frame_merge_s:=0.05 _gesture_config:="$T/gestures_broken.yaml"
+run gc_vf GestureCommander _uav_count:=3 _sender_name:=gesture _frame_wait_s:=0.1 _frame_merge_s:=0.05 _gesture_config:="$T/gestures_vf_broken.yaml" \
   gesture_status_out:=gc_vf_status
 run vo_bad ViewObserver observation_out:=vo_bad_observation
 make_key "$T/keys"; chmod 644 "$T/keys"

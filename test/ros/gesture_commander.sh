@@ -28,7 +28,7 @@ for v in single:$T/gestures_single.yaml voted:$T/gestures_vote.yaml confirm3d:$T
   name=${v%%:*} file=${v#*:}
   lead=false; [ "$name" = lead ] && lead=true  # follows /lead/leadership_state (LeadershipState)
   timeout 60 rosrun nodelet nodelet standalone gesture_formation/GestureCommander __name:=gc_$name \
-    _uav_count:=3 _sender_name:=gesture _frame_wait_s:=0.1 _gesture_config:="$file" _leadership:=$lead \
+    _uav_count:=3 _sender_name:=gesture _frame_wait_s:=0.1 _frame_merge_s:=0.05 _gesture_config:="$file" _leadership:=$lead \
     leadership_state_in:=/$name/leadership_state \
     observation_in:=/$name/observation peer_observations_in:=/$name/peer_observations \
     formation_command_out:=/$name/formation_command gesture_status_out:=/$name/gesture_status \

@@ -98,8 +98,8 @@ struct GestureObservationMessage {
 };
 
 /// \brief An abort command as it travels (docs/safety.md §2.8): the command's id and who issued it.
-/// When it was sent is the envelope's stamp (each copy — the sender's repeats, the leader's relay in
-/// its share — is a new envelope, stamped when sent: planning::AbortCommand::sent_s); replays are
+/// When it was sent is the envelope's stamp (each copy — the sender's repeats, every UAV's relay of
+/// the abort it accepted — is a new envelope, stamped when sent: planning::AbortCommand::sent_s); replays are
 /// the envelope's to refuse (sequence, age).
 struct AbortMessage {
   formation::CommandId id;  ///< sender name (1..kMaxSenderNameBytes printable ASCII, no spaces), sequence

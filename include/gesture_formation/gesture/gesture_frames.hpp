@@ -3,7 +3,11 @@
 /// \brief Gesture-frame aggregation — the one home of what the leader's GestureCommander nodelet
 /// and `gfctl simulate` do with the formation's classifications (docs/gestures.md §4.1):
 /// every camera's classification of a frame is an observation stamped with the frame's time;
-/// observations are grouped by that stamp; a frame is closed once every view has reported it,
+/// observations are grouped by that stamp — with `merge_window_s` > 0 (cameras that are not
+/// synchronised, e.g. onboard) an observation joins the earliest open frame within that window of
+/// it that its view has not reported in yet, and the frame takes the latest stamp of its
+/// observations (one observation per view per frame: the filter sees frames at the camera rate,
+/// not at the rate of all cameras together); a frame is closed once every view has reported it,
 /// or `close_after_s` = max(frame_wait_s, view_fusion.fusion_lag_s) after its stamp (a view
 /// that did not classify it, an offline follower, a delayed link). A closed frame with at least
 /// one accepted observation is fused at its own time (gesture::ViewFusion: the vote, the
@@ -14,7 +18,6 @@
 /// filter unchanged and the followers' observations are ignored.
 /// Thread safety: not thread-safe; one instance (the leader's).
 
-#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -40,9 +43,11 @@ class GestureFrames {
  public:
   /// \param uav_count cameras of the formation (leader + followers), ≥ 1.
   /// \param frame_wait_s how long after its stamp a frame waits for missing views, ≥ 0.
+  /// \param merge_window_s 0: a frame is one exact stamp (synchronised cameras: gfctl simulate);
+  /// > 0: see the file comment (the GestureCommander's frame_merge_s).
   /// Preconditions: filter.validate() and fusion.validate() are empty.
   GestureFrames(const GestureFilterConfig& filter, const ViewFusionConfig& fusion, GestureMapping mapping,
-                int uav_count, double frame_wait_s);
+                int uav_count, double frame_wait_s, double merge_window_s = 0.0);
 
   /// \brief Takes one camera's observation (o.view = the UAV index). Returns the frames it
   /// completed (every view reported), in time order; `accepted` / `reason` say whether the
@@ -67,20 +72,26 @@ class GestureFrames {
 
  private:
   struct Pending {
+    double t_s = 0.0;  ///< its stamp (merging: the latest of its observations)
     int reported = 0;
     bool accepted = false;
     int own_id = 0;  ///< the leader's classification (single-camera mode)
+    std::vector<bool> seen;  ///< views that reported in it (merging)
   };
+  /// The open frame `o` belongs to, opened if none.
+  Pending& frameOf(const ViewObservation& o);
   std::vector<GestureFrame> closeUpTo(double t_s);
-  GestureFrame process(double t_s, const Pending& p);
+  GestureFrame process(const Pending& p);
 
   GestureFilter filter_;
   ViewFusion fusion_;
   GestureMapping mapping_;
   int views_ = 1;
   double close_after_s_ = 0.0;
-  std::map<double, Pending> pending_;
+  double merge_window_s_ = 0.0;
+  std::vector<Pending> pending_;  ///< open frames in the order they were opened
   double last_closed_s_ = -1e300;
+  double last_filtered_s_ = -1e300;  ///< the filter's time never goes back (merged stamps may overlap)
 };
 
 }  // namespace gesture_formation::gesture

@@ -75,8 +75,8 @@ struct AbortConfig {
   double max_command_age_s = 10.0;
   int repeats = 10;                   ///< the sender sends each abort command this many times, ≥ 1
   double repeat_period_s = 0.2;       ///< … this far apart [s], > 0
-  /// … and then one copy this often for as long as it runs [s], (0, 60]: a UAV out of reach for
-  /// the whole burst (link outage, reboot) still receives it when it is back.
+  /// … and then one copy this often for as long as it runs [s], [0.1, 60], ≥ repeat_period_s: a
+  /// UAV out of reach for the whole burst (link outage, reboot) still receives it when it is back.
   double resend_period_s = 1.0;
   AbortAfter after = AbortAfter::kHover;  ///< `after: hover | return_home | land`
 

@@ -87,7 +87,7 @@ TEST(LinkSettingsTest, MapUpdatesComeFromTheKnownUavsOnly) {
   EXPECT_EQ(c.senders_by_type.at(MessageType::kMapUpdate), (std::vector<std::uint16_t>{1, 2}));
 }
 
-// Aborts come from the ground station and the leader's relay: their own sender list.
+// Aborts come from the ground station and the UAVs' relay: their own sender list.
 TEST(LinkSettingsTest, AbortSendersAreTheirOwnList) {
   LinkSettings s;
   s.sender_id = 1;

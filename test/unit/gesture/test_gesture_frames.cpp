@@ -163,3 +163,46 @@ TEST(GestureFramesTest, ANewLeadersFramesWaitForTheGestureInProgressToBeReleased
   run(1, 9.0);
   EXPECT_EQ(fired, 1);
 }
+
+// Unsynchronised cameras (onboard): three 15 Hz cameras whose frames are 0, 20 and 45 ms apart.
+// Grouped by exact stamps every observation would be a frame of its own (45 a second, each voted on
+// by one fresh view); merged within 50 ms, one frame per camera period holds one observation of each
+// view and closes as soon as the third arrives, stamped with the latest of them.
+TEST(GestureFramesTest, UnsynchronisedCamerasMergeIntoOneFramePerPeriodOneObservationPerView) {
+  const double period = 1.0 / 15.0, offsets[3] = {0.0, 0.020, 0.045};
+  auto run = [&](double merge_s, std::vector<gg::GestureFrame>& closed) {
+    gg::GestureFrames frames(filter(), fusion(2), gg::GestureMapping::paperDefault(), 3, 0.1, merge_s);
+    for (int k = 0; k < 15; ++k) {
+      for (int v = 0; v < 3; ++v) {
+        for (auto& f : frames.observe(obs(v, 10.0 + k * period + offsets[v], 2))) closed.push_back(f);
+      }
+    }
+    for (auto& f : frames.closeDue(20.0)) closed.push_back(f);
+  };
+  std::vector<gg::GestureFrame> merged, exact;
+  run(0.05, merged);
+  run(0.0, exact);
+  EXPECT_EQ(exact.size(), 45u);
+  ASSERT_EQ(merged.size(), 15u);
+  for (std::size_t k = 0; k < merged.size(); ++k) {
+    EXPECT_EQ(merged[k].reported, 3) << k;
+    EXPECT_NEAR(merged[k].t_s, 10.0 + k * period + 0.045, 1e-9) << k;  // the latest stamp of its three
+    EXPECT_EQ(merged[k].fused.agreeing_views, 3) << k;
+    if (k > 0) {
+      EXPECT_GT(merged[k].t_s, merged[k - 1].t_s);
+    }
+  }
+  // One view's two observations 30 ms apart never share a frame.
+  gg::GestureFrames frames(filter(), fusion(2), gg::GestureMapping::paperDefault(), 3, 0.1, 0.05);
+  EXPECT_TRUE(frames.observe(obs(0, 1.00, 2)).empty());
+  EXPECT_TRUE(frames.observe(obs(0, 1.03, 2)).empty());
+  EXPECT_TRUE(frames.observe(obs(1, 1.01, 2)).empty());  // joins the first frame
+  const auto first = frames.observe(obs(2, 1.02, 2));    // … which is complete now
+  ASSERT_EQ(first.size(), 1u);
+  EXPECT_EQ(first[0].reported, 3);
+  EXPECT_DOUBLE_EQ(first[0].t_s, 1.02);
+  const auto rest = frames.closeDue(2.0);
+  ASSERT_EQ(rest.size(), 1u);
+  EXPECT_EQ(rest[0].reported, 1);
+  EXPECT_DOUBLE_EQ(rest[0].t_s, 1.03);
+}

@@ -90,3 +90,23 @@ TEST(OnboardSettingsTest, GestureRearmModeIsReadFromTheMission) {
   EXPECT_NE(bad.reason().find("mission.gestures.rearm"), std::string::npos) << bad.reason();
   EXPECT_NE(bad.reason().find("twice"), std::string::npos) << bad.reason();
 }
+
+TEST(OnboardSettingsTest, AHorizonShorterThanTheLongestBrakeIsRefusedNamingTheNumbers) {
+  // The limits' defaults (config/planner.yaml): 5 m/s at 3 m/s² brakes in 1.67 s, on 0.2 s samples
+  // in 1.8 s; a horizon of 9 steps spans 1.6 s, and a brake plan would end moving.
+  const auto short_horizon = go::loadOnboardSettings(
+      writeTemp("onboard_short_horizon.yaml", "mission:\n  horizon_dt_s: 0.2\n  horizon_steps: 9\n"));
+  ASSERT_FALSE(short_horizon);
+  for (const char* needle : {"mission.horizon_steps", "= 1.6 s", "longest brake 1.8 s", "need horizon_steps >= 10"}) {
+    EXPECT_NE(short_horizon.reason().find(needle), std::string::npos) << needle << "\n" << short_horizon.reason();
+  }
+  const auto fits = go::loadOnboardSettings(
+      writeTemp("onboard_fitting_horizon.yaml", "mission:\n  horizon_dt_s: 0.2\n  horizon_steps: 10\n"));
+  EXPECT_TRUE(fits) << fits.reason();
+  // The vertical bounds can bind: 2 m/s at 0.5 m/s² takes 4 s.
+  const auto vertical = go::loadOnboardSettings(writeTemp(
+      "onboard_vertical_brake.yaml",
+      "mission:\n  horizon_dt_s: 0.2\n  horizon_steps: 10\n  planner:\n    limits: {max_vertical_acceleration_mps2: 0.5}\n"));
+  ASSERT_FALSE(vertical);
+  EXPECT_NE(vertical.reason().find("need horizon_steps >= 21"), std::string::npos) << vertical.reason();
+}

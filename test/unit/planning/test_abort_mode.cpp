@@ -192,6 +192,7 @@ TEST(LandingPointTest, BelowTheGoalWhenItsColumnIsClearElseBelowHomeElseNone) {
 TEST(LandingPointTest, ATakeOffPointBesideTheWorkerOrOutsideTheMapIsRefusedNamingWhy) {
   const pl::AbortConfig c;  // retreat_distance_m 15
   EXPECT_EQ(pl::homeProblem(Eigen::Vector3d(-12.0, -12.0, 6.0), kWorker, world().space(), c), "");
+  EXPECT_EQ(pl::homeProblem(Eigen::Vector3d(-12.0, -12.0, 0.0), kWorker, world().space(), c), "");  // on the pad
   const std::string beside = pl::homeProblem(Eigen::Vector3d(5.0, 3.0, 6.0), kWorker, world().space(), c);
   EXPECT_NE(beside.find("retreat_distance_m"), std::string::npos) << beside;
   EXPECT_NE(beside.find("5.83"), std::string::npos) << beside;  // its distance from the worker estimate
