@@ -15,7 +15,9 @@
 // LcmBridge) as worker_state_out; starting to act it takes the last shared estimate over
 // (HumanKalman::adopt: position, velocity, position covariance, last fusion) and fuses its own
 // camera from there, publishing on worker_state_out and on share_out (to the LcmBridge) — as
-// gfctl simulate's new leader does.
+// gfctl simulate's new leader does. Through a lapse of its lease in the term it acted in (frequent
+// on a lossy link) it keeps its filter and fuses on, publishing to its own planner only (no share
+// while the lease is out, as in gfctl simulate); only a new term of its own starts from the share.
 #include <mutex>
 #include <optional>
 
@@ -118,17 +120,17 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
   }
 
   /// ~leadership: the estimate is this UAV's own only while it acts as leader.
-  bool estimates() const { return !leadership_ || acting_; }
+  bool estimates() const { return !leadership_ || owns_; }
   void publish(const gesture_formation::WorkerState& out) {
     state_pub_.publish(out);
-    if (leadership_) share_pub_.publish(out);
+    if (leadership_ && acting_) share_pub_.publish(out);
     ++published_since_report_;
   }
 
   // The acting leader's estimate over LCM: handed on while this UAV does not act, kept for a take-over.
   void onShared(const gesture_formation::WorkerState::ConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (acting_) return;
+    if (owns_) return;
     last_share_ = *msg;
     state_pub_.publish(*msg);
     ++published_since_report_;
@@ -137,13 +139,17 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
   // This UAV's leadership view: starting to act, the estimator continues from the last share.
   void onLeadership(const gesture_formation::LeadershipState::ConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (msg->acting == acting_) return;
     acting_ = msg->acting;
+    // Its own filter while it acts and through a lapse of its lease in the term it acted in.
+    const bool owns = msg->acting || (msg->role == gesture_formation::LeadershipState::ROLE_LEADER && msg->term == acted_term_);
+    if (msg->acting) acted_term_ = msg->term;
+    if (owns == owns_) return;
+    owns_ = owns;
     filter_ = estimation::HumanKalman(config_.filter);
     last_fused_ = ros::Time();
-    if (!acting_ || !last_share_) {
-      NODELET_WARN_STREAM("WorkerEstimator: " << (acting_ ? "acts as leader with no shared estimate: starts from its own detections"
-                                                           : "no longer acts as leader: hands on the leader's estimate"));
+    if (!owns_ || !last_share_) {
+      NODELET_WARN_STREAM("WorkerEstimator: " << (owns_ ? "acts as leader with no shared estimate: starts from its own detections"
+                                                         : "no longer the leader of its term: hands on the leader's estimate"));
       return;
     }
     const auto& w = *last_share_;
@@ -214,8 +220,19 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
 
   void onTimer(const ros::TimerEvent& event) {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!estimates() || !filter_.confirmed()) return;
     const double t = event.current_real.toSec();
+    // ROS time went back (sim time restarted, a bag replayed in a loop): the track is of another
+    // time line — every new detection would be refused as out of order while the old track, its
+    // stamps now in the future, kept being published as fresh. Start afresh.
+    if (filter_.confirmed() && t < filter_.time() - kTimeJumpS) {
+      NODELET_WARN_STREAM("WorkerEstimator: ROS time went back from " << filter_.time() << " s to " << t
+                                                                      << " s: the track is dropped, starting afresh");
+      filter_ = estimation::HumanKalman(config_.filter);
+      last_fused_ = ros::Time();
+      last_uwb_stamp_ = ros::Time();
+      return;
+    }
+    if (!estimates() || !filter_.confirmed()) return;
     const auto s = filter_.predicted(t);
     estimation::Vector6d x;
     x << s.p_world, s.v_world;
@@ -246,7 +263,11 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
   ros::Time last_fused_;  ///< the last accepted measurement's stamp (WorkerState.last_fused)
   tf2_ros::Buffer tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
-  bool leadership_ = false, acting_ = false;  ///< ~leadership; this UAV acts as leader
+  bool leadership_ = false, acting_ = false;  ///< ~leadership; this UAV acts as leader (its lease holds)
+  /// ROS time this far behind the filter's time is a jump back, not a late timer tick [s].
+  static constexpr double kTimeJumpS = 1.0;
+  bool owns_ = false;                         ///< it keeps its own filter: acting, or lapsed in the term it acted in
+  std::uint32_t acted_term_ = 0;              ///< the last term in which it acted
   std::optional<gesture_formation::WorkerState> last_share_;  ///< the acting leader's last estimate (~leadership)
   ros::Publisher state_pub_, share_pub_;
   ros::Subscriber detection_sub_, shared_sub_, leadership_sub_;

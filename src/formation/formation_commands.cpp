@@ -3,6 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
+#include <sstream>
+
+#include "gesture_formation/common/format_number.hpp"
+#include "gesture_formation/formation/formation_geometry.hpp"
 
 namespace gesture_formation::formation {
 
@@ -211,6 +216,25 @@ double FormationState::clampValue(UavIndex uav, Parameter parameter, double requ
   return requested;
 }
 
+std::optional<SlotPair> closestSlots(const FormationParams& params) {
+  // The reference positions around a worker at the origin facing +x, the leader at its desired
+  // heading and pitch: their distances depend on the parameters only.
+  std::vector<Eigen::Vector3d> p;
+  const UavReference leader = leaderReference(Eigen::Vector3d::Zero(), 0.0, params.leader);
+  p.push_back(leader.p_world);
+  for (const UavObservation& f : params.followers) {
+    p.push_back(followerReference(Eigen::Vector3d::Zero(), leader.heading_rad, leader.pitch_rad, f).p_world);
+  }
+  std::optional<SlotPair> best;
+  for (std::size_t a = 0; a < p.size(); ++a) {
+    for (std::size_t b = a + 1; b < p.size(); ++b) {
+      const double d = (p[a] - p[b]).norm();
+      if (!best || d < best->distance_m) best = SlotPair{static_cast<int>(a), static_cast<int>(b), d};
+    }
+  }
+  return best;
+}
+
 CommandOutcome FormationState::apply(const FormationCommand& command) {
   CommandOutcome out;
   const std::string id = command.id.sender + "/" + std::to_string(command.id.sequence);
@@ -247,6 +271,7 @@ CommandOutcome FormationState::apply(const FormationCommand& command) {
       return out;
     case DuplicateWindow::Check::kNew: break;
   }
+  const FormationParams before = params_;
   for (const UavIndex u : *targets) {
     UavObservation& o = params_.uav(u);
     double& q = command.parameter == Parameter::kBeta    ? o.beta_deg
@@ -261,6 +286,25 @@ CommandOutcome FormationState::apply(const FormationCommand& command) {
     c.clamped = !c.clamp_rule.empty();
     q = c.applied;
     out.changes.push_back(std::move(c));
+  }
+  // Two slots closer than Γ_dis cannot both be flown (the planner keeps the UAVs Γ_dis apart, so
+  // neither reaches its view; a group 'set' of β puts both followers on one point): refused,
+  // nothing changed — unless they were closer already and the command moves them apart.
+  const double min_separation_m = limits_.safety_distance_m;
+  const auto closest = closestSlots(params_);
+  if (closest && closest->distance_m < min_separation_m) {
+    const auto before_pair = closestSlots(before);
+    const bool worse = !before_pair || closest->distance_m < before_pair->distance_m - 1e-9;
+    if (worse) {
+      params_ = before;
+      out.changes.clear();
+      std::ostringstream os;
+      os << "command " << id << " would put the slots of UAV " << closest->a << " and UAV " << closest->b << " "
+         << common::formatNumber(closest->distance_m) << " m apart, less than limits.safety_distance_m ("
+         << common::formatNumber(min_separation_m) << " m, Gamma_dis)";
+      out.reason = os.str();
+      return out;
+    }
   }
   duplicates_.record(command.id);
   out.status = CommandStatus::kApplied;

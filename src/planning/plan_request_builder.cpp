@@ -68,7 +68,11 @@ PlanRequest buildPlanRequest(const PlanRequestInputs& in) {
 
 std::string holdReason(int uav_index, double t_s, double share_stamp_s, double worker_stamp_s,
                        const FreshnessLimits& limits) {
-  const auto older = [&](double stamp, double limit) { return !std::isfinite(stamp) || !(t_s - stamp <= limit); };
+  // A stamp further in the future than the limit (a clock gone back, another time line) is as
+  // unusable as an old one: its age would pass for fresh for as long as the clocks differ.
+  const auto older = [&](double stamp, double limit) {
+    return !std::isfinite(stamp) || !(t_s - stamp <= limit) || !(stamp - t_s <= limit);
+  };
   if (uav_index == 0) {
     return older(worker_stamp_s, limits.max_worker_age_s) ? "worker not seen for more than max_worker_age_s" : "";
   }

@@ -158,6 +158,14 @@ inline common::Result<PositionMeasurement> makeMeasurement(const CameraModel& ca
     m.source = DistanceSource::kStereo;
     m.distance_m = d_stereo_m;
   } else {
+    // A box at the image's top or bottom edge is clipped (the detectors cut boxes to the image):
+    // its height is not the person's, and the distance from it would be too long — refused.
+    const double edge_px = 0.5, height_px = camera.intrinsics().height_px;
+    if (box.v <= edge_px || box.v + box.h >= height_px - edge_px) {
+      return R::fail("box touches the image's top or bottom edge (v " + std::to_string(box.v) + ", h " +
+                     std::to_string(box.h) + " of " + std::to_string(height_px) +
+                     " px): clipped, its height gives no distance, and no UWB or stereo range");
+    }
     const auto d = apparentDistance(camera, box, human_height_m);
     if (!d) return R::fail(d.reason());
     m.source = DistanceSource::kApparent;

@@ -25,6 +25,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -102,6 +103,17 @@ struct ParameterChange {
   bool clamped = false;    ///< applied ≠ requested because of a limit (β wrapping is not clamping)
   std::string clamp_rule;  ///< the limit that clamped it, e.g. "limits.distance_min_m" (empty if not clamped)
 };
+
+/// \brief Two UAVs' reference positions (slots) and their distance [m].
+struct SlotPair {
+  int a = 0, b = 0;  ///< UAV indices (0 = leader), a < b
+  double distance_m = 0.0;
+};
+/// \brief The two closest slots of `params` (empty with one UAV): the references around a worker
+/// at the origin, the leader at its desired heading and pitch — their distances depend on the
+/// parameters only. FormationState::apply refuses a command that brings two slots closer than
+/// limits.safety_distance_m (Γ_dis) unless they were closer already and it moves them apart.
+std::optional<SlotPair> closestSlots(const FormationParams& params);
 
 enum class CommandStatus {
   kApplied,    ///< changes holds one entry per addressed UAV

@@ -116,3 +116,23 @@ TEST(MeasurementModelTest, BoxPartlyOutsideButCentreInsideIsAccepted) {
   const auto m = makeMeasurement(kCam, lookingAlongX(), Box{-10, 100, 40, 100}, 10.0, std::nan(""), 1.75, kNoise);
   EXPECT_TRUE(m) << m.reason();
 }
+
+// A worker 6 m away whose feet are below the image: the detector's box, cut at the bottom edge, is
+// 89 of his 179 px and would put him at 12 m. Without a UWB or stereo range such a box gives no
+// measurement; with one it still does (the ray is right, the range comes from the sensor).
+TEST(MeasurementModelTest, ABoxClippedAtTheTopOrBottomEdgeGivesNoApparentDistance) {
+  const double H = 1.75, nan = std::nan("");
+  const Box clipped_bottom{300.0, 391.0, 40.0, 89.0};  // v + h = 480: the image's bottom edge
+  const auto none = makeMeasurement(kCam, lookingAlongX(), clipped_bottom, nan, nan, H, kNoise);
+  ASSERT_FALSE(none);
+  EXPECT_NE(none.reason().find("edge"), std::string::npos) << none.reason();
+  const Box clipped_top{300.0, 0.0, 40.0, 89.0};
+  EXPECT_FALSE(makeMeasurement(kCam, lookingAlongX(), clipped_top, nan, nan, H, kNoise));
+  const auto with_uwb = makeMeasurement(kCam, lookingAlongX(), clipped_bottom, 6.0, nan, H, kNoise);
+  ASSERT_TRUE(with_uwb) << with_uwb.reason();
+  EXPECT_EQ(with_uwb->source, DistanceSource::kUwb);
+  // One pixel inside both edges: a whole person, measured.
+  const auto inside = makeMeasurement(kCam, lookingAlongX(), Box{300.0, 1.0, 40.0, 478.0}, nan, nan, H, kNoise);
+  ASSERT_TRUE(inside) << inside.reason();
+  EXPECT_EQ(inside->source, DistanceSource::kApparent);
+}

@@ -182,6 +182,9 @@ TEST(HoldReasonTest, EachAgeLimitDecidesWithItsOwnStamp) {
   EXPECT_EQ(gf::planning::holdReason(1, 10.0, 7.9, 9.0, lim), "leader share older than max_share_age_s");
   EXPECT_EQ(gf::planning::holdReason(2, 10.0, 7.9, 1.0, lim), "leader share older than max_share_age_s");
   EXPECT_EQ(gf::planning::holdReason(2, 10.0, 9.9, 6.5, lim), "worker estimate older than max_worker_age_s");
+  // Stamped further in the future than the limit (ROS time went back): unusable, like an old one.
+  EXPECT_EQ(gf::planning::holdReason(0, 10.0, 10.0, 500.0, lim), "worker not seen for more than max_worker_age_s");
+  EXPECT_EQ(gf::planning::holdReason(1, 10.0, 500.0, 500.0, lim), "leader share older than max_share_age_s");
   // No stamp at all (NaN / inf) is infinitely old, never fresh.
   const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
   EXPECT_FALSE(gf::planning::holdReason(0, 10.0, 10.0, nan, lim).empty());
