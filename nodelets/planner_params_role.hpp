@@ -61,23 +61,28 @@ class PlannerParamsRole {
     const auto change = own_->setActing(msg->acting, msg->header.stamp.toSec(), msg->leader, msg->term);  // also the slot flown
     if (change == Change::kResumed) {
       const double now = ros::Time::now().toSec();
-      std::size_t applied = 0;
-      for (const auto& m : kept_) {
-        if (now - m->header.stamp.toSec() > max_command_age_s_) continue;
-        applyCommand(*m);
+      std::size_t applied = 0, commands = 0;
+      // In the order they arrived, as gfctl simulate: a request for assistance before a gesture
+      // command holds against it, an acknowledgement before it lets it through.
+      for (const auto& k : kept_) {
+        if (k.assistance) {
+          handleAssistance(*k.assistance);
+          continue;
+        }
+        ++commands;
+        if (now - k.command->header.stamp.toSec() > max_command_age_s_) continue;
+        applyCommand(*k.command);
         ++applied;
       }
-      for (const auto& m : kept_assistance_) handleAssistance(*m);
-      if (!kept_.empty()) {
+      if (commands > 0) {
         ROS_WARN_STREAM("FormationPlanner UAV " << uav_index_ << ": acts as leader again (term " << msg->term << "): " << applied
-                                                << " of " << kept_.size() << " commands kept since its lease lapsed applied");
+                                                << " of " << commands << " commands kept since its lease lapsed applied");
       }
     }
     const bool keeping = own_->keepsCommand(ros::Time::now().toSec());  // lapsed in the term it acted in
     if (change == Change::kResumed || change == Change::kStarted || (!own_->owns() && !keeping)) {
       // applied above, or its predecessor's, or a newer term's (they may be another leader's)
       kept_.clear();
-      kept_assistance_.clear();
     }
     if (change == Change::kNone || change == Change::kResumed) return;
     const bool started = change == Change::kStarted;
@@ -101,7 +106,7 @@ class PlannerParamsRole {
   void onCommand(const gesture_formation::FormationCommand::ConstPtr& msg) {
     std::lock_guard<std::mutex> lock(*mutex_);
     const double stamp = msg->header.stamp.toSec();
-    if (own_->keepsCommand(stamp)) kept_.push_back(msg);  // its lease lapsed: applied if it resumes in this term
+    if (own_->keepsCommand(stamp)) kept_.push_back(Kept{msg, nullptr});  // its lease lapsed: applied if it resumes in this term
     if (own_->takesCommand(stamp)) applyCommand(*msg);
   }
 
@@ -115,7 +120,7 @@ class PlannerParamsRole {
   // The worker's request (GestureCommander) or the operator's acknowledgement (over LCM) → the latch.
   void onAssistance(const gesture_formation::AssistanceState::ConstPtr& m) {
     std::lock_guard<std::mutex> lock(*mutex_);
-    if (own_->keepsCommand(ros::Time::now().toSec())) kept_assistance_.push_back(m);  // its lease lapsed: on resuming
+    if (own_->keepsCommand(ros::Time::now().toSec())) kept_.push_back(Kept{nullptr, m});  // its lease lapsed: on resuming
     if (own_->owns()) handleAssistance(*m);  // ~leadership: the acting UAV's latch
   }
   void handleAssistance(const gesture_formation::AssistanceState& m) {
@@ -139,8 +144,12 @@ class PlannerParamsRole {
   double max_command_age_s_ = 5.0;
   std::string world_frame_;
   std::optional<onboard::ParamsOwnership> own_;
-  std::vector<gesture_formation::FormationCommand::ConstPtr> kept_;  ///< reached it while its lease lapsed
-  std::vector<gesture_formation::AssistanceState::ConstPtr> kept_assistance_;  ///< the same for the assistance latch
+  /// A command or an assistance message that reached it while its lease lapsed (one of the two set).
+  struct Kept {
+    gesture_formation::FormationCommand::ConstPtr command;
+    gesture_formation::AssistanceState::ConstPtr assistance;
+  };
+  std::vector<Kept> kept_;  ///< in the order they arrived
   ros::Publisher params_pub_, ack_pub_, assistance_pub_;
   ros::Subscriber command_sub_, params_sub_, assistance_sub_, leadership_sub_;
   ros::Timer params_timer_;

@@ -55,11 +55,19 @@ ParamsOwnership::Change ParamsOwnership::setActing(bool acting, double t_s, int 
   if (!follow_) return Change::kNone;
   leader_ = leader;
   term_ = term;
+  if (!acting && leader >= 0 && leader != uav_index_) other_leader_seen_ = true;
   if (acting == acting_) return Change::kNone;
   acting_ = acting;
   if (!acting_) return Change::kStopped;
   if (term != 0 && term == acted_term_) return Change::kResumed;  // nobody else acted since
+  // Elected again in a newer term with no other leader seen since it last acted (none sent
+  // parameters either): it was the last owner — its role stays, with the assistance latch (a
+  // pending request is not dropped), the duplicate window and the version; as gfctl simulate,
+  // where a take-over happens only when another UAV acts.
+  const bool still_the_owner = acted_term_ != 0 && !other_leader_seen_;
   acted_term_ = term;
+  other_leader_seen_ = false;
+  if (still_the_owner) return Change::kStarted;
   formation::FormationConfig cfg = config_;
   cfg.params = role_->params();
   base_version_ = version();
@@ -82,6 +90,10 @@ int ParamsOwnership::leaderIndex() const {
 
 common::Result<bool> ParamsOwnership::receive(const formation::FormationParams& params, std::uint64_t version) {
   if (owns()) return common::Result<bool>::ok(false);  // the owner's own parameters are the formation's
+  // Lapsed in the term it acted in: nobody else can own them in this term — a late copy of an
+  // earlier owner's must not overwrite the parameters it resumes with.
+  if (keepsCommand(took_over_s_)) return common::Result<bool>::ok(false);
+  other_leader_seen_ = true;  // another UAV owned the parameters
   base_version_ = 0;                                    // the received version is the formation's
   return role_->receive(params, version);
 }

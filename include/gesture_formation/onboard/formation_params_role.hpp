@@ -82,7 +82,9 @@ class ParamsOwnership {
   /// and the leader of its term as far as it knows (`leader`, −1: none). Starting to act, the role
   /// becomes the leader's from the parameters held, version carried on.
   /// `term`: its leadership term (0: not known — never resumes). Acting again in the term in which
-  /// it last acted is kResumed: the role, its parameters and the take-over time are kept.
+  /// it last acted is kResumed: the role, its parameters and the take-over time are kept. Acting
+  /// in a newer term with no other leader seen since (nor parameters received) is kStarted with
+  /// the role kept too (its assistance latch, duplicate window and version).
   Change setActing(bool acting, double t_s, int leader = -1, std::uint32_t term = 0);
   /// \brief The formation slot this UAV flies (planning::ReplanInputs::slot), as gfctl simulate's
   /// hand-over assigns it: the acting leader flies the leader's (0); UAV 0, no longer acting,
@@ -99,7 +101,8 @@ class ParamsOwnership {
   bool keepsCommand(double stamp_s) const {
     return follow_ && !acting_ && acted_term_ != 0 && term_ == acted_term_ && stamp_s >= took_over_s_;
   }
-  /// \brief The owner's parameters as received; ignored (ok(false)) while this UAV owns them.
+  /// \brief The owner's parameters as received; ignored (ok(false)) while this UAV owns them or
+  /// its lease has lapsed in the term it acted in (a late copy of an earlier owner's).
   common::Result<bool> receive(const formation::FormationParams& params, std::uint64_t version);
   /// The parameters' version: the one taken over plus this UAV's own applied commands.
   std::uint64_t version() const { return base_version_ + role_->version(); }
@@ -117,6 +120,7 @@ class ParamsOwnership {
   double took_over_s_ = 0.0;        ///< when this UAV last started acting
   std::uint32_t term_ = 0;          ///< its leadership term now (0: not known)
   std::uint32_t acted_term_ = 0;    ///< the term in which it last acted (0: none known)
+  bool other_leader_seen_ = false;  ///< since it last acted, another UAV led or sent parameters
 };
 
 }  // namespace gesture_formation::onboard

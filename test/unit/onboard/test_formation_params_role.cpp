@@ -178,9 +178,9 @@ TEST(ParamsOwnershipTest, ALeaderResumingInItsTermKeepsTheGapsCommands) {
   EXPECT_DOUBLE_EQ(own.tookOverS(), 1.0);
   EXPECT_TRUE(own.takesCommand(3.2)) << "the gap's command is now its to apply";
 
-  // It learns a newer term (another UAV stands): nothing is kept any more, and acting again is a take-over.
+  // It learns a newer term led by another UAV: nothing is kept any more, and acting again is a take-over.
   ASSERT_EQ(own.setActing(false, 5.0, 0, 1), Change::kStopped);
-  EXPECT_EQ(own.setActing(false, 5.5, -1, 2), Change::kNone);
+  EXPECT_EQ(own.setActing(false, 5.5, 2, 2), Change::kNone);
   EXPECT_FALSE(own.keepsCommand(5.6)) << "a newer term: another UAV may act";
   ASSERT_EQ(own.setActing(true, 8.0, 0, 3), Change::kStarted);
   EXPECT_DOUBLE_EQ(own.tookOverS(), 8.0);
@@ -195,6 +195,39 @@ TEST(ParamsOwnershipTest, ALeaderResumingInItsTermKeepsTheGapsCommands) {
   // Not following the leadership: never kept.
   onboard::ParamsOwnership by_index(config, 0, false);
   EXPECT_FALSE(by_index.keepsCommand(1.0));
+}
+
+// Review finding: the same UAV elected again in a newer term (its lease out long enough for an
+// election under a lossy link, no other leader in between) got a fresh role: the worker's pending
+// assistance request was dropped (gestures applied again, the operator's banner gone) and the
+// version restarted. Now the role stays, as in gfctl simulate; a late copy of parameters arriving
+// while its lease has lapsed in its term does not overwrite the ones it resumes with.
+TEST(ParamsOwnershipTest, TheSameLeaderReElectedKeepsItsRoleAndAPendingAssistanceRequest) {
+  using Change = onboard::ParamsOwnership::Change;
+  formation::FormationConfig config;
+  onboard::ParamsOwnership own(config, 0, true);
+  ASSERT_EQ(own.setActing(true, 1.0, 0, 1), Change::kStarted);
+  own.role().apply(common::Result<formation::FormationCommand>::ok(distancePlusOne(1)), "op #1", "operator", 2.0);
+  ASSERT_TRUE(own.role().assistance().request(3.0, "gesture"));
+  ASSERT_EQ(own.setActing(false, 4.0, 0, 1), Change::kStopped);
+  formation::FormationParams stale = config.params;  // an earlier owner's parameters, arriving late
+  stale.followers[0].distance_m = 20.0;
+  ASSERT_TRUE(own.receive(stale, 7));
+  EXPECT_FALSE(*own.receive(stale, 7)) << "lapsed in its own term: nobody else owns the parameters";
+  EXPECT_EQ(own.setActing(false, 5.0, -1, 2), Change::kNone);  // a newer term, its leader unknown
+  ASSERT_EQ(own.setActing(true, 6.0, 0, 3), Change::kStarted);
+  EXPECT_EQ(own.role().assistance().state().phase, formation::AssistancePhase::kRequested);
+  EXPECT_DOUBLE_EQ(own.role().assistance().state().requested_s, 3.0);
+  EXPECT_EQ(own.version(), 1u);
+  EXPECT_EQ(own.role().params().followers[0].distance_m, config.params.followers[0].distance_m + 1.0);
+  // With another leader in between it is a take-over: a fresh role from the parameters received.
+  ASSERT_EQ(own.setActing(false, 7.0, 0, 3), Change::kStopped);
+  EXPECT_EQ(own.setActing(false, 7.5, 1, 4), Change::kNone);
+  ASSERT_TRUE(own.receive(stale, 9));
+  ASSERT_EQ(own.setActing(true, 9.0, 0, 5), Change::kStarted);
+  EXPECT_EQ(own.role().assistance().state().phase, formation::AssistancePhase::kNone);
+  EXPECT_EQ(own.version(), 9u);
+  EXPECT_EQ(own.role().params().followers[0].distance_m, 20.0);
 }
 
 TEST(ParamsOwnershipTest, TheSlotAndTheLeadersPlanFollowTheLeadership) {
