@@ -27,6 +27,8 @@
 #include <map>
 #include <mutex>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
@@ -37,6 +39,7 @@
 #include "gesture_formation/AcknowledgeAssistance.h"
 #include "gesture_formation/SendAbort.h"
 #include "gesture_formation/SendCommand.h"
+#include "gesture_formation/formation/uav_list.hpp"
 #include "param_loader.hpp"
 
 namespace gesture_formation::nodelets {
@@ -229,17 +232,17 @@ class OperatorInterfaceNodelet : public nodelet::Nodelet {
     gesture_formation::FormationCommand msg;
     std::string target = req.target;
     if (!target.empty() && target.front() == '[') {
-      // "[0, 2]": a list of UAV indices
+      // "[0, 2]": a list of UAV indices — digits separated by commas (and spaces), closed by ']';
+      // anything else ("[-1]", "[1.5]", "[1, 2") is refused, not guessed at.
       msg.target = "list";
-      std::string digits;
-      for (const char c : target.substr(1)) {
-        if (std::isdigit(static_cast<unsigned char>(c))) {
-          digits += c;
-        } else if (!digits.empty()) {
-          msg.uavs.push_back(std::stoi(digits));
-          digits.clear();
-        }
+      const auto uavs = formation::parseUavList(target);
+      if (!uavs) {
+        res.accepted = false;
+        res.message = "target '" + target + "': expected a list of UAV indices such as [0, 2]";
+        NODELET_WARN_STREAM("OperatorInterface: command refused: " << res.message);
+        return true;
       }
+      msg.uavs = *uavs;
     } else {
       msg.target = target;
     }

@@ -18,6 +18,7 @@
 // gfctl simulate's new leader does. Through a lapse of its lease in the term it acted in (frequent
 // on a lossy link) it keeps its filter and fuses on, publishing to its own planner only (no share
 // while the lease is out, as in gfctl simulate); only a new term of its own starts from the share.
+#include <algorithm>
 #include <mutex>
 #include <optional>
 
@@ -131,6 +132,8 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
   void onShared(const gesture_formation::WorkerState::ConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
     if (owns_) return;
+    // The newest by stamp (the link may deliver an older one late): handed on and kept, as gfctl simulate.
+    if (last_share_ && msg->header.stamp <= last_share_->header.stamp) return;
     last_share_ = *msg;
     state_pub_.publish(*msg);
     ++published_since_report_;
@@ -154,10 +157,10 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
     }
     const auto& w = *last_share_;
     const double t = w.header.stamp.toSec(), fused = std::min(w.last_fused.toSec(), t);
-    Eigen::Matrix3d cov;
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) cov(r, c) = w.covariance[static_cast<std::size_t>(r * 6 + c)];
-    }
+    // Only the diagonal crosses the link (its correlations are lost): each variance at least
+    // 1 m² — gfctl simulate's take-over starts from 1 m per axis (docs/safety.md §1.2).
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (int r = 0; r < 3; ++r) cov(r, r) = std::max(1.0, w.covariance[static_cast<std::size_t>(r * 6 + r)]);
     const bool adopted = filter_.adopt(t, toEigen(w.position), w.lost ? Eigen::Vector3d::Zero() : toEigen(w.velocity), cov, fused);
     if (adopted) last_fused_ = ros::Time(fused);
     NODELET_WARN_STREAM("WorkerEstimator: acts as leader (term " << msg->term << "): "

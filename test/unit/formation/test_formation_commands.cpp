@@ -5,6 +5,7 @@
 #include <random>
 
 #include "gesture_formation/formation/formation_commands.hpp"
+#include "gesture_formation/formation/uav_list.hpp"
 
 using namespace gesture_formation::formation;
 
@@ -322,4 +323,15 @@ TEST(FormationCommandsTest, WrapDeg) {
   EXPECT_EQ(wrapDeg(-190.0), 170.0);
   EXPECT_EQ(wrapDeg(359.0), -1.0);
   EXPECT_TRUE(std::isnan(wrapDeg(std::nan(""))));
+}
+
+// The operator's "[0, 2]" target (OperatorInterface send_command): strict, never guessed at
+// (review finding: "[-1]" was read as follower 1, "[1.5]" as [1, 5], "[1, 2" as [1]).
+TEST(UavListTest, ParsesExactlyAListOfIndices) {
+  EXPECT_EQ(parseUavList("[0, 2]"), (std::vector<int>{0, 2}));
+  EXPECT_EQ(parseUavList("[1]"), (std::vector<int>{1}));
+  EXPECT_EQ(parseUavList("[ 3 ,1 ]"), (std::vector<int>{3, 1}));
+  for (const char* bad : {"[-1]", "[1.5]", "[1, 2", "[]", "[1,,2]", "[1 2]", "[a]", "1, 2]", "[1,]", "[1234]", ""}) {
+    EXPECT_FALSE(parseUavList(bad)) << bad;
+  }
 }
