@@ -81,6 +81,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     rc.uav_index = uav_index_;
     rc.uav_count = uav_count_;
     rc.worker_heading = fcfg.worker_heading;
+    rc.formation_limits = fcfg.limits;
     step_ = std::make_unique<planning::ReplanStep>(rc,
                                                    std::make_unique<planning::UavPlannerAdapter>(std::make_unique<planning::UavPlanner>(
                                                        settings.planner, world_.map, world_.field, live_map_.seen())),

@@ -41,17 +41,21 @@ PlanRequest buildPlanRequest(const PlanRequestInputs& in) {
     formation::leaderHorizon(in.worker, in.params->leader, req.reference);
   } else {
     formation::LeaderPlan lp;
+    const formation::UavObservation& own = in.params->followers[static_cast<std::size_t>(slot - 1)];
     if (leader_plan_fresh) {
       lp.heading_rad.resize(1, steps);
       lp.pitch_rad.resize(1, steps);
+      // The follower's elevation γ_i − ξ_L within the limits: ξ_L in [γ_i − gamma_max, γ_i − gamma_min].
+      const double deg = M_PI / 180.0;
+      const double lo = in.limits ? (own.gamma_deg - in.limits->gamma_max_deg) * deg : -1e9;
+      const double hi = in.limits ? (own.gamma_deg - in.limits->gamma_min_deg) * deg : 1e9;
       for (int k = 0; k < steps; ++k) {
         const auto s = in.leader_plan->sampleAt(in.t_s + k * in.dt_s);
         lp.heading_rad(k) = s.heading_rad;
-        lp.pitch_rad(k) = s.pitch_rad;
+        lp.pitch_rad(k) = std::clamp(s.pitch_rad, lo, hi);
       }
     }
-    formation::followerHorizon(in.worker, in.params->leader, leader_plan_fresh ? &lp : nullptr,
-                               in.params->followers[static_cast<std::size_t>(slot - 1)], req.reference);
+    formation::followerHorizon(in.worker, in.params->leader, leader_plan_fresh ? &lp : nullptr, own, req.reference);
     if (has_leader_plan) req.higher_priority_plans.push_back(*in.leader_plan);
   }
   if (in.received == nullptr) return req;

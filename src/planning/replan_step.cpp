@@ -209,6 +209,7 @@ ReplanOutcome ReplanStep::step(const ReplanInputs& in) {
   req_in.hold_reference = choice.given ? &choice.reference : nullptr;  // also: avoid every received plan
   if (choice.camera_target.cols() > 0) req_in.camera_target = &choice.camera_target;
   req_in.rule = config_.rule;
+  req_in.limits = &config_.formation_limits;
   PlanRequest request = buildPlanRequest(req_in);
   // A back-off is for an unseen worker's reach; once the UAV tracks (or holds) again, a failed plan
   // brakes where it is rather than flying the back-off on, away from the worker and out of view.

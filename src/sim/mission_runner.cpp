@@ -264,6 +264,7 @@ std::string MissionRun::addUavs() {
     rc.uav_index = i;
     rc.uav_count = n_;
     rc.worker_heading = cfg_.formation.worker_heading;
+    rc.formation_limits = cfg_.formation.limits;
     rc.reach.worker_min_distance_m = cfg_.formation.limits.safety_distance_m;  // Γ_dis: the reach keeps it
     rc.home_world = s0.p_world;  // the mission starts in the air: its take-off point is where it starts
     planning::RetreatSpace space;

@@ -109,6 +109,9 @@ struct ReplanConfig {
   SearchConfig search;              ///< the leader's camera search
   double brake_accel_mps2 = 4.0;    ///< where a holding UAV stops (brakingPoint)
   formation::WorkerHeadingConfig worker_heading;  ///< the worker-heading filter (^Hφ)
+  /// The formation's limits: a follower's elevation over the leader's planned pitch is kept within
+  /// gamma_min_deg … gamma_max_deg (PlanRequestInputs::limits).
+  formation::FormationLimits formation_limits;
   AbortConfig abort;                ///< the abort's settings (mission abort.*)
   /// The worker's reach while holding or searching (faults.reach_*; worker_min_distance_m: the
   /// formation's limits.safety_distance_m, set by the owner) — planning::ReachKeeper.

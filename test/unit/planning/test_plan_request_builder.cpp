@@ -113,6 +113,43 @@ TEST(PlanRequestBuilderTest, ReferencesAndHold) {
   EXPECT_EQ(senders(req3), std::vector<int>({0, 2}));
 }
 
+// Review finding: a leader above the worker plans its camera steeply down (to the gimbal's −80°);
+// a follower with γ_i 20° then got an elevation γ_i − ξ_L of 100°: its reference over the worker's
+// head, which limits.gamma_max_deg (60°) is there to prevent. With the limits the leader's planned
+// pitch is clamped for the follower's reference: its elevation is 60° at most; within the limits
+// nothing changes.
+TEST(PlanRequestBuilderTest, AFollowersElevationOverTheLeadersPlannedPitchKeepsTheLimits) {
+  RequestFixture f;
+  f.params.followers[0].gamma_deg = 20.0;
+  for (auto& s : f.leader.samples) s.pitch_rad = -80.0 * M_PI / 180.0;
+  const gf::formation::FormationLimits limits;  // gamma -30 .. 60
+  auto in = f.inputs(1, true);
+  const auto unclamped = gf::planning::buildPlanRequest(in);
+  in.limits = &limits;
+  const auto clamped = gf::planning::buildPlanRequest(in);
+  for (int k = 0; k < clamped.reference.steps(); ++k) {
+    const Eigen::Vector3d worker = in.worker.p_world.col(k);
+    const auto elevation = [&](const gf::planning::PlanRequest& r) {
+      return gf::formation::viewGeometry(r.reference.p_world.col(k), worker).elevation_deg;
+    };
+    EXPECT_NEAR(elevation(unclamped), 80.0, 1e-6) << k;  // 100° folded over the head: asin gives 80
+    EXPECT_NEAR(elevation(clamped), 60.0, 1e-6) << k;
+    // On the leader's side of the worker, not beyond his head: the horizontal offset along the
+    // leader's planned heading points away from the leader's camera.
+    const Eigen::Vector2d off = (Eigen::Vector3d(clamped.reference.p_world.col(k)) - worker).head<2>();
+    EXPECT_LT(off.dot(Eigen::Vector2d(std::cos(0.7 - f.params.followers[0].beta_deg * M_PI / 180.0),
+                                      std::sin(0.7 - f.params.followers[0].beta_deg * M_PI / 180.0))),
+              0.0)
+        << k;
+  }
+  // Within the limits the planned pitch is used as it is.
+  RequestFixture g;
+  auto plain = g.inputs(1, true);
+  const auto before = gf::planning::buildPlanRequest(plain);
+  plain.limits = &limits;
+  EXPECT_TRUE(gf::planning::buildPlanRequest(plain).reference.p_world.isApprox(before.reference.p_world, 1e-12));
+}
+
 // A hand-over (docs/safety.md §1.2): follower 1 leads — it flies the leader's slot and avoids UAV 0's
 // last plan and follower 2's; follower 2 follows UAV 1's plan (leader_index 1), avoids it once (as
 // the leader's plan, not again as received[1]) and avoids UAV 0's last plan; UAV 0, back as a
