@@ -99,7 +99,9 @@ max_age_s: 10.0
 ratio_threshold: 0.5
 cooldown_s: 0.0
 followers:
-  - {beta_deg: 90, gamma_deg: 0, distance_m: 8}
+  # follower 1 sweeps all round (beta +45 per command) at its own distance: at 8 m like the
+  # others it was put on follower 2's point, a command the formation now refuses (formation.md 4)
+  - {beta_deg: 90, gamma_deg: 0, distance_m: 15}
   - {beta_deg: 180, gamma_deg: 0, distance_m: 8}
   - {beta_deg: -90, gamma_deg: 5, distance_m: 8}
 mapping:
