@@ -213,7 +213,7 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
         last_fired_ = "gesture " + std::to_string(id) + ": event " + gesture::toString(f.action->event);
         if (f.action->event == gesture::GestureEvent::kAbort) {
           // The leader's own ReplanStep takes it (abort_out → its FormationPlanner's abort_in); once
-          // accepted it travels in the leader's share (LcmBridge relay), as in gfctl simulate.
+          // accepted every UAV's LcmBridge relays it with its heartbeats, as in gfctl simulate.
           gesture_formation::AbortCommand abort;
           abort.source = gesture_formation::AbortCommand::SOURCE_GESTURE;
           abort.sender = sender_;

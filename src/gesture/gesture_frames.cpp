@@ -15,25 +15,37 @@ GestureFrames::GestureFrames(const GestureFilterConfig& filter, const ViewFusion
       close_after_s_(std::max(frame_wait_s, views_ > 1 ? fusion.fusion_lag_s : 0.0)),
       merge_window_s_(std::max(0.0, merge_window_s)) {}
 
-GestureFrames::Pending& GestureFrames::frameOf(const ViewObservation& o) {
+const GestureFrames::Pending& GestureFrames::addToFrame(const ViewObservation& o, bool ok) {
   const auto view = static_cast<std::size_t>(o.view);
-  for (Pending& p : pending_) {
-    const bool joins = merge_window_s_ > 0.0 ? std::abs(o.t_s - p.t_s) <= merge_window_s_ && !p.seen[view]
-                                             : o.t_s == p.t_s;  // exact stamps: every copy counts (as reported)
-    if (joins) {
-      p.t_s = std::max(p.t_s, o.t_s);
-      return p;
+  const auto byStamp = [](const Pending& a, const Pending& b) { return a.t_s < b.t_s; };
+  if (merge_window_s_ > 0.0) {  // a copy of an observation already counted (a duplicated datagram)
+    for (const Pending& p : pending_) {
+      if (p.seen[view] && p.view_t[view] == o.t_s) return p;
     }
   }
-  // A new frame, kept in stamp order (exact stamps) / opening order (merging).
-  Pending fresh;
-  fresh.t_s = o.t_s;
-  fresh.seen.assign(static_cast<std::size_t>(views_), false);
-  auto at = pending_.end();
-  if (merge_window_s_ <= 0.0) {
-    at = std::find_if(pending_.begin(), pending_.end(), [&](const Pending& p) { return p.t_s > o.t_s; });
+  auto it = std::find_if(pending_.begin(), pending_.end(), [&](const Pending& p) {
+    return merge_window_s_ > 0.0 ? std::abs(o.t_s - p.t_s) <= merge_window_s_ && !p.seen[view]
+                                 : o.t_s == p.t_s;  // exact stamps: every copy counts (as reported)
+  });
+  if (it == pending_.end()) {  // a new frame, in stamp order
+    Pending fresh;
+    fresh.t_s = o.t_s;
+    fresh.seen.assign(static_cast<std::size_t>(views_), false);
+    fresh.view_t.assign(static_cast<std::size_t>(views_), 0.0);
+    it = pending_.insert(std::upper_bound(pending_.begin(), pending_.end(), fresh, byStamp), std::move(fresh));
   }
-  return *pending_.insert(at, std::move(fresh));
+  ++it->reported;
+  it->seen[view] = true;
+  it->view_t[view] = o.t_s;
+  it->accepted = it->accepted || ok;
+  if (ok && o.view == 0) it->own_id = o.gesture_id;
+  if (o.t_s <= it->t_s) return *it;
+  // Merging: the frame takes the latest stamp of its observations and moves to its place in
+  // stamp order (frames close, and are filtered, in time order).
+  Pending moved = std::move(*it);
+  moved.t_s = o.t_s;
+  pending_.erase(it);
+  return *pending_.insert(std::upper_bound(pending_.begin(), pending_.end(), moved, byStamp), std::move(moved));
 }
 
 std::vector<GestureFrame> GestureFrames::observe(const ViewObservation& o, bool* accepted, std::string* reason) {
@@ -45,12 +57,8 @@ std::vector<GestureFrame> GestureFrames::observe(const ViewObservation& o, bool*
   const bool ok = fusion_.observe(o, reason);
   if (accepted != nullptr) *accepted = ok;
   if (o.t_s <= last_closed_s_) return {};  // its frame is closed: it votes in the next ones
-  Pending& p = frameOf(o);
-  ++p.reported;
-  p.seen[static_cast<std::size_t>(o.view)] = true;
-  p.accepted = p.accepted || ok;
-  if (ok && o.view == 0) p.own_id = o.gesture_id;
-  if (p.reported >= views_) return closeUpTo(p.t_s);
+  const Pending& p = addToFrame(o, ok);
+  if (p.reported >= views_) return closeUpTo(p.t_s);  // it and every earlier frame, in time order
   return {};
 }
 

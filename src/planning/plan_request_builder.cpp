@@ -45,10 +45,17 @@ PlanRequest buildPlanRequest(const PlanRequestInputs& in) {
     if (leader_plan_fresh) {
       lp.heading_rad.resize(1, steps);
       lp.pitch_rad.resize(1, steps);
-      // The follower's elevation γ_i − ξ_L within the limits: ξ_L in [γ_i − gamma_max, γ_i − gamma_min].
+      // Every follower's elevation γ_j − ξ_L within the limits: ξ_L in [max_j γ_j − gamma_max,
+      // min_j γ_j − gamma_min] — one range for all followers (clamped each to its own, two could
+      // meet at one elevation); FormationState keeps the desired −γ_L inside it.
       const double deg = M_PI / 180.0;
-      const double lo = in.limits ? (own.gamma_deg - in.limits->gamma_max_deg) * deg : -1e9;
-      const double hi = in.limits ? (own.gamma_deg - in.limits->gamma_min_deg) * deg : 1e9;
+      double lo = -1e9, hi = 1e9;
+      if (in.limits) {
+        for (const formation::UavObservation& f : in.params->followers) {
+          lo = std::max(lo, (f.gamma_deg - in.limits->gamma_max_deg) * deg);
+          hi = std::min(hi, (f.gamma_deg - in.limits->gamma_min_deg) * deg);
+        }
+      }
       for (int k = 0; k < steps; ++k) {
         const auto s = in.leader_plan->sampleAt(in.t_s + k * in.dt_s);
         lp.heading_rad(k) = s.heading_rad;

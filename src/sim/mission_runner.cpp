@@ -836,6 +836,7 @@ void MissionRun::replan(int i, double t) {
   if (!out.planned()) {
     ++M_.plans_skipped;  // nothing known about the worker: the controller holds (its plan's end, or brakes)
     if (!leads) setMode(i, t, "hold", out.reason);
+    relayAbort(i, t);  // an accepted abort is relayed whether or not the planner planned
     return;
   }
   if (out.holding()) ++M_.plans_hold;

@@ -76,10 +76,12 @@ class GestureFrames {
     int reported = 0;
     bool accepted = false;
     int own_id = 0;  ///< the leader's classification (single-camera mode)
-    std::vector<bool> seen;  ///< views that reported in it (merging)
+    std::vector<bool> seen;      ///< views that reported in it (merging)
+    std::vector<double> view_t;  ///< … and their observations' stamps (a duplicated copy is not counted again)
   };
-  /// The open frame `o` belongs to, opened if none.
-  Pending& frameOf(const ViewObservation& o);
+  /// Counts `o` (accepted by the vote: `ok`) in the open frame it belongs to, opened if none;
+  /// pending_ stays in stamp order. Returns that frame.
+  const Pending& addToFrame(const ViewObservation& o, bool ok);
   std::vector<GestureFrame> closeUpTo(double t_s);
   GestureFrame process(const Pending& p);
 
@@ -89,7 +91,7 @@ class GestureFrames {
   int views_ = 1;
   double close_after_s_ = 0.0;
   double merge_window_s_ = 0.0;
-  std::vector<Pending> pending_;  ///< open frames in the order they were opened
+  std::vector<Pending> pending_;  ///< open frames in stamp order
   double last_closed_s_ = -1e300;
   double last_filtered_s_ = -1e300;  ///< the filter's time never goes back (merged stamps may overlap)
 };

@@ -70,8 +70,8 @@ struct PlanRequestInputs {
   const formation::ReferenceTrajectory* hold_reference = nullptr;
   /// Non-null: where the camera looks instead of the worker prediction (PlanRequest::camera_target).
   const formation::HorizonPoints* camera_target = nullptr;
-  /// Non-null: a follower's elevation above the worker — its γ_i less the leader's planned pitch —
-  /// is kept within limits.gamma_min_deg … gamma_max_deg by clamping that pitch (FormationState
+  /// Non-null: every follower's elevation above the worker — its γ_i less the leader's planned
+  /// pitch — is kept within limits.gamma_min_deg … gamma_max_deg by clamping that pitch (FormationState
   /// holds the rule for the leader's desired pitch −γ_L only; a leader above the worker plans down
   /// to the gimbal's −80° and would put the follower's reference over the worker's head).
   const formation::FormationLimits* limits = nullptr;

@@ -23,7 +23,7 @@ namespace gesture_formation::sim {
 /// operator link, repeated abort.repeats times abort.repeat_period_s apart) or by the worker's
 /// gesture (accepted by the leader's gesture pipeline at t_s — the recognition itself is not
 /// simulated by this event; a gesture mapped to {event: abort} that the pipeline recognises takes
-/// the same path). The leader relays an accepted abort in every share it sends.
+/// the same path). Every UAV relays the abort it accepted to the others every replanning period.
 struct AbortEvent {
   double t_s = 0.0;
   planning::AbortSource source = planning::AbortSource::kOperator;

@@ -206,3 +206,33 @@ TEST(GestureFramesTest, UnsynchronisedCamerasMergeIntoOneFramePerPeriodOneObserv
   EXPECT_EQ(rest[0].reported, 1);
   EXPECT_DOUBLE_EQ(rest[0].t_s, 1.03);
 }
+
+// Merging, out of order (review finding): a follower's observation of an earlier frame arriving
+// after the leader opened two later ones opens its own frame before them; frames close and are
+// filtered in time order, a completed frame behind an open one is returned with it, and a
+// duplicated copy of an observation is not counted twice.
+TEST(GestureFramesTest, MergedFramesCloseInTimeOrderWhateverTheArrivalOrder) {
+  gg::GestureFrames frames(filter(), fusion(2), gg::GestureMapping::paperDefault(), 3, 0.1, 0.05);
+  EXPECT_TRUE(frames.observe(obs(0, 1.000, 2)).empty());  // A
+  EXPECT_TRUE(frames.observe(obs(0, 1.067, 2)).empty());  // B
+  EXPECT_TRUE(frames.observe(obs(1, 0.940, 2)).empty());  // C: 60 ms before A, its own frame
+  EXPECT_TRUE(frames.observe(obs(1, 0.940, 2)).empty());  // a duplicate of it: not counted
+  EXPECT_TRUE(frames.observe(obs(2, 0.945, 2)).empty());  // joins C (2 of 3)
+  EXPECT_TRUE(frames.observe(obs(1, 1.070, 2)).empty());  // joins B (A is 70 ms away)
+  const auto closed = frames.closeDue(10.0);
+  ASSERT_EQ(closed.size(), 3u);
+  EXPECT_DOUBLE_EQ(closed[0].t_s, 0.945);  // C, its latest stamp
+  EXPECT_EQ(closed[0].reported, 2);        // the duplicate not counted
+  EXPECT_DOUBLE_EQ(closed[1].t_s, 1.000);  // A
+  EXPECT_DOUBLE_EQ(closed[2].t_s, 1.070);  // B with follower 1's 1.070
+  EXPECT_EQ(closed[2].reported, 2);
+  // A frame completed behind an open one comes out with it, in time order.
+  gg::GestureFrames g(filter(), fusion(2), gg::GestureMapping::paperDefault(), 3, 0.1, 0.05);
+  EXPECT_TRUE(g.observe(obs(0, 2.000, 2)).empty());  // D
+  EXPECT_TRUE(g.observe(obs(1, 1.900, 2)).empty());  // E, before D
+  EXPECT_TRUE(g.observe(obs(0, 1.905, 2)).empty());  // joins E
+  const auto done = g.observe(obs(2, 1.910, 2));     // completes E (D still open)
+  ASSERT_EQ(done.size(), 1u);
+  EXPECT_DOUBLE_EQ(done[0].t_s, 1.910);
+  EXPECT_EQ(done[0].reported, 3);
+}
