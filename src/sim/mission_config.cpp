@@ -324,31 +324,20 @@ void readPlannerOutages(ConfigReader& r, const std::string& fk, std::vector<Plan
   }
 }
 
-void readOperatorOutages(ConfigReader& r, const std::string& fk, std::vector<PlannerOutage>& out) {
-  const YAML::Node oo = r.node(fk + "operator_outages");
-  if (oo.IsDefined() && oo.IsSequence()) {
-    for (std::size_t i = 0; i < oo.size(); ++i) {
-      const std::string k = fk + "operator_outages[" + std::to_string(i) + "].";
-      PlannerOutage o;
-      plannerOutageFields().readRequiredFields(r, k, o, "an outage names its UAV and window");
+/// A required list of {uav, from_s, to_s} windows at fk + name, each entry's fields all required
+/// (`missing` says what an entry must name); problems named by key.
+template <class Window>
+void readUavWindows(ConfigReader& r, const std::string& fk, const char* name, const common::FieldTable<Window>& fields,
+                    const char* missing, std::vector<Window>& out) {
+  const YAML::Node list = r.node(fk + name);
+  if (list.IsDefined() && list.IsSequence()) {
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      Window o;
+      fields.readRequiredFields(r, fk + name + "[" + std::to_string(i) + "].", o, missing);
       out.push_back(o);
     }
-  } else if (oo.IsDefined()) {
-    r.addError(fk + "operator_outages", "must be a list of {uav, from_s, to_s}");
-  }
-}
-
-void readFollowerDropouts(ConfigReader& r, const std::string& fk, std::vector<UavDropout>& out) {
-  const YAML::Node fd = r.node(fk + "follower_dropouts");
-  if (fd.IsDefined() && fd.IsSequence()) {
-    for (std::size_t i = 0; i < fd.size(); ++i) {
-      const std::string k = fk + "follower_dropouts[" + std::to_string(i) + "].";
-      UavDropout o;
-      uavDropoutFields().readRequiredFields(r, k, o, "a dropout names its follower and window");
-      out.push_back(o);
-    }
-  } else if (fd.IsDefined()) {
-    r.addError(fk + "follower_dropouts", "must be a list of {uav, from_s, to_s}");
+  } else if (list.IsDefined()) {
+    r.addError(fk + name, "must be a list of {uav, from_s, to_s}");
   }
 }
 
@@ -365,8 +354,10 @@ void readFaults(ConfigReader& r, const std::string& m, MissionConfig& c) {
   readWindows(r, fk + "uwb_dropouts", c.faults.uwb_dropouts);
   readWindows(r, fk + "stereo_dropouts", c.faults.stereo_dropouts);
   readPlannerOutages(r, fk, c.faults.planner_outages);
-  readFollowerDropouts(r, fk, c.faults.follower_dropouts);
-  readOperatorOutages(r, fk, c.faults.operator_outages);
+  readUavWindows(r, fk, "follower_dropouts", uavDropoutFields(), "a dropout names its follower and window",
+                 c.faults.follower_dropouts);
+  readUavWindows(r, fk, "operator_outages", plannerOutageFields(), "an outage names its UAV and window",
+                 c.faults.operator_outages);
   readAbortEvent(r, fk + "abort", c.faults.abort);
   readWorkerApproach(r, fk + "worker_approach", c.faults.worker_approach);
   readLeaderSilence(r, fk + "leader_silence", c.faults.leader_silence);
