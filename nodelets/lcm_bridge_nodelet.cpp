@@ -26,6 +26,7 @@
 #include "gesture_formation/comm/link_inbox.hpp"
 #include "gesture_formation/comm/outgoing_repeats.hpp"
 #include "gesture_formation/comm/sequence_store.hpp"
+#include "gesture_formation/comm/standing_messages.hpp"
 #include "gesture_formation/lcm_bridge/link_diagnostics.hpp"
 #include "gesture_formation/lcm_bridge/link_startup.hpp"
 #include "link_params.hpp"
@@ -134,7 +135,7 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
       send(heartbeat_, "heartbeat");
       // This UAV's accepted abort, with every timed heartbeat (heartbeat_rate_hz): also while its
       // planner publishes nothing (stale odometry, no worker estimate, an outage).
-      if (relay_) send(*relay_, "abort (relay)");
+      if (const auto& relay = standing_.withHeartbeat()) send(*relay, "abort (relay)");
     });
   }
 
@@ -168,7 +169,7 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     std::lock_guard<std::mutex> lock(mutex_);
     heartbeat_.worker_visible = !msg->lost;
     send(toWire(*msg), "worker state");
-    if (assistance_ && assistance_->state.phase == formation::AssistancePhase::kRequested) send(*assistance_, "assistance");
+    if (const auto assistance = standing_.withWorkerState()) send(*assistance, "assistance");
   }
   void onPlan(const gesture_formation::PlannedTrajectory::ConstPtr& msg) {
     auto plan = fromMsg(*msg);
@@ -189,13 +190,13 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     }
     std::lock_guard<std::mutex> lock(mutex_);
     send(*m, what, copies, period_s);
-    if constexpr (std::is_same_v<T, comm::AssistanceMessage>) assistance_ = *m;  // re-sent while requested
+    if constexpr (std::is_same_v<T, comm::AssistanceMessage>) standing_.assistanceSent(*m);  // re-sent while requested
   }
   // This UAV's abort state: once it accepted an abort, the command is relayed (docs/safety.md §2.8).
   void onAbortState(const gesture_formation::AbortState::ConstPtr& msg) {
     auto a = toWire(msg->command);
     std::lock_guard<std::mutex> lock(mutex_);
-    if (msg->phase != gesture_formation::AbortState::PHASE_NONE && a) relay_ = *a;
+    standing_.abortState(msg->phase != gesture_formation::AbortState::PHASE_NONE, a ? std::optional(*a) : std::nullopt);
   }
 
   // Called from drain() (mutex held). An authenticated payload that the decoders let through and a
@@ -296,8 +297,7 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
   int command_repeats_ = 1;
   double command_repeat_period_s_ = 0.1;
   comm::OutgoingRepeats repeats_;  ///< copies of single events still to send
-  std::optional<comm::AssistanceMessage> assistance_;  ///< the last assistance state sent (leader: re-sent while requested)
-  std::optional<comm::AbortMessage> relay_;  ///< this UAV's accepted abort, sent with every timed heartbeat
+  comm::StandingMessages standing_;  ///< the accepted abort (relayed), the assistance state (re-sent while requested)
   /// LCM messages handled per 5 ms drain: bounded, so a flood cannot keep the mutex from heartbeats.
   static constexpr int kMaxDrainPerTick = 2000;
   lcm_bridge::HighWaterMarkSaver marks_;  ///< high_water_file, saved when the marks changed
