@@ -44,7 +44,7 @@ void BM_MeasurementPlusPredictUpdate(benchmark::State& state) {
   for (auto _ : state) {
     t += 0.033;
     const Box box{300.0 + std::sin(t), 200.0, 30.0, 100.0};
-    const auto m = makeMeasurement(cam, p, box, std::nan(""), std::nan(""), 1.75, noise);
+    const auto m = makeMeasurement(cam, p, box, std::nan(""), std::nan(""), 1.75, noise, 40.0);
     benchmark::DoNotOptimize(kf.step(t, *m));
   }
 }

@@ -1,6 +1,8 @@
 #pragma once
 // All message <-> core conversions of the nodelets (house style: one header, no math).
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <string>
 
@@ -506,7 +508,9 @@ inline planning::WorkerKnowledge toWorkerKnowledge(const gesture_formation::Work
 }
 
 // ---- gesture observations (the multi-view vote) ---------------------------------------------
-/// CameraInfo (plumb_bob or no distortion) → intrinsics; fails naming what is unusable.
+/// CameraInfo (plumb_bob or no distortion) → the intrinsics of the image it describes: the full
+/// sensor's calibration with the binning and region of interest applied (REP 104;
+/// estimation::readoutIntrinsics); fails naming what is unusable.
 inline common::Result<estimation::CameraIntrinsics> toIntrinsics(const sensor_msgs::CameraInfo& m) {
   using R = common::Result<estimation::CameraIntrinsics>;
   estimation::CameraIntrinsics k;
@@ -525,7 +529,16 @@ inline common::Result<estimation::CameraIntrinsics> toIntrinsics(const sensor_ms
   }
   const auto errors = k.validate();
   if (!errors.empty()) return R::fail("CameraInfo: " + errors.front());
-  return R::ok(k);
+  estimation::SensorReadout r;
+  r.binning_x = static_cast<int>(std::min<std::uint32_t>(m.binning_x, 1u << 20));
+  r.binning_y = static_cast<int>(std::min<std::uint32_t>(m.binning_y, 1u << 20));
+  r.roi_x_offset = static_cast<int>(std::min<std::uint32_t>(m.roi.x_offset, 1u << 30));
+  r.roi_y_offset = static_cast<int>(std::min<std::uint32_t>(m.roi.y_offset, 1u << 30));
+  r.roi_width = static_cast<int>(std::min<std::uint32_t>(m.roi.width, 1u << 30));
+  r.roi_height = static_cast<int>(std::min<std::uint32_t>(m.roi.height, 1u << 30));
+  const auto image = estimation::readoutIntrinsics(k, r);
+  if (!image) return R::fail("CameraInfo: " + image.reason());
+  return image;
 }
 // ---- a skeleton with its camera (view_fusion.confirm_3d; Gesture / GestureObservation) -----
 /// The 17 keypoints as (u, v, confidence) triples.

@@ -124,6 +124,7 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
   bool estimates() const { return !leadership_ || owns_; }
   void publish(const gesture_formation::WorkerState& out) {
     state_pub_.publish(out);
+    if (leadership_) last_own_ = out;
     if (leadership_ && acting_) share_pub_.publish(out);
     ++published_since_report_;
   }
@@ -148,6 +149,10 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
     if (msg->acting) acted_term_ = msg->term;
     if (owns == owns_) return;
     owns_ = owns;
+    // No longer its own: its last estimate is the newest it knows until the next leader shares one
+    // (re-elected before any share arrives, it continues from its own, not a predecessor's older one).
+    if (!owns_ && last_own_ && (!last_share_ || last_own_->header.stamp > last_share_->header.stamp)) last_share_ = last_own_;
+    last_own_.reset();
     filter_ = estimation::HumanKalman(config_.filter);
     last_fused_ = ros::Time();
     if (!owns_ || !last_share_) {
@@ -196,7 +201,8 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
       return;
     }
     const auto m = estimation::makeMeasurement(*camera_->model(), toCameraPose(T_world_camera), toBox(*msg), d_uwb,
-                                               msg->stereo_distance_m, config_.human_height_m, config_.noise);
+                                               msg->stereo_distance_m, config_.human_height_m, config_.noise,
+                                               config_.max_apparent_distance_m);
     if (!m) {
       ++rejected_since_report_;
       NODELET_WARN_STREAM_THROTTLE(1.0, "WorkerEstimator: detection rejected: " << m.reason());
@@ -227,20 +233,25 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
     // ROS time went back (sim time restarted, a bag replayed in a loop): the track is of another
     // time line — every new detection would be refused as out of order while the old track, its
     // stamps now in the future, kept being published as fresh. Start afresh.
-    if (filter_.confirmed() && t < filter_.time() - kTimeJumpS) {
+    // A tentative track too (its stamps would refuse every new detection), and a follower's kept
+    // share (every newer share would be refused as older than it: nothing handed on, no take-over).
+    if (filter_.initialized() && t < filter_.time() - kTimeJumpS) {
       NODELET_WARN_STREAM("WorkerEstimator: ROS time went back from " << filter_.time() << " s to " << t
                                                                       << " s: the track is dropped, starting afresh");
       filter_ = estimation::HumanKalman(config_.filter);
       last_fused_ = ros::Time();
       last_uwb_stamp_ = ros::Time();
+      last_share_.reset();
+      last_own_.reset();
       return;
     }
+    if (last_share_ && t < last_share_->header.stamp.toSec() - kTimeJumpS) {
+      NODELET_WARN_STREAM("WorkerEstimator: ROS time went back from " << last_share_->header.stamp.toSec() << " s to " << t
+                                                                      << " s: the kept shared estimate is dropped");
+      last_share_.reset();
+    }
     if (!estimates() || !filter_.confirmed()) return;
-    const auto s = filter_.predicted(t);
-    estimation::Vector6d x;
-    x << s.p_world, s.v_world;
-    estimation::Matrix6d P = filter_.covariance();
-    P.topLeftCorner<3, 3>() = s.cov_p;
+    const auto [x, P] = filter_.predictedState(t);  // one prediction: a consistent 6x6 covariance
     auto out = toWorkerState(x, P);
     out.header.stamp = event.current_real;
     out.header.frame_id = world_frame_;
@@ -272,6 +283,7 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
   bool owns_ = false;                         ///< it keeps its own filter: acting, or lapsed in the term it acted in
   std::uint32_t acted_term_ = 0;              ///< the last term in which it acted
   std::optional<gesture_formation::WorkerState> last_share_;  ///< the acting leader's last estimate (~leadership)
+  std::optional<gesture_formation::WorkerState> last_own_;    ///< its own last estimate while it owns the filter
   ros::Publisher state_pub_, share_pub_;
   ros::Subscriber detection_sub_, shared_sub_, leadership_sub_;
   ros::Subscriber uwb_sub_, info_sub_;

@@ -17,6 +17,7 @@ const common::FieldTable<EstimatorConfig>& fields() {
   using C = EstimatorConfig;
   static const common::FieldTable<EstimatorConfig> t{{
       {"human_height_m", Range::openClosed(0.5, 2.5), [](C& c) { return &c.human_height_m; }},
+      {"max_apparent_distance_m", Range::openClosed(0.0, 1000.0), [](C& c) { return &c.max_apparent_distance_m; }},
       {"measurement_noise.sigma_xy_m", Range::positive(), [](C& c) { return &c.noise.sigma_xy_m; }},
       {"measurement_noise.sigma_z_uwb_m", Range::positive(), [](C& c) { return &c.noise.sigma_z_uwb_m; }},
       {"measurement_noise.sigma_z_stereo_m", Range::positive(), [](C& c) { return &c.noise.sigma_z_stereo_m; }},

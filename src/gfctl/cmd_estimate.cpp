@@ -79,7 +79,8 @@ int cmdEstimate(const Args& args) {
       warn("field 't': non-finite time; row ignored");
     } else if (has_detection) {
       ++detections;
-      const auto m = estimation::makeMeasurement(camera, pose, box, d_uwb, d_stereo, cfg->human_height_m, cfg->noise);
+      const auto m = estimation::makeMeasurement(camera, pose, box, d_uwb, d_stereo, cfg->human_height_m, cfg->noise,
+                                                 cfg->max_apparent_distance_m);
       if (!m) {
         warn("measurement rejected: " + m.reason());
         filter.predict(t);  // the row still advances the filter's time (Q once per row)

@@ -640,7 +640,8 @@ void MissionRun::cameraFrame(double t, const WorkerState& ws) {
     const UavRuntime& L = uav(owner_);
     const estimation::CameraPose est_pose = cameraPose(L.est.p_world, L.est.heading_rad, L.est.pitch_rad);
     const auto meas = estimation::makeMeasurement(*cam_model_.model(), est_pose, frame.box, frame.d_uwb_m, frame.d_stereo_m,
-                                                  cfg_.estimator.human_height_m, cfg_.estimator.noise);
+                                                  cfg_.estimator.human_height_m, cfg_.estimator.noise,
+                                                  cfg_.estimator.max_apparent_distance_m);
     if (meas && estimation::accepted(kf_.step(t, *meas))) last_fused_s_ = t;
   }
   actOnFrames(t, aggregateViews(t, cf));

@@ -24,6 +24,7 @@ import yaml
 DEFAULTS = {
     "camera": {"fx": 615.0, "fy": 615.0, "cx": 320.0, "cy": 240.0, "distortion": [0, 0, 0, 0, 0]},
     "human_height_m": 1.75,
+    "max_apparent_distance_m": 40.0,
     "process_noise": {"sigma_p_m": 0.1, "sigma_v_mps": 0.1},
     "measurement_noise": {"sigma_xy_m": 0.05, "sigma_z_uwb_m": 0.1, "sigma_z_stereo_m": 0.3,
                           "sigma_z_apparent_m": 0.6},
@@ -102,6 +103,7 @@ def main():
         cfg = yaml.safe_load(f) or {}
     cam = Camera(merged(cfg, "camera"))
     H_m = merged(cfg, "human_height_m")
+    max_apparent_m = merged(cfg, "max_apparent_distance_m")
     pn = merged(cfg, "process_noise")
     mn = merged(cfg, "measurement_noise")
     sv0 = merged(cfg, "initial_velocity_std_mps")
@@ -137,13 +139,18 @@ def main():
                         d, sz, source = d_uwb, mn["sigma_z_uwb_m"], "uwb"
                     elif d_st is not None and math.isfinite(d_st) and d_st > 0:
                         d, sz, source = d_st, mn["sigma_z_stereo_m"], "stereo"
+                    elif v <= 0.5 or v + h >= cam.height - 0.5:
+                        d = None  # clipped at the top or bottom edge: its height gives no distance
                     else:
                         rt, rb = cam.ray(cu, v), cam.ray(cu, v + h)
                         alpha = math.atan2(np.linalg.norm(np.cross(rt, rb)), float(rt @ rb))
                         d, sz, source = H_m / (2 * math.tan(alpha / 2)), mn["sigma_z_apparent_m"], "apparent"
-                    z = R @ (d * dhat) + np.array(pose[:3])
-                    S_m = R @ np.diag([mn["sigma_xy_m"] ** 2, mn["sigma_xy_m"] ** 2, sz ** 2]) @ R.T
-                    meas = (z, S_m)
+                        if not d <= max_apparent_m:
+                            d, source = None, "none"
+                    if d is not None:
+                        z = R @ (d * dhat) + np.array(pose[:3])
+                        S_m = R @ np.diag([mn["sigma_xy_m"] ** 2, mn["sigma_xy_m"] ** 2, sz ** 2]) @ R.T
+                        meas = (z, S_m)
             if x is None:
                 if meas is not None and math.isfinite(t):
                     x = np.concatenate([meas[0], np.zeros(3)])

@@ -15,6 +15,8 @@
 #include <Eigen/Core>
 #include <Eigen/LU>
 
+#include "gesture_formation/common/result.hpp"
+
 namespace gesture_formation::common {
 template <class Config>
 struct FieldTable;
@@ -42,6 +44,24 @@ struct CameraIntrinsics {
 /// `camera.width`, `camera.height`) with their ranges: the only place they are written, used by
 /// validate() and by the estimator's YAML reader (common/config_fields.hpp).
 const common::FieldTable<CameraIntrinsics>& cameraIntrinsicsFields();
+
+/// \brief What part of the sensor an image shows (ROS sensor_msgs/CameraInfo, REP 104): the
+/// calibration (K, width, height) is the full sensor's; a camera that bins pixels (binning 0 or 1:
+/// none) or reads out a region (width or height 0: the full image) publishes a smaller image.
+struct SensorReadout {
+  int binning_x = 0, binning_y = 0;           ///< ≥ 0
+  int roi_x_offset = 0, roi_y_offset = 0;     ///< full-resolution pixels, ≥ 0
+  int roi_width = 0, roi_height = 0;          ///< full-resolution pixels, ≥ 0 (0: the full image)
+};
+
+/// \brief The intrinsics of the image a camera calibrated as `full` publishes with `readout`: the
+/// region's offset subtracted, then every length divided by the binning. Pixel centres are at
+/// integers (this file's convention), so a binned pixel i covers full pixels b·i … b·i + b − 1 and
+/// the principal point is (c − offset − (b − 1)/2) / b (image_geometry's PinholeCameraModel drops
+/// the half-pixel term: (b − 1) / (2b) px apart). Distortion acts on normalised coordinates and is
+/// unchanged. Fails naming the field and value: a region outside the sensor, a region with a zero
+/// and a non-zero side, an offset without a region, a negative binning, or an image of no pixels.
+common::Result<CameraIntrinsics> readoutIntrinsics(const CameraIntrinsics& full, const SensorReadout& readout);
 
 /// \brief Projection and back-projection through a plumb_bob camera.
 /// Thread safety: immutable after construction; all methods are const and reentrant.

@@ -19,6 +19,9 @@ namespace gesture_formation::estimation {
 struct EstimatorConfig {
   CameraIntrinsics camera;
   double human_height_m = 1.75;  ///< the worker's height for the apparent distance, (0.5, 2.5] m
+  /// Longest apparent distance taken [m], (0, 1000]: a smaller box (a far or partial person, a
+  /// spurious detection) gives no distance — a 1 px box would put the worker a kilometre away.
+  double max_apparent_distance_m = 40.0;
   MeasurementNoise noise;
   HumanKalmanConfig filter;
   StereoDistanceConfig stereo;
@@ -28,7 +31,7 @@ struct EstimatorConfig {
 };
 
 /// \brief Reads an EstimatorConfig from `reader`, starting from the defaults above.
-/// Keys: `camera.{fx,fy,cx,cy,distortion,width,height}`, `human_height_m`,
+/// Keys: `camera.{fx,fy,cx,cy,distortion,width,height}`, `human_height_m`, `max_apparent_distance_m`,
 /// `process_noise.{sigma_p_m,sigma_v_mps,reference_period_s}`,
 /// `measurement_noise.{sigma_xy_m,sigma_z_uwb_m,sigma_z_stereo_m,sigma_z_apparent_m}`,
 /// `initial_velocity_std_mps`, `gate_chi2`, `max_consecutive_rejections`, `lost_timeout_s`,

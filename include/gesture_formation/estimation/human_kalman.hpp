@@ -22,6 +22,7 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Cholesky>
@@ -292,6 +293,19 @@ class HumanKalman {
     s.v_world = copy.x_.tail<3>();
     s.cov_p = copy.P_.topLeftCorner<3, 3>();
     return s;
+  }
+
+  /// \brief The whole state and its 6×6 covariance predicted to `t_s` as one prediction step would
+  /// (Q once), without changing the filter; before time() the position extrapolated back without
+  /// noise (as predicted()) and the filter's covariance. Position, velocity and their correlation
+  /// come from one step, so the covariance stays symmetric positive semi-definite (a position
+  /// block predicted alone beside the old velocity blocks need not be). Requires initialized().
+  std::pair<Vector6d, Matrix6d> predictedState(double t_s) const {
+    HumanKalman copy = *this;
+    if (t_s > t_) copy.predict(t_s);
+    Vector6d x = copy.x_;
+    x.head<3>() += (t_s - copy.t_) * copy.x_.tail<3>();  // zero unless t_s < time()
+    return {x, copy.P_};
   }
 
   /// \brief The predicted trajectory over a horizon for the planner: `steps` samples at

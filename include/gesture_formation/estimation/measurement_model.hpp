@@ -136,11 +136,12 @@ inline common::Result<double> apparentDistance(const CameraModel& camera, const 
 inline bool distanceAvailable(double d_m) { return std::isfinite(d_m) && d_m > 0.0; }
 
 /// \brief Builds the measurement of design.md §3 from a detection. `d_uwb_m`, `d_stereo_m`: NaN
-/// when unavailable. Fails (with a reason) for a bad box, pose or geometry; never returns
-/// non-finite values.
+/// when unavailable. Fails (with a reason) for a bad box, pose or geometry, and for an apparent
+/// distance over `max_apparent_distance_m`; never returns non-finite values.
 inline common::Result<PositionMeasurement> makeMeasurement(const CameraModel& camera, const CameraPose& pose,
                                                            const Box& box, double d_uwb_m, double d_stereo_m,
-                                                           double human_height_m, const MeasurementNoise& noise) {
+                                                           double human_height_m, const MeasurementNoise& noise,
+                                                           double max_apparent_distance_m) {
   using R = common::Result<PositionMeasurement>;
   const auto box_ok = validateBox(box, camera.intrinsics());
   if (!box_ok) return R::fail(box_ok.reason());
@@ -168,6 +169,11 @@ inline common::Result<PositionMeasurement> makeMeasurement(const CameraModel& ca
     }
     const auto d = apparentDistance(camera, box, human_height_m);
     if (!d) return R::fail(d.reason());
+    if (!(*d <= max_apparent_distance_m)) {
+      return R::fail("box of " + std::to_string(box.h) + " px gives an apparent distance of " + std::to_string(*d) +
+                     " m, over max_apparent_distance_m (" + std::to_string(max_apparent_distance_m) +
+                     " m), and no UWB or stereo range");
+    }
     m.source = DistanceSource::kApparent;
     m.distance_m = *d;
   }

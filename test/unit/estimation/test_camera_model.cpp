@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include <opencv2/calib3d.hpp>
@@ -88,4 +89,57 @@ TEST(CameraModelTest, ValidateNamesFields) {
   ASSERT_EQ(e.size(), 2u);
   EXPECT_NE(e[0].find("camera.fx"), std::string::npos);
   EXPECT_NE(e[1].find("camera.width"), std::string::npos);
+}
+
+// CameraInfo's calibration is the full sensor's (REP 104); a camera that bins or reads out a region
+// publishes a smaller image, and a pixel of it must back-project through the intrinsics of that image.
+TEST(CameraModelTest, ReadoutIntrinsicsMapFullSensorPixelsToTheBinnedRegion) {
+  CameraIntrinsics full = distorted();
+  full.fx = 1220.0;
+  full.fy = 1224.0;
+  full.cx = 636.0;
+  full.cy = 486.0;
+  full.width_px = 1280;
+  full.height_px = 960;
+  const CameraModel full_model(full);
+  for (const SensorReadout& r : {SensorReadout{2, 2, 0, 0, 0, 0}, SensorReadout{0, 0, 320, 240, 640, 480},
+                                SensorReadout{2, 3, 100, 60, 1000, 840}, SensorReadout{1, 1, 0, 0, 0, 0}}) {
+    const auto k = readoutIntrinsics(full, r);
+    ASSERT_TRUE(k) << k.reason();
+    const int bx = std::max(1, r.binning_x), by = std::max(1, r.binning_y);
+    EXPECT_EQ(k->width_px, (r.roi_width ? r.roi_width : 1280) / bx);
+    EXPECT_EQ(k->height_px, (r.roi_height ? r.roi_height : 960) / by);
+    EXPECT_EQ(k->distortion, full.distortion);
+    const CameraModel model(*k);
+    for (const Eigen::Vector3d& p : {Eigen::Vector3d(0.3, -0.2, 4.0), Eigen::Vector3d(-0.8, 0.5, 6.0), Eigen::Vector3d(0.0, 0.0, 9.0)}) {
+      const auto uv_full = full_model.project(p);
+      const auto uv = model.project(p);
+      ASSERT_TRUE(uv_full && uv);
+      // full pixel u covers binned pixel (u - offset - (b - 1)/2) / b (pixel centres at integers)
+      EXPECT_NEAR(uv->x(), (uv_full->x() - r.roi_x_offset - 0.5 * (bx - 1)) / bx, 1e-9);
+      EXPECT_NEAR(uv->y(), (uv_full->y() - r.roi_y_offset - 0.5 * (by - 1)) / by, 1e-9);
+    }
+  }
+  const SensorReadout none{};
+  const auto same = readoutIntrinsics(full, none);
+  ASSERT_TRUE(same);
+  EXPECT_EQ(same->fx, full.fx);
+  EXPECT_EQ(same->cx, full.cx);
+  EXPECT_EQ(same->width_px, full.width_px);
+}
+
+TEST(CameraModelTest, ReadoutIntrinsicsRefuseAnImpossibleReadoutNamingIt) {
+  CameraIntrinsics full;  // 640x480
+  auto reason = [&](const SensorReadout& r) {
+    const auto k = readoutIntrinsics(full, r);
+    EXPECT_FALSE(k);
+    return k ? std::string() : k.reason();
+  };
+  EXPECT_NE(reason({0, 0, 400, 0, 300, 480}).find("outside the 640x480 sensor"), std::string::npos);
+  EXPECT_NE(reason({0, 0, 0, 0, 320, 0}).find("roi 320x0"), std::string::npos);
+  EXPECT_NE(reason({0, 0, 10, 0, 0, 0}).find("roi offset (10, 0)"), std::string::npos);
+  const std::string negative = reason({-2, 0, 0, -1, 0, 0});
+  EXPECT_NE(negative.find("binning_x -2"), std::string::npos);
+  EXPECT_NE(negative.find("roi.y_offset -1"), std::string::npos);
+  EXPECT_NE(reason({1000, 1, 0, 0, 0, 0}).find("leaves no pixel"), std::string::npos);
 }

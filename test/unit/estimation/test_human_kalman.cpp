@@ -261,6 +261,33 @@ TEST(HumanKalmanTest, PredictedTrajectoryFollowsConstantVelocity) {
   EXPECT_TRUE(HumanKalman().predictTrajectory(0, 0.2, 40).empty());
 }
 
+// The WorkerEstimator's timer publishes the state predicted to its tick: the 6×6 covariance must be
+// one prediction's — position, velocity and their correlation together — symmetric and positive
+// semi-definite; before, the position block was predicted and the rest left at the filter's time.
+TEST(HumanKalmanTest, PredictedStateIsOnePredictionStepWithAConsistentCovariance) {
+  HumanKalman kf;
+  double t = 0.0;
+  for (int i = 0; i <= 20; ++i, t += 0.1) kf.step(t, meas(Eigen::Vector3d(1.0 * t, -0.5 * t, 0.2 * t), 0.02));
+  const double t0 = kf.time();
+  ASSERT_GT((kf.covariance().topRightCorner<3, 3>().norm()), 1e-6) << "the scenario needs position-velocity correlation";
+  for (const double dt : {0.05, 0.5, 3.0, 8.0}) {  // 8 s: past lost_timeout_s, the velocity forgotten
+    HumanKalman stepped = kf;
+    ASSERT_TRUE(stepped.predict(t0 + dt));
+    const auto [x, P] = kf.predictedState(t0 + dt);
+    EXPECT_LT((x - stepped.state()).norm(), 1e-12) << "dt " << dt;
+    EXPECT_LT((P - stepped.covariance()).norm(), 1e-12) << "dt " << dt;
+    EXPECT_LT((P - P.transpose()).norm(), 1e-12) << "dt " << dt;
+    const Eigen::SelfAdjointEigenSolver<Matrix6d> eig(P);
+    EXPECT_GE(eig.eigenvalues().minCoeff(), -1e-12) << "dt " << dt;
+    EXPECT_NEAR((x.head<3>() - kf.predicted(t0 + dt).p_world).norm(), 0.0, 1e-12) << "dt " << dt;
+  }
+  EXPECT_DOUBLE_EQ(kf.time(), t0) << "predictedState() must not change the filter";
+  // Before time(): the position extrapolated back without noise, the filter's covariance.
+  const auto [x_back, P_back] = kf.predictedState(t0 - 0.2);
+  EXPECT_LT((x_back.head<3>() - (kf.state().head<3>() - 0.2 * kf.state().tail<3>())).norm(), 1e-12);
+  EXPECT_LT((P_back - kf.covariance()).norm(), 1e-15);
+}
+
 // docs/safety.md §4.6: a worker climbing at 0.5 m/s leaves the camera; the estimate must not keep
 // climbing with him for minutes (it reached 56 m above ground in delay_jitter seed 11).
 TEST(HumanKalmanTest, LostFilterHoldsThePositionAndGrowsItsCovariance) {

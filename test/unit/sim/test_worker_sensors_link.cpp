@@ -111,7 +111,7 @@ TEST(SyntheticSensorsTest, BoxFeedsEstimatorToWithinNoise) {
   EXPECT_NEAR(f.d_uwb_m, d.norm(), 1e-12);
   EXPECT_NEAR(f.d_stereo_m, d.norm(), 1e-12);
   const auto m = gf::estimation::makeMeasurement(s.camera(), pose, f.box, f.d_uwb_m, f.d_stereo_m, 1.78,
-                                                 gf::estimation::MeasurementNoise{});
+                                                 gf::estimation::MeasurementNoise{}, 40.0);
   ASSERT_TRUE(m);
   EXPECT_LT((m->z_world - mid).norm(), 0.1);  // box centre ≈ mid-body (perspective only)
   // Behind the camera / out of the field of view: no box.
