@@ -83,7 +83,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         break;
       }
       case MessageType::kFormationParams: {
-        formation::FormationParams m;
+        FormationParamsMessage m;
         decoder.decode(r.envelope, m);
         break;
       }

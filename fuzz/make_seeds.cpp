@@ -45,7 +45,8 @@ int main(int argc, char** argv) {
   planning::PlannedTrajectory plan;
   plan.uav_index = 1;
   plan.samples.resize(3);
-  formation::FormationParams params;
+  FormationParamsMessage params;
+  params.version = 3;
   formation::FormationCommand cmd;
   cmd.id = {"operator", 7};
   cmd.target = formation::CommandTarget::list({1, 2});

@@ -253,6 +253,12 @@ inline common::Result<formation::FormationParams> fromMsg(const std::vector<gest
 inline common::Result<formation::FormationParams> fromMsg(const gesture_formation::FormationParams& m) {
   return fromMsg(m.uavs);
 }
+/// The owner's parameters as they travel: with their version (a new leader carries it on).
+inline common::Result<comm::FormationParamsMessage> toWire(const gesture_formation::FormationParams& m) {
+  auto p = fromMsg(m);
+  if (!p) return common::Result<comm::FormationParamsMessage>::fail(p.reason());
+  return common::Result<comm::FormationParamsMessage>::ok(comm::FormationParamsMessage{std::move(*p), m.version});
+}
 inline common::Result<formation::Parameter> parameterFromName(const std::string& name) {
   using R = common::Result<formation::Parameter>;
   for (const auto p : {formation::Parameter::kBeta, formation::Parameter::kGamma, formation::Parameter::kDistance}) {

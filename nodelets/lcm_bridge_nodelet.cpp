@@ -94,7 +94,7 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     worker_sub_ = nh.subscribe("worker_state_in", 50, &LcmBridgeNodelet::onWorker, this);
     plan_sub_ = nh.subscribe("plan_in", 50, &LcmBridgeNodelet::onPlan, this);
     params_sub_ = nh.subscribe<gesture_formation::FormationParams>(
-        "formation_params_in", 20, [this](const gesture_formation::FormationParams::ConstPtr& m) { sendChecked(fromMsg(*m), "formation parameters"); });
+        "formation_params_in", 20, [this](const gesture_formation::FormationParams::ConstPtr& m) { sendChecked(toWire(*m), "formation parameters"); });
     observations_pub_ = nh.advertise<gesture_formation::GestureObservation>("gesture_observations_out", 200);
     observation_sub_ = nh.subscribe<gesture_formation::GestureObservation>(
         "gesture_observation_in", 100, [this](const gesture_formation::GestureObservation::ConstPtr& m) { sendChecked(toWire(*m), "gesture observation"); });
@@ -227,8 +227,8 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
       m.fallback = p->fallback;
       m.status = m.fallback ? "fallback" : "optimized";
       plans_pub_.publish(m);
-    } else if (const auto* f = std::get_if<formation::FormationParams>(&item)) {
-      auto m = toMsg(*f, 0);
+    } else if (const auto* f = std::get_if<comm::FormationParamsMessage>(&item)) {
+      auto m = toMsg(f->params, f->version);
       m.header.stamp = ros::Time(e.stamp_s);
       m.header.frame_id = world_frame_;
       params_pub_.publish(m);

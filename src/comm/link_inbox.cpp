@@ -37,7 +37,7 @@ InboxItem LinkInbox::decodeOne(const Envelope& e) {
       return m;
     }
     case MessageType::kFormationParams: {
-      formation::FormationParams p;
+      FormationParamsMessage p;
       if (decoder_.decode(e, p)) return p;
       return {};
     }

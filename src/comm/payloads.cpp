@@ -280,9 +280,10 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, planning:
   return d.report(reason);
 }
 
-// ---- formation params: leader (β, γ, d), u8 follower count, count × (β, γ, d) ---------------
+// ---- formation params: leader (β, γ, d), u8 follower count, count × (β, γ, d), u64 version ---
 
-EncodeResult encodePayload(const formation::FormationParams& m) {
+EncodeResult encodePayload(const FormationParamsMessage& msg) {
+  const formation::FormationParams& m = msg.params;
   if (m.followers.size() > kMaxFollowers) {
     return EncodeResult::fail("formation_params.followers has " + std::to_string(m.followers.size()) + " entries, at most " + std::to_string(kMaxFollowers));
   }
@@ -301,13 +302,15 @@ EncodeResult encodePayload(const formation::FormationParams& m) {
   put(m.leader);
   w.u8(static_cast<std::uint8_t>(m.followers.size()));
   for (const formation::UavObservation& o : m.followers) put(o);
+  w.u64(msg.version);
   return EncodeResult::ok(w.release());
 }
 
-PayloadError decodePayload(const std::uint8_t* data, std::size_t size, formation::FormationParams& out,
+PayloadError decodePayload(const std::uint8_t* data, std::size_t size, FormationParamsMessage& out,
                            std::string* reason) {
   Decoder d(data, size);
-  formation::FormationParams m;
+  FormationParamsMessage msg;
+  formation::FormationParams& m = msg.params;
   auto get = [&d](formation::UavObservation& o, const std::string& name) {
     d.f64(o.beta_deg, name + ".beta_deg");
     d.f64(o.gamma_deg, name + ".gamma_deg");
@@ -322,7 +325,8 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, formation
     m.followers.assign(count, formation::UavObservation{});
     for (std::size_t i = 0; i < count && d.ok(); ++i) get(m.followers[i], "formation_params.followers[" + std::to_string(i) + "]");
   }
-  if (d.finish()) out = std::move(m);
+  d.u64(msg.version, "formation_params.version");
+  if (d.finish()) out = std::move(msg);
   return d.report(reason);
 }
 

@@ -9,7 +9,7 @@ from the stamp of an acting state to the stamp of its next state, or to the end;
 stamped with its end by the nodelet); the new leader's term is newer than 1 and the other follower
 names it as leader. Then an operator request (`tools/gf_command.py followers distance_m 1`, through the
 ground station and LCM) is applied by the new leader — acknowledged as applied, its parameters
-published with a newer version than it took over — and reaches the other follower over LCM; UAV 0,
+published with a newer version than it took over — and reaches the other follower over LCM with that version; UAV 0,
 which no longer acts, publishes no parameters after its lease. The estimator follows too: the new
 leader's WorkerEstimator fuses its own camera's detections after the take-over (SimWorld's leader
 camera moves to the acting UAV; last_fused later than the take-over, not lost) and the other follower
@@ -53,7 +53,7 @@ def intervals(states, t_end):
 
 
 def same_views(a, b):
-    """Two FormationParams with the same views (LCM carries parameters without their version)."""
+    """Two FormationParams with the same views."""
     return len(a.uavs) == len(b.uavs) and all(
         abs(x.beta_deg - y.beta_deg) < 1e-9 and abs(x.gamma_deg - y.gamma_deg) < 1e-9 and abs(x.distance_m - y.distance_m) < 1e-9
         for x, y in zip(a.uavs, b.uavs))
@@ -80,6 +80,10 @@ def check_request(src, new, other, published, received, t_silence):
     check(bool(applied) and not same_views(applied[0], taken[-1]) and any(same_views(m, applied[0]) for m in received[other]),
           f"UAV {other} received the new parameters over LCM (followers' distances "
           f"{[round(u.distance_m, 2) for u in received[other][-1].uavs] if received[other] else None})")
+    got = [m.version for m in received[other] if applied and same_views(m, applied[0])]
+    check(bool(got) and got[-1] == applied[0].version,
+          f"UAV {other} received them with their version over LCM ({got[-1] if got else None}, "
+          f"UAV {new} published {applied[0].version if applied else None})")
     late = [m for m in published[0] if m.header.stamp.to_sec() > t_silence + LEASE_S + 0.5]
     check(not late, f"UAV 0 published no parameters after its lease ({len(late)} did)")
 

@@ -35,7 +35,7 @@ struct ReceivedPlanMessage {
 
 /// \brief What one envelope yields to hand on (monostate: nothing — a heartbeat, a command's copy,
 /// a refusal).
-using InboxItem = std::variant<std::monostate, WorkerStateMessage, ReceivedPlanMessage, formation::FormationParams,
+using InboxItem = std::variant<std::monostate, WorkerStateMessage, ReceivedPlanMessage, FormationParamsMessage,
                                formation::FormationCommand, GestureObservationMessage, planning::AbortCommand,
                                CommandAckMessage, AssistanceMessage, formation::LeadershipMessage>;
 

@@ -45,6 +45,14 @@ constexpr std::size_t kMaxSenderNameBytes = 64;
 /// NAME@ID, ID the link sender (≤ 65535), which must fit kMaxSenderNameBytes.
 constexpr std::size_t kMaxOperatorNameBytes = kMaxSenderNameBytes - 6;
 
+/// \brief The parameter owner's formation parameters and their version: the commands applied since
+/// the mission's start, carried on by a new leader from the version it held (docs/safety.md §1.2),
+/// so a follower, the operator's acknowledgements and every UAV's plan name one sequence of versions.
+struct FormationParamsMessage {
+  formation::FormationParams params;
+  std::uint64_t version = 0;
+};
+
 /// \brief Liveness of one UAV, sent periodically (e.g. 5 Hz).
 struct Heartbeat {
   enum class Status : std::uint8_t { kOk = 0, kDegraded = 1, kFailsafe = 2, kLanding = 3 };
@@ -158,7 +166,7 @@ const char* toString(PayloadError e);
 common::Result<std::vector<std::uint8_t>> encodePayload(const Heartbeat& m);
 common::Result<std::vector<std::uint8_t>> encodePayload(const WorkerStateMessage& m);
 common::Result<std::vector<std::uint8_t>> encodePayload(const planning::PlannedTrajectory& m);
-common::Result<std::vector<std::uint8_t>> encodePayload(const formation::FormationParams& m);
+common::Result<std::vector<std::uint8_t>> encodePayload(const FormationParamsMessage& m);
 common::Result<std::vector<std::uint8_t>> encodePayload(const formation::FormationCommand& m);
 common::Result<std::vector<std::uint8_t>> encodePayload(const GestureObservationMessage& m);
 common::Result<std::vector<std::uint8_t>> encodePayload(const AbortMessage& m);
@@ -172,7 +180,7 @@ common::Result<std::vector<std::uint8_t>> encodePayload(const formation::Leaders
 inline MessageType messageTypeOf(const Heartbeat&) { return MessageType::kHeartbeat; }
 inline MessageType messageTypeOf(const WorkerStateMessage&) { return MessageType::kWorkerState; }
 inline MessageType messageTypeOf(const planning::PlannedTrajectory&) { return MessageType::kPlannedTrajectory; }
-inline MessageType messageTypeOf(const formation::FormationParams&) { return MessageType::kFormationParams; }
+inline MessageType messageTypeOf(const FormationParamsMessage&) { return MessageType::kFormationParams; }
 inline MessageType messageTypeOf(const formation::FormationCommand&) { return MessageType::kFormationCommand; }
 inline MessageType messageTypeOf(const GestureObservationMessage&) { return MessageType::kGestureObservation; }
 inline MessageType messageTypeOf(const AbortMessage&) { return MessageType::kAbortCommand; }
@@ -186,7 +194,7 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, WorkerSta
                            std::string* reason = nullptr);
 PayloadError decodePayload(const std::uint8_t* data, std::size_t size, planning::PlannedTrajectory& out,
                            std::string* reason = nullptr);
-PayloadError decodePayload(const std::uint8_t* data, std::size_t size, formation::FormationParams& out,
+PayloadError decodePayload(const std::uint8_t* data, std::size_t size, FormationParamsMessage& out,
                            std::string* reason = nullptr);
 PayloadError decodePayload(const std::uint8_t* data, std::size_t size, formation::FormationCommand& out,
                            std::string* reason = nullptr);

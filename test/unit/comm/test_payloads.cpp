@@ -209,27 +209,32 @@ TEST(CommPayloadsTest, PlannedTrajectoryRefusals) {
 }
 
 TEST(CommPayloadsTest, FormationParamsRoundTripAndLimits) {
-  formation::FormationParams p;  // Table II
-  p.followers.push_back({15.0, -5.0, 9.5});
+  FormationParamsMessage p;  // Table II
+  p.params.followers.push_back({15.0, -5.0, 9.5});
+  p.version = 0x0102030405060708ULL;  // the version travels: a follower and a new leader carry it on
   const auto b = encoded(p);
-  ASSERT_EQ(b.size(), 24 + 1 + 3 * 24u);
-  formation::FormationParams d;
-  d.followers.clear();
+  ASSERT_EQ(b.size(), 24 + 1 + 3 * 24u + 8);
+  FormationParamsMessage d;
+  d.params.followers.clear();
   ASSERT_EQ(decode(b, d), PayloadError::kNone);
-  ASSERT_EQ(d.uavCount(), 4);
+  ASSERT_EQ(d.params.uavCount(), 4);
   for (int u = 0; u < 4; ++u) {
-    EXPECT_EQ(d.uav(u).beta_deg, p.uav(u).beta_deg);
-    EXPECT_EQ(d.uav(u).gamma_deg, p.uav(u).gamma_deg);
-    EXPECT_EQ(d.uav(u).distance_m, p.uav(u).distance_m);
+    EXPECT_EQ(d.params.uav(u).beta_deg, p.params.uav(u).beta_deg);
+    EXPECT_EQ(d.params.uav(u).gamma_deg, p.params.uav(u).gamma_deg);
+    EXPECT_EQ(d.params.uav(u).distance_m, p.params.uav(u).distance_m);
   }
+  EXPECT_EQ(d.version, p.version);
   auto bad = b;
   bad[24] = static_cast<std::uint8_t>(kMaxFollowers + 1);
   EXPECT_EQ(decode(bad, d), PayloadError::kOversizeArray);
-  EXPECT_EQ(d.uavCount(), 4);  // untouched
+  EXPECT_EQ(d.params.uavCount(), 4);  // untouched
   bad = b;
   putDouble(bad, 16, -1.0);  // leader distance
   EXPECT_EQ(decode(bad, d), PayloadError::kOutOfRange);
-  p.followers.assign(kMaxFollowers + 1, formation::UavObservation{});
+  bad.assign(b.begin(), b.end() - 8);  // without its version (an older build's payload)
+  EXPECT_EQ(decode(bad, d), PayloadError::kTruncated);
+  EXPECT_EQ(d.version, p.version);  // untouched
+  p.params.followers.assign(kMaxFollowers + 1, formation::UavObservation{});
   EXPECT_FALSE(encodePayload(p));
 }
 
