@@ -133,11 +133,16 @@ def main():
     span = burst[-1].stamp.to_sec() - burst[0].stamp.to_sec()
     check(len(burst) == n_burst and len(ids) == 1 and span <= (n_burst - 1) * cfg["repeat_period_s"] + 0.1,
           f"the ground station sent {len(burst)} copies of one id ({len(ids)} id(s) in all) within {span:.2f} s")
-    # Then one copy every resend_period_s (its timer ticks every repeat_period_s: a copy is up to one tick late).
-    gaps = [b.stamp.to_sec() - a.stamp.to_sec() for a, b in zip(sent[n_burst - 1:], resends)]
-    low, high = cfg["resend_period_s"] - 0.05, cfg["resend_period_s"] + cfg["repeat_period_s"] + 0.1
-    check(len(resends) >= 3 and all(low <= g <= high for g in gaps),
-          f"then {len(resends)} resends, gaps {', '.join(f'{g:.2f}' for g in gaps[:6])} s (want {low:.2f} .. {high:.2f})")
+    # Then one copy every resend_period_s, on a schedule anchored at the burst's last copy: resend k
+    # is due at anchor + k * resend_period_s and goes out on the first tick of the timer (every
+    # repeat_period_s) at or after that — up to one tick late, never early, without drift (two
+    # consecutive gaps may differ by a tick, so the schedule is checked, not the gaps).
+    anchor, period = burst[-1].stamp.to_sec() if burst else 0.0, cfg["resend_period_s"]
+    lateness = [m.stamp.to_sec() - (anchor + (k + 1) * period) for k, m in enumerate(resends)]
+    low, high = -0.05, cfg["repeat_period_s"] + 0.1
+    check(len(resends) >= 3 and all(low <= d <= high for d in lateness),
+          f"then {len(resends)} resends, each {', '.join(f'{d:+.2f}' for d in lateness[:6])} s from its schedule "
+          f"(burst end + k x {period:.2f} s; want {low:+.2f} .. {high:+.2f})")
     for i in range(UAVS):
         by = {j: len([m for m in copies[i] if m.link_sender == j and m.sequence == sent[0].sequence]) for j in range(UAVS)}
         check(all(by[j] > 0 for j in range(UAVS) if j != i),

@@ -8,6 +8,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "gesture_formation/common/config_reader.hpp"
@@ -28,7 +29,8 @@ struct WallWorld {
   pl::PrimitiveSet solids;
   pl::OccupancyMap map;
   pl::DistanceField field;
-  WallWorld() : solids(makeSolids()), map(makeMap(solids)), field(map) {}
+  WallWorld() : WallWorld(makeSolids()) {}
+  explicit WallWorld(pl::PrimitiveSet s) : solids(std::move(s)), map(makeMap(solids)), field(map) {}
   static pl::PrimitiveSet makeSolids() {
     pl::PrimitiveSet s;
     pl::OrientedBox wall;
@@ -275,25 +277,59 @@ TEST(AbortPlannerTest, RetreatsThenReturnsHome) {
   EXPECT_EQ(a.decide(at(20.0, at(0, goal).home_world)).phase, pl::AbortPhase::kAtHome);
 }
 
-TEST(AbortPlannerTest, ATakeOffPointBesideTheWorkerIsNotReturnedToNorLandedBelow) {
+TEST(AbortPlannerTest, ATakeOffPointBesideTheWorkerIsNotReturnedTo) {
   // A planner restarted mid-mission took its slot beside the worker for its take-off point.
-  for (const auto after : {pl::AbortAfter::kReturnHome, pl::AbortAfter::kLand}) {
-    pl::AbortConfig c;
-    c.after = after;
-    pl::AbortPlanner a(0, 3, c, world().space());
+  pl::AbortConfig c;
+  c.after = pl::AbortAfter::kReturnHome;
+  pl::AbortPlanner a(0, 3, c, world().space());
+  a.receive(command(0.0), 0.0);
+  a.decide(at(0.0, Eigen::Vector3d(-8.0, 0.0, 6.0)));
+  const Eigen::Vector3d goal = *a.retreatGoal();
+  auto s = at(9.0, goal);
+  s.home_world = Eigen::Vector3d(-6.0, 2.0, 5.0);  // 6.3 m from the worker
+  const auto d = a.decide(s);
+  EXPECT_EQ(d.phase, pl::AbortPhase::kAtRetreat) << d.reason;
+  EXPECT_NE(d.reason.find("retreat_distance_m"), std::string::npos) << d.reason;
+  EXPECT_EQ(*a.currentGoal(), goal);
+}
+
+// Landing: the column below the retreat goal comes first, the take-off point's only when that one is
+// blocked — so the goal's column is blocked here (a box 2 m beside it, out of the goal's clearance),
+// and a take-off point beside the worker, whose column is clear, must still not be landed below.
+TEST(AbortPlannerTest, NoLandingBelowATakeOffPointBesideTheWorker) {
+  pl::AbortConfig c;
+  c.after = pl::AbortAfter::kLand;
+  const Eigen::Vector3d start(-8.0, 0.0, 6.0);
+  pl::AbortPlanner first(0, 3, c, world().space());
+  first.receive(command(0.0), 0.0);
+  first.decide(at(0.0, start));
+  const Eigen::Vector3d goal = *first.retreatGoal();
+  ASSERT_GE(goal.z() - 3.5, c.land_height_m) << "the box must lie beside the landing column";
+  pl::PrimitiveSet solids = WallWorld::makeSolids();
+  pl::OrientedBox box;
+  box.center_world = Eigen::Vector3d(goal.x() + 2.5, goal.y(), goal.z() - 3.5);
+  box.size_m = Eigen::Vector3d(1.0, 1.0, 1.0);
+  solids.boxes.push_back(box);
+  const WallWorld blocked(solids);
+  const Eigen::Vector3d beside(-6.0, 2.0, 5.0), far(-12.0, -12.0, 6.0);  // 6.3 m and 17 m from the worker
+  // The scenario: the same retreat goal, its column blocked, the columns below both take-off points clear.
+  ASSERT_FALSE(pl::chooseLandingPoint(goal, std::nullopt, blocked.space(), c));
+  ASSERT_TRUE(pl::chooseLandingPoint(goal, beside, blocked.space(), c));
+  for (const auto& home : {beside, far}) {
+    pl::AbortPlanner a(0, 3, c, blocked.space());
     a.receive(command(0.0), 0.0);
-    a.decide(at(0.0, Eigen::Vector3d(-8.0, 0.0, 6.0)));
-    const Eigen::Vector3d goal = *a.retreatGoal();
+    a.decide(at(0.0, start));
+    ASSERT_EQ(*a.retreatGoal(), goal) << "the box must not move the retreat goal";
     auto s = at(9.0, goal);
-    s.home_world = Eigen::Vector3d(-6.0, 2.0, 5.0);  // 6.3 m from the worker
+    s.home_world = home;
     const auto d = a.decide(s);
-    if (after == pl::AbortAfter::kReturnHome) {
+    if (home == beside) {  // nothing verified to land on: it stays at the retreat goal, saying why
       EXPECT_EQ(d.phase, pl::AbortPhase::kAtRetreat) << d.reason;
       EXPECT_NE(d.reason.find("retreat_distance_m"), std::string::npos) << d.reason;
       EXPECT_EQ(*a.currentGoal(), goal);
-    } else {  // the column below the goal is clear: it lands there, never below the take-off point
+    } else {  // a take-off point far from the worker: it lands below it
       EXPECT_EQ(d.phase, pl::AbortPhase::kLanding) << d.reason;
-      EXPECT_EQ(*a.currentGoal(), Eigen::Vector3d(goal.x(), goal.y(), c.land_height_m));
+      EXPECT_EQ(*a.currentGoal(), Eigen::Vector3d(far.x(), far.y(), c.land_height_m));
     }
   }
 }
