@@ -52,7 +52,7 @@ int cmdGestureFilter(const Args& args) {
   if (!out) return badInput(args, args.get("out") + ": cannot open for writing");
   out << "t,gesture_id,parameter,increment,value\n";
 
-  std::size_t rows = 0, rejected = 0, fired = 0, clamped = 0, warned = 0;
+  std::size_t rows = 0, rejected = 0, fired = 0, clamped = 0, warned = 0, refused = 0;
   std::uint64_t sequence = 0;
   while (in.next()) {
     ++rows;
@@ -78,10 +78,13 @@ int cmdGestureFilter(const Args& args) {
       out << gesture::toString(action->event) << ",0,nan\n";
     } else {
       const formation::CommandOutcome c = formation_state.apply(gesture::toCommand(*action, ++sequence));
-      if (c.status != formation::CommandStatus::kApplied) {
-        return badInput(args, in.path() + ":" + std::to_string(in.lineNumber()) + ": command not applied: " + c.reason);
-      }
       out << action->parameter_path << ',' << formatDouble(action->increment) << ',';
+      if (c.status != formation::CommandStatus::kApplied) {  // e.g. two slots closer than Γ_dis: nothing changed
+        ++refused;
+        out << "nan\n";
+        std::cerr << "gfctl gesture-filter: t=" << formatDouble(t) << " s: command refused: " << c.reason << "\n";
+        continue;
+      }
       for (std::size_t i = 0; i < c.changes.size(); ++i) out << (i ? ";" : "") << formatDouble(c.changes[i].applied);
       out << '\n';
       for (const auto& ch : c.changes) {
@@ -98,7 +101,7 @@ int cmdGestureFilter(const Args& args) {
   if (!out) return badInput(args, args.get("out") + ": write failed");
   if (warned > kMaxWarnings) std::cerr << "gfctl gesture-filter: " << (warned - kMaxWarnings) << " more warnings not shown\n";
   std::cout << "gfctl gesture-filter: " << rows << " rows, " << rejected << " rejected, " << fired << " commands fired, "
-            << clamped << " values clamped\n";
+            << refused << " refused by the formation, " << clamped << " values clamped\n";
   return kExitOk;
 }
 

@@ -110,6 +110,10 @@ mapping:
   3: {parameter: leader.gamma_deg, increment: -20}
   4: {event: abort}
 YAML
+# The same sweep at 8 m: follower 1 reaches follower 2's point (beta 180, 8 m) — refused by the
+# formation (docs/formation.md §4: two slots closer than safety_distance_m), a row with value nan,
+# nothing changed, and the sweep goes on from where it stood.
+sed 's/{beta_deg: 90, gamma_deg: 0, distance_m: 15}/{beta_deg: 90, gamma_deg: 0, distance_m: 8}/' "$OUT/events3.yaml" > "$OUT/slots8.yaml"
 cat > "$OUT/boundary.yaml" <<'YAML'
 window_size: 8
 min_measurements: 4
@@ -166,6 +170,8 @@ run events3_noisy "$OUT/events3.yaml" noisy
 run boundary_exact "$OUT/boundary.yaml" boundary
 run boundary_release "$OUT/boundary_release.yaml" boundary
 run events3_bursty "$OUT/events3.yaml" bursty
+run slots8_noisy "$OUT/slots8.yaml" noisy
+run slots8_bursty "$OUT/slots8.yaml" bursty
 run default_invalid "$SRC/config/gestures.yaml" invalid
 run small_invalid "$OUT/small.yaml" invalid
 
@@ -175,6 +181,9 @@ grep -q "values clamped" "$OUT/distance5_noisy.log" && ! grep -q " 0 values clam
   || { echo "FAIL: distance5 never clamped"; fails=$((fails + 1)); }
 [ "$(cat "$OUT/sparse_age_boundary.count")" -ge 3 ] || { echo "FAIL: sparse stream at the age boundary never fired"; fails=$((fails + 1)); }
 grep -q "abort\|assist_requested" "$OUT/events3_noisy_gfctl.csv" || { echo "FAIL: no event fired"; fails=$((fails + 1)); }
+grep -q "^[^,]*,1,follower1.beta_deg,45,nan$" "$OUT/slots8_noisy_gfctl.csv" "$OUT/slots8_bursty_gfctl.csv" \
+  && grep -q "command refused: .*safety_distance_m" "$OUT/slots8_noisy.err" "$OUT/slots8_bursty.err" \
+  || { echo "FAIL: slots8: no command refused by the slot rule"; fails=$((fails + 1)); }
 grep -q "measurement rejected: out of order" "$OUT/default_invalid.err" || { echo "FAIL: no out-of-order row"; fails=$((fails + 1)); }
 grep -q "measurement rejected: unknown gesture id" "$OUT/default_invalid.err" || { echo "FAIL: no unknown id"; fails=$((fails + 1)); }
 # boundary: 4 Hz of gesture 1, t_d = 2.5 s exactly representable → commands exactly 2.5 s apart.

@@ -17,7 +17,9 @@ the parameter after the increment, beta wrapped to (-180, 180], gamma / distance
 (docs/formation.md §3-4: every UAV's elevation - leader gamma_L, follower gamma_L + gamma_i -
 within [gamma_min_deg, gamma_max_deg]; distance within [max(distance_min_m,
 safety_distance_m), distance_max_m]); UAVs of a group updated leader first, values joined
-with ';'. Events: parameter = event name, increment 0, value nan; unmapped: none,0,nan.
+with ';'. A command that would bring two UAVs' slots (their references around the worker)
+closer than safety_distance_m, when they were not closer already, is refused: nothing changes,
+value nan. Events: parameter = event name, increment 0, value nan; unmapped: none,0,nan.
 """
 import argparse
 import collections
@@ -82,7 +84,34 @@ class Formation:
         assert who.startswith("follower")
         return [int(who[len("follower"):])]
 
+    def slots(self):
+        """Every UAV's reference around a worker at the origin facing +x (docs/formation.md §2)."""
+        gl, bl, dl = math.radians(self.uavs[0]["gamma_deg"]), math.radians(self.uavs[0]["beta_deg"]), self.uavs[0]["distance_m"]
+        phi = -bl
+        out = [(-dl * math.cos(phi) * math.cos(gl), -dl * math.sin(phi) * math.cos(gl), dl * math.sin(gl))]
+        for f in self.uavs[1:]:
+            az, e, d = phi - math.radians(f["beta_deg"]), gl + math.radians(f["gamma_deg"]), f["distance_m"]
+            out.append((-d * math.cos(az) * math.cos(e), -d * math.sin(az) * math.cos(e), d * math.sin(e)))
+        return out
+
+    def closest(self):
+        p = self.slots()
+        return min((math.dist(p[a], p[b]) for a in range(len(p)) for b in range(a + 1, len(p))), default=None)
+
     def apply(self, path, inc):
+        """The values after the command, or None when it is refused (nothing changes): it would bring
+        two slots closer than safety_distance_m, and they were not closer already."""
+        before = [dict(u) for u in self.uavs]
+        before_min = self.closest()
+        values = self.apply_clamped(path, inc)
+        after_min = self.closest()
+        if after_min is not None and after_min < self.lim["safety_distance_m"] and (
+                before_min is None or after_min < before_min - 1e-9):
+            self.uavs = before
+            return None
+        return values
+
+    def apply_clamped(self, path, inc):
         who, name = path.split(".")
         values = []
         for u in sorted(set(self.targets(who))):
@@ -176,7 +205,8 @@ def main():
             else:
                 inc = float(action["increment"])
                 vals = formation.apply(action["parameter"], inc)
-                out.append(f"{fmt(t)},{dominant},{action['parameter']},{fmt(inc)},{';'.join(fmt(v) for v in vals)}")
+                value = "nan" if vals is None else ";".join(fmt(v) for v in vals)  # refused: nothing changed
+                out.append(f"{fmt(t)},{dominant},{action['parameter']},{fmt(inc)},{value}")
     with open(args.out, "w") as f:
         f.write("\n".join(out) + "\n")
     return 0
