@@ -96,7 +96,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     abort_sub_ = nh.subscribe("abort_in", 20, &FormationPlannerNodelet::onAbort, this);
     abort_pub_ = nh.advertise<gesture_formation::AbortState>("abort_state_out", 5, true);
     abort_pub_.publish(toAbortState(step_->abort(), uav_index_, ros::Time::now().toSec(), "", -1, world_frame_));
-    params_role_.setUp(nh, mutex_, fcfg, uav_index_, leadership_, params_rate_hz, settings.max_command_age_s, world_frame_);
+    params_role_.setUp(nh, getPrivateNodeHandle(), mutex_, fcfg, uav_index_, leadership_, params_rate_hz, settings.max_command_age_s, world_frame_);
     // Staggered replanning: UAV i plans at k·period + i·period/n (as in gfctl simulate).
     offset_s_ = period_s_ * uav_index_ / uav_count_;
     timer_ = nh.createTimer(ros::Duration(period_s_ / 8.0), &FormationPlannerNodelet::onTimer, this);

@@ -7,7 +7,13 @@
 // ~leadership its own LeadershipState (leadership_state_in). A leader whose lease lapses keeps the
 // commands that reach it meanwhile and applies them if it resumes in the same term within
 // max_command_age_s of their sending (ParamsOwnership::keepsCommand), and the assistance requests and
-// acknowledgements that reached it likewise. Every callback takes the nodelet's mutex.
+// acknowledgements that reached it likewise. The leader by index (no ~leadership) keeps its parameters,
+// their version and the ids it applied in ~params_state_file (optional; default
+// $ROS_HOME/gesture_formation/formation_params_uav0) after every applied command, named by the ROS run
+// (/run_id): restarted in the same run (a crashed or reloaded nodelet, a respawned manager) it continues
+// from them instead of the config's — whose version-0 parameters the followers would otherwise take,
+// losing every adjustment of the mission (docs/safety.md §2.4). A record of another run, or one that
+// does not fit the formation, is not used (WARN naming why). Every callback takes the nodelet's mutex.
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -18,6 +24,7 @@
 
 #include "conversions.hpp"
 #include "gesture_formation/LeadershipState.h"
+#include "gesture_formation/comm/sequence_store.hpp"
 #include "gesture_formation/onboard/formation_params_role.hpp"
 
 namespace gesture_formation::nodelets {
@@ -25,13 +32,14 @@ namespace gesture_formation::nodelets {
 class PlannerParamsRole {
  public:
   /// Creates the ownership and the topics of this UAV's role. `mutex` must outlive this.
-  void setUp(ros::NodeHandle& nh, std::mutex& mutex, const formation::FormationConfig& formation, int uav_index,
+  void setUp(ros::NodeHandle& nh, const ros::NodeHandle& pnh, std::mutex& mutex, const formation::FormationConfig& formation, int uav_index,
              bool leadership, double params_rate_hz, double max_command_age_s, const std::string& world_frame) {
     mutex_ = &mutex;
     uav_index_ = uav_index;
     max_command_age_s_ = max_command_age_s;
     world_frame_ = world_frame;
     own_.emplace(formation, uav_index, leadership);  // the config was validated by its loader
+    if (uav_index == formation::kLeader && !leadership) resumeRecord(pnh);
     if (uav_index == formation::kLeader || leadership) {
       params_pub_ = nh.advertise<gesture_formation::FormationParams>("formation_params_out", 5, true);
       command_sub_ = nh.subscribe("formation_command_in", 20, &PlannerParamsRole::onCommand, this);
@@ -110,8 +118,40 @@ class PlannerParamsRole {
     if (own_->takesCommand(stamp)) applyCommand(*msg);
   }
 
+  // The leader by index: its record of this run, if any, instead of the config's parameters.
+  void resumeRecord(const ros::NodeHandle& pnh) {
+    pnh.param<std::string>("params_state_file", state_file_, comm::defaultStateDirectory() + "/formation_params_uav0");
+    if (!ros::param::get("/run_id", run_) || run_.empty() || run_.find_first_of(" \t\r\n") != std::string::npos) {
+      ROS_WARN_STREAM("FormationPlanner: no usable /run_id: the parameters are not kept for a restart");
+      run_.clear();
+      return;
+    }
+    comm::ensureStateDirectory(comm::defaultStateDirectory(), {state_file_});
+    bool exists = false;
+    const auto text = comm::readStateFile(state_file_, exists);
+    if (!exists && text) return;  // the first start of this machine
+    const auto record = text ? onboard::parseParamsRecord(*text) : common::Result<onboard::ParamsRecord>::fail(text.reason());
+    if (!record) {
+      ROS_WARN_STREAM("FormationPlanner: " << state_file_ << " not used (" << record.reason() << "): the config's parameters");
+    } else if (record->run != run_) {
+      ROS_INFO_STREAM("FormationPlanner: the kept parameters are of another run (" << record->run << "): the config's parameters");
+    } else if (const auto resumed = own_->resume(*record); !resumed) {
+      ROS_WARN_STREAM("FormationPlanner: the kept parameters of this run not used (" << resumed.reason() << "): the config's parameters");
+    } else {
+      ROS_WARN_STREAM("FormationPlanner: restarted in run " << run_ << ": continues from parameters version "
+                                                            << own_->version() << " (" << state_file_ << ")");
+    }
+  }
+  void keepRecord() {
+    if (run_.empty()) return;
+    const auto w = comm::writeStateFile(state_file_, onboard::formatParamsRecord(own_->role().record(run_)));
+    if (!w) ROS_WARN_STREAM_THROTTLE(5.0, "FormationPlanner: parameters not kept for a restart: " << w.reason());
+  }
+
   void applyCommand(const gesture_formation::FormationCommand& msg) {
+    const std::uint64_t before = own_->version();
     const auto& r = own_->role().apply(fromMsg(msg), describe(msg), msg.source, msg.header.stamp.toSec());
+    if (own_->version() != before) keepRecord();  // the leader by index only (run_ empty otherwise)
     ROS_INFO_STREAM("FormationPlanner: command " << r.text << " → " << r.outcome);
     publishParams();
     ack_pub_.publish(toAck(msg, r.status, r.outcome, own_->version(), ros::Time::now()));  // to the operator
@@ -141,6 +181,7 @@ class PlannerParamsRole {
 
   std::mutex* mutex_ = nullptr;
   int uav_index_ = 0;
+  std::string state_file_, run_;  ///< the leader by index: where its record is kept, the ROS run (empty: none kept)
   double max_command_age_s_ = 5.0;
   std::string world_frame_;
   std::optional<onboard::ParamsOwnership> own_;

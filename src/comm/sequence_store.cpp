@@ -25,7 +25,21 @@ struct Fd {
   }
 };
 
-/// Reads a whole state file; `exists` false (and ok) when there is none.
+bool parseUnsigned(const std::string& s, std::uint64_t max, std::uint64_t& out) {
+  if (s.empty() || s.size() > 20) return false;
+  std::uint64_t v = 0;
+  for (char c : s) {
+    if (c < '0' || c > '9') return false;
+    const std::uint64_t d = static_cast<std::uint64_t>(c - '0');
+    if (v > (max - d) / 10) return false;
+    v = v * 10 + d;
+  }
+  out = v;
+  return true;
+}
+
+}  // namespace
+
 Result<std::string> readStateFile(const std::string& path, bool& exists) {
   auto fail = [&](const std::string& m) { return Result<std::string>::fail("state file '" + path + "': " + m); };
   exists = false;
@@ -58,7 +72,6 @@ Result<std::string> readStateFile(const std::string& path, bool& exists) {
   return Result<std::string>::ok(std::move(text));
 }
 
-/// Writes `text` to path.tmp (0600), fsyncs it and renames it over `path`.
 Result<bool> writeStateFile(const std::string& path, const std::string& text) {
   auto fail = [&](const std::string& m) { return Result<bool>::fail("state file '" + path + "': " + m); };
   const std::string tmp = path + ".tmp";
@@ -89,21 +102,6 @@ Result<bool> writeStateFile(const std::string& path, const std::string& text) {
   if (::fsync(d.fd) != 0) return fail(std::string("fsync of its directory failed: ") + std::strerror(errno));
   return Result<bool>::ok(true);
 }
-
-bool parseUnsigned(const std::string& s, std::uint64_t max, std::uint64_t& out) {
-  if (s.empty() || s.size() > 20) return false;
-  std::uint64_t v = 0;
-  for (char c : s) {
-    if (c < '0' || c > '9') return false;
-    const std::uint64_t d = static_cast<std::uint64_t>(c - '0');
-    if (v > (max - d) / 10) return false;
-    v = v * 10 + d;
-  }
-  out = v;
-  return true;
-}
-
-}  // namespace
 
 Result<std::uint32_t> advanceBootCounter(const std::string& path) {
   bool exists = false;

@@ -1,5 +1,9 @@
 #include "gesture_formation/onboard/formation_params_role.hpp"
 
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
 #include <utility>
 
 namespace gesture_formation::onboard {
@@ -31,9 +35,113 @@ const CommandRecord& FormationParamsRole::apply(const common::Result<formation::
       ++version_;
       params_ = state_->params();
       for (const auto& c : out.changes) last_.uavs.push_back(c.uav);
+      applied_.push_back(command->id);
+      if (applied_.size() > kMaxRecordedCommands) applied_.pop_front();
     }
   }
   return last_;
+}
+
+common::Result<bool> FormationParamsRole::resume(const ParamsRecord& record, const formation::FormationConfig& config) {
+  using R = common::Result<bool>;
+  if (!state_) return R::fail("not the leader: a follower takes the leader's parameters");
+  if (record.params.uavCount() != params_.uavCount()) {
+    return R::fail("a record for " + std::to_string(record.params.uavCount()) + " UAVs, the formation has " +
+                   std::to_string(params_.uavCount()));
+  }
+  auto st = formation::FormationState::create(record.params, config.limits, config.duplicates);
+  if (!st) return R::fail("its parameters are outside the limits: " + st.reason());
+  for (const auto& id : record.applied) st->rememberApplied(id);
+  state_.emplace(std::move(*st));
+  params_ = record.params;
+  version_ = record.version;
+  applied_.assign(record.applied.begin(), record.applied.end());
+  while (applied_.size() > kMaxRecordedCommands) applied_.pop_front();
+  return R::ok(true);
+}
+
+ParamsRecord FormationParamsRole::record(const std::string& run) const {
+  return ParamsRecord{run, version_, params_, std::vector<formation::CommandId>(applied_.begin(), applied_.end())};
+}
+
+std::string formatParamsRecord(const ParamsRecord& r) {
+  std::ostringstream os;
+  os.precision(17);
+  os << "gesture_formation_params 1\nrun " << r.run << "\nversion " << r.version << "\n";
+  for (int u = 0; u < r.params.uavCount(); ++u) {
+    const formation::UavObservation& o = r.params.uav(u);
+    os << "uav " << u << ' ' << o.beta_deg << ' ' << o.gamma_deg << ' ' << o.distance_m << "\n";
+  }
+  for (const auto& id : r.applied) {  // a name the line cannot hold is left out (its copies were the link's to drop)
+    const bool one_word = !id.sender.empty() && id.sender.find_first_of(" \t\r\n") == std::string::npos;
+    if (one_word) os << "applied " << id.sender << ' ' << id.sequence << "\n";
+  }
+  return os.str();
+}
+
+namespace {
+/// Digits only (istream would take "-1" into an unsigned as its maximum), within 64 bits.
+bool readUnsigned(std::istream& in, std::uint64_t& out) {
+  std::string word;
+  if (!(in >> word) || word.empty() || word.size() > 20 || word.find_first_not_of("0123456789") != std::string::npos) return false;
+  errno = 0;
+  char* end = nullptr;
+  const unsigned long long v = std::strtoull(word.c_str(), &end, 10);
+  if (errno == ERANGE || end != word.c_str() + word.size()) return false;
+  out = static_cast<std::uint64_t>(v);
+  return true;
+}
+}  // namespace
+
+common::Result<ParamsRecord> parseParamsRecord(const std::string& text) {
+  using R = common::Result<ParamsRecord>;
+  std::istringstream in(text);
+  std::string line;
+  ParamsRecord r;
+  int line_no = 0, uavs = 0;
+  bool has_run = false, has_version = false;
+  auto bad = [&](const std::string& what) { return R::fail("line " + std::to_string(line_no) + ": " + what + " ('" + line + "')"); };
+  while (std::getline(in, line)) {
+    ++line_no;
+    std::istringstream f(line);
+    std::string key, extra;
+    f >> key;
+    if (line_no == 1) {
+      int format = 0;
+      if (key != "gesture_formation_params" || !(f >> format) || format != 1 || (f >> extra)) return bad("not a parameter record of format 1");
+      continue;
+    }
+    if (key == "run") {
+      if (!(f >> r.run) || (f >> extra)) return bad("run: one word expected");
+      has_run = true;
+    } else if (key == "version") {
+      if (!readUnsigned(f, r.version) || (f >> extra)) return bad("version: an unsigned integer expected");
+      has_version = true;
+    } else if (key == "uav") {
+      int u = -1;
+      formation::UavObservation o;
+      if (!(f >> u >> o.beta_deg >> o.gamma_deg >> o.distance_m) || (f >> extra)) return bad("uav: index, beta_deg, gamma_deg, distance_m expected");
+      if (u != uavs) return bad("uav " + std::to_string(u) + " out of order (expected " + std::to_string(uavs) + ")");
+      if (!std::isfinite(o.beta_deg) || !std::isfinite(o.gamma_deg) || !std::isfinite(o.distance_m)) return bad("uav: values must be finite");
+      if (u == 0) {
+        r.params.leader = o;
+        r.params.followers.clear();
+      } else {
+        r.params.followers.push_back(o);
+      }
+      ++uavs;
+    } else if (key == "applied") {
+      formation::CommandId id;
+      if (!(f >> id.sender) || !readUnsigned(f, id.sequence) || (f >> extra)) return bad("applied: sender and sequence expected");
+      if (r.applied.size() == kMaxRecordedCommands) return bad("more than " + std::to_string(kMaxRecordedCommands) + " applied ids");
+      r.applied.push_back(id);
+    } else if (!key.empty()) {
+      return bad("unknown key '" + key + "'");
+    }
+  }
+  if (line_no == 0) return R::fail("empty record");
+  if (!has_run || !has_version || uavs == 0) return R::fail("incomplete record: run, version and the leader's uav line are required");
+  return R::ok(std::move(r));
 }
 
 common::Result<bool> FormationParamsRole::receive(const formation::FormationParams& params, std::uint64_t version) {
@@ -86,6 +194,11 @@ int ParamsOwnership::leaderIndex() const {
   if (!follow_) return formation::kLeader;
   if (acting_) return uav_index_;
   return leader_ >= 0 ? leader_ : formation::kLeader;
+}
+
+common::Result<bool> ParamsOwnership::resume(const ParamsRecord& record) {
+  if (follow_) return common::Result<bool>::fail("following the leadership: the parameters come from the acting leader");
+  return role_->resume(record, config_);
 }
 
 common::Result<bool> ParamsOwnership::receive(const formation::FormationParams& params, std::uint64_t version) {

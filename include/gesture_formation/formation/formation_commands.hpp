@@ -178,6 +178,8 @@ class FormationState {
 
   /// \brief Applies a command (see the file comment). Never throws on bad input.
   CommandOutcome apply(const FormationCommand& command);
+  /// \brief Remembers `id` as applied (a state resumed after a restart: its copies stay duplicates).
+  void rememberApplied(const CommandId& id) { duplicates_.record(id); }
 
   const FormationParams& params() const { return params_; }
   const FormationLimits& limits() const { return limits_; }

@@ -9,6 +9,7 @@
 /// Thread safety: none (the caller's lock).
 
 #include <cstdint>
+#include <deque>
 #include <optional>
 #include <string>
 #include <vector>
@@ -19,6 +20,23 @@
 #include "gesture_formation/formation/formation_config.hpp"
 
 namespace gesture_formation::onboard {
+
+/// \brief What a fixed leader keeps on disk to resume after a restart of its planner in the same
+/// run (docs/safety.md §2.4): the parameters, their version and the ids of the commands it applied
+/// last (a copy still on the link stays a duplicate). `run` names the run (ROS: /run_id) — a record
+/// of another run is not resumed. Text: formatParamsRecord / parseParamsRecord.
+struct ParamsRecord {
+  std::string run;
+  std::uint64_t version = 0;
+  formation::FormationParams params;
+  std::vector<formation::CommandId> applied;  ///< oldest first, ≤ kMaxRecordedCommands
+};
+constexpr std::size_t kMaxRecordedCommands = 64;
+/// \brief Lines: `gesture_formation_params 1`, `run <id>`, `version <n>`, one `uav <i> <beta_deg>
+/// <gamma_deg> <distance_m>` per UAV from 0 (the leader), one `applied <sender> <sequence>` per id.
+std::string formatParamsRecord(const ParamsRecord& record);
+/// \brief Fails naming the line and what is wrong (every number finite, UAVs 0..n−1 in order, ≥ 1).
+common::Result<ParamsRecord> parseParamsRecord(const std::string& text);
 
 /// \brief The last command the leader handled (FormationParams.last_* in ROS).
 struct CommandRecord {
@@ -43,6 +61,13 @@ class FormationParamsRole {
   /// \brief A follower: the leader's parameters; refused (nothing changes) naming the UAV count.
   common::Result<bool> receive(const formation::FormationParams& params, std::uint64_t version);
 
+  /// \brief The leader: continues from `record` (its parameters, version and applied ids), as
+  /// checked against `config`'s limits; refused naming why (nothing changes) for a follower or
+  /// parameters outside the limits or for another number of UAVs.
+  common::Result<bool> resume(const ParamsRecord& record, const formation::FormationConfig& config);
+  /// \brief The leader's state to keep (resume), named `run`.
+  ParamsRecord record(const std::string& run) const;
+
   const formation::FormationParams& params() const { return params_; }
   /// \brief The leader: the version of its parameters (applied commands); a follower: the version received.
   std::uint64_t version() const { return version_; }
@@ -57,6 +82,7 @@ class FormationParamsRole {
   std::uint64_t version_ = 0;
   CommandRecord last_;
   formation::AssistanceLatch assistance_;
+  std::deque<formation::CommandId> applied_;  ///< the last kMaxRecordedCommands applied, oldest first
 };
 
 /// \brief Who owns the formation's parameters (the FormationPlanner's role): the leader by index,
@@ -104,6 +130,9 @@ class ParamsOwnership {
   /// \brief The owner's parameters as received; ignored (ok(false)) while this UAV owns them or
   /// its lease has lapsed in the term it acted in (a late copy of an earlier owner's).
   common::Result<bool> receive(const formation::FormationParams& params, std::uint64_t version);
+  /// \brief The leader by index (not following the leadership), restarted in the same run: continues
+  /// from `record` (FormationParamsRole::resume); refused naming why for any other UAV.
+  common::Result<bool> resume(const ParamsRecord& record);
   /// The parameters' version: the one taken over plus this UAV's own applied commands.
   std::uint64_t version() const { return base_version_ + role_->version(); }
   double tookOverS() const { return took_over_s_; }

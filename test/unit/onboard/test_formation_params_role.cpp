@@ -261,3 +261,71 @@ TEST(ParamsOwnershipTest, TheSlotAndTheLeadersPlanFollowTheLeadership) {
   EXPECT_EQ(uav0.slot(), 1) << "UAV 0 flies the slot its successor left";
   EXPECT_EQ(uav0.leaderIndex(), 1);
 }
+
+// A fixed leader's planner restarted mid-mission (leadership off) started again from the config's
+// parameters at version 0, and the followers took them: every adjustment of the mission lost. Its
+// record (parameters, version, applied ids) lets it continue; a copy of a command it applied before
+// the restart stays a duplicate.
+TEST(FormationParamsRoleTest, ARestartedLeaderResumesItsRecordAndKnowsWhatItApplied) {
+  formation::FormationConfig config;
+  FormationParamsRole before(config, 0);
+  before.apply(common::Result<formation::FormationCommand>::ok(distancePlusOne(3)), "op #3", "operator", 7.5);
+  before.apply(common::Result<formation::FormationCommand>::ok(distancePlusOne(4)), "op #4", "operator", 8.5);
+  ASSERT_EQ(before.version(), 2u);
+  const auto text = onboard::formatParamsRecord(before.record("run-42"));
+  const auto parsed = onboard::parseParamsRecord(text);
+  ASSERT_TRUE(parsed) << parsed.reason() << "\n" << text;
+  EXPECT_EQ(parsed->run, "run-42");
+  EXPECT_EQ(parsed->version, 2u);
+  ASSERT_EQ(parsed->applied.size(), 2u);
+  EXPECT_EQ(parsed->applied[1].sender, "operator@100");
+  EXPECT_EQ(parsed->applied[1].sequence, 4u);
+
+  FormationParamsRole after(config, 0);
+  ASSERT_TRUE(after.resume(*parsed, config));
+  EXPECT_EQ(after.version(), 2u);
+  for (int u = 0; u < 3; ++u) {
+    EXPECT_EQ(after.params().uav(u).distance_m, before.params().uav(u).distance_m) << "UAV " << u;  // exact: %.17g
+    EXPECT_EQ(after.params().uav(u).beta_deg, before.params().uav(u).beta_deg) << "UAV " << u;
+  }
+  after.apply(common::Result<formation::FormationCommand>::ok(distancePlusOne(4)), "op #4", "operator", 8.7);
+  EXPECT_EQ(after.last().status, "duplicate");
+  after.apply(common::Result<formation::FormationCommand>::ok(distancePlusOne(5)), "op #5", "operator", 9.0);
+  EXPECT_EQ(after.last().status, "applied");
+  EXPECT_EQ(after.version(), 3u);
+  EXPECT_DOUBLE_EQ(after.params().uav(1).distance_m, config.params.uav(1).distance_m + 3.0);
+
+  // Refused, nothing changed: a follower; another UAV count; parameters outside the limits.
+  FormationParamsRole follower(config, 1);
+  EXPECT_FALSE(follower.resume(*parsed, config));
+  onboard::ParamsRecord two = *parsed;
+  two.params.followers.pop_back();
+  FormationParamsRole fresh(config, 0);
+  const auto count = fresh.resume(two, config);
+  ASSERT_FALSE(count);
+  EXPECT_NE(count.reason().find("2 UAVs"), std::string::npos) << count.reason();
+  onboard::ParamsRecord far = *parsed;
+  far.params.leader.distance_m = 1000.0;
+  const auto limits = fresh.resume(far, config);
+  ASSERT_FALSE(limits);
+  EXPECT_NE(limits.reason().find("distance"), std::string::npos) << limits.reason();
+  EXPECT_EQ(fresh.version(), 0u);
+  EXPECT_EQ(fresh.params().uav(0).distance_m, config.params.uav(0).distance_m);
+}
+
+TEST(FormationParamsRoleTest, ABadRecordIsRefusedNamingTheLine) {
+  const std::string good = "gesture_formation_params 1\nrun r1\nversion 3\nuav 0 90 11 10\nuav 1 60 0 8\n";
+  ASSERT_TRUE(onboard::parseParamsRecord(good));
+  auto reason = [](const std::string& text) {
+    const auto r = onboard::parseParamsRecord(text);
+    EXPECT_FALSE(r) << text;
+    return r ? std::string() : r.reason();
+  };
+  EXPECT_NE(reason("gesture_formation_params 2\n").find("line 1"), std::string::npos);
+  EXPECT_NE(reason(good + "uav 3 0 0 8\n").find("line 6: uav 3 out of order"), std::string::npos);
+  EXPECT_NE(reason("gesture_formation_params 1\nrun r1\nversion -1\nuav 0 90 11 10\n").find("line 3: version"), std::string::npos);
+  EXPECT_NE(reason("gesture_formation_params 1\nrun r1\nversion 1\nuav 0 nan 11 10\n").find("line 4: uav"), std::string::npos);
+  EXPECT_NE(reason("gesture_formation_params 1\nrun r1\nversion 1\n").find("incomplete"), std::string::npos);
+  EXPECT_NE(reason(good + "speed 3\n").find("unknown key 'speed'"), std::string::npos);
+  EXPECT_NE(reason("").find("empty"), std::string::npos);
+}
