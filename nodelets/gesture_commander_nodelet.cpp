@@ -20,8 +20,9 @@
 // Parameters (required): ~gesture_config (config/gestures.yaml: filter, mapping, view_fusion.*)
 //   or ~mission_file (a scenario's mission.gestures), ~uav_count, ~sender_name, ~frame_wait_s,
 //   ~frame_merge_s (unsynchronised cameras: one observation per view per frame, gesture::GestureFrames).
-//   Command sequence numbers start at the wall clock in microseconds, so a restarted commander
-//   is never taken for a duplicate.
+//   Command sequence numbers start at the sender's boot counter (optional ~sequence_file,
+//   command_sequence.hpp), so a restarted commander is never taken for a duplicate nor refused as
+//   stale, whatever the clock did.
 // Leader hand-over (optional ~leadership, default false; docs/safety.md §1.2): the commander runs on
 // every UAV and follows this UAV's leadership_state_in (LeadershipState): only while it acts are
 // observations taken and commands sent — and through a lapse of its lease in the term it acts in (the
@@ -46,6 +47,7 @@
 #include "gesture_formation/GestureStatus.h"
 #include "gesture_formation/LeadershipState.h"
 #include "gesture_formation/gesture/gesture_frames.hpp"
+#include "command_sequence.hpp"
 #include "param_loader.hpp"
 
 namespace gesture_formation::nodelets {
@@ -88,6 +90,7 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
       params.addError("frame_wait_s: value " + std::to_string(frame_wait_s_) +
                       " must be below view_fusion.max_age_s " + std::to_string(vcfg.max_age_s));
     }
+    if (params.ok()) sequence_ = commandSequenceStart(params, getPrivateNodeHandle().getNamespace());
     if (!params.ok()) {
       NODELET_ERROR_STREAM("GestureCommander refuses to start; fix these parameters:\n" << params.report());
       return;
@@ -104,7 +107,6 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
                         << "] deg, confirm_3d " << (vcfg.confirm_3d ? "on" : "off") << ", require_3d "
                         << (vcfg.require_3d ? "on" : "off") << ", frames closed "
                         << frames_->closeAfterS() << " s after their stamp\n");
-    sequence_ = static_cast<std::uint64_t>(ros::WallTime::now().toNSec() / 1000);
     command_pub_ = nh.advertise<gesture_formation::FormationCommand>("formation_command_out", 10);
     status_pub_ = nh.advertise<gesture_formation::GestureStatus>("gesture_status_out", 10);
     abort_pub_ = nh.advertise<gesture_formation::AbortCommand>("abort_out", 10);

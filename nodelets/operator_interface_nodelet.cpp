@@ -2,7 +2,8 @@
 // as a service (send_command: gesture_formation/SendCommand; CLI tools/gf_command.py) or a topic
 // (command_in: FormationCommand, e.g. a GUI or a scheduled mission); each is checked
 // (target, parameter, kind, finite amount: formation core parsers), numbered (sender
-// ~sender_name, sequence from the wall clock in µs, so a restart never reuses numbers) and
+// ~sender_name, sequence from the sender's boot counter, command_sequence.hpp: a restart never reuses
+// numbers, whatever the clock did) and
 // published on formation_command_out (to the LcmBridge → the leader's FormationPlanner, which
 // applies and clamps it).
 // Abort (docs/safety.md §2.8): the service send_abort (gesture_formation/SendAbort; tools/gf_command.py
@@ -40,6 +41,7 @@
 #include "gesture_formation/SendAbort.h"
 #include "gesture_formation/SendCommand.h"
 #include "gesture_formation/formation/uav_list.hpp"
+#include "command_sequence.hpp"
 #include "param_loader.hpp"
 
 namespace gesture_formation::nodelets {
@@ -74,12 +76,12 @@ class OperatorInterfaceNodelet : public nodelet::Nodelet {
                         " must be >= abort_repeat_period_s " + std::to_string(abort_period_s_));
       }
     }
+    if (params.ok()) sequence_ = commandSequenceStart(params, getPrivateNodeHandle().getNamespace());
     if (!params.ok()) {
       NODELET_ERROR_STREAM("OperatorInterface refuses to start; fix these parameters:\n" << params.report());
       return;
     }
     NODELET_INFO_STREAM("OperatorInterface loaded:\n" << params.loaded());
-    sequence_ = static_cast<std::uint64_t>(ros::WallTime::now().toNSec() / 1000);
     command_pub_ = nh.advertise<gesture_formation::FormationCommand>("formation_command_out", 20);
     command_sub_ = nh.subscribe("command_in", 20, &OperatorInterfaceNodelet::onCommand, this);
     service_ = nh.advertiseService("send_command", &OperatorInterfaceNodelet::onService, this);
