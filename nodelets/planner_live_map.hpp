@@ -158,8 +158,16 @@ class PlannerLiveMap {
       info = info_;
     }
     if (!info) return refuse("no CameraInfo on depth_info_in yet");
-    if (info->width != m->width || info->height != m->height) return refuse("depth image size differs from its CameraInfo");
-    frame.intrinsics = {info->K[0], info->K[4], info->K[2], info->K[5]};
+    // The image's own pinhole: the calibration with the binning and region applied (REP 104); the
+    // aligned depth is taken as rectified, whatever distortion model the driver names.
+    sensor_msgs::CameraInfo pinhole = *info;
+    pinhole.D.clear();
+    const auto k = toIntrinsics(pinhole);
+    if (!k) return refuse("depth_info_in: " + k.reason());
+    if (static_cast<std::uint32_t>(k->width_px) != m->width || static_cast<std::uint32_t>(k->height_px) != m->height) {
+      return refuse("depth image size differs from its CameraInfo");
+    }
+    frame.intrinsics = {k->fx, k->fy, k->cx, k->cy};
     auto depth = toDepth(*m);
     if (!depth) return refuse("depth_in: " + depth.reason());
     if (depth->type() == CV_16UC1) {  // millimetres; 0: no return (REP 118) -> NaN

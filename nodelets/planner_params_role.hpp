@@ -8,12 +8,14 @@
 // commands that reach it meanwhile and applies them if it resumes in the same term within
 // max_command_age_s of their sending (ParamsOwnership::keepsCommand), and the assistance requests and
 // acknowledgements that reached it likewise. The leader by index (no ~leadership) keeps its parameters,
-// their version and the ids it applied in ~params_state_file (optional; default
-// $ROS_HOME/gesture_formation/formation_params_uav0) after every applied command, named by the ROS run
-// (/run_id): restarted in the same run (a crashed or reloaded nodelet, a respawned manager) it continues
-// from them instead of the config's — whose version-0 parameters the followers would otherwise take,
-// losing every adjustment of the mission (docs/safety.md §2.4). A record of another run, or one that
-// does not fit the formation, is not used (WARN naming why). Every callback takes the nodelet's mutex.
+// their version, the ids it applied and the assistance latch in ~params_state_file (optional; default
+// $ROS_HOME/gesture_formation/formation_params_uav0) after every applied command and latch change,
+// named by the ROS run and the launch (/run_id, ~launch_id — a master kept up across missions keeps its
+// run id): restarted in the same launch (a crashed or reloaded nodelet, a respawned manager) it
+// continues from them instead of the config's — whose version-0 parameters the followers would
+// otherwise take, losing every adjustment of the mission and a pending request for assistance
+// (docs/safety.md §2.4). A record of another run, or one that does not fit the formation, is not used
+// (WARN naming why). Every callback takes the nodelet's mutex.
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -121,10 +123,16 @@ class PlannerParamsRole {
   // The leader by index: its record of this run, if any, instead of the config's parameters.
   void resumeRecord(const ros::NodeHandle& pnh) {
     pnh.param<std::string>("params_state_file", state_file_, comm::defaultStateDirectory() + "/formation_params_uav0");
-    if (!ros::param::get("/run_id", run_) || run_.empty() || run_.find_first_of(" \t\r\n") != std::string::npos) {
-      ROS_WARN_STREAM("FormationPlanner: no usable /run_id: the parameters are not kept for a restart");
+    std::string launch_id;
+    pnh.param<std::string>("launch_id", launch_id, "");
+    if (!ros::param::get("/run_id", run_) || run_.empty()) {
+      ROS_WARN_STREAM("FormationPlanner: no /run_id: the parameters are not kept for a restart");
       run_.clear();
       return;
+    }
+    if (!launch_id.empty()) run_ += "@" + launch_id;
+    for (char& c : run_) {
+      if (c < 0x21 || c > 0x7e) c = '_';  // one word of the record's line
     }
     comm::ensureStateDirectory(comm::defaultStateDirectory(), {state_file_});
     bool exists = false;
@@ -134,7 +142,8 @@ class PlannerParamsRole {
     if (!record) {
       ROS_WARN_STREAM("FormationPlanner: " << state_file_ << " not used (" << record.reason() << "): the config's parameters");
     } else if (record->run != run_) {
-      ROS_INFO_STREAM("FormationPlanner: the kept parameters are of another run (" << record->run << "): the config's parameters");
+      ROS_WARN_STREAM("FormationPlanner: the kept parameters are of another run or launch (" << record->run << ", this is " << run_
+                                                                                      << "): the config's parameters");
     } else if (const auto resumed = own_->resume(*record); !resumed) {
       ROS_WARN_STREAM("FormationPlanner: the kept parameters of this run not used (" << resumed.reason() << "): the config's parameters");
     } else {
@@ -167,6 +176,7 @@ class PlannerParamsRole {
     auto state = fromMsg(m);
     auto& latch = own_->role().assistance();
     if (!state || !latch.receive(*state)) return;
+    keepRecord();  // a pending request survives a restart
     ROS_WARN_STREAM("FormationPlanner: assistance " << formation::toString(latch.state().phase) << " (requested at "
                                                     << latch.state().requested_s << " s by " << latch.state().requested_by
                                                     << "; the worker's gestures are refused while requested)");

@@ -74,7 +74,7 @@ Result<std::string> readStateFile(const std::string& path, bool& exists) {
 
 Result<bool> writeStateFile(const std::string& path, const std::string& text) {
   auto fail = [&](const std::string& m) { return Result<bool>::fail("state file '" + path + "': " + m); };
-  const std::string tmp = path + ".tmp";
+  const std::string tmp = path + ".tmp." + std::to_string(::getpid());  // two writers never share one
   {
     const Fd f{::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC | O_NOFOLLOW, 0600)};
     if (f.fd < 0) return fail(std::string("cannot create '") + tmp + "': " + std::strerror(errno));

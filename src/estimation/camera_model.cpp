@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -58,7 +59,7 @@ common::Result<CameraIntrinsics> readoutIntrinsics(const CameraIntrinsics& full,
                    ") with no region (roi 0x0 is the full image)");
   }
   const int w = whole ? full.width_px : r.roi_width, h = whole ? full.height_px : r.roi_height;
-  if (r.roi_x_offset + w > full.width_px || r.roi_y_offset + h > full.height_px) {
+  if (std::int64_t{r.roi_x_offset} + w > full.width_px || std::int64_t{r.roi_y_offset} + h > full.height_px) {
     return R::fail("roi (" + std::to_string(r.roi_x_offset) + ", " + std::to_string(r.roi_y_offset) + ") " +
                    std::to_string(w) + "x" + std::to_string(h) + " lies outside the " + std::to_string(full.width_px) + "x" +
                    std::to_string(full.height_px) + " sensor");

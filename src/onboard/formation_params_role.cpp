@@ -57,12 +57,25 @@ common::Result<bool> FormationParamsRole::resume(const ParamsRecord& record, con
   version_ = record.version;
   applied_.assign(record.applied.begin(), record.applied.end());
   while (applied_.size() > kMaxRecordedCommands) applied_.pop_front();
+  assistance_.restore(record.assistance);
   return R::ok(true);
 }
 
 ParamsRecord FormationParamsRole::record(const std::string& run) const {
-  return ParamsRecord{run, version_, params_, std::vector<formation::CommandId>(applied_.begin(), applied_.end())};
+  return ParamsRecord{run, version_, params_, std::vector<formation::CommandId>(applied_.begin(), applied_.end()),
+                      assistance_.state()};
 }
+
+namespace {
+/// Printable ASCII without spaces (as the wire's sender names): one word of a record's line.
+bool oneWord(const std::string& s) {
+  if (s.empty() || s == "-") return false;
+  for (const char c : s) {
+    if (c < 0x21 || c > 0x7e) return false;
+  }
+  return true;
+}
+}  // namespace
 
 std::string formatParamsRecord(const ParamsRecord& r) {
   std::ostringstream os;
@@ -73,9 +86,12 @@ std::string formatParamsRecord(const ParamsRecord& r) {
     os << "uav " << u << ' ' << o.beta_deg << ' ' << o.gamma_deg << ' ' << o.distance_m << "\n";
   }
   for (const auto& id : r.applied) {  // a name the line cannot hold is left out (its copies were the link's to drop)
-    const bool one_word = !id.sender.empty() && id.sender.find_first_of(" \t\r\n") == std::string::npos;
-    if (one_word) os << "applied " << id.sender << ' ' << id.sequence << "\n";
+    if (oneWord(id.sender)) os << "applied " << id.sender << ' ' << id.sequence << "\n";
   }
+  const formation::AssistanceState& a = r.assistance;
+  os << "assistance " << formation::toString(a.phase) << ' ' << a.requested_s << ' ' << a.acknowledged_s << ' '
+     << (oneWord(a.requested_by) ? a.requested_by : "-") << ' ' << (oneWord(a.acknowledged_by) ? a.acknowledged_by : "-")
+     << "\n";
   return os.str();
 }
 
@@ -135,6 +151,19 @@ common::Result<ParamsRecord> parseParamsRecord(const std::string& text) {
       if (!(f >> id.sender) || !readUnsigned(f, id.sequence) || (f >> extra)) return bad("applied: sender and sequence expected");
       if (r.applied.size() == kMaxRecordedCommands) return bad("more than " + std::to_string(kMaxRecordedCommands) + " applied ids");
       r.applied.push_back(id);
+    } else if (key == "assistance") {
+      std::string phase, by, ack_by;
+      formation::AssistanceState& a = r.assistance;
+      if (!(f >> phase >> a.requested_s >> a.acknowledged_s >> by >> ack_by) || (f >> extra)) {
+        return bad("assistance: phase, requested_s, acknowledged_s, requested_by, acknowledged_by expected");
+      }
+      if (phase == "none") a.phase = formation::AssistancePhase::kNone;
+      else if (phase == "requested") a.phase = formation::AssistancePhase::kRequested;
+      else if (phase == "acknowledged") a.phase = formation::AssistancePhase::kAcknowledged;
+      else return bad("assistance: phase '" + phase + "' is not none | requested | acknowledged");
+      if (!std::isfinite(a.requested_s) || !std::isfinite(a.acknowledged_s)) return bad("assistance: times must be finite");
+      a.requested_by = by == "-" ? "" : by;
+      a.acknowledged_by = ack_by == "-" ? "" : ack_by;
     } else if (!key.empty()) {
       return bad("unknown key '" + key + "'");
     }

@@ -41,7 +41,7 @@ void ensureStateDirectory(const std::string& dir, const std::vector<std::string>
 /// \brief Reads a whole state file (a regular file, mode 0600 or stricter, ≤ 64 KiB); `exists`
 /// false (and ok, empty) when there is none. Fails naming the path and the problem.
 common::Result<std::string> readStateFile(const std::string& path, bool& exists);
-/// \brief Writes `text` durably: to path.tmp (0600), fsync, rename over `path`, fsync of the
+/// \brief Writes `text` durably: to path.tmp.<pid> (0600), fsync, rename over `path`, fsync of the
 /// directory; the old file is kept on failure.
 common::Result<bool> writeStateFile(const std::string& path, const std::string& text);
 

@@ -71,6 +71,8 @@ class AssistanceLatch {
            " s: the views are held until the operator acknowledges";
   }
   const AssistanceState& state() const { return state_; }
+  /// \brief Takes `s` as it was kept (a leader restarted in the same run: onboard::ParamsRecord).
+  void restore(const AssistanceState& s) { state_ = s; }
 
  private:
   AssistanceState state_;

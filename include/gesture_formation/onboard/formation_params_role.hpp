@@ -22,18 +22,22 @@
 namespace gesture_formation::onboard {
 
 /// \brief What a fixed leader keeps on disk to resume after a restart of its planner in the same
-/// run (docs/safety.md §2.4): the parameters, their version and the ids of the commands it applied
-/// last (a copy still on the link stays a duplicate). `run` names the run (ROS: /run_id) — a record
-/// of another run is not resumed. Text: formatParamsRecord / parseParamsRecord.
+/// run (docs/safety.md §2.4): the parameters, their version, the ids of the commands it applied
+/// last (a copy still on the link stays a duplicate) and the assistance latch (a pending request
+/// stays pending). `run` names the run (ROS: /run_id and the launch's id) — a record of another run
+/// is not resumed. Text: formatParamsRecord / parseParamsRecord.
 struct ParamsRecord {
   std::string run;
   std::uint64_t version = 0;
   formation::FormationParams params;
   std::vector<formation::CommandId> applied;  ///< oldest first, ≤ kMaxRecordedCommands
+  formation::AssistanceState assistance;
 };
 constexpr std::size_t kMaxRecordedCommands = 64;
 /// \brief Lines: `gesture_formation_params 1`, `run <id>`, `version <n>`, one `uav <i> <beta_deg>
-/// <gamma_deg> <distance_m>` per UAV from 0 (the leader), one `applied <sender> <sequence>` per id.
+/// <gamma_deg> <distance_m>` per UAV from 0 (the leader), one `applied <sender> <sequence>` per id
+/// (names of printable ASCII without spaces; another is left out), `assistance <phase> <requested_s>
+/// <acknowledged_s> <requested_by> <acknowledged_by>` (a name '-' when empty or not one word).
 std::string formatParamsRecord(const ParamsRecord& record);
 /// \brief Fails naming the line and what is wrong (every number finite, UAVs 0..n−1 in order, ≥ 1).
 common::Result<ParamsRecord> parseParamsRecord(const std::string& text);

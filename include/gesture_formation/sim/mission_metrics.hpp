@@ -277,7 +277,7 @@ struct CommandOutcome {
 };
 
 /// \brief The parameter versions the leader published, to tell which one a follower planned
-/// with when only the parameters travel with its plan (over LCM, without a version).
+/// with from the parameters its plan lists.
 class ParamsVersions {
  public:
   explicit ParamsVersions(const formation::FormationParams& initial) { versions_.emplace_back(0, initial); }

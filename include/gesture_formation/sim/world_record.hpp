@@ -109,9 +109,9 @@ class WorldRecord {
               const std::string& dir, std::string* error, std::string* warning);
 
  private:
-  /// The parameter version a plan was made with: the leader's says it; a follower's parameters come
-  /// over LCM without their version, so it is the latest version the leader published with
-  /// exactly the parameters the plan lists.
+  /// The parameter version a plan was made with: the leader's says it; a follower's is taken as the
+  /// latest version the leader published with exactly the parameters the plan lists (the version it
+  /// received with them over LCM; matched by parameters, as before the version travelled).
   std::uint64_t planVersion(const PlanReport& p) const;
 
   int n_;

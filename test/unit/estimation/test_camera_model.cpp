@@ -142,4 +142,5 @@ TEST(CameraModelTest, ReadoutIntrinsicsRefuseAnImpossibleReadoutNamingIt) {
   EXPECT_NE(negative.find("binning_x -2"), std::string::npos);
   EXPECT_NE(negative.find("roi.y_offset -1"), std::string::npos);
   EXPECT_NE(reason({1000, 1, 0, 0, 0, 0}).find("leaves no pixel"), std::string::npos);
+  EXPECT_NE(reason({0, 0, 1 << 30, 0, 1 << 30, 480}).find("outside"), std::string::npos);  // no int overflow
 }

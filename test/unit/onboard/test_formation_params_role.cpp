@@ -272,6 +272,7 @@ TEST(FormationParamsRoleTest, ARestartedLeaderResumesItsRecordAndKnowsWhatItAppl
   before.apply(common::Result<formation::FormationCommand>::ok(distancePlusOne(3)), "op #3", "operator", 7.5);
   before.apply(common::Result<formation::FormationCommand>::ok(distancePlusOne(4)), "op #4", "operator", 8.5);
   ASSERT_EQ(before.version(), 2u);
+  before.assistance().request(8.9, "gesture");  // the worker waits for help: it must stay pending
   const auto text = onboard::formatParamsRecord(before.record("run-42"));
   const auto parsed = onboard::parseParamsRecord(text);
   ASSERT_TRUE(parsed) << parsed.reason() << "\n" << text;
@@ -284,6 +285,10 @@ TEST(FormationParamsRoleTest, ARestartedLeaderResumesItsRecordAndKnowsWhatItAppl
   FormationParamsRole after(config, 0);
   ASSERT_TRUE(after.resume(*parsed, config));
   EXPECT_EQ(after.version(), 2u);
+  EXPECT_EQ(after.assistance().state().phase, formation::AssistancePhase::kRequested);
+  EXPECT_EQ(after.assistance().state().requested_s, 8.9);
+  EXPECT_EQ(after.assistance().state().requested_by, "gesture");
+  EXPECT_TRUE(after.assistance().refusal(formation::CommandSource::kGesture)) << "the worker's gestures stay refused";
   for (int u = 0; u < 3; ++u) {
     EXPECT_EQ(after.params().uav(u).distance_m, before.params().uav(u).distance_m) << "UAV " << u;  // exact: %.17g
     EXPECT_EQ(after.params().uav(u).beta_deg, before.params().uav(u).beta_deg) << "UAV " << u;
@@ -328,4 +333,14 @@ TEST(FormationParamsRoleTest, ABadRecordIsRefusedNamingTheLine) {
   EXPECT_NE(reason("gesture_formation_params 1\nrun r1\nversion 1\n").find("incomplete"), std::string::npos);
   EXPECT_NE(reason(good + "speed 3\n").find("unknown key 'speed'"), std::string::npos);
   EXPECT_NE(reason("").find("empty"), std::string::npos);
+  EXPECT_NE(reason(good + "assistance pending 1 0 gesture -\n").find("phase 'pending'"), std::string::npos);
+  // A sender name a line cannot hold (a vertical tab splits it for the parser) is left out, not the record.
+  onboard::ParamsRecord r;
+  r.run = "r1";
+  r.applied = {{"op\vx", 3}, {"operator@100", 4}};
+  const auto back = onboard::parseParamsRecord(onboard::formatParamsRecord(r));
+  ASSERT_TRUE(back) << back.reason();
+  ASSERT_EQ(back->applied.size(), 1u);
+  EXPECT_EQ(back->applied[0].sequence, 4u);
+  EXPECT_EQ(back->assistance.phase, formation::AssistancePhase::kNone);
 }
