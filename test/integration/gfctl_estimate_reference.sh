@@ -19,6 +19,14 @@ run clean "$SRC/config/estimator.yaml" "$SRC/test/data/flights/sample_flight.csv
 cp "$SRC/test/data/flights/nasty_flight_camera.yaml" "$OUT/nasty.yaml"
 printf 'gate_chi2: 9.0\nmax_consecutive_rejections: 2\n' >> "$OUT/nasty.yaml"
 run nasty "$OUT/nasty.yaml" "$SRC/test/data/flights/nasty_flight.csv"
+# Apparent distances only from row 5 on (test/data/flights/apparent_limits.csv, the clean flight's
+# first 12 rows): a box 11 px tall (~98 m, over max_apparent_distance_m) and boxes clipped at the top
+# and bottom edges give no measurement, in both implementations.
+run limits "$SRC/config/estimator.yaml" "$SRC/test/data/flights/apparent_limits.csv"
+grep -q "over max_apparent_distance_m" "$OUT/limits.log" || { echo "FAIL: no apparent distance over the limit"; cat "$OUT/limits.log"; exit 1; }
+[ "$(grep -c "touches the image's top or bottom edge" "$OUT/limits.log")" -eq 2 ] \
+  || { echo "FAIL: not two clipped boxes refused"; cat "$OUT/limits.log"; exit 1; }
+[ "$(grep -c ',none,0,' "$OUT/limits_ref.csv")" -eq 3 ] || { echo "FAIL: the reference did not refuse the three rows"; exit 1; }
 # The nasty flight must actually exercise the robust paths.
 grep -q "gated [1-9]" "$OUT/nasty.log" || { echo "nasty flight gated nothing"; cat "$OUT/nasty.log"; exit 1; }
 grep -q "re-initialised [1-9]" "$OUT/nasty.log" || { echo "nasty flight never re-initialised"; cat "$OUT/nasty.log"; exit 1; }
