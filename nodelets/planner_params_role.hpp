@@ -16,10 +16,13 @@
 // otherwise take, losing every adjustment of the mission and a pending request for assistance
 // (docs/safety.md §2.4). A record of another run, or one that does not fit the formation, is not used
 // (WARN naming why). Every callback takes the nodelet's mutex.
+#include <condition_variable>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
+#include <utility>
 #include <vector>
 
 #include <ros/ros.h>
@@ -30,6 +33,49 @@
 #include "gesture_formation/onboard/formation_params_role.hpp"
 
 namespace gesture_formation::nodelets {
+
+/// Writes the newest text handed to it, in order, on a thread of its own: the durable write (two
+/// fsyncs, up to tens of milliseconds on an SD card) stays out of the planner's lock. What is pending
+/// when it is destroyed is written first.
+class LatestFileWriter {
+ public:
+  ~LatestFileWriter() {
+    {
+      std::lock_guard<std::mutex> lock(m_);
+      stop_ = true;
+    }
+    cv_.notify_one();
+    if (thread_.joinable()) thread_.join();
+  }
+  void post(const std::string& path, std::string text) {
+    {
+      std::lock_guard<std::mutex> lock(m_);
+      pending_ = std::make_pair(path, std::move(text));
+      if (!thread_.joinable()) thread_ = std::thread([this] { run(); });
+    }
+    cv_.notify_one();
+  }
+
+ private:
+  void run() {
+    std::unique_lock<std::mutex> lock(m_);
+    for (;;) {
+      cv_.wait(lock, [this] { return stop_ || pending_; });
+      if (!pending_) return;  // stopped, nothing left
+      const auto [path, text] = std::move(*pending_);
+      pending_.reset();
+      lock.unlock();
+      const auto w = comm::writeStateFile(path, text);
+      if (!w) ROS_WARN_STREAM_THROTTLE(5.0, "FormationPlanner: parameters not kept for a restart: " << w.reason());
+      lock.lock();
+    }
+  }
+  std::mutex m_;
+  std::condition_variable cv_;
+  std::optional<std::pair<std::string, std::string>> pending_;
+  bool stop_ = false;
+  std::thread thread_;
+};
 
 class PlannerParamsRole {
  public:
@@ -152,9 +198,7 @@ class PlannerParamsRole {
     }
   }
   void keepRecord() {
-    if (run_.empty()) return;
-    const auto w = comm::writeStateFile(state_file_, onboard::formatParamsRecord(own_->role().record(run_)));
-    if (!w) ROS_WARN_STREAM_THROTTLE(5.0, "FormationPlanner: parameters not kept for a restart: " << w.reason());
+    if (!run_.empty()) writer_.post(state_file_, onboard::formatParamsRecord(own_->role().record(run_)));
   }
 
   void applyCommand(const gesture_formation::FormationCommand& msg) {
@@ -192,6 +236,7 @@ class PlannerParamsRole {
   std::mutex* mutex_ = nullptr;
   int uav_index_ = 0;
   std::string state_file_, run_;  ///< the leader by index: where its record is kept, the ROS run (empty: none kept)
+  LatestFileWriter writer_;        ///< the record's writes, off the planner's lock
   double max_command_age_s_ = 5.0;
   std::string world_frame_;
   std::optional<onboard::ParamsOwnership> own_;
