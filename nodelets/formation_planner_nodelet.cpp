@@ -109,8 +109,16 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
       NODELET_ERROR_STREAM_THROTTLE(2.0, "FormationPlanner: odometry refused (nothing from it is used): " << *e);
       return;
     }
+    const planning::UavKinematicState state = toKinematicState(*msg);
+    if (!state.p_world.allFinite() || !state.v_world.allFinite() || !std::isfinite(state.heading_rad) ||
+        !std::isfinite(state.pitch_rad)) {
+      // Nothing from it is used: the last good odometry ages out (max_odometry_age_s) and the relay
+      // flies the last verified plan to its end and holds, as with no odometry at all.
+      NODELET_ERROR_STREAM_THROTTLE(2.0, "FormationPlanner: odometry with a non-finite position, velocity or orientation refused");
+      return;
+    }
     std::lock_guard<std::mutex> lock(mutex_);
-    odom_ = toKinematicState(*msg);
+    odom_ = state;
     odom_stamp_s_ = msg->header.stamp.toSec();
   }
   void onWind(const geometry_msgs::TwistWithCovarianceStamped::ConstPtr& msg) {

@@ -1,5 +1,6 @@
 #include "gesture_formation/planning/replan_step.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -65,18 +66,34 @@ void ReplanStep::restart(std::unique_ptr<Planner> planner) {
   flying_backoff_ = false;
 }
 
-std::string ReplanStep::listeningHold(double t_s, const std::vector<std::optional<ReceivedPlan>>* received) {
-  if (!listening_) return "";
-  if (!std::isfinite(listen_since_s_)) listen_since_s_ = t_s;
-  static const std::vector<std::optional<ReceivedPlan>> kNone;
-  const auto& plans = received != nullptr ? *received : kNone;
-  const std::vector<int> unheard = unheardFollowers(config_.uav_index, listen_since_s_, plans, nullptr);
+std::vector<int> ReplanStep::unheardSince(const ReplanInputs& in, double since_s) const {
+  if (in.received == nullptr) return {};
+  const auto& plans = *in.received;
+  const int self = config_.uav_index;
+  std::vector<int> unheard = unheardFollowers(self, since_s, plans, nullptr);
   // A follower that is not in the received table at all (fewer entries) is waited for too.
-  if (unheard.empty() || t_s - listen_since_s_ > config_.rule.max_plan_age_s) {
+  for (int j = std::max(1, static_cast<int>(plans.size())); j < config_.uav_count; ++j) {
+    if (j != self) unheard.push_back(j);
+  }
+  // The leader's plan: with its share in gfctl simulate; over ROS on the plan link only.
+  const int L = in.leader_index;
+  if (!in.leader_plan_in_share && L != self && L >= 0 && L < config_.uav_count) {
+    const bool heard = L < static_cast<int>(plans.size()) && plans[static_cast<std::size_t>(L)] &&
+                       plans[static_cast<std::size_t>(L)]->plan.t0_s >= since_s;
+    if (!heard && std::find(unheard.begin(), unheard.end(), L) == unheard.end()) unheard.insert(unheard.begin(), L);
+  }
+  return unheard;
+}
+
+std::string ReplanStep::listeningHold(const ReplanInputs& in) {
+  if (!listening_) return "";
+  if (!std::isfinite(listen_since_s_)) listen_since_s_ = in.t_s;
+  const std::vector<int> unheard = unheardSince(in, listen_since_s_);
+  if (unheard.empty() || in.t_s - listen_since_s_ > config_.rule.max_plan_age_s) {
     listening_ = false;
     return "";
   }
-  return listeningReason(config_.uav_index, listen_since_s_, plans, nullptr);
+  return "listening: waiting for a plan from every other UAV since the (re)start";
 }
 
 struct ReplanStep::Choice {
@@ -159,6 +176,13 @@ ReplanOutcome ReplanStep::step(const ReplanInputs& in) {
   const int i = config_.uav_index;
   const int role = in.slot >= 0 ? in.slot : i;  // 0: plans as the leader (a hand-over moves the slot)
   const double t = in.t_s;
+  // A state that is not finite (odometry gone wrong) plans nothing: a braking point, a hold point,
+  // an abort's goal or the take-off point latched from it would stay NaN for the rest of the hold
+  // or abort (every plan then refused, the reach check silently off).
+  if (!in.state.p_world.allFinite() || !in.state.v_world.allFinite() || !std::isfinite(t)) {
+    out.reason = "the UAV's state (position, velocity) or the time is not finite";
+    return out;
+  }
   if (!home_) home_ = config_.home_world.allFinite() ? config_.home_world : in.state.p_world;
   if (in.worker == nullptr) {
     out.reason = role == 0 ? "no confirmed worker estimate yet" : "no leader share received yet";
@@ -173,10 +197,9 @@ ReplanOutcome ReplanStep::step(const ReplanInputs& in) {
   if (hold.empty()) {
     const double since = listen_since_s_;
     const bool was_listening = listening_;
-    hold = listeningHold(t, in.received);
+    hold = listeningHold(in);
     if (was_listening && !listening_ && in.received != nullptr) {
-      const std::vector<int> unheard =
-          unheardFollowers(i, std::isfinite(since) ? since : t, *in.received, nullptr);
+      const std::vector<int> unheard = unheardSince(in, std::isfinite(since) ? since : t);
       if (!unheard.empty()) {
         out.note = "no plan since the start from UAV(s)";
         for (int j : unheard) out.note += " " + std::to_string(j);

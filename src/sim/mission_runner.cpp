@@ -826,6 +826,7 @@ void MissionRun::replan(int i, double t) {
   in.worker = leads ? (leader_knowledge_ ? &*leader_knowledge_ : nullptr) : (share != nullptr ? &share->worker : nullptr);
   in.params = params;
   in.leader_plan = share != nullptr ? &share->plan : nullptr;
+  in.leader_plan_in_share = true;  // LeaderShare.plan: listening waits for the followers' plans only
   in.received = &u.received;
   in.slot = slotOf(i);
   in.leader_index = leads ? i : (share != nullptr ? share->from : 0);

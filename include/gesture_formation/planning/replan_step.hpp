@@ -150,7 +150,12 @@ struct ReplanInputs {
   /// the leader (its own estimate's freshness, the search) —, j = follower j's; −1: its own index.
   int slot = -1;
   int leader_index = 0;  ///< whose plan leader_plan is (PlanRequestInputs::leader_index)
-  const std::vector<std::optional<ReceivedPlan>>* received = nullptr;  ///< plans by sender (may be null)
+  /// The leader's plan travels with its share (gfctl simulate's LeaderShare.plan): listening does
+  /// not wait for it on the plan link. Over ROS the share (WorkerState) carries no plan: false, and a
+  /// (re)started UAV waits for the leader's plan in `received` like every other UAV's.
+  bool leader_plan_in_share = false;
+  /// Plans by sender (null: no listening at all); a UAV missing from a shorter table is waited for.
+  const std::vector<std::optional<ReceivedPlan>>* received = nullptr;
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
 
@@ -206,7 +211,9 @@ class ReplanStep {
   const ReplanConfig& config() const { return config_; }
 
  private:
-  std::string listeningHold(double t_s, const std::vector<std::optional<ReceivedPlan>>* received);
+  std::string listeningHold(const ReplanInputs& in);
+  /// The other UAVs with no plan in `in.received` made at or after `since_s` (see ReplanInputs).
+  std::vector<int> unheardSince(const ReplanInputs& in, double since_s) const;
   /// The hold / search or abort decision of one replanning (its reference, camera target, mode).
   struct Choice;
   Choice choose(const ReplanInputs& in, const std::string& hold, const Eigen::Vector3d& worker_p0, ReplanOutcome& out);

@@ -458,6 +458,7 @@ struct Follower {
     in.params = &params;
     pl::PlannedTrajectory leader = planOf(0, t - 0.2).plan;
     in.leader_plan = &leader;
+    in.leader_plan_in_share = true;  // as gfctl simulate's share
     in.received = &received;
     return step.step(in);
   }
@@ -507,6 +508,7 @@ TEST(ReplanStepAbortTest, ARestartedUavListensFirstAndForgetsTheAbortUntilItIsRe
   in.state.p_world = Eigen::Vector3d(-8.0, 2.0, 6.0);
   in.worker = &w;
   in.params = &f.params;
+  in.leader_plan_in_share = true;
   in.received = &f.received;
   const auto out = f.step.step(in);
   EXPECT_EQ(out.mode, pl::ReplanMode::kHold);

@@ -47,6 +47,7 @@ class RecordingPlanner : public pl::Planner {
 pl::ReplanConfig config(int uav) {
   pl::ReplanConfig c;
   c.uav_index = uav;
+  c.uav_count = 3;
   c.dt_s = 0.2;
   c.steps = 10;
   c.freshness = pl::FreshnessLimits{2.0, 3.0};
@@ -82,6 +83,7 @@ struct Fixture {
     received.resize(3);
     in.params = &params;
     in.received = &received;
+    in.leader_plan_in_share = true;  // as gfctl simulate (LeaderShare.plan); ROS: ListeningWaitsForTheLeadersPlan…
     in.state.p_world = Eigen::Vector3d(0.0, -8.0, 6.0);
   }
   pl::ReplanOutcome at(double t, const pl::WorkerKnowledge* w) {
@@ -126,6 +128,52 @@ TEST(ReplanStepTest, ListensAtStartUntilEveryOtherFollowerPlannedSinceThen) {
   f.received[2].reset();
   w = fresh(1.4, p, Eigen::Vector3d::Zero());
   EXPECT_EQ(f.at(1.4, &w).mode, pl::ReplanMode::kTrack);
+}
+
+// Over ROS the leader's share (WorkerState) carries no plan: a (re)started follower that heard the
+// other follower but not the leader kept listening only for followers and tracked without avoiding
+// the leader. It waits for the leader's plan on the plan link unless the plan came with the share
+// (gfctl simulate); a UAV missing from a short received table is waited for too.
+TEST(ReplanStepTest, ListeningWaitsForTheLeadersPlanUnlessItCameWithTheShare) {
+  const Eigen::Vector3d p(0.0, 0.0, 0.0);
+  for (const bool in_share : {false, true}) {
+    Fixture f(1);
+    f.in.leader_plan_in_share = in_share;
+    f.received[2] = planFrom(2, 1.1);
+    for (const double t : {1.0, 1.2}) {
+      const auto w = fresh(t, p, Eigen::Vector3d::Zero());
+      const auto out = f.at(t, &w);
+      if (in_share && t > 1.0) {
+        EXPECT_EQ(out.mode, pl::ReplanMode::kTrack) << out.reason;
+      } else if (!in_share) {
+        EXPECT_EQ(out.mode, pl::ReplanMode::kHold) << "t " << t;
+        EXPECT_NE(out.reason.find("listening"), std::string::npos) << out.reason;
+      }
+    }
+    if (in_share) continue;
+    f.received[0] = planFrom(0, 1.3);  // the leader's plan since the start: heard
+    const auto w = fresh(1.4, p, Eigen::Vector3d::Zero());
+    EXPECT_EQ(f.at(1.4, &w).mode, pl::ReplanMode::kTrack);
+  }
+  Fixture short_table(1);
+  short_table.in.leader_plan_in_share = true;
+  short_table.received.resize(2);  // follower 2 has no entry at all
+  const auto w = fresh(1.2, p, Eigen::Vector3d::Zero());
+  short_table.at(1.0, &w);
+  const auto out = short_table.at(1.2, &w);
+  EXPECT_EQ(out.mode, pl::ReplanMode::kHold) << "follower 2, missing from the table, is waited for";
+}
+
+// Odometry gone wrong (a NaN position or velocity) plans nothing: a hold or abort point latched
+// from it would stay NaN for the rest of the hold.
+TEST(ReplanStepTest, ANonFiniteStatePlansNothing) {
+  Fixture f(0);
+  const auto w = fresh(1.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+  f.in.state.v_world.x() = std::nan("");
+  const auto out = f.at(1.0, &w);
+  EXPECT_FALSE(out.planned());
+  EXPECT_NE(out.reason.find("not finite"), std::string::npos) << out.reason;
+  EXPECT_TRUE(f.log->empty());
 }
 
 TEST(ReplanStepTest, ListeningEndsAfterMaxPlanAgeNamingTheUnheard) {
