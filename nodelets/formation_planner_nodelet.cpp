@@ -172,6 +172,13 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     std::lock_guard<std::mutex> lock(mutex_);
     const double t = ros::Time::now().toSec();
     if (t <= 0.0) return;
+    // ROS time went back (sim time restarted, a bag looped): the schedule starts again from now —
+    // else no replanning until the clock caught up with the old schedule.
+    if (next_plan_s_ > t + 2.0 * period_s_) {
+      NODELET_WARN_STREAM("FormationPlanner UAV " << uav_index_ << ": ROS time went back from " << next_plan_s_ << " s to " << t
+                                                  << " s: replanning from now");
+      next_plan_s_ = -1.0;
+    }
     if (next_plan_s_ < 0.0) next_plan_s_ = (std::floor(t / period_s_) + 1.0) * period_s_ + offset_s_;
     if (t < next_plan_s_) return;
     next_plan_s_ += period_s_ * std::max(1.0, std::ceil((t - next_plan_s_) / period_s_ + 1e-9));
