@@ -221,7 +221,12 @@ VerificationReport TrajectoryVerifier::verify(const PlannedTrajectory& tr, doubl
   }
   const bool has_worker = worker.steps() > 0;
   const double start_worker = has_worker ? (start.p - workerPositionAt(worker, worker_t0, worker_dt, tr.t0_s)).norm() : 0.0;
-  const double start_clear = field_.clearance(start.p) - rho;
+  // The first interval is relaxed only for a start that is itself closer than verify_clearance_m,
+  // and then to "not worse" than it (docs/planning.md §7): measured exactly once the field's lower
+  // bound — up to sqrt(3)·resolution + rho short — says it might be; the bound alone relaxed a start
+  // that was clear, and let one that was not get closer by the field's error.
+  double start_clear = field_.clearance(start.p) - rho;
+  if (start_clear < config_.verify_clearance_m) start_clear = fcl_.clearance(start.p);
 
   rep.min_obstacle_clearance_m = std::numeric_limits<double>::infinity();
   rep.min_uav_margin_m = std::numeric_limits<double>::infinity();

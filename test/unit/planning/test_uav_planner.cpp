@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
 
 #include "gesture_formation/common/angles.hpp"
 #include "gesture_formation/planning/distance_field.hpp"
@@ -1662,4 +1663,67 @@ TEST(TrajectoryVerifierTest, ANonFiniteOtherPlanOrWorkerPredictionFailsVerificat
   const VerificationReport with_nan_worker = verifier.verify(mine, t, {}, nan_worker, t, 0.2);
   EXPECT_FALSE(with_nan_worker.ok);
   EXPECT_NE(with_nan_worker.reason.find("from the worker"), std::string::npos) << with_nan_worker.reason;
+}
+
+// The first interval is relaxed only for a start closer than verify_clearance_m (docs/planning.md
+// §7). The start's clearance came from the distance field's lower bound, up to sqrt(3)·resolution +
+// rho short: a start that was clear relaxed its first interval, and a plan dipping towards a wall
+// within it passed. Now the start is measured exactly: the dip fails. A wall x in [-0.4, 0]; the
+// plan stands at x = X but its first interval swings towards the wall (Hermite: -u then +u, dip
+// h·u/4) and back.
+TEST(TrajectoryVerifierTest, AClearStartDoesNotRelaxTheFirstInterval) {
+  MapConfig mc;
+  mc.resolution_m = 0.2;
+  mc.bounds = Aabb{Eigen::Vector3d(-6, -6, 0), Eigen::Vector3d(6, 6, 10)};
+  PrimitiveSet wall;
+  OrientedBox b;
+  b.center_world = Eigen::Vector3d(-0.2, 0.0, 5.0);
+  b.size_m = Eigen::Vector3d(0.4, 10.0, 10.0);
+  wall.boxes.push_back(b);
+  const OccupancyMap map = OccupancyMap::fromPrimitives(mc, wall, GroundSpec{});
+  const DistanceField field(map);
+  const FclClearance fcl(map);
+  const PlannerConfig cfg = testConfig();
+  const double rho = OccupancyMap::rasterInflation(map.resolution());
+  // A start clear of verify_clearance_m whose field bound says it is not (the field's error there
+  // exceeds the dip found below).
+  std::optional<Eigen::Vector3d> start;
+  double dip = 0.0;
+  for (double x = 0.3; x < 1.5 && !start; x += 0.01) {
+    for (double y = -0.1; y <= 0.1 && !start; y += 0.02) {
+      const Eigen::Vector3d p(x, y, 5.03);
+      const double exact = fcl.clearance(p), lower = field.clearance(p) - rho;
+      if (exact >= cfg.verify_clearance_m + 0.01 && exact <= cfg.verify_clearance_m + 0.05 &&
+          lower < cfg.verify_clearance_m - 0.08) {
+        start = p;
+        dip = exact - cfg.verify_clearance_m + 0.04;  // the swing comes 0.04 m inside the clearance
+      }
+    }
+  }
+  ASSERT_TRUE(start) << "no point where the field's bound is 0.08 m below a clear start";
+  const double h = 1.0, u = 4.0 * dip / h;
+  PlannedTrajectory tr;
+  tr.uav_index = 1;
+  tr.t0_s = 10.0;
+  tr.dt_s = h;
+  for (int k = 0; k < 12; ++k) {
+    TrajectorySample s;
+    s.p_world = *start;
+    if (k == 0) s.v_world = Eigen::Vector3d(-u, 0.0, 0.0);  // towards the wall
+    if (k == 1) s.v_world = Eigen::Vector3d(u, 0.0, 0.0);   // and away again: the dip lies in interval 0
+    tr.samples.push_back(s);
+  }
+  // The swing's deepest point, checked at substep 2 of 4: inside the clearance, outside the bound.
+  const Eigen::Vector3d deepest = *start - Eigen::Vector3d(0.25 * h * u, 0.0, 0.0);
+  ASSERT_LT(fcl.clearance(deepest), cfg.verify_clearance_m);
+  ASSERT_GT(fcl.clearance(deepest), field.clearance(*start) - rho) << "before, this dip passed";
+  const TrajectoryVerifier verifier(map, field, cfg);
+  const VerificationReport r = verifier.verify(tr, tr.t0_s, {}, {}, tr.t0_s, 0.2);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.reason.find("obstacle within 0.5"), std::string::npos) << r.reason;
+  // Without the dip the same plan verifies (it is the dip, not the start, that fails).
+  tr.samples[0].v_world.setZero();
+  tr.samples[1].v_world.setZero();
+  const VerificationReport still = verifier.verify(tr, tr.t0_s, {}, {}, tr.t0_s, 0.2);
+  EXPECT_TRUE(still.ok) << still.reason;
 }
