@@ -114,7 +114,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
         !std::isfinite(state.pitch_rad)) {
       // Nothing from it is used: the last good odometry ages out (max_odometry_age_s) and the relay
       // flies the last verified plan to its end and holds, as with no odometry at all.
-      NODELET_ERROR_STREAM_THROTTLE(2.0, "FormationPlanner: odometry with a non-finite position, velocity or orientation refused");
+      NODELET_ERROR_STREAM_THROTTLE(2.0, "FormationPlanner UAV " << uav_index_ << ": odometry with a non-finite position, velocity or orientation refused");
       return;
     }
     std::lock_guard<std::mutex> lock(mutex_);
@@ -178,6 +178,8 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
       NODELET_WARN_STREAM("FormationPlanner UAV " << uav_index_ << ": ROS time went back from " << next_plan_s_ << " s to " << t
                                                   << " s: replanning from now");
       next_plan_s_ = -1.0;
+      for (auto& r : received_) r.reset();  // stamped in the old future: each newer plan would be refused as older
+      worker_.reset();
     }
     if (next_plan_s_ < 0.0) next_plan_s_ = (std::floor(t / period_s_) + 1.0) * period_s_ + offset_s_;
     if (t < next_plan_s_) return;

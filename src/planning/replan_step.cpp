@@ -70,17 +70,15 @@ std::vector<int> ReplanStep::unheardSince(const ReplanInputs& in, double since_s
   if (in.received == nullptr) return {};
   const auto& plans = *in.received;
   const int self = config_.uav_index;
-  std::vector<int> unheard = unheardFollowers(self, since_s, plans, nullptr);
-  // A follower that is not in the received table at all (fewer entries) is waited for too.
-  for (int j = std::max(1, static_cast<int>(plans.size())); j < config_.uav_count; ++j) {
-    if (j != self) unheard.push_back(j);
-  }
-  // The leader's plan: with its share in gfctl simulate; over ROS on the plan link only.
-  const int L = in.leader_index;
-  if (!in.leader_plan_in_share && L != self && L >= 0 && L < config_.uav_count) {
-    const bool heard = L < static_cast<int>(plans.size()) && plans[static_cast<std::size_t>(L)] &&
-                       plans[static_cast<std::size_t>(L)]->plan.t0_s >= since_s;
-    if (!heard && std::find(unheard.begin(), unheard.end(), L) == unheard.end()) unheard.insert(unheard.begin(), L);
+  std::vector<int> unheard;
+  // Every other UAV — UAV 0 too when, after a hand-over, it flies as a follower — but the leader
+  // whose plan came with its share (gfctl simulate; over ROS it comes on the plan link only). A UAV
+  // missing from a short received table is waited for too.
+  for (int j = 0; j < std::max(config_.uav_count, static_cast<int>(plans.size())); ++j) {
+    if (j == self || (j == in.leader_index && in.leader_plan_in_share)) continue;
+    const bool heard = j < static_cast<int>(plans.size()) && plans[static_cast<std::size_t>(j)] &&
+                       plans[static_cast<std::size_t>(j)]->plan.t0_s >= since_s;
+    if (!heard) unheard.push_back(j);
   }
   return unheard;
 }

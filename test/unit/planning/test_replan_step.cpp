@@ -155,6 +155,21 @@ TEST(ReplanStepTest, ListeningWaitsForTheLeadersPlanUnlessItCameWithTheShare) {
     const auto w = fresh(1.4, p, Eigen::Vector3d::Zero());
     EXPECT_EQ(f.at(1.4, &w).mode, pl::ReplanMode::kTrack);
   }
+  // After a hand-over UAV 1 leads (its plan with the share) and UAV 0 flies on as a follower: a
+  // restarted UAV 2 waits for UAV 0's plan too.
+  {
+    Fixture f(2);
+    f.in.leader_index = 1;
+    f.received[1] = planFrom(1, 1.1);
+    auto w = fresh(1.0, p, Eigen::Vector3d::Zero());
+    f.at(1.0, &w);
+    w = fresh(1.2, p, Eigen::Vector3d::Zero());
+    const auto waiting = f.at(1.2, &w);
+    EXPECT_EQ(waiting.mode, pl::ReplanMode::kHold) << "UAV 0, demoted, not heard yet";
+    f.received[0] = planFrom(0, 1.3);
+    w = fresh(1.4, p, Eigen::Vector3d::Zero());
+    EXPECT_EQ(f.at(1.4, &w).mode, pl::ReplanMode::kTrack);
+  }
   Fixture short_table(1);
   short_table.in.leader_plan_in_share = true;
   short_table.received.resize(2);  // follower 2 has no entry at all

@@ -1684,6 +1684,7 @@ TEST(TrajectoryVerifierTest, AClearStartDoesNotRelaxTheFirstInterval) {
   const DistanceField field(map);
   const FclClearance fcl(map);
   const PlannerConfig cfg = testConfig();
+  ASSERT_EQ(cfg.verify_substeps % 2, 0) << "the swing's deepest point (mid-interval) must be a checked substep";
   const double rho = OccupancyMap::rasterInflation(map.resolution());
   // A start clear of verify_clearance_m whose field bound says it is not (the field's error there
   // exceeds the dip found below).
@@ -1726,4 +1727,23 @@ TEST(TrajectoryVerifierTest, AClearStartDoesNotRelaxTheFirstInterval) {
   tr.samples[1].v_world.setZero();
   const VerificationReport still = verifier.verify(tr, tr.t0_s, {}, {}, tr.t0_s, 0.2);
   EXPECT_TRUE(still.ok) << still.reason;
+  // A start truly inside the clearance (0.3 m from the wall's face) moving straight away, out of it
+  // within the first interval (the only one relaxed): it need not be worse than the start there —
+  // and the start itself must pass (a ball of exactly its clearance touches the wall, which FCL
+  // counts as a collision: every plan from such a start was refused, the brake plan too).
+  PlannedTrajectory away;
+  away.uav_index = 1;
+  away.t0_s = 10.0;
+  away.dt_s = 0.2;
+  const Eigen::Vector3d inside(0.3, 0.0, 5.0);
+  ASSERT_LT(fcl.clearance(inside), cfg.verify_clearance_m);
+  for (int k = 0; k < 11; ++k) {  // 2 m/s straight away from the wall: 0.4 m out per interval
+    TrajectorySample s;
+    s.p_world = inside + Eigen::Vector3d(2.0 * 0.2 * k, 0.0, 0.0);
+    s.v_world = Eigen::Vector3d(2.0, 0.0, 0.0);
+    away.samples.push_back(s);
+  }
+  ASSERT_GE(fcl.clearance(away.samples[1].p_world), cfg.verify_clearance_m) << "out of the clearance after one interval";
+  const VerificationReport leaving = verifier.verify(away, away.t0_s, {}, {}, away.t0_s, 0.2);
+  EXPECT_TRUE(leaving.ok) << leaving.reason;
 }

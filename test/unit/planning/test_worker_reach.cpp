@@ -263,6 +263,7 @@ struct HoldingFollower {
     in.state.p_world = p;
     in.worker = &w;
     in.params = &params;
+    in.leader_plan_in_share = true;  // as gfctl simulate's share: listening ends by hearing follower 2
     in.received = &received;
     return step.step(in);
   }
