@@ -16,8 +16,6 @@ cat > "$T/restart.py" <<'PY'
 """Sends the request at 5 s, unloads /uav0/formation_planner at 10 s and loads it again at 13 s with
 the remaps of launch/sim_uav.launch; then checks what the leader publishes and follower 1 receives."""
 import os
-import re
-import signal
 import subprocess
 import sys
 import time
@@ -26,6 +24,8 @@ import rospy
 from gesture_formation.msg import FormationParams
 
 src = sys.argv[1]
+sys.path.insert(0, os.path.join(src, "test/ros"))
+import planner_reload  # noqa: E402
 rospy.init_node("leader_restart", anonymous=True)
 leader, follower = [], []
 rospy.Subscriber("/uav0/formation_params", FormationParams, lambda m: leader.append((rospy.get_time(), m)))
@@ -56,24 +56,14 @@ wait_until(10.0)
 before = leader[-1][1] if leader else None
 check(before is not None and before.version >= 1, "the leader's parameters before the restart: version %s" % (before.version if before else None))
 config_views = views(next(m for _, m in leader if m.version == 0)) if any(m.version == 0 for _, m in leader) else None
-info = subprocess.run(["rosnode", "info", "/uav0/formation_planner"], capture_output=True, text=True).stdout
-pid = re.search(r"Pid: (\d+)", info)
-if not pid:
-    print("FAIL: no pid of /uav0/formation_planner:", info)
+failure = planner_reload.unload("/uav0")
+if failure is not None:
+    print("FAIL: no pid of /uav0/formation_planner:", failure)
     sys.exit(1)
-os.kill(int(pid.group(1)), signal.SIGINT)
 t_unload = rospy.get_time()
 print("unloaded /uav0/formation_planner at %.2f s" % t_unload, flush=True)
 wait_until(13.0)
-remaps = ["odometry_in:=odometry", "worker_state_in:=worker_state", "plans_in:=lcm/plans",
-          "wind_estimate_in:=wind_estimation", "plan_out:=plan", "formation_params_in:=formation_params",
-          "formation_params_out:=formation_params", "formation_command_in:=formation_command",
-          "leadership_state_in:=leadership_state", "abort_in:=abort", "abort_state_out:=abort_state",
-          "command_ack_out:=command_ack", "assistance_in:=assistance", "assistance_state_out:=assistance_state"]
-env = dict(os.environ, ROS_NAMESPACE="/uav0")
-loader = open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "reload.log"), "w")
-subprocess.Popen(["rosrun", "nodelet", "nodelet", "load", "gesture_formation/FormationPlanner", "manager",
-                  "__name:=formation_planner"] + remaps, env=env, stdout=loader, stderr=subprocess.STDOUT)
+planner_reload.load("/uav0", os.path.join(os.path.dirname(os.path.abspath(__file__)), "reload.log"))
 t_load = rospy.get_time()
 print("loaded /uav0/formation_planner again at %.2f s" % t_load, flush=True)
 deadline = time.time() + 20

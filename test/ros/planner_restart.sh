@@ -12,38 +12,28 @@ source "$(dirname "$0")/common.bash"
 make_key "$T/keys"
 mkdir -p "$T/out"
 cat > "$T/restart.py" <<'PY'
-"""At sim time 10 s unloads /uav2/formation_planner (SIGINT to its loader process), at 16 s loads
-it again into /uav2/manager with the remaps of launch/sim_uav.launch (its private parameters are
-still on the parameter server). Prints what it did with the sim times."""
+"""At sim time 10 s unloads /uav2/formation_planner, at 16 s loads it again (test/ros/planner_reload.py).
+Prints what it did with the sim times."""
 import os
-import re
-import signal
-import subprocess
 import sys
 import time
 
 import rospy
 
+sys.path.insert(0, os.path.join(sys.argv[1], "test/ros"))
+import planner_reload  # noqa: E402
+
 rospy.init_node("planner_restart", anonymous=True)
 while not rospy.is_shutdown() and rospy.get_time() < 10.0:
     time.sleep(0.02)
-info = subprocess.run(["rosnode", "info", "/uav2/formation_planner"], capture_output=True, text=True).stdout
-pid = re.search(r"Pid: (\d+)", info)
-if not pid:
-    print("FAIL: no pid of /uav2/formation_planner:", info)
+failure = planner_reload.unload("/uav2")
+if failure is not None:
+    print("FAIL: no pid of /uav2/formation_planner:", failure)
     sys.exit(1)
-os.kill(int(pid.group(1)), signal.SIGINT)
 print("unloaded /uav2/formation_planner at %.2f s" % rospy.get_time(), flush=True)
 while not rospy.is_shutdown() and rospy.get_time() < 16.0:
     time.sleep(0.02)
-remaps = ["odometry_in:=odometry", "worker_state_in:=worker_state", "plans_in:=lcm/plans",
-          "wind_estimate_in:=wind_estimation", "plan_out:=plan", "formation_params_in:=formation_params",
-          "formation_params_out:=formation_params", "formation_command_in:=formation_command",
-          "abort_in:=abort", "abort_state_out:=abort_state"]
-env = dict(os.environ, ROS_NAMESPACE="/uav2")
-loader = open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "reload.log"), "w")
-subprocess.Popen(["rosrun", "nodelet", "nodelet", "load", "gesture_formation/FormationPlanner", "manager",
-                  "__name:=formation_planner"] + remaps, env=env, stdout=loader, stderr=subprocess.STDOUT)
+planner_reload.load("/uav2", os.path.join(os.path.dirname(os.path.abspath(__file__)), "reload.log"))
 print("loaded /uav2/formation_planner again at %.2f s" % rospy.get_time(), flush=True)
 rospy.spin()
 PY
@@ -53,7 +43,7 @@ roslaunch -p $PORT gesture_formation simulation.launch key_file:=$T/keys output_
   real_time_factor:=1.5 > "$T/launch.log" 2>&1 &
 launch=\$!
 for _ in \$(seq 50); do rosparam get /use_sim_time > /dev/null 2>&1 && break; sleep 0.2; done
-python3 "$T/restart.py" > "$T/restart.log" 2>&1 &
+python3 "$T/restart.py" "$SRC" > "$T/restart.log" 2>&1 &
 restart=\$!
 for _ in \$(seq 140); do [ -f "$T/out/metrics.json" ] && break; sleep 0.5; done
 sleep 0.5
