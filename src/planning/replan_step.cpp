@@ -64,6 +64,7 @@ void ReplanStep::restart(std::unique_ptr<Planner> planner) {
   listen_since_s_ = std::numeric_limits<double>::quiet_NaN();
   listening_ = true;
   flying_backoff_ = false;
+  verified_for_.reset();
 }
 
 std::vector<int> ReplanStep::unheardSince(const ReplanInputs& in, double since_s) const {
@@ -169,6 +170,16 @@ void ReplanStep::keepReachClear(const ReplanInputs& in, const Eigen::Vector3d& w
                                   config_.dt_s, config_.steps);
 }
 
+bool ReplanStep::mayReflyVerified(ReplanMode mode) const {
+  if (!verified_for_) return true;  // none, or a stop
+  // A hold or search that flew on the tracking plan would follow the stale prediction the hold
+  // is for, for up to the plan's horizon; an abort that flew on anything but its own would not
+  // retreat.
+  if (mode == ReplanMode::kAbort) return *verified_for_ == ReplanMode::kAbort;
+  if (mode == ReplanMode::kHold || mode == ReplanMode::kSearch) return *verified_for_ != ReplanMode::kTrack;
+  return true;
+}
+
 ReplanOutcome ReplanStep::step(const ReplanInputs& in) {
   ReplanOutcome out;
   const int i = config_.uav_index;
@@ -205,8 +216,9 @@ ReplanOutcome ReplanStep::step(const ReplanInputs& in) {
       }
     }
   }
-  // The worker over the horizon: extrapolated from its stamp while fresh, frozen otherwise.
-  const bool still = !hold.empty() || !stale.empty() || w.lost;
+  // The worker over the horizon: extrapolated from its stamp while fresh (a listening hold too:
+  // he may walk up to the holding UAV), frozen otherwise.
+  const bool still = !stale.empty() || w.lost;
   const Eigen::Vector3d v0 = still ? Eigen::Vector3d::Zero() : w.v_world;
   const Eigen::Vector3d p0 = still ? w.p_world : w.positionAt(std::max(t, w.stamp_s));
   const double heading = still ? heading_.heading() : heading_.update(v0);
@@ -234,9 +246,11 @@ ReplanOutcome ReplanStep::step(const ReplanInputs& in) {
   PlanRequest request = buildPlanRequest(req_in);
   // A back-off is for an unseen worker's reach; once the UAV tracks (or holds) again, a failed plan
   // brakes where it is rather than flying the back-off on, away from the worker and out of view.
-  request.reuse_previous = !flying_backoff_ || out.backing_off;
+  request.reuse_previous = (!flying_backoff_ || out.backing_off) && mayReflyVerified(out.mode);
   out.reference = request.reference;
   out.result = planner_->plan(request);
+  if (out.result.verified && out.result.status == PlanStatus::kOptimized) verified_for_ = out.mode;
+  if (out.result.verified && out.result.status == PlanStatus::kFallbackBrake) verified_for_.reset();
   if (out.backing_off) {
     flying_backoff_ = !out.result.trajectory.empty();
   } else if (out.result.status == PlanStatus::kOptimized) {

@@ -134,6 +134,24 @@ std::vector<Eigen::Vector3d> keptBrakeEnvelope(const PlannedTrajectory& other, i
   return {};
 }
 
+namespace {
+
+/// Another plan without a finite t0 or a positive, finite dt would read as hovering at its first
+/// sample (evaluateTrajectory): where its UAV is is unknown. The reason, or empty.
+std::string untimedPlan(const std::vector<PlannedTrajectory>& others) {
+  for (const auto& other : others) {
+    if (!std::isfinite(other.t0_s) || !(other.dt_s > 0.0) || !std::isfinite(other.dt_s)) {
+      std::ostringstream os;
+      os << "verify: UAV " << other.uav_index << "'s plan has t0 " << other.t0_s << " s, dt " << other.dt_s
+         << " s: its positions are unknown";
+      return os.str();
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
 TrajectoryVerifier::TrajectoryVerifier(const OccupancyMap& map, const DistanceField& field, const PlannerConfig& config,
                                        const SeenSpace* seen)
     : map_(map), field_(field), config_(config), fcl_(map), seen_(seen) {}
@@ -204,6 +222,7 @@ VerificationReport TrajectoryVerifier::verify(const PlannedTrajectory& tr, doubl
       return fail(os.str());
     }
   }
+  if (const std::string why = untimedPlan(others); !why.empty()) return fail(why);
   // Required distances to the other plans (age margin; recovery: requiredUavDistance) and to the worker.
   std::vector<double> required(others.size());
   for (std::size_t j = 0; j < others.size(); ++j) {

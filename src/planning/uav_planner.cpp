@@ -439,15 +439,30 @@ PlanResult UavPlanner::fallback(const PlanRequest& req, PlanResult result, const
   // Brake points are not chosen against each other, and a hovering UAV drifts: a stop point
   // closer than Γ_dis + buffer to another UAV's plan is moved away (docs/safety.md §4.4).
   std::string separated;
+  PlannedTrajectory unmoved;
   if (auto moved = separateHoldPoint(req, result.trajectory, separated)) {
+    unmoved = std::move(result.trajectory);
     result.trajectory = std::move(*moved);
-    result.reason += separated;
   }
   result.trajectory.sequence = ++sequence_;
-  brake_ = result.trajectory;  // held: the same curve (re-timed), now under this sequence number
   if (verifier_) {
-    const VerificationReport rep =
-        verifier_->verify(result.trajectory, req.t_now_s, req.higher_priority_plans, req.worker, req.t_now_s, dt);
+    const auto verify = [&](const PlannedTrajectory& tr) {
+      return verifier_->verify(tr, req.t_now_s, req.higher_priority_plans, req.worker, req.t_now_s, dt);
+    };
+    VerificationReport rep = verify(result.trajectory);
+    if (!rep.ok && !unmoved.empty()) {
+      // The move is checked against the others and the worker only pointwise (never closer than
+      // the hold where that is near): where the full check (braking envelopes, recovery pace)
+      // refuses it and the unmoved brake plan verifies, the unmoved one is flown.
+      unmoved.sequence = result.trajectory.sequence;
+      const VerificationReport rep_unmoved = verify(unmoved);
+      if (rep_unmoved.ok) {
+        separated = "; not moving the brake point (the move fails: " + rep.reason + ")";
+        result.trajectory = std::move(unmoved);
+        rep = rep_unmoved;
+      }
+    }
+    result.reason += separated;
     result.verified = rep.ok;
     result.min_obstacle_clearance_m = rep.min_obstacle_clearance_m;
     result.min_uav_margin_m = rep.min_uav_margin_m;
@@ -457,7 +472,10 @@ PlanResult UavPlanner::fallback(const PlanRequest& req, PlanResult result, const
     } else {
       result.reason += " (brake plan NOT verified: " + rep.reason + ")";
     }
+  } else {
+    result.reason += separated;
   }
+  brake_ = result.trajectory;  // held: the same curve (re-timed), now under this sequence number
   result.timings.verify_ms += msSince(t_fb);
   return result;
 }

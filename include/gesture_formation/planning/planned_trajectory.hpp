@@ -41,8 +41,10 @@ struct PlannedTrajectory {
 
   bool empty() const { return samples.empty(); }
   double tEnd() const { return t0_s + dt_s * static_cast<double>(samples.empty() ? 0 : samples.size() - 1); }
-  /// Linear interpolation in time; before t0 the first sample; after the end the last
-  /// position with zero velocity and acceleration (hover).
+  /// The plan at t_s: position, velocity and acceleration on the cubic Hermite curve through the
+  /// samples (evaluateTrajectory(), the curve the verifier checks), heading and pitch linear
+  /// between samples; before t0 the first sample; after the end the last position with zero
+  /// velocity and acceleration (hover).
   TrajectorySample sampleAt(double t_s) const;
   /// The state the plan commands at t_s (sampleAt as a UavKinematicState with t_s set).
   UavKinematicState stateAt(double t_s) const;

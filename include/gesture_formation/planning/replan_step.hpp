@@ -219,6 +219,8 @@ class ReplanStep {
   Choice choose(const ReplanInputs& in, const std::string& hold, const Eigen::Vector3d& worker_p0, ReplanOutcome& out);
   /// Holding or searching: the back-off from the worker's reach replaces the hold reference.
   void keepReachClear(const ReplanInputs& in, const Eigen::Vector3d& worker_p0, Choice& c, ReplanOutcome& out);
+  /// Whether the planner may fall back to its last verified plan in `mode` (verified_for_).
+  bool mayReflyVerified(ReplanMode mode) const;
 
   ReplanConfig config_;
   std::unique_ptr<Planner> planner_;
@@ -234,6 +236,11 @@ class ReplanStep {
   /// The plan flown is a back-off's (since the last optimized plan of another mode): a UAV that no
   /// longer backs off does not fall back to it (PlanRequest::reuse_previous).
   bool flying_backoff_ = false;
+  /// The mode the planner's last verified plan — the one its fallback re-flies — was optimized
+  /// for; none before the first and after a verified brake plan (a stop, re-flown in any mode).
+  /// A hold, search or abort does not fly on a tracking plan, an abort on nothing but its own
+  /// (PlanRequest::reuse_previous).
+  std::optional<ReplanMode> verified_for_;
 };
 
 }  // namespace gesture_formation::planning

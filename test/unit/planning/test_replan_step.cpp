@@ -15,23 +15,28 @@ namespace pl = gf::planning;
 
 namespace {
 
-/// Test-only planner: records every request; returns a plan along the reference whose samples
-/// all command `accel` (so that the next request's start acceleration can be checked).
+/// Test-only planner: records every request; returns a plan along the reference that accelerates
+/// from rest at `accel` (p_k = reference_k + accel·t_k²/2, v_k = accel·t_k: with a reference
+/// standing still, a constant acceleration on the plan's Hermite curve too), so that the next
+/// request's start acceleration can be checked.
 class RecordingPlanner : public pl::Planner {
  public:
   RecordingPlanner(std::shared_ptr<std::vector<pl::PlanRequest>> log, Eigen::Vector3d accel,
-                   pl::PlanStatus status = pl::PlanStatus::kOptimized)
-      : log_(std::move(log)), accel_(std::move(accel)), status_(status) {}
+                   std::shared_ptr<const pl::PlanStatus> status)
+      : log_(std::move(log)), accel_(std::move(accel)), status_(std::move(status)) {}
   pl::PlanResult plan(const pl::PlanRequest& r) override {
     log_->push_back(r);
     pl::PlanResult res;
-    res.status = status_;
+    res.status = *status_;
+    res.verified = true;
     res.trajectory.uav_index = r.uav_index;
     res.trajectory.t0_s = r.t_now_s;
     res.trajectory.dt_s = r.dt_s;
     for (int k = 0; k < r.reference.steps(); ++k) {
       pl::TrajectorySample s;
-      s.p_world = r.reference.p_world.col(k);
+      const double t = k * r.dt_s;
+      s.p_world = r.reference.p_world.col(k) + 0.5 * t * t * accel_;
+      s.v_world = t * accel_;
       s.a_world = accel_;
       res.trajectory.samples.push_back(s);
     }
@@ -41,7 +46,7 @@ class RecordingPlanner : public pl::Planner {
  private:
   std::shared_ptr<std::vector<pl::PlanRequest>> log_;
   Eigen::Vector3d accel_;
-  pl::PlanStatus status_;
+  std::shared_ptr<const pl::PlanStatus> status_;  ///< what every plan reports (the fixture may change it)
 };
 
 pl::ReplanConfig config(int uav) {
@@ -77,8 +82,9 @@ std::optional<pl::ReceivedPlan> planFrom(int uav, double t0) {
 
 struct Fixture {
   explicit Fixture(int uav, Eigen::Vector3d accel = Eigen::Vector3d::Zero(),
-                   pl::PlanStatus status = pl::PlanStatus::kOptimized)
+                   pl::PlanStatus status_all = pl::PlanStatus::kOptimized)
       : log(std::make_shared<std::vector<pl::PlanRequest>>()),
+        status(std::make_shared<pl::PlanStatus>(status_all)),
         step(config(uav), std::make_unique<RecordingPlanner>(log, accel, status)) {
     received.resize(3);
     in.params = &params;
@@ -92,6 +98,7 @@ struct Fixture {
     return step.step(in);
   }
   std::shared_ptr<std::vector<pl::PlanRequest>> log;
+  std::shared_ptr<pl::PlanStatus> status;  ///< the recording planner's status (verified) from now on
   pl::ReplanStep step;
   gf::formation::FormationParams params;  // paper Table II: leader + 2 followers
   std::vector<std::optional<pl::ReceivedPlan>> received;
@@ -232,6 +239,20 @@ TEST(ReplanStepTest, FreshWorkerIsExtrapolatedFromItsStampStaleIsFrozen) {
   EXPECT_NEAR((out.reference.p_world.col(0) - out.reference.p_world.col(9)).norm(), 0.0, 1e-12);
 }
 
+// A UAV listening after its (re)start holds, but the worker's data is fresh: his prediction
+// moves with him (frozen, a worker walking up to the holding UAV was checked where he had been).
+TEST(ReplanStepTest, AListeningHoldPredictsAFreshWorkerMoving) {
+  Fixture f(0);  // nothing heard from UAVs 1 and 2: listening
+  const Eigen::Vector3d p(1.0, 2.0, 0.0), v(0.5, 0.0, 0.0);
+  auto w = fresh(4.6, p, v);
+  const auto out = f.at(5.0, &w);
+  ASSERT_EQ(out.mode, pl::ReplanMode::kHold) << out.reason;
+  EXPECT_NE(out.reason.find("listening"), std::string::npos) << out.reason;
+  EXPECT_NEAR((out.worker.p_world.col(0) - (p + 0.4 * v)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((out.worker.p_world.col(3) - (p + (0.4 + 3 * 0.2) * v)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((out.reference.p_world.col(0) - out.reference.p_world.col(9)).norm(), 0.0, 1e-12);  // it holds
+}
+
 TEST(ReplanStepTest, LeaderThatLostTheWorkerSearchesAFollowerHolds) {
   for (int uav : {0, 1}) {
     Fixture f(uav);
@@ -265,6 +286,54 @@ TEST(ReplanStepTest, StartAccelerationIsWhatTheFlownPlanCommandsNotTheInput) {
   EXPECT_EQ(f.step.flownPlan().t0_s, 1.2);
 }
 
+// The planner's first fallback re-flies its last verified plan. A hold must not fly on the
+// tracking plan (it follows the stale prediction the hold is for, for up to the horizon), an
+// abort on nothing but its own (it would not retreat); a verified brake plan (a stop) may be
+// re-flown in any mode.
+TEST(ReplanStepTest, AHoldOrAbortDoesNotFallBackToAPlanMadeForAnotherMode) {
+  Fixture f(0);
+  f.received[1] = planFrom(1, 1.0);
+  f.received[2] = planFrom(2, 1.0);
+  const Eigen::Vector3d p(0.0, 0.0, 0.0);
+  auto w = fresh(1.0, p, Eigen::Vector3d::Zero());
+  struct Step {
+    double t;
+    pl::ReplanMode mode;
+    bool reuse;
+  };
+  const auto expectStep = [&](const Step& s) {
+    const auto out = f.at(s.t, &w);
+    ASSERT_EQ(out.mode, s.mode) << "t=" << s.t << ": " << out.reason;
+    EXPECT_EQ(f.log->back().reuse_previous, s.reuse) << "t=" << s.t << " (" << pl::toString(s.mode) << ")";
+  };
+  expectStep({1.0, pl::ReplanMode::kTrack, true});  // nothing verified yet
+  w = fresh(1.2, p, Eigen::Vector3d::Zero());
+  expectStep({1.2, pl::ReplanMode::kTrack, true});  // a tracking plan, tracking
+  // The worker's data goes stale (max_worker_age_s 3 s): hold.
+  expectStep({4.6, pl::ReplanMode::kHold, false});  // the last verified plan tracked
+  expectStep({4.8, pl::ReplanMode::kHold, true});   // now a hold plan
+  ASSERT_EQ(f.step.receiveAbort(pl::AbortCommand{{"gcs", 7}, pl::AbortSource::kOperator, 4.9}, 4.9),
+            pl::AbortAcceptance::kAccepted);
+  expectStep({5.0, pl::ReplanMode::kAbort, false});  // the last verified plan held
+  expectStep({5.2, pl::ReplanMode::kAbort, true});   // its own
+  // A verified brake plan (a stop) is re-flown in any mode; a tracking plan in a track again.
+  Fixture g(0);
+  g.received[1] = planFrom(1, 1.0);
+  g.received[2] = planFrom(2, 1.0);
+  w = fresh(1.0, p, Eigen::Vector3d::Zero());
+  g.at(1.0, &w);
+  *g.status = pl::PlanStatus::kFallbackBrake;
+  w = fresh(1.2, p, Eigen::Vector3d::Zero());
+  g.at(1.2, &w);
+  *g.status = pl::PlanStatus::kOptimized;
+  const auto hold = g.at(4.6, &w);
+  ASSERT_EQ(hold.mode, pl::ReplanMode::kHold) << hold.reason;
+  EXPECT_TRUE(g.log->back().reuse_previous);
+  w = fresh(4.8, p, Eigen::Vector3d::Zero());
+  ASSERT_EQ(g.at(4.8, &w).mode, pl::ReplanMode::kTrack);
+  EXPECT_TRUE(g.log->back().reuse_previous);  // a hold plan stands: tracking may re-fly it
+}
+
 TEST(ReplanStepTest, PlannerFallbackIsFlaggedForTheOthers) {
   Fixture f(2, Eigen::Vector3d::Zero(), pl::PlanStatus::kFallbackPrevious);
   f.received[1] = planFrom(1, 1.0);
@@ -280,7 +349,7 @@ TEST(ReplanStepTest, RestartForgetsAndListensAgain) {
   auto w = fresh(1.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
   ASSERT_EQ(f.at(1.0, &w).mode, pl::ReplanMode::kTrack);
   ASSERT_FALSE(f.step.flownPlan().empty());
-  f.step.restart(std::make_unique<RecordingPlanner>(f.log, Eigen::Vector3d::Zero()));
+  f.step.restart(std::make_unique<RecordingPlanner>(f.log, Eigen::Vector3d::Zero(), f.status));
   EXPECT_TRUE(f.step.flownPlan().empty());
   w = fresh(5.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
   const auto out = f.at(5.0, &w);  // follower 2's plan is from before the restart

@@ -1198,6 +1198,47 @@ TEST(UavPlannerTest, BrakePointMovesAwayPastAFarUavButNotIntoAnOldPlansMargin) {
   }
 }
 
+// The move of a brake point is checked against the others pointwise only; the verifier also
+// keeps Γ_dis from the braking envelope of a lower-priority UAV's plan (brake_envelope_lead_s).
+// Here the worker stands 3.05 m off (inside worker_safety_distance_m + buffer: the stop point
+// moves away from him by 0.1 m) and UAV 2, 4 m further along that line, flies at 3 m/s towards
+// it: where it would stop if it braked now is 2.52 m from the stop point, 2.42 m from the moved
+// one. The unmoved brake plan verifies, the moved one does not: the unmoved one is flown (before,
+// the moved one was, unverified).
+TEST(UavPlannerTest, AMoveOfTheBrakePointThatFailsVerificationIsNotFlown) {
+  const World& w = towers();
+  PlannerConfig cfg = testConfig();
+  UavPlanner planner(cfg, w.map, w.field);
+  const Eigen::Vector3d start(-8, -12, 10), u = Eigen::Vector3d(0, -2, 1).normalized();
+  const double margin = cfg.worker_safety_distance_m + 0.05;
+  ASSERT_GT(cfg.qp_distance_buffer_m, 0.1);  // the move: 0.1 m
+  const Eigen::Vector3d worker = start - margin * u;
+  const Eigen::Vector3d fast(-3.0 * u);
+  const double stop_distance = (brakeStop(Eigen::Vector3d::Zero(), fast, cfg.limits, 0.2)).norm();
+  const Eigen::Vector3d tip = start + (cfg.mutual_distance_m + 0.02) * u;
+  PlannedTrajectory other = standingPlan(2, tip + stop_distance * u, 10.0);
+  other.samples[0].v_world = fast;
+  ASSERT_LT((brakeStop(other.samples[0].p_world, fast, cfg.limits, 0.2) - tip).norm(), 1e-9);
+  PlanRequest req = straightRequest(1, 10.0, stateAt(start, 10.0), start, start, 0.0, worker);
+  req.reference.p_world(0, 5) = std::numeric_limits<double>::quiet_NaN();  // the replanning fails
+  req.higher_priority_plans = {other};
+  const PlanResult r = planner.plan(req);
+  ASSERT_EQ(r.status, PlanStatus::kFallbackBrake) << r.reason;
+  EXPECT_TRUE(r.verified) << r.reason;
+  EXPECT_NE(r.reason.find("not moving the brake point (the move fails: verify: "), std::string::npos) << r.reason;
+  EXPECT_NE(r.reason.find("braking envelope"), std::string::npos) << r.reason;
+  EXPECT_LT((r.trajectory.samples.back().p_world - start).norm(), 1e-9);
+  expectSafe(r.trajectory, *w.map, cfg);
+  // Without UAV 2 the same stop point is moved (the scenario does exercise the move).
+  UavPlanner alone(cfg, w.map, w.field);
+  req.higher_priority_plans.clear();
+  const PlanResult moved = alone.plan(req);
+  ASSERT_EQ(moved.status, PlanStatus::kFallbackBrake) << moved.reason;
+  EXPECT_TRUE(moved.verified) << moved.reason;
+  EXPECT_NE(moved.reason.find("moving the brake point 0.1 m away from the worker"), std::string::npos) << moved.reason;
+  EXPECT_NEAR((moved.trajectory.samples.back().p_world - start).norm(), 0.1, 1e-6);
+}
+
 TEST(UavPlannerTest, BoxedInBrakePointIsNotMoved) {
   const World& w = towers();
   PlannerConfig cfg = testConfig();
@@ -1656,6 +1697,16 @@ TEST(TrajectoryVerifierTest, ANonFiniteOtherPlanOrWorkerPredictionFailsVerificat
   const VerificationReport with_nan_plan = verifier.verify(mine, t, {bad}, {}, t, 0.2);
   EXPECT_FALSE(with_nan_plan.ok);
   EXPECT_NE(with_nan_plan.reason.find("UAV 0's plan"), std::string::npos) << with_nan_plan.reason;
+  // A plan whose t0 or dt is not usable read as hovering at its first sample.
+  for (const auto& [t0, dt] : {std::pair<double, double>{std::numeric_limits<double>::quiet_NaN(), 0.2}, {t, 0.0},
+                               {t, std::numeric_limits<double>::quiet_NaN()}, {t, std::numeric_limits<double>::infinity()}}) {
+    PlannedTrajectory timeless = standingPlan(0, far, t);
+    timeless.t0_s = t0;
+    timeless.dt_s = dt;
+    const VerificationReport rep = verifier.verify(mine, t, {timeless}, {}, t, 0.2);
+    EXPECT_FALSE(rep.ok) << "t0 " << t0 << ", dt " << dt;
+    EXPECT_NE(rep.reason.find("UAV 0's plan has t0"), std::string::npos) << rep.reason;
+  }
   const auto worker = gesture_formation::formation::constantVelocityHorizon(far, Eigen::Vector3d::Zero(), 0.0, 41, 0.2);
   ASSERT_TRUE(verifier.verify(mine, t, {}, worker, t, 0.2).ok);
   const auto nan_worker = gesture_formation::formation::constantVelocityHorizon(
