@@ -36,6 +36,7 @@
 #include "planner_live_map.hpp"
 #include "planner_params_role.hpp"
 #include "gesture_formation/onboard/frame_check.hpp"
+#include "gesture_formation/onboard/odometry_adapter.hpp"
 #include "gesture_formation/onboard/wind_input.hpp"
 #include "gesture_formation/planning/replan_health.hpp"
 #include "gesture_formation/planning/replan_step.hpp"
@@ -205,7 +206,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     if (worker_) worker = toWorkerKnowledge(*worker_);
     planning::ReplanInputs in;
     in.t_s = t;
-    in.state = *odom_;
+    in.state = onboard::carriedTo(*odom_, odom_stamp_s_, t);  // the odometry's stamp is up to max_odometry_age_s earlier
     if (const auto w = wind_.at(t)) in.wind_estimate_mps = *w;
     in.worker = worker ? &*worker : nullptr;
     in.params = &params_role_.own().role().params();

@@ -63,7 +63,12 @@ class SetpointRelayNodelet : public nodelet::Nodelet {
     std::lock_guard<std::mutex> lock(mutex_);
     if (!refusal) {
       auto plan = fromMsg(*msg);
-      refusal = plan ? relay_.accept(std::move(*plan)) : std::optional<std::string>(plan.reason());
+      const double now = ros::Time::now().toSec();
+      if (plan && relay_.hasPlan() && relay_.planT0() > now + onboard::SetpointRelay::kClockBackS) {
+        NODELET_WARN_STREAM("SetpointRelay: ROS time went back (held plan from " << relay_.planT0() << " s, now " << now
+                                                                                 << " s): the new plan replaces it");
+      }
+      refusal = plan ? relay_.accept(std::move(*plan), now) : std::optional<std::string>(plan.reason());
     }
     if (refusal) {
       ++refused_;

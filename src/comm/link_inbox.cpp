@@ -31,6 +31,18 @@ InboxItem LinkInbox::decodeOne(const Envelope& e) {
     case MessageType::kPlannedTrajectory: {
       ReceivedPlanMessage m;
       if (!decoder_.decode(e, m.plan)) return {};
+      // A UAV sends its own plans only, made before it sent them: a plan for another UAV (a
+      // holder of one key speaking for another UAV) or starting after its envelope's stamp (it
+      // would outrank every later plan of that UAV: receivers keep the newest t0) is refused.
+      if (m.plan.uav_index != static_cast<int>(e.sender_id) || !(m.plan.t0_s <= e.stamp_s + kPlanT0AllowanceS)) {
+        ++plans_refused_;
+        std::ostringstream os;
+        os.precision(12);
+        os << "plan refused (" << plans_refused_ << " so far): sender " << e.sender_id << ", uav_index "
+           << m.plan.uav_index << ", t0 " << m.plan.t0_s << " s, envelope stamp " << e.stamp_s << " s";
+        last_refusal_ = os.str();
+        return {};
+      }
       const auto peer = peers_.find(e.sender_id);
       m.fallback = peer != peers_.end() && peer->second.status != Heartbeat::Status::kOk &&
                    peer->second.last_plan_sequence == m.plan.sequence;

@@ -13,7 +13,8 @@ std::vector<comm::DiagnosticEntry> linkDiagnostics(comm::RejectionReport& report
                                                       {"published", t.published},
                                                       {"publish_failed", t.publish_failed},
                                                       {"command_copies_dropped", inbox.commandCopiesDropped()},
-                                                      {"observations_refused", inbox.observationsRefused()}},
+                                                      {"observations_refused", inbox.observationsRefused()},
+                                                      {"plans_refused", inbox.plansRefused()}},
                                                      {"channel_mismatch", "undecodable_lcm"})};
   for (const auto& [sender, counters] : senders) out.push_back(report.sender(sender, counters));
   return out;

@@ -63,4 +63,12 @@ common::Result<planning::UavKinematicState> toPlannerState(const FlightStackOdom
   return R::ok(s);
 }
 
+planning::UavKinematicState carriedTo(const planning::UavKinematicState& odom, double stamp_s, double t_s) {
+  planning::UavKinematicState s = odom;
+  const double age = t_s - stamp_s;
+  if (age > 0.0 && std::isfinite(age)) s.p_world += age * odom.v_world;
+  s.t_s = t_s;
+  return s;
+}
+
 }  // namespace gesture_formation::onboard

@@ -43,7 +43,7 @@ const char* toString(RelayMode mode) {
   return "unknown";
 }
 
-std::optional<std::string> SetpointRelay::accept(planning::PlannedTrajectory plan) {
+std::optional<std::string> SetpointRelay::accept(planning::PlannedTrajectory plan, double t_now_s) {
   if (plan.samples.empty()) return std::string("plan: no samples");
   if (!std::isfinite(plan.t0_s)) return std::string("plan t0: not finite");
   if (!(plan.dt_s > 0.0) || !std::isfinite(plan.dt_s)) {
@@ -55,7 +55,7 @@ std::optional<std::string> SetpointRelay::accept(planning::PlannedTrajectory pla
       return "plan sample " + std::to_string(k) + ": not finite";
     }
   }
-  if (plan_) {
+  if (plan_ && !(plan_->t0_s > t_now_s + kClockBackS)) {
     const bool newer = plan.t0_s > plan_->t0_s || (plan.t0_s == plan_->t0_s && plan.sequence > plan_->sequence);
     if (!newer) {
       std::ostringstream os;

@@ -3,7 +3,8 @@
 /// \brief What a receiving node does with each authenticated envelope before it hands the content
 /// on (the LcmBridge's receive side, docs/security.md §2–3), ROS-free: the payload decoded
 /// (comm::PayloadDecoder: strict, every refusal counted), heartbeats kept per peer (a plan whose
-/// sequence a degraded heartbeat named just before is a fallback plan), formation commands through
+/// sequence a degraded heartbeat named just before is a fallback plan), plans refused unless their
+/// UAV is the envelope's sender and their t0 is not after the envelope's stamp, formation commands through
 /// comm::CommandIntake (first copy of each id, name bound to the envelope sender), gesture
 /// observations refused when the observing UAV is not the envelope's sender or the frame time is
 /// not a valid time, abort commands handed on at every copy with sent_s = the envelope's stamp (the
@@ -51,6 +52,12 @@ class LinkInbox {
 
   std::uint64_t commandCopiesDropped() const { return intake_.copiesDropped(); }
   std::uint64_t observationsRefused() const { return observations_refused_; }
+  /// \brief Plans whose uav_index was not the envelope's sender, or whose t0 was later than the
+  /// envelope's stamp + kPlanT0AllowanceS.
+  std::uint64_t plansRefused() const { return plans_refused_; }
+  /// \brief How far a plan's t0 may lie after its envelope's stamp [s] (both the sender's clock:
+  /// a plan is stamped at its replanning, then sent; rounding only).
+  static constexpr double kPlanT0AllowanceS = 0.001;
   /// \brief Leadership messages whose `from` was not the envelope's sender.
   std::uint64_t leadershipRefused() const { return leadership_refused_; }
   const PayloadCounters& payloadCounters() const { return decoder_.counters(); }
@@ -69,6 +76,7 @@ class LinkInbox {
   std::set<AckKey> acks_seen_;
   std::deque<AckKey> acks_order_;
   std::uint64_t observations_refused_ = 0;
+  std::uint64_t plans_refused_ = 0;
   std::uint64_t leadership_refused_ = 0;
   std::string last_refusal_;
   bool last_decode_failure_ = false;

@@ -47,4 +47,11 @@ struct FlightStackOdometry {
 /// others are normalised) or a vertical optical axis (heading undefined).
 common::Result<planning::UavKinematicState> toPlannerState(const FlightStackOdometry& odom, const CameraMount& mount);
 
+/// \brief The odometry's state carried to `t_s` (a replanning's time) at its velocity: a plan
+/// starts at t_s, and from the state of the odometry's stamp it would start where the UAV was up
+/// to the planner's max_odometry_age_s earlier (1.5 m at 3 m/s and 0.5 s), the relay pulling the
+/// UAV back towards it. Position only (velocity, angles as measured); a stamp at or after t_s
+/// (clocks a little apart) is taken as it is; t_s.
+planning::UavKinematicState carriedTo(const planning::UavKinematicState& odom, double stamp_s, double t_s);
+
 }  // namespace gesture_formation::onboard

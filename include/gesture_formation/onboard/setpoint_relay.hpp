@@ -13,6 +13,7 @@
 /// stopped): the plan's last point with zero velocity, held — rule 5, what the simulated tracker
 /// does (`PlannedTrajectory::sampleAt`), and where the other UAVs expect this one to be.
 
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -62,8 +63,13 @@ class SetpointRelay {
  public:
   /// \brief Takes `plan` when it is usable and newer than the one held (by t0_s; an equal t0_s
   /// with a higher sequence also replaces); else the reason, naming the field and value, and the
-  /// held plan is kept.
-  std::optional<std::string> accept(planning::PlannedTrajectory plan);
+  /// held plan is kept. A held plan whose t0_s is more than kClockBackS after `t_now_s` (ROS time
+  /// went back: the simulation restarted, a bag looped) is replaced by any usable plan — else
+  /// every new plan would be refused as older until the clock caught up, the UAV holding the old
+  /// plan's end. NaN `t_now_s`: no such check.
+  std::optional<std::string> accept(planning::PlannedTrajectory plan,
+                                    double t_now_s = std::numeric_limits<double>::quiet_NaN());
+  static constexpr double kClockBackS = 1.0;
   /// \brief The setpoint at `t_s`; nullopt without a plan.
   std::optional<Setpoint> sample(double t_s) const;
   bool hasPlan() const { return plan_.has_value(); }

@@ -25,8 +25,9 @@ Envelope envelopeOf(const T& message, std::uint16_t sender, double stamp_s = 10.
   return e;
 }
 
-planning::PlannedTrajectory plan(std::uint32_t sequence) {
+planning::PlannedTrajectory plan(std::uint32_t sequence, int uav = 1) {
   planning::PlannedTrajectory p;
+  p.uav_index = uav;
   p.sequence = sequence;
   p.t0_s = 10.0;
   p.dt_s = 0.1;
@@ -51,8 +52,29 @@ TEST(LinkInboxTest, APlanIsAFallbackOnlyWhenTheDegradedHeartbeatBeforeItNamedIt)
   EXPECT_TRUE(std::get<ReceivedPlanMessage>(item).fallback);
   item = inbox.take(envelopeOf(plan(7), 1));  // a later plan: not the one the heartbeat named
   EXPECT_FALSE(std::get<ReceivedPlanMessage>(item).fallback);
-  item = inbox.take(envelopeOf(plan(6), 2));  // another sender's heartbeat state is its own
+  item = inbox.take(envelopeOf(plan(6, 2), 2));  // another sender's heartbeat state is its own
   EXPECT_FALSE(std::get<ReceivedPlanMessage>(item).fallback);
+}
+
+// A holder of UAV 2's key must not speak for the leader: a plan claiming UAV 0 from sender 2 would
+// be the leader's plan at every receiver (avoided instead of the real one, shaping the followers'
+// references). Nor may a plan start after it was sent: receivers keep the newest t0, so a t0 an
+// hour ahead would outrank every real plan of that UAV.
+TEST(LinkInboxTest, APlanOfAnotherUavOrStartingAfterItsEnvelopeIsRefused) {
+  LinkInbox inbox;
+  EXPECT_TRUE(std::holds_alternative<ReceivedPlanMessage>(inbox.take(envelopeOf(plan(1, 2), 2, 10.0))));
+  EXPECT_TRUE(std::holds_alternative<std::monostate>(inbox.take(envelopeOf(plan(2, 0), 2, 10.0))));
+  EXPECT_EQ(inbox.plansRefused(), 1u);
+  EXPECT_NE(inbox.lastRefusal().find("plan refused (1 so far): sender 2, uav_index 0"), std::string::npos)
+      << inbox.lastRefusal();
+  planning::PlannedTrajectory future = plan(3, 2);
+  future.t0_s = 10.0 + 3600.0;
+  EXPECT_TRUE(std::holds_alternative<std::monostate>(inbox.take(envelopeOf(future, 2, 10.0))));
+  EXPECT_EQ(inbox.plansRefused(), 2u);
+  EXPECT_NE(inbox.lastRefusal().find("t0 3610 s, envelope stamp 10 s"), std::string::npos) << inbox.lastRefusal();
+  future.t0_s = 10.0;  // made at the stamp: accepted
+  EXPECT_TRUE(std::holds_alternative<ReceivedPlanMessage>(inbox.take(envelopeOf(future, 2, 10.0))));
+  EXPECT_EQ(inbox.plansRefused(), 2u);
 }
 
 TEST(LinkInboxTest, CommandsForwardOnceWithTheNameBoundToTheSender) {

@@ -193,3 +193,23 @@ TEST(OdometryAdapterTest, SlightlyDenormalisedQuaternionIsNormalised) {
   ASSERT_TRUE(s);
   EXPECT_NEAR(s->heading_rad, 0.5, 1e-12);
 }
+
+// A replanning at t starts from the state at t: the odometry 0.3 s old is carried along its
+// velocity (before, a plan at 3 m/s started 0.9 m behind the UAV); a stamp after t is taken as is.
+TEST(OdometryAdapterTest, TheStateIsCarriedToTheReplanningTime) {
+  gf::planning::UavKinematicState odom;
+  odom.t_s = 10.0;
+  odom.p_world = Eigen::Vector3d(1.0, 2.0, 5.0);
+  odom.v_world = Eigen::Vector3d(3.0, 0.0, -0.5);
+  odom.heading_rad = 0.4;
+  odom.pitch_rad = -0.2;
+  const auto s = gf::onboard::carriedTo(odom, 10.0, 10.3);
+  EXPECT_NEAR((s.p_world - Eigen::Vector3d(1.9, 2.0, 4.85)).norm(), 0.0, 1e-12);
+  EXPECT_EQ(s.v_world, odom.v_world);
+  EXPECT_DOUBLE_EQ(s.heading_rad, 0.4);
+  EXPECT_DOUBLE_EQ(s.pitch_rad, -0.2);
+  EXPECT_DOUBLE_EQ(s.t_s, 10.3);
+  const auto ahead = gf::onboard::carriedTo(odom, 10.05, 10.0);
+  EXPECT_EQ(ahead.p_world, odom.p_world);
+  EXPECT_DOUBLE_EQ(ahead.t_s, 10.0);
+}

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "gesture_formation/onboard/setpoint_relay.hpp"
+#include "gesture_formation/planning/trajectory_verifier.hpp"
 
 namespace go = gesture_formation::onboard;
 namespace gp = gesture_formation::planning;
@@ -48,6 +49,29 @@ TEST(SetpointRelayTest, InsideThePlanInterpolatesLikeTheTracker) {
   EXPECT_NEAR(s->yaw_rate_radps, 0.5, 1e-12);  // 0.1 rad per 0.2 s
   EXPECT_NEAR(s->pitch_rad, -0.2, 1e-12);
   EXPECT_DOUBLE_EQ(s->past_end_s, 0.0);
+}
+
+// The setpoints lie on the curve the verifier checked (the cubic Hermite through the samples,
+// here exactly the plan's x = 1.5·t² from rest at 3 m/s²); linear interpolation between the
+// samples cut it by a·dt²/8 = 1.5 cm halfway between samples 1 and 2.
+TEST(SetpointRelayTest, InsideThePlanSetpointsLieOnTheVerifiedCurve) {
+  gp::PlannedTrajectory p = straightPlan(100.0);
+  const double a = 3.0;
+  for (std::size_t k = 0; k < p.samples.size(); ++k) {
+    const double t = 0.2 * static_cast<double>(k);
+    p.samples[k].p_world.x() = 0.5 * a * t * t;
+    p.samples[k].v_world.x() = a * t;
+    p.samples[k].a_world.x() = a;
+  }
+  go::SetpointRelay relay;
+  ASSERT_FALSE(relay.accept(p));
+  for (double tau : {0.05, 0.3, 0.47, 0.9}) {
+    const auto s = relay.sample(100.0 + tau);
+    ASSERT_TRUE(s);
+    EXPECT_NEAR(s->p_world.x(), 0.5 * a * tau * tau, 1e-12) << "t0 + " << tau;
+    EXPECT_NEAR(s->v_world.x(), a * tau, 1e-12) << "t0 + " << tau;
+    EXPECT_NEAR((s->p_world - gp::evaluateTrajectory(p, 100.0 + tau).p).norm(), 0.0, 1e-12) << "t0 + " << tau;
+  }
 }
 
 TEST(SetpointRelayTest, YawRateWrapsAcrossPi) {
@@ -127,4 +151,17 @@ TEST(SetpointRelayTest, SetpointOutputsParseAndRefuseNamingTheValue) {
   const auto bad = go::parseSetpointOutputs("attitude");
   ASSERT_FALSE(bad);
   EXPECT_NE(bad.reason().find("'attitude'"), std::string::npos);
+}
+
+// ROS time went back (the simulation restarted, a bag looped): the held plan was made in the old
+// future; a new plan at the new time replaces it (before: refused as older until the clock caught
+// up, the UAV holding the old plan's end). Without the jump an older plan is still refused.
+TEST(SetpointRelayTest, AfterRosTimeWentBackANewPlanReplacesTheHeldOne) {
+  go::SetpointRelay relay;
+  ASSERT_FALSE(relay.accept(straightPlan(100.0), 100.05));
+  EXPECT_TRUE(relay.accept(straightPlan(99.0, 6, 2), 100.1));  // older, the clock did not go back
+  EXPECT_TRUE(relay.accept(straightPlan(99.5, 6, 2), 99.6));   // 0.4 s back: within kClockBackS, a late plan
+  EXPECT_FALSE(relay.accept(straightPlan(5.0, 6, 2), 5.05));   // 95 s back
+  EXPECT_DOUBLE_EQ(relay.planT0(), 5.0);
+  EXPECT_TRUE(relay.accept(straightPlan(4.8, 6, 3), 5.1));     // and from then on the usual order
 }
