@@ -22,7 +22,9 @@ inline diagnostic_msgs::DiagnosticStatus plannerHealth(const planning::ReplanHea
       .value("fallbacks", r.fallbacks)
       .value("last_status", r.last_status)
       .value("last_planning_ms", r.last_planning_ms)
-      .value("last_plan_age_s", r.last_plan_age_s);
+      .value("last_plan_age_s", r.last_plan_age_s)
+      .value("off_plan_replannings", r.off_plan)
+      .value("max_off_plan_m", r.max_off_plan_m);
   return h.status();
 }
 

@@ -569,6 +569,7 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
   ctx.allowance = std::clamp(tracking_deviation_m_, config_.tracking_allowance_min_m + wind_allowance,
                              config_.tracking_allowance_max_m + wind_allowance);
   result.tracking_allowance_m = ctx.allowance;
+  result.tracking_deviation_m = tracking_deviation_m_;
   result.wind_allowance_m = wind_allowance;
   ctx.wind_allowance = wind_allowance;
   if (wind_allowance > 0.0 && mean_wind_.norm() > 1e-6) ctx.downwind = mean_wind_.normalized();

@@ -20,6 +20,10 @@ struct ReplanHealthReport {
   std::string last_status = "none";
   double last_planning_ms = 0.0;
   double last_plan_age_s = -1.0;  ///< −1: no plan yet
+  /// Replannings whose measured tracking deviation exceeded the allowance they planned with
+  /// (PlanResult::tracking_deviation_m > tracking_allowance_m), and the largest excess [m].
+  int off_plan = 0;
+  double max_off_plan_m = 0.0;
 };
 
 class ReplanHealth {
@@ -27,7 +31,8 @@ class ReplanHealth {
   /// \brief A replanning at t_s (only planned ones count).
   void record(const ReplanOutcome& outcome, double t_s);
   /// \brief The report at now_s, then a new interval: ERROR when the last plan is older than 3
-  /// replanning periods (after the first plan), WARN while not tracking or after a fallback.
+  /// replanning periods (after the first plan), WARN while not tracking, after a fallback, or when
+  /// the UAV was farther off its plan than the tracking allowance (off_plan).
   ReplanHealthReport report(double now_s, double period_s);
 
  private:

@@ -128,6 +128,11 @@ struct PlanResult {
   /// (PlannerConfig::tracking_allowance_*): the largest recent deviation of the state from the
   /// plan being flown.
   double tracking_allowance_m = 0.0;
+  /// The measured deviation the allowance follows (the largest recent distance of the state from
+  /// the plan being flown, decaying): above tracking_allowance_m the UAV is farther off its plan
+  /// than planning allowed for — the other UAVs and the clearances count on it being on it (a
+  /// flight stack lagging its setpoints, wind beyond the allowance).
+  double tracking_deviation_m = 0.0;
   /// The part of tracking_allowance_m's bounds due to the wind (PlannerConfig::wind_allowance_*).
   double wind_allowance_m = 0.0;
 };

@@ -51,3 +51,26 @@ TEST(ReplanHealthTest, HoldingOrFallingBackWarnsAndSilenceIsAnError) {
   EXPECT_EQ(r.level, Level::kError);
   EXPECT_EQ(r.message.rfind("no plan for", 0), 0u) << r.message;
 }
+
+// A UAV farther off its plan than the tracking allowance it planned with (a flight stack lagging
+// position-only setpoints, wind beyond the allowance) warns with the largest excess; within the
+// allowance it does not.
+TEST(ReplanHealthTest, BeingOffThePlanBeyondTheAllowanceWarns) {
+  ReplanHealth h;
+  ReplanOutcome o = outcome(ReplanMode::kTrack, false);
+  o.result.tracking_allowance_m = 0.5;
+  o.result.tracking_deviation_m = 0.4;
+  h.record(o, 1.0);
+  EXPECT_EQ(h.report(1.1, 0.2).level, Level::kOk);
+  o.result.tracking_deviation_m = 3.2;
+  h.record(o, 1.2);
+  o.result.tracking_deviation_m = 1.0;
+  h.record(o, 1.4);
+  const ReplanHealthReport r = h.report(1.5, 0.2);
+  EXPECT_EQ(r.level, Level::kWarn);
+  EXPECT_EQ(r.off_plan, 2);
+  EXPECT_NEAR(r.max_off_plan_m, 2.7, 1e-12);
+  EXPECT_EQ(r.message.rfind("off its plan by up to 2.7 m beyond the tracking allowance in 2 replanning(s)", 0), 0u)
+      << r.message;
+  EXPECT_EQ(h.report(1.6, 0.2).off_plan, 0);  // a new interval
+}

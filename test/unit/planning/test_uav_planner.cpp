@@ -1319,6 +1319,7 @@ TEST(UavPlannerTest, TrackingAllowanceDecaysAndIsClamped) {
   s.p_world += Eigen::Vector3d(0.6, 0, 0);  // 0.6 m off: clamped to the cap
   r = planner.plan(straightRequest(0, 0.4, s, from, from, 0.0, worker));
   EXPECT_DOUBLE_EQ(r.tracking_allowance_m, 0.4);
+  EXPECT_NEAR(r.tracking_deviation_m, 0.6, 1e-9);  // what it measured: 0.2 m beyond what it planned with
   double t = 0.4;
   for (int cycle = 0; cycle < 25; ++cycle) {  // 10 s of perfect tracking: 0.6 − 0.02·10 = 0.4 ...
     t += 0.4;
