@@ -83,10 +83,8 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     rc.uav_count = uav_count_;
     rc.worker_heading = fcfg.worker_heading;
     rc.formation_limits = fcfg.limits;
-    step_ = std::make_unique<planning::ReplanStep>(rc,
-                                                   std::make_unique<planning::UavPlannerAdapter>(std::make_unique<planning::UavPlanner>(
-                                                       settings.planner, world_.map, world_.field, live_map_.seen())),
-                                                   retreatSpace(world_));
+    planner_config_ = settings.planner;
+    step_ = std::make_unique<planning::ReplanStep>(rc, makePlanner(), retreatSpace(world_));
     received_.resize(static_cast<std::size_t>(uav_count_));
     plan_pub_ = nh.advertise<gesture_formation::PlannedTrajectory>("plan_out", 5);
     traj_pub_ = nh.advertise<trajectory_msgs::MultiDOFJointTrajectory>("trajectory_out", 5);
@@ -181,6 +179,12 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
       next_plan_s_ = -1.0;
       for (auto& r : received_) r.reset();  // stamped in the old future: each newer plan would be refused as older
       worker_.reset();
+      odom_.reset();
+      // The replanning step and the planner hold times of the old timeline (listening's start, the
+      // hold, an accepted abort, the last verified and brake plans): it restarts as after a reboot
+      // — no memory, it listens before it moves (a listening hold would otherwise last until the
+      // clock caught up).
+      step_->restart(makePlanner());
     }
     if (next_plan_s_ < 0.0) next_plan_s_ = (std::floor(t / period_s_) + 1.0) * period_s_ + offset_s_;
     if (t < next_plan_s_) return;
@@ -254,6 +258,13 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
   std::string mode_ = "track";             ///< track | hold | search | abort (logged on change)
   WorldMap world_;  ///< the map and field the planner and the abort's goal search use (live: live_map_'s)
   PlannerLiveMap live_map_;  ///< ~mapping_config: the depth camera's live map
+  /// A new planner over the world's map (and the live map's seen space).
+  std::unique_ptr<planning::Planner> makePlanner() {
+    return std::make_unique<planning::UavPlannerAdapter>(
+        std::make_unique<planning::UavPlanner>(planner_config_, world_.map, world_.field, live_map_.seen()));
+  }
+
+  planning::PlannerConfig planner_config_;
   std::unique_ptr<planning::ReplanStep> step_;  ///< planner, hold / search, listening (shared with gfctl simulate)
   std::optional<planning::UavKinematicState> odom_;
   double odom_stamp_s_ = 0.0;         ///< odom_'s stamp (ROS time)
