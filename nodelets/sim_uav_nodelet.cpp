@@ -1,7 +1,9 @@
 // SimUav nodelet: one simulated UAV of the mission (the sim core of `gfctl simulate`:
 // sim::Multirotor plant + sim::TrackingController + sim::Odometry, in the same wind field, with
-// the same seeds), stepping at the mission's step_s in sim time. It executes the plans of its
-// FormationPlanner exactly as received (an empty plan: brake to hover). Its callbacks run on its
+// the same seeds), stepping at the mission's step_s in sim time. It takes the plans of its
+// FormationPlanner by the SetpointRelay's rules (onboard::SetpointRelay::accept: an empty,
+// broken or older plan is refused and the held one flown on — what flies on hardware) and tracks
+// them as gfctl simulate's UAVs do (PlannedTrajectory::sampleAt, the relay's sampling too). Its callbacks run on its
 // own thread, not the nodelet manager's workers; odometry and tf carry the state at the clock.
 //
 // Topics: plan_in (PlannedTrajectory) → odometry_out (nav_msgs/Odometry, the noisy estimate the
@@ -26,6 +28,7 @@
 #include "sim_conversions.hpp"
 #include "gesture_formation/formation/formation_geometry.hpp"
 #include "gesture_formation/formation/worker_heading.hpp"
+#include "gesture_formation/onboard/setpoint_relay.hpp"
 #include "gesture_formation/sim/multirotor.hpp"
 #include "gesture_formation/sim/odometry.hpp"
 #include "gesture_formation/sim/random.hpp"
@@ -112,11 +115,13 @@ class SimUavNodelet : public nodelet::Nodelet {
   void onPlan(const gesture_formation::PlannedTrajectory::ConstPtr& msg) {
     auto plan = fromMsg(*msg);
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!plan || plan->empty()) {
-      ctl_->clearPlan();
-    } else {
-      ctl_->setPlan(*plan);
+    const std::optional<std::string> refusal =
+        plan ? relay_.accept(*plan, ros::Time::now().toSec()) : std::optional<std::string>(plan.reason());
+    if (refusal) {
+      NODELET_ERROR_STREAM_THROTTLE(2.0, "SimUav: plan refused (the held plan is flown on): " << *refusal);
+      return;
     }
+    ctl_->setPlan(*plan);
   }
 
   void onStep(const ros::TimerEvent&) {
@@ -189,6 +194,7 @@ class SimUavNodelet : public nodelet::Nodelet {
   double step_s_ = 0.01, ground_m_ = 0.0, t_ = -1.0;
   std::optional<sim::Multirotor> plant_;
   std::optional<sim::TrackingController> ctl_;
+  onboard::SetpointRelay relay_;  ///< the hardware relay's acceptance rules for the plans flown
   std::optional<sim::Odometry> odo_;
   std::optional<sim::WindModel> wind_;
   sim::WindEstimate wind_estimate_;
