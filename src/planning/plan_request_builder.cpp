@@ -92,23 +92,6 @@ std::string holdReason(int uav_index, double t_s, double share_stamp_s, double w
   return "";
 }
 
-std::vector<int> unheardFollowers(int uav_index, double since_s, const std::vector<std::optional<ReceivedPlan>>& received,
-                                  const std::function<bool(int)>& absent) {
-  std::vector<int> unheard;
-  for (int j = 1; j < static_cast<int>(received.size()); ++j) {
-    const auto& m = received[static_cast<std::size_t>(j)];
-    if (j != uav_index && !(absent && absent(j)) && (!m || m->plan.t0_s < since_s)) unheard.push_back(j);
-  }
-  return unheard;
-}
-
-std::string listeningReason(int uav_index, double since_s, const std::vector<std::optional<ReceivedPlan>>& received,
-                            const std::function<bool(int)>& absent) {
-  return unheardFollowers(uav_index, since_s, received, absent).empty()
-             ? ""
-             : "listening: waiting for a plan from every other UAV since the (re)start";
-}
-
 Eigen::Vector3d brakingPoint(const Eigen::Vector3d& p_world, const Eigen::Vector3d& v_world, double brake_accel_mps2) {
   const double a = std::max(1e-3, brake_accel_mps2);
   return p_world + v_world * (v_world.norm() / (2.0 * a));

@@ -98,18 +98,6 @@ struct FreshnessLimits {
 std::string holdReason(int uav_index, double t_s, double share_stamp_s, double worker_stamp_s,
                        const FreshnessLimits& limits);
 
-/// \brief "Listen before moving" (docs/safety.md §2.4): a UAV whose memory was reset at since_s
-/// (a follower rejoining after a reboot; a FormationPlanner that (re)started) holds until it has,
-/// from every other follower j ≥ 1 (j ≠ uav_index) for which absent(j) is false, a plan made at or
-/// after since_s — the leader's plan comes with its share. Returns the hold reason, "" once it may
-/// track (from then on the rule is done: the caller stops asking).
-std::string listeningReason(int uav_index, double since_s, const std::vector<std::optional<ReceivedPlan>>& received,
-                            const std::function<bool(int)>& absent);
-/// \brief The followers listeningReason still waits for: every j ≥ 1 (j ≠ uav_index, absent(j)
-/// false or absent empty) without a plan made at or after since_s, ascending. Empty: it may track.
-std::vector<int> unheardFollowers(int uav_index, double since_s, const std::vector<std::optional<ReceivedPlan>>& received,
-                                  const std::function<bool(int)>& absent);
-
 /// \brief Where braking from velocity v at `brake_accel_mps2` ends: p + v|v|/(2a). A UAV entering
 /// hold latches this point and holds it until it tracks again (docs/safety.md §1 rule 3).
 Eigen::Vector3d brakingPoint(const Eigen::Vector3d& p_world, const Eigen::Vector3d& v_world, double brake_accel_mps2);

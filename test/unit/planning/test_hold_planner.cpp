@@ -1,6 +1,6 @@
 // The hold / search / listening rules of one replanning (docs/safety.md §1 rules 2–4, §2.2,
 // §2.4): planning::holdReason, brakingPoint, holdReference, searching, searchTargets,
-// HoldPlanner, listeningReason — the parts planning::ReplanStep is made of.
+// HoldPlanner — the parts planning::ReplanStep is made of (listening: test_replan_step.cpp).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -191,46 +191,5 @@ TEST(HoldReasonTest, EachAgeLimitDecidesWithItsOwnStamp) {
   EXPECT_FALSE(gf::planning::holdReason(0, 10.0, 10.0, -inf, lim).empty());
   EXPECT_FALSE(gf::planning::holdReason(1, 10.0, nan, 10.0, lim).empty());
   EXPECT_FALSE(gf::planning::holdReason(1, 10.0, 10.0, inf, lim).empty());
-}
-
-// docs/safety.md §2.4: listen before moving — the rule gfctl simulate applies to a rejoining
-// follower and the FormationPlanner nodelet to its own (re)start.
-TEST(ListeningTest, WaitsForAPlanMadeSinceTheResetFromEveryOtherPresentFollower) {
-  namespace pl = gf::planning;
-  const auto plan = [](int uav, double t0) {
-    pl::ReceivedPlan r;
-    r.plan.uav_index = uav;
-    r.plan.t0_s = t0;
-    return std::optional<pl::ReceivedPlan>(r);
-  };
-  const auto present = [](int) { return false; };
-  const std::string waiting = "listening: waiting for a plan from every other UAV since the (re)start";
-  // Follower 1 reset at 15 s; entry 0 (the leader: its plan comes with the share) is never waited for.
-  std::vector<std::optional<pl::ReceivedPlan>> rx(4);
-  EXPECT_EQ(pl::listeningReason(1, 15.0, rx, present), waiting);  // nothing received
-  rx[2] = plan(2, 15.2);
-  EXPECT_EQ(pl::listeningReason(1, 15.0, rx, present), waiting);  // follower 3 still missing
-  rx[3] = plan(3, 14.9);
-  EXPECT_EQ(pl::listeningReason(1, 15.0, rx, present), waiting);  // made before the reset
-  rx[3] = plan(3, 15.0);
-  EXPECT_EQ(pl::listeningReason(1, 15.0, rx, present), "");       // made at the reset counts
-  // Its own entry and absent UAVs are not waited for; the leader waits for every follower.
-  rx[3].reset();
-  EXPECT_EQ(pl::listeningReason(1, 15.0, rx, [](int j) { return j == 3; }), "");
-  EXPECT_EQ(pl::listeningReason(3, 15.0, rx, present), waiting);  // follower 1's plan missing
-  rx[1] = plan(1, 15.3);
-  EXPECT_EQ(pl::listeningReason(3, 15.0, rx, present), "");
-  EXPECT_EQ(pl::listeningReason(0, 15.0, rx, present), waiting);  // the leader: follower 3's missing
-  EXPECT_EQ(pl::listeningReason(0, 15.0, rx, nullptr), waiting);  // no absent predicate: wait for all
-  // The same rule as a list (the FormationPlanner nodelet names the UAVs it stopped waiting for).
-  EXPECT_EQ(pl::unheardFollowers(0, 15.0, rx, nullptr), std::vector<int>{3});
-  rx[2] = plan(2, 14.0);
-  EXPECT_EQ(pl::unheardFollowers(0, 15.0, rx, nullptr), (std::vector<int>{2, 3}));
-  EXPECT_EQ(pl::unheardFollowers(0, 15.0, rx, [](int j) { return j == 2; }), std::vector<int>{3});
-  EXPECT_EQ(pl::unheardFollowers(2, 15.0, rx, present), std::vector<int>{3});  // not itself
-  rx[2] = plan(2, 15.5);
-  rx[3] = plan(3, 15.1);
-  EXPECT_TRUE(pl::unheardFollowers(0, 15.0, rx, present).empty());
-  EXPECT_EQ(pl::listeningReason(0, 15.0, rx, present), "");
 }
 
