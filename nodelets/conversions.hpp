@@ -153,14 +153,14 @@ inline common::Result<planning::PlanStatus> planStatusFromName(const std::string
   }
   return R::fail("PlannedTrajectory.status '" + name + "': expected optimized | fallback_previous | fallback_brake");
 }
-/// Fails naming the field when the arrays disagree in length or dt is not positive.
+/// Fails naming the field when the arrays disagree in length or dt is not positive and finite.
 inline common::Result<planning::PlannedTrajectory> fromMsg(const gesture_formation::PlannedTrajectory& m) {
   using R = common::Result<planning::PlannedTrajectory>;
   const std::size_t n = m.positions.size();
   if (m.velocities.size() != n || m.accelerations.size() != n || m.heading_rad.size() != n || m.pitch_rad.size() != n) {
     return R::fail("PlannedTrajectory: positions, velocities, accelerations, heading_rad, pitch_rad differ in length");
   }
-  if (!(m.dt_s > 0.0)) return R::fail("PlannedTrajectory.dt_s: must be > 0");
+  if (!(m.dt_s > 0.0) || !std::isfinite(m.dt_s)) return R::fail("PlannedTrajectory.dt_s: must be finite and > 0, got " + std::to_string(m.dt_s));
   planning::PlannedTrajectory p;
   p.uav_index = m.uav_index;
   p.sequence = m.sequence;

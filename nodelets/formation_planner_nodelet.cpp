@@ -181,10 +181,19 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
       worker_.reset();
       odom_.reset();
       // The replanning step and the planner hold times of the old timeline (listening's start, the
-      // hold, an accepted abort, the last verified and brake plans): it restarts as after a reboot
-      // — no memory, it listens before it moves (a listening hold would otherwise last until the
-      // clock caught up).
+      // hold, the abort's phase, the last verified and brake plans): it restarts as after a reboot
+      // — it listens before it moves (a listening hold would otherwise last until the clock caught
+      // up) — but keeps an accepted abort.
+      // An accepted abort is kept (the senders may have stopped repeating it): taken again on the
+      // new timeline, its phase and goals chosen anew.
+      const std::optional<planning::AbortCommand> abort = step_->abort().command();
       step_->restart(makePlanner());
+      if (abort) {
+        planning::AbortCommand again = *abort;
+        again.sent_s = t;
+        step_->receiveAbort(again, t);
+        abort_pub_.publish(toAbortState(step_->abort(), uav_index_, t, "kept across the clock jump", abort_link_sender_, world_frame_));
+      }
     }
     if (next_plan_s_ < 0.0) next_plan_s_ = (std::floor(t / period_s_) + 1.0) * period_s_ + offset_s_;
     if (t < next_plan_s_) return;

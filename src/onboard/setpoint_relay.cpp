@@ -55,6 +55,12 @@ std::optional<std::string> SetpointRelay::accept(planning::PlannedTrajectory pla
       return "plan sample " + std::to_string(k) + ": not finite";
     }
   }
+  // A plan from the future (another timeline: queued before ROS time went back) is not flown.
+  if (plan.t0_s > t_now_s + kClockBackS) {
+    std::ostringstream os;
+    os << "plan t0 " << plan.t0_s << " s: more than " << kClockBackS << " s after now (" << t_now_s << " s)";
+    return os.str();
+  }
   if (plan_ && !(plan_->t0_s > t_now_s + kClockBackS)) {
     const bool newer = plan.t0_s > plan_->t0_s || (plan.t0_s == plan_->t0_s && plan.sequence > plan_->sequence);
     if (!newer) {

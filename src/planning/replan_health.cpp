@@ -39,7 +39,7 @@ ReplanHealthReport ReplanHealth::report(double now_s, double period_s) {
     std::ostringstream os;
     os.precision(3);
     os << "off its plan by up to " << r.max_off_plan_m << " m beyond the tracking allowance in " << r.off_plan
-       << " replanning(s): the flight stack does not track the setpoints";
+       << " replanning(s): the flight stack lags its setpoints, or wind beyond the allowance";
     r.message = os.str();
   }
   next_.plans = 0;

@@ -170,14 +170,15 @@ void ReplanStep::keepReachClear(const ReplanInputs& in, const Eigen::Vector3d& w
                                   config_.dt_s, config_.steps);
 }
 
-bool ReplanStep::mayReflyVerified(ReplanMode mode) const {
-  if (!verified_for_) return true;  // none, or a stop
+std::string ReplanStep::reflyRefusal(ReplanMode mode) const {
+  if (!verified_for_) return "";  // none, or a stop
   // A hold or search that flew on the tracking plan would follow the stale prediction the hold
   // is for, for up to the plan's horizon; an abort that flew on anything but its own would not
   // retreat.
-  if (mode == ReplanMode::kAbort) return *verified_for_ == ReplanMode::kAbort;
-  if (mode == ReplanMode::kHold || mode == ReplanMode::kSearch) return *verified_for_ != ReplanMode::kTrack;
-  return true;
+  const bool refused = mode == ReplanMode::kAbort ? *verified_for_ != ReplanMode::kAbort
+                       : mode == ReplanMode::kHold || mode == ReplanMode::kSearch ? *verified_for_ == ReplanMode::kTrack
+                                                                                  : false;
+  return refused ? std::string("previous plan made for ") + toString(*verified_for_) + ", not " + toString(mode) : "";
 }
 
 ReplanOutcome ReplanStep::step(const ReplanInputs& in) {
@@ -246,7 +247,9 @@ ReplanOutcome ReplanStep::step(const ReplanInputs& in) {
   PlanRequest request = buildPlanRequest(req_in);
   // A back-off is for an unseen worker's reach; once the UAV tracks (or holds) again, a failed plan
   // brakes where it is rather than flying the back-off on, away from the worker and out of view.
-  request.reuse_previous = (!flying_backoff_ || out.backing_off) && mayReflyVerified(out.mode);
+  const std::string refly_refusal = reflyRefusal(out.mode);
+  request.reuse_previous = (!flying_backoff_ || out.backing_off) && refly_refusal.empty();
+  if (!refly_refusal.empty()) request.no_reuse_reason = refly_refusal;
   out.reference = request.reference;
   out.result = planner_->plan(request);
   if (out.result.verified && out.result.status == PlanStatus::kOptimized) verified_for_ = out.mode;

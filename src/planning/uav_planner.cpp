@@ -156,6 +156,7 @@ void UavPlanner::reset() {
   brake_ = PlannedTrajectory{};
   flown_ = PlannedTrajectory{};
   tracking_deviation_m_ = 0.0;
+  last_deviation_m_ = 0.0;
   wind_speeds_.clear();
   mean_wind_.setZero();
   sequence_ = 0;
@@ -168,9 +169,13 @@ void UavPlanner::updateTrackingAllowance(const PlanRequest& req) {
   tracking_deviation_m_ = std::max(0.0, tracking_deviation_m_ - config_.tracking_allowance_decay_mps * elapsed);
   allowance_t_s_ = req.t_now_s;
   // ... and grows to the deviation of the state from the plan being flown.
+  last_deviation_m_ = 0.0;
   if (!flown_.empty() && req.state.p_world.allFinite()) {
     const double d = (evaluateTrajectory(flown_, req.t_now_s).p - req.state.p_world).norm();
-    if (std::isfinite(d)) tracking_deviation_m_ = std::max(tracking_deviation_m_, d);
+    if (std::isfinite(d)) {
+      tracking_deviation_m_ = std::max(tracking_deviation_m_, d);
+      last_deviation_m_ = d;
+    }
   }
 }
 
@@ -350,50 +355,65 @@ void UavPlanner::aimCamera(const PlanRequest& req, PlannedTrajectory& tr) const 
   }
 }
 
+bool UavPlanner::reusePrevious(const PlanRequest& req, PlanResult& result, std::string& why_not) {
+  const bool state_finite = req.state.p_world.allFinite();
+  const int n = std::max(2, req.reference.steps());
+  const double dt = req.dt_s > 0.0 && std::isfinite(req.dt_s) ? req.dt_s : 0.2;
+  if (last_verified_.empty()) {
+    why_not = "no previous plan";
+    return false;
+  }
+  if (!std::isfinite(req.t_now_s) || last_verified_.tEnd() < req.t_now_s + config_.fallback_min_horizon_s) {
+    std::ostringstream os;
+    os << "previous plan ends at " << last_verified_.tEnd() << " s, before t_now + " << config_.fallback_min_horizon_s << " s";
+    why_not = os.str();
+    return false;
+  }
+  const TrajectoryPoint at_now = evaluateTrajectory(last_verified_, req.t_now_s);
+  const double deviation = (at_now.p - req.state.p_world).norm();
+  if (state_finite && !(deviation <= config_.fallback_max_deviation_m)) {
+    std::ostringstream os;
+    os << "previous plan is " << deviation << " m from the state";
+    why_not = os.str();
+    return false;
+  }
+  PlannedTrajectory prev = retimeThenBrake(last_verified_, req.t_now_s, dt, n, config_.limits);
+  prev.uav_index = req.uav_index;
+  const VerificationReport rep =
+      verifier_ ? verifier_->verify(prev, req.t_now_s, req.higher_priority_plans, req.worker, req.t_now_s, dt)
+                : VerificationReport{};
+  if (!rep.ok) {
+    why_not = "previous plan fails now: " + rep.reason;
+    return false;
+  }
+  result.trajectory = prev;
+  result.status = PlanStatus::kFallbackPrevious;
+  result.verified = true;
+  result.min_obstacle_clearance_m = rep.min_obstacle_clearance_m;
+  result.min_uav_margin_m = rep.min_uav_margin_m;
+  result.min_worker_distance_m = rep.min_worker_distance_m;
+  result.reason += "; reusing verified plan #" + std::to_string(last_verified_.sequence);
+  if (brake_.sequence != last_verified_.sequence) brake_ = PlannedTrajectory{};  // another plan is flown now
+  result.trajectory.sequence = ++sequence_;
+  return true;
+}
+
 PlanResult UavPlanner::fallback(const PlanRequest& req, PlanResult result, const std::string& reason) {
   const auto t_fb = Clock::now();
   result.reason = reason;
   const bool state_finite = req.state.p_world.allFinite();
   const int n = std::max(2, req.reference.steps());
   const double dt = req.dt_s > 0.0 && std::isfinite(req.dt_s) ? req.dt_s : 0.2;
-  // 1. The last verified plan, re-timed to t_now, if it still covers enough and verifies now.
+  // 1. The last verified plan, re-timed to t_now, if it still covers enough and verifies now
+  // (unless the request prefers not to: then only when the brake plan does not verify, below).
   std::string why_not;
   if (last_verified_.empty()) {
     why_not = "no previous plan";
   } else if (!req.reuse_previous) {
-    why_not = "previous plan is a back-off no longer needed";
-  } else if (!std::isfinite(req.t_now_s) || last_verified_.tEnd() < req.t_now_s + config_.fallback_min_horizon_s) {
-    std::ostringstream os;
-    os << "previous plan ends at " << last_verified_.tEnd() << " s, before t_now + " << config_.fallback_min_horizon_s << " s";
-    why_not = os.str();
-  } else {
-    const TrajectoryPoint at_now = evaluateTrajectory(last_verified_, req.t_now_s);
-    const double deviation = (at_now.p - req.state.p_world).norm();
-    if (state_finite && !(deviation <= config_.fallback_max_deviation_m)) {
-      std::ostringstream os;
-      os << "previous plan is " << deviation << " m from the state";
-      why_not = os.str();
-    } else {
-      PlannedTrajectory prev = retimeThenBrake(last_verified_, req.t_now_s, dt, n, config_.limits);
-      prev.uav_index = req.uav_index;
-      const VerificationReport rep =
-          verifier_ ? verifier_->verify(prev, req.t_now_s, req.higher_priority_plans, req.worker, req.t_now_s, dt)
-                    : VerificationReport{};
-      if (rep.ok) {
-        result.trajectory = prev;
-        result.status = PlanStatus::kFallbackPrevious;
-        result.verified = true;
-        result.min_obstacle_clearance_m = rep.min_obstacle_clearance_m;
-        result.min_uav_margin_m = rep.min_uav_margin_m;
-        result.min_worker_distance_m = rep.min_worker_distance_m;
-        result.reason += "; reusing verified plan #" + std::to_string(last_verified_.sequence);
-        if (brake_.sequence != last_verified_.sequence) brake_ = PlannedTrajectory{};  // another plan is flown now
-        result.trajectory.sequence = ++sequence_;
-        result.timings.verify_ms += msSince(t_fb);
-        return result;
-      }
-      why_not = "previous plan fails now: " + rep.reason;
-    }
+    why_not = req.no_reuse_reason;
+  } else if (reusePrevious(req, result, why_not)) {
+    result.timings.verify_ms += msSince(t_fb);
+    return result;
   }
   // 2. Last resort: brake to hover along the current velocity.
   result.status = PlanStatus::kFallbackBrake;
@@ -471,6 +491,13 @@ PlanResult UavPlanner::fallback(const PlanRequest& req, PlanResult result, const
       last_verified_ = result.trajectory;  // the UAV now executes it; reusable next time
     } else {
       result.reason += " (brake plan NOT verified: " + rep.reason + ")";
+      // Verified first: the previous plan the request preferred not to re-fly, if it verifies now.
+      std::string why_not_previous;
+      if (!req.reuse_previous && reusePrevious(req, result, why_not_previous)) {
+        result.reason += "; " + req.no_reuse_reason + ", but it verifies where the brake plan does not";
+        result.timings.verify_ms += msSince(t_fb);
+        return result;
+      }
     }
   } else {
     result.reason += separated;
@@ -569,7 +596,7 @@ PlanResult UavPlanner::plan(const PlanRequest& req) {
   ctx.allowance = std::clamp(tracking_deviation_m_, config_.tracking_allowance_min_m + wind_allowance,
                              config_.tracking_allowance_max_m + wind_allowance);
   result.tracking_allowance_m = ctx.allowance;
-  result.tracking_deviation_m = tracking_deviation_m_;
+  result.tracking_deviation_m = last_deviation_m_;
   result.wind_allowance_m = wind_allowance;
   ctx.wind_allowance = wind_allowance;
   if (wind_allowance > 0.0 && mean_wind_.norm() > 1e-6) ctx.downwind = mean_wind_.normalized();

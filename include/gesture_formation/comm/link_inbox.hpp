@@ -55,9 +55,11 @@ class LinkInbox {
   /// \brief Plans whose uav_index was not the envelope's sender, or whose t0 was later than the
   /// envelope's stamp + kPlanT0AllowanceS.
   std::uint64_t plansRefused() const { return plans_refused_; }
-  /// \brief How far a plan's t0 may lie after its envelope's stamp [s] (both the sender's clock:
-  /// a plan is stamped at its replanning, then sent; rounding only).
-  static constexpr double kPlanT0AllowanceS = 0.001;
+  /// \brief How far a plan's t0 may lie after its envelope's stamp [s]. Both are the sender's ROS
+  /// time — the planner's t0 at its replanning, the bridge's stamp when it sends — but in separate
+  /// processes under simulated time each reads /clock on its own, the bridge up to a few clock
+  /// ticks behind (standalone nodelets in SITL); a t0 far ahead is still refused.
+  static constexpr double kPlanT0AllowanceS = 0.5;
   /// \brief Leadership messages whose `from` was not the envelope's sender.
   std::uint64_t leadershipRefused() const { return leadership_refused_; }
   const PayloadCounters& payloadCounters() const { return decoder_.counters(); }

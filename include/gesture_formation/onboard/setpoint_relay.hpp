@@ -66,7 +66,8 @@ class SetpointRelay {
   /// held plan is kept. A held plan whose t0_s is more than kClockBackS after `t_now_s` (ROS time
   /// went back: the simulation restarted, a bag looped) is replaced by any usable plan — else
   /// every new plan would be refused as older until the clock caught up, the UAV holding the old
-  /// plan's end. NaN `t_now_s`: no such check.
+  /// plan's end; and a plan whose t0_s is more than kClockBackS after `t_now_s` is refused (one of
+  /// the old timeline still queued). NaN `t_now_s`: neither check.
   std::optional<std::string> accept(planning::PlannedTrajectory plan,
                                     double t_now_s = std::numeric_limits<double>::quiet_NaN());
   static constexpr double kClockBackS = 1.0;

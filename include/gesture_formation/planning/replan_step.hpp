@@ -219,8 +219,9 @@ class ReplanStep {
   Choice choose(const ReplanInputs& in, const std::string& hold, const Eigen::Vector3d& worker_p0, ReplanOutcome& out);
   /// Holding or searching: the back-off from the worker's reach replaces the hold reference.
   void keepReachClear(const ReplanInputs& in, const Eigen::Vector3d& worker_p0, Choice& c, ReplanOutcome& out);
-  /// Whether the planner may fall back to its last verified plan in `mode` (verified_for_).
-  bool mayReflyVerified(ReplanMode mode) const;
+  /// Why the planner should not fall back to its last verified plan in `mode` (verified_for_);
+  /// empty: it may.
+  std::string reflyRefusal(ReplanMode mode) const;
 
   ReplanConfig config_;
   std::unique_ptr<Planner> planner_;
@@ -238,8 +239,9 @@ class ReplanStep {
   bool flying_backoff_ = false;
   /// The mode the planner's last verified plan — the one its fallback re-flies — was optimized
   /// for; none before the first and after a verified brake plan (a stop, re-flown in any mode).
-  /// A hold, search or abort does not fly on a tracking plan, an abort on nothing but its own
-  /// (PlanRequest::reuse_previous).
+  /// A hold, search or abort prefers not to fly on a tracking plan, an abort on anything but its
+  /// own (PlanRequest::reuse_previous: the planner still does when the brake plan fails
+  /// verification and that plan verifies).
   std::optional<ReplanMode> verified_for_;
 };
 

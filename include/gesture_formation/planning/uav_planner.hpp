@@ -63,10 +63,13 @@ struct PlanRequest {
   /// `wind_estimation`); non-finite: none. Feeds the wind allowance
   /// (PlannerConfig::wind_allowance_*).
   Eigen::Vector3d wind_estimate_mps = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
-  /// False: a failed request brakes to hover instead of reusing the last verified plan — set by
-  /// planning::ReplanStep while that plan is a back-off from the worker's reach the UAV no longer
-  /// needs (it tracks again: flying the back-off on would carry it out of the camera's view).
+  /// False: a failed request brakes to hover rather than reusing the last verified plan — set by
+  /// planning::ReplanStep when that plan was made for another kind of flight (a back-off the UAV
+  /// no longer needs: flying it on would carry it out of the camera's view; a tracking plan in a
+  /// hold or abort), naming why in `no_reuse_reason`. Only a preference: when the brake plan fails
+  /// verification and the previous plan verifies, the previous plan is flown (verified first).
   bool reuse_previous = true;
+  std::string no_reuse_reason = "previous plan is a back-off no longer needed";
 };
 
 enum class PlanStatus {
@@ -128,10 +131,10 @@ struct PlanResult {
   /// (PlannerConfig::tracking_allowance_*): the largest recent deviation of the state from the
   /// plan being flown.
   double tracking_allowance_m = 0.0;
-  /// The measured deviation the allowance follows (the largest recent distance of the state from
-  /// the plan being flown, decaying): above tracking_allowance_m the UAV is farther off its plan
-  /// than planning allowed for — the other UAVs and the clearances count on it being on it (a
-  /// flight stack lagging its setpoints, wind beyond the allowance).
+  /// The state's distance from the plan being flown at this replanning (0 without one): above
+  /// tracking_allowance_m the UAV is farther off its plan than planning allowed for — the other
+  /// UAVs and the clearances count on it being on it (a flight stack lagging its setpoints, wind
+  /// beyond the allowance).
   double tracking_deviation_m = 0.0;
   /// The part of tracking_allowance_m's bounds due to the wind (PlannerConfig::wind_allowance_*).
   double wind_allowance_m = 0.0;
@@ -211,6 +214,9 @@ class UavPlanner {
   std::string planCamera(PlanContext& c) const;
   std::string verifyAndAccept(PlanContext& c, PlanResult& result);
   PlanResult fallback(const PlanRequest& request, PlanResult result, const std::string& reason);
+  /// Fallback 1: the last verified plan re-timed to t_now, if it covers enough, is near the state
+  /// and verifies now (result filled, true); else false with why_not set.
+  bool reusePrevious(const PlanRequest& request, PlanResult& result, std::string& why_not);
   PlannedTrajectory brakePlan(const PlanRequest& request) const;
   /// The brake plan `hold` with its stop point moved away from the other UAVs' plans and the
   /// worker's prediction it is closer to than Γ_dis / worker_safety_distance_m (+ qp buffer),
@@ -249,6 +255,7 @@ class UavPlanner {
   /// measured against it (PlannerConfig::tracking_allowance_*), updated at allowance_t_s_.
   PlannedTrajectory flown_;
   double tracking_deviation_m_ = 0.0;
+  double last_deviation_m_ = 0.0;  ///< the state's distance from flown_ at the last replanning
   double allowance_t_s_ = 0.0;
   /// Horizontal wind estimates of the last wind_window_s: their peak speed sizes the wind
   /// allowance, their mean gives the downwind direction (docs/safety.md §4.7, §4.13).

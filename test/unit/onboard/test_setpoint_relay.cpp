@@ -164,4 +164,7 @@ TEST(SetpointRelayTest, AfterRosTimeWentBackANewPlanReplacesTheHeldOne) {
   EXPECT_FALSE(relay.accept(straightPlan(5.0, 6, 2), 5.05));   // 95 s back
   EXPECT_DOUBLE_EQ(relay.planT0(), 5.0);
   EXPECT_TRUE(relay.accept(straightPlan(4.8, 6, 3), 5.1));     // and from then on the usual order
+  // A plan of the old timeline still queued does not swap back in.
+  EXPECT_TRUE(relay.accept(straightPlan(100.4, 6, 4), 5.2));
+  EXPECT_DOUBLE_EQ(relay.planT0(), 5.0);
 }

@@ -311,6 +311,7 @@ TEST(ReplanStepTest, AHoldOrAbortDoesNotFallBackToAPlanMadeForAnotherMode) {
   expectStep({1.2, pl::ReplanMode::kTrack, true});  // a tracking plan, tracking
   // The worker's data goes stale (max_worker_age_s 3 s): hold.
   expectStep({4.6, pl::ReplanMode::kHold, false});  // the last verified plan tracked
+  EXPECT_EQ(f.log->back().no_reuse_reason, "previous plan made for track, not hold");
   expectStep({4.8, pl::ReplanMode::kHold, true});   // now a hold plan
   ASSERT_EQ(f.step.receiveAbort(pl::AbortCommand{{"gcs", 7}, pl::AbortSource::kOperator, 4.9}, 4.9),
             pl::AbortAcceptance::kAccepted);

@@ -428,6 +428,54 @@ TEST(UavPlannerTest, AFailedRequestThatMayNotReuseThePreviousPlanBrakes) {
 // interval, which failed verification ("acceleration 26 m/s^2"), so a failed replanning braked
 // instead of flying the verified plan (found in the sideways-search catch-up, docs/planning.md §12).
 // Now it brakes to hover after its end, within the limits, and verifies.
+// A request that prefers not to re-fly the previous plan (reuse_previous false: ReplanStep, a
+// hold after tracking) brakes — unless the brake plan fails verification and the previous plan
+// verifies: verified first. Here UAV 0 arrives, 3 s from now, at the point this UAV's brake would
+// stop at, while its previous plan has flown on by then.
+TEST(UavPlannerTest, APreferenceNotToReflyThePreviousPlanYieldsToVerification) {
+  const World& w = towers();
+  const PlannerConfig cfg = testConfig();
+  const Eigen::Vector3d from(6, -12, 10), to(46, -12, 10), worker(-5, -3, 1);
+  const auto run = [&](bool with_uav0) {
+    UavPlanner planner(cfg, w.map, w.field);
+    const PlanResult first = planner.plan(straightRequest(1, 0.0, stateAt(from), from, to, 4.0, worker));
+    EXPECT_EQ(first.status, PlanStatus::kOptimized) << first.reason;
+    const UavKinematicState s = advance(first.trajectory, 0.4);
+    PlanRequest bad = straightRequest(1, 0.4, s, from, to, 4.0, worker);
+    bad.reference.p_world(1, 7) = std::numeric_limits<double>::quiet_NaN();
+    bad.reuse_previous = false;
+    bad.no_reuse_reason = "previous plan made for track, not hold";
+    if (with_uav0) {
+      const Eigen::Vector3d stop = brakeStop(s.p_world, s.v_world, cfg.limits, 0.2);
+      PlannedTrajectory other;
+      other.uav_index = 0;
+      other.t0_s = 0.4;
+      other.dt_s = 0.2;
+      for (int k = 0; k < 41; ++k) {
+        const double t = k * 0.2;
+        TrajectorySample x;
+        x.p_world = stop + Eigen::Vector3d(0, t < 3.0 ? 10.0 * (1.0 - t / 3.0) : 0.0, 0);
+        x.v_world = Eigen::Vector3d(0, t < 3.0 ? -10.0 / 3.0 : 0.0, 0);
+        other.samples.push_back(x);
+      }
+      bad.higher_priority_plans = {other};
+    }
+    return planner.plan(bad);
+  };
+  const PlanResult alone = run(false);
+  EXPECT_EQ(alone.status, PlanStatus::kFallbackBrake) << alone.reason;
+  EXPECT_TRUE(alone.verified) << alone.reason;
+  EXPECT_NE(alone.reason.find("previous plan made for track, not hold; braking to hover"), std::string::npos) << alone.reason;
+  const PlanResult r = run(true);
+  EXPECT_EQ(r.status, PlanStatus::kFallbackPrevious) << r.reason;
+  EXPECT_TRUE(r.verified) << r.reason;
+  EXPECT_NE(r.reason.find("brake plan NOT verified"), std::string::npos) << r.reason;
+  EXPECT_NE(r.reason.find("previous plan made for track, not hold, but it verifies where the brake plan does not"),
+            std::string::npos)
+      << r.reason;
+  expectSafe(r.trajectory, *w.map, cfg);
+}
+
 TEST(UavPlannerTest, PreviousPlanThatEndsMovingBrakesAfterItsEndWhenReused) {
   const World& w = towers();
   const PlannerConfig cfg = testConfig();
@@ -1324,6 +1372,7 @@ TEST(UavPlannerTest, TrackingAllowanceDecaysAndIsClamped) {
   for (int cycle = 0; cycle < 25; ++cycle) {  // 10 s of perfect tracking: 0.6 − 0.02·10 = 0.4 ...
     t += 0.4;
     r = planner.plan(straightRequest(0, t, advance(r.trajectory, t), from, from, 0.0, worker));
+    EXPECT_LT(r.tracking_deviation_m, 1e-9) << "cycle " << cycle;  // on its plan now (the allowance decays)
   }
   EXPECT_NEAR(r.tracking_allowance_m, 0.4, 1e-9);
   for (int cycle = 0; cycle < 25; ++cycle) {  // ... 0.2 after 10 s more
