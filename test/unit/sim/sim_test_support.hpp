@@ -68,10 +68,13 @@ struct PlanCall {
   std::vector<double> avoided_t0;  ///< and its t0_s
 };
 
-/// Test-only stand-in planner: returns the reference as the plan (referenceAsPlan) and records the request.
+/// Test-only planner that records every request: returns the reference as the plan
+/// (referenceAsPlan), or with `inner` that planner's plan (the product's, for the statements that
+/// need avoidance: the reference alone dodges nobody).
 class RecordingPlanner : public MissionPlanner {
  public:
-  explicit RecordingPlanner(std::shared_ptr<std::vector<PlanCall>> calls) : calls_(std::move(calls)) {}
+  explicit RecordingPlanner(std::shared_ptr<std::vector<PlanCall>> calls, std::unique_ptr<MissionPlanner> inner = nullptr)
+      : calls_(std::move(calls)), inner_(std::move(inner)) {}
   planning::PlanResult plan(const planning::PlanRequest& r) override {
     PlanCall c;
     c.uav = r.uav_index;
@@ -87,11 +90,12 @@ class RecordingPlanner : public MissionPlanner {
       c.avoided_t0.push_back(p.t0_s);
     }
     calls_->push_back(c);
-    return referenceAsPlan(r);
+    return inner_ ? inner_->plan(r) : referenceAsPlan(r);
   }
 
  private:
   std::shared_ptr<std::vector<PlanCall>> calls_;
+  std::unique_ptr<MissionPlanner> inner_;
 };
 
 }  // namespace gesture_formation::sim::test

@@ -1,6 +1,7 @@
 // Fault injection and the safety behaviour of docs/safety.md (issue 9), held to each statement
-// with a test-only stand-in planner (the plan is the stage-1 reference; safe in an empty world)
-// that records every request it gets.
+// with a planner that records every request it gets: a test-only stand-in (the plan is the
+// stage-1 reference; safe in an empty world) for the statements about requests and modes, the
+// product's UavPlanner behind the recorder for those about Γ_dis (the stand-in dodges nobody).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -52,6 +53,22 @@ Flight fly(const gf::sim::MissionConfig& cfg, double duration_s, std::uint64_t s
   gf::sim::MissionWorld world{&w.map, &w.field, 0.0};
   auto calls = r.calls;
   const gf::sim::PlannerFactory factory = [calls](int) { return std::make_unique<RecordingPlanner>(calls); };
+  r.out = gf::sim::runMission(cfg, world, factory, nullptr, seed, duration_s);
+  return r;
+}
+
+/// The same, each UAV planning with the product's planner (planning::UavPlanner over the same
+/// empty world): the statements about Γ_dis and collisions then hold for a planner that avoids —
+/// the stand-in flies the reference and dodges nobody.
+Flight flyWithTheProductsPlanner(const gf::sim::MissionConfig& cfg, double duration_s, std::uint64_t seed = 5) {
+  static const World w;
+  static const auto map = std::make_shared<const gf::planning::OccupancyMap>(w.map);
+  static const auto field = std::make_shared<const gf::planning::DistanceField>(*map);
+  Flight r;
+  gf::sim::MissionWorld world{map.get(), field.get(), 0.0};
+  auto calls = r.calls;
+  const gf::sim::PlannerFactory product = gf::sim::uavPlannerFactory(cfg.planner, map, field);
+  const gf::sim::PlannerFactory factory = [calls, product](int i) { return std::make_unique<RecordingPlanner>(calls, product(i)); };
   r.out = gf::sim::runMission(cfg, world, factory, nullptr, seed, duration_s);
   return r;
 }
@@ -342,11 +359,11 @@ TEST(FaultSafetyTest, ShortWorkerLossBelowTheAgeDoesNotHold) {
 
 // §2.4: a follower drops out (its computer reboots) and rejoins: it plans nothing while
 // offline, listens before it moves (holds until it has a fresh share and a plan from every
-// other UAV), and Γ_dis holds throughout.
+// other UAV), and Γ_dis holds throughout (the product's planner).
 TEST(FaultSafetyTest, RejoiningFollowerListensFirstAndKeepsGammaDis) {
   auto cfg = baseMission();
   cfg.faults.follower_dropouts.push_back({2, 5.0, 15.0});
-  const Flight r = fly(cfg, 40.0);
+  const Flight r = flyWithTheProductsPlanner(cfg, 40.0);
   ASSERT_TRUE(r.out) << r.out.reason();
   bool first_after = true;
   for (const Call& c : *r.calls) {
@@ -376,21 +393,25 @@ TEST(FaultSafetyTest, RejoiningFollowerListensFirstAndKeepsGammaDis) {
   }
   EXPECT_GT(leader_calls, 10);
   EXPECT_EQ(leader_avoids, leader_calls);
+  // The product's planner flew it (most replannings optimized, not braked): Γ_dis is its doing.
+  const auto& m = r.out->metrics;
+  EXPECT_LT(m.plans_fallback_previous + m.plans_fallback_brake, m.plans / 10) << m.plans << " plans";
   EXPECT_GE(r.out->metrics.min_mutual_distance_m, 2.5);
   EXPECT_EQ(r.out->metrics.collisions, 0);
 }
 
 // §2.1 with the links themselves: 50 % loss, jitter, duplication and reordering — every follower
 // request that tracks comes from a share no older than max_share_age_s (shown by the absence
-// of hold when shares keep coming), Γ_dis holds, and a run repeats exactly for its seed.
+// of hold when shares keep coming), Γ_dis holds with the product's planner, and a run repeats
+// exactly for its seed.
 TEST(FaultSafetyTest, LossyReorderingLinksStaySafeAndDeterministic) {
   auto cfg = baseMission();
   cfg.link.loss_probability = 0.5;
   cfg.link.jitter_s = 0.3;
   cfg.link.duplicate_probability = 0.3;
   cfg.link.reorder_probability = 0.3;
-  const Flight a = fly(cfg, 30.0, 11);
-  const Flight b = fly(cfg, 30.0, 11);
+  const Flight a = flyWithTheProductsPlanner(cfg, 30.0, 11);
+  const Flight b = flyWithTheProductsPlanner(cfg, 30.0, 11);
   ASSERT_TRUE(a.out) << a.out.reason();
   ASSERT_TRUE(b.out);
   ASSERT_EQ(a.out->timeline.size(), b.out->timeline.size());
@@ -399,6 +420,8 @@ TEST(FaultSafetyTest, LossyReorderingLinksStaySafeAndDeterministic) {
   }
   EXPECT_GT(a.out->metrics.messages_lost, a.out->metrics.messages_sent / 3);
   EXPECT_GT(a.out->metrics.messages_reordered, 0);
+  const auto& m = a.out->metrics;
+  EXPECT_LT(m.plans_fallback_previous + m.plans_fallback_brake, m.plans / 10) << m.plans << " plans";
   EXPECT_GE(a.out->metrics.min_mutual_distance_m, 2.5);
   EXPECT_EQ(a.out->metrics.collisions, 0);
 }
