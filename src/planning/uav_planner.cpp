@@ -493,10 +493,13 @@ PlanResult UavPlanner::fallback(const PlanRequest& req, PlanResult result, const
       result.reason += " (brake plan NOT verified: " + rep.reason + ")";
       // Verified first: the previous plan the request preferred not to re-fly, if it verifies now.
       std::string why_not_previous;
-      if (!req.reuse_previous && reusePrevious(req, result, why_not_previous)) {
-        result.reason += "; " + req.no_reuse_reason + ", but it verifies where the brake plan does not";
-        result.timings.verify_ms += msSince(t_fb);
-        return result;
+      if (!req.reuse_previous) {
+        if (reusePrevious(req, result, why_not_previous)) {
+          result.reason += "; " + req.no_reuse_reason + ", but it verifies where the brake plan does not";
+          result.timings.verify_ms += msSince(t_fb);
+          return result;
+        }
+        result.reason += "; nor the previous plan: " + why_not_previous;
       }
     }
   } else {

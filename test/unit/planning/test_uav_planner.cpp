@@ -423,11 +423,6 @@ TEST(UavPlannerTest, AFailedRequestThatMayNotReuseThePreviousPlanBrakes) {
   EXPECT_LT(r.trajectory.samples.back().v_world.norm(), 1e-6);
 }
 
-// A catch-up plan ends moving (the reference is far; the terminal velocity is only penalised).
-// Re-timed for a fallback it used to hover after its end — a velocity step of ~4 m/s within one
-// interval, which failed verification ("acceleration 26 m/s^2"), so a failed replanning braked
-// instead of flying the verified plan (found in the sideways-search catch-up, docs/planning.md §12).
-// Now it brakes to hover after its end, within the limits, and verifies.
 // A request that prefers not to re-fly the previous plan (reuse_previous false: ReplanStep, a
 // hold after tracking) brakes — unless the brake plan fails verification and the previous plan
 // verifies: verified first. Here UAV 0 arrives, 3 s from now, at the point this UAV's brake would
@@ -476,6 +471,11 @@ TEST(UavPlannerTest, APreferenceNotToReflyThePreviousPlanYieldsToVerification) {
   expectSafe(r.trajectory, *w.map, cfg);
 }
 
+// A catch-up plan ends moving (the reference is far; the terminal velocity is only penalised).
+// Re-timed for a fallback it used to hover after its end — a velocity step of ~4 m/s within one
+// interval, which failed verification ("acceleration 26 m/s^2"), so a failed replanning braked
+// instead of flying the verified plan (found in the sideways-search catch-up, docs/planning.md §12).
+// Now it brakes to hover after its end, within the limits, and verifies.
 TEST(UavPlannerTest, PreviousPlanThatEndsMovingBrakesAfterItsEndWhenReused) {
   const World& w = towers();
   const PlannerConfig cfg = testConfig();
