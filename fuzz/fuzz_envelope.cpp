@@ -78,7 +78,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         break;
       }
       case MessageType::kPlannedTrajectory: {
-        planning::PlannedTrajectory m;
+        PlanMessage m;
         decoder.decode(r.envelope, m);
         break;
       }

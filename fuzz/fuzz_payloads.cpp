@@ -61,7 +61,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   switch (data[0] % 5) {
     case 0: roundTrip<Heartbeat>(payload, n); break;
     case 1: roundTrip<WorkerStateMessage>(payload, n); break;
-    case 2: roundTrip<planning::PlannedTrajectory>(payload, n); break;
+    case 2: roundTrip<PlanMessage>(payload, n); break;
     case 3: roundTrip<FormationParamsMessage>(payload, n); break;
     default: roundTrip<formation::FormationCommand>(payload, n); break;
   }

@@ -42,9 +42,10 @@ int main(int argc, char** argv) {
   WorkerStateMessage ws;
   ws.p_world = {1, 2, 3};
   ws.covariance_diag = {0.1, 0.1, 0.1, 1, 1, 1};
-  planning::PlannedTrajectory plan;
-  plan.uav_index = 1;
-  plan.samples.resize(3);
+  PlanMessage plan;
+  plan.plan.uav_index = 1;
+  plan.plan.samples.resize(3);
+  plan.fallback = true;
   FormationParamsMessage params;
   params.version = 3;
   formation::FormationCommand cmd;

@@ -154,11 +154,16 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     auto c = fromMsg(*msg);
     std::lock_guard<std::mutex> lock(mutex_);
     const double t = ros::Time::now().toSec();
+    if (t <= 0.0) return;  // no ROS time yet (sim time before the first /clock): the copies are repeated
     const auto a = c ? step_->receiveAbort(*c, t) : planning::AbortAcceptance::kStale;
     if (a == planning::AbortAcceptance::kAlreadyAborting) return;
     if (a != planning::AbortAcceptance::kAccepted) {
       NODELET_WARN_STREAM_THROTTLE(1.0, "FormationPlanner UAV " << uav_index_ << ": abort " << msg->sender << "#"
-                                        << msg->sequence << " refused: " << (c ? "older than abort.max_command_age_s" : c.reason()));
+                                        << msg->sequence << " refused: "
+                                        << (!c ? c.reason()
+                                               : a == planning::AbortAcceptance::kFromTheFuture
+                                                     ? "sent more than abort.max_command_age_s after now (ROS time went back?)"
+                                                     : "older than abort.max_command_age_s"));
       return;
     }
     abort_link_sender_ = msg->link_sender;

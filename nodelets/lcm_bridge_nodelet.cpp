@@ -1,7 +1,7 @@
 // LcmBridge nodelet: the only code that touches LCM (lcm_bridge::SecureLink: signed envelopes with
 // sender id, sequence and stamp; docs/security.md); a thin adapter between ROS topics and the link
-// (topics, parameters, defaults: docs/ros.md "LcmBridge"). ROS → LCM: the share, plans (their
-// fallback flag in a heartbeat sent just before), parameters, gesture observations, aborts (this
+// (topics, parameters, defaults: docs/ros.md "LcmBridge"). ROS → LCM: the share, plans (with their
+// fallback flag; the heartbeat sent just before names the plan and the status), parameters, gesture observations, aborts (this
 // UAV's accepted abort also with every timed heartbeat, whether or not its planner plans), single events repeated like a command
 // (~command_repeats copies, comm::OutgoingRepeats: commands, the leader's acknowledgements and
 // assistance state — also with every share while requested —, the ground's acknowledgement of it),
@@ -177,8 +177,8 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
     std::lock_guard<std::mutex> lock(mutex_);
     heartbeat_.status = msg->fallback ? comm::Heartbeat::Status::kDegraded : comm::Heartbeat::Status::kOk;
     heartbeat_.last_plan_sequence = msg->sequence;
-    send(heartbeat_, "heartbeat");  // before the plan: it carries the plan's fallback flag
-    send(*plan, "plan");
+    send(heartbeat_, "heartbeat");  // before the plan: this UAV's status with its newest plan
+    send(comm::PlanMessage{std::move(*plan), static_cast<bool>(msg->fallback)}, "plan");
   }
   // An abort to send (the ground station's copies: the OperatorInterface repeats it).
   void onAbort(const gesture_formation::AbortCommand::ConstPtr& msg) { sendChecked(toWire(*msg), "abort"); }
@@ -215,13 +215,12 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
 
   // What to hand on: comm::LinkInbox.
   void onEnvelope(const comm::Envelope& e) {
-    if (e.type == comm::MessageType::kMapUpdate) return onMapUpdate(e);  // not an inbox item
     const comm::InboxItem item = inbox_.take(e);
     if (const auto* w = std::get_if<comm::WorkerStateMessage>(&item)) {
       auto m = fromWire(*w);
       m.header.frame_id = world_frame_;
       worker_pub_.publish(m);
-    } else if (const auto* p = std::get_if<comm::ReceivedPlanMessage>(&item)) {
+    } else if (const auto* p = std::get_if<comm::PlanMessage>(&item)) {
       auto m = toMsg(p->plan);
       m.header.frame_id = world_frame_;
       m.fallback = p->fallback;
@@ -248,20 +247,13 @@ class LcmBridgeNodelet : public nodelet::Nodelet {
       auto m = fromWire(*k);
       m.header.stamp = ros::Time(e.stamp_s);
       ack_pub_.publish(m);
+    } else if (const auto* u = std::get_if<comm::MapUpdate>(&item)) {
+      map_update_pub_.publish(toMsg(*u));  // to the planner's live map, which checks it against its grid
     }
     if (inbox_.lastWasDecodeFailure()) link_->verifier().countDecodeFailure(e.sender_id);
     if (!inbox_.lastRefusal().empty()) {
       NODELET_WARN_STREAM_THROTTLE(1.0, "LcmBridge: from sender " << e.sender_id << ": " << inbox_.lastRefusal());
     }
-  }
-
-  // Called from drain() (mutex held). A UAV's map changes, handed to the planner.
-  void onMapUpdate(const comm::Envelope& e) {
-    bool undecodable = false;
-    const auto m = mapUpdateFrom(e, &undecodable);
-    if (m) return map_update_pub_.publish(toMsg(*m));
-    if (undecodable) link_->verifier().countDecodeFailure(e.sender_id);
-    NODELET_WARN_STREAM_THROTTLE(1.0, "LcmBridge: map update from sender " << e.sender_id << " refused: " << m.reason());
   }
 
   // Called from drain() (mutex held).

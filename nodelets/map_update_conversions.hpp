@@ -49,18 +49,4 @@ inline common::Result<comm::MapUpdate> fromMsg(const gesture_formation::MapUpdat
   return R::ok(u);
 }
 
-/// The map update an authenticated envelope carries; fails naming the field when its payload does not
-/// decode (`*undecodable` set) or when it speaks for another UAV than its sender.
-inline common::Result<comm::MapUpdate> mapUpdateFrom(const comm::Envelope& e, bool* undecodable) {
-  using R = common::Result<comm::MapUpdate>;
-  comm::MapUpdate m;
-  std::string why;
-  *undecodable = comm::decodePayload(e.payload.data(), e.payload.size(), m, &why) != comm::PayloadError::kNone;
-  if (*undecodable) return R::fail(why);
-  if (m.uav_index != e.sender_id) {
-    return R::fail("map_update.uav_index " + std::to_string(m.uav_index) + " is not its sender " + std::to_string(e.sender_id));
-  }
-  return R::ok(std::move(m));
-}
-
 }  // namespace gesture_formation::nodelets

@@ -64,11 +64,13 @@ class SetpointRelayNodelet : public nodelet::Nodelet {
     if (!refusal) {
       auto plan = fromMsg(*msg);
       const double now = ros::Time::now().toSec();
-      if (plan && relay_.hasPlan() && relay_.planT0() > now + onboard::SetpointRelay::kClockBackS) {
-        NODELET_WARN_STREAM("SetpointRelay: ROS time went back (held plan from " << relay_.planT0() << " s, now " << now
-                                                                                 << " s): the new plan replaces it");
-      }
+      const bool held_ahead = relay_.heldPlanAhead(now);
+      const double held_t0 = relay_.planT0();
       refusal = plan ? relay_.accept(std::move(*plan), now) : std::optional<std::string>(plan.reason());
+      if (!refusal && held_ahead) {
+        NODELET_WARN_STREAM("SetpointRelay: ROS time went back (held plan from " << held_t0 << " s, now " << now
+                                                                                 << " s): the new plan replaced it");
+      }
     }
     if (refusal) {
       ++refused_;

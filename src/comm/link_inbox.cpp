@@ -20,7 +20,7 @@ InboxItem LinkInbox::decodeOne(const Envelope& e) {
   switch (e.type) {
     case MessageType::kHeartbeat: {
       Heartbeat h;
-      if (decoder_.decode(e, h)) peers_[e.sender_id] = h;
+      decoder_.decode(e, h);  // liveness is the link's (per-sender counters); nothing to hand on
       return {};
     }
     case MessageType::kWorkerState: {
@@ -29,8 +29,8 @@ InboxItem LinkInbox::decodeOne(const Envelope& e) {
       return {};
     }
     case MessageType::kPlannedTrajectory: {
-      ReceivedPlanMessage m;
-      if (!decoder_.decode(e, m.plan)) return {};
+      PlanMessage m;
+      if (!decoder_.decode(e, m)) return {};
       // A UAV sends its own plans only, made before it sent them: a plan for another UAV (a
       // holder of one key speaking for another UAV) or starting after its envelope's stamp (it
       // would outrank every later plan of that UAV: receivers keep the newest t0) is refused.
@@ -43,9 +43,6 @@ InboxItem LinkInbox::decodeOne(const Envelope& e) {
         last_refusal_ = os.str();
         return {};
       }
-      const auto peer = peers_.find(e.sender_id);
-      m.fallback = peer != peers_.end() && peer->second.status != Heartbeat::Status::kOk &&
-                   peer->second.last_plan_sequence == m.plan.sequence;
       return m;
     }
     case MessageType::kFormationParams: {
@@ -108,8 +105,18 @@ InboxItem LinkInbox::decodeOne(const Envelope& e) {
       }
       return m;
     }
-    case MessageType::kMapUpdate:
-      return {};  // not an inbox item: map updates go to the live map (docs/mapping.md §8)
+    case MessageType::kMapUpdate: {
+      MapUpdate m;
+      if (!decoder_.decode(e, m)) return {};
+      // A UAV shares its own map changes only (a captured key cannot speak for another UAV's map).
+      if (m.uav_index != e.sender_id) {
+        ++map_updates_refused_;
+        last_refusal_ = "map update refused (" + std::to_string(map_updates_refused_) + " so far): sender " +
+                        std::to_string(e.sender_id) + ", uav_index " + std::to_string(m.uav_index);
+        return {};
+      }
+      return m;
+    }
   }
   return {};
 }

@@ -213,10 +213,12 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, WorkerSta
   return d.report(reason);
 }
 
-// ---- planned trajectory: u16 uav_index, u32 sequence, f64 t0_s, f64 dt_s (> 0), u16 count,
+// ---- planned trajectory: u16 uav_index, u32 sequence, u8 flags (bit 0 fallback), f64 t0_s,
+//      f64 dt_s (> 0), u16 count,
 //      count × (p[3] v[3] a[3] heading pitch) ------------------------------------------------
 
-EncodeResult encodePayload(const planning::PlannedTrajectory& m) {
+EncodeResult encodePayload(const PlanMessage& msg) {
+  const planning::PlannedTrajectory& m = msg.plan;
   if (!validUavIndex(m.uav_index)) return EncodeResult::fail("planned_trajectory.uav_index " + std::to_string(m.uav_index) + " outside [0, " + std::to_string(kMaxUavIndex) + "]");
   if (const std::string e = wireTimeProblem(m.t0_s, "planned_trajectory.t0_s"); !e.empty()) return EncodeResult::fail(e);
   if (!(std::isfinite(m.dt_s) && m.dt_s > 0)) return EncodeResult::fail("planned_trajectory.dt_s must be finite and > 0");
@@ -232,6 +234,7 @@ EncodeResult encodePayload(const planning::PlannedTrajectory& m) {
   ByteWriter w;
   w.u16(static_cast<std::uint16_t>(m.uav_index));
   w.u32(m.sequence);
+  w.u8(msg.fallback ? 1 : 0);
   w.f64(m.t0_s);
   w.f64(m.dt_s);
   w.u16(static_cast<std::uint16_t>(m.samples.size()));
@@ -245,14 +248,15 @@ EncodeResult encodePayload(const planning::PlannedTrajectory& m) {
   return EncodeResult::ok(w.release());
 }
 
-PayloadError decodePayload(const std::uint8_t* data, std::size_t size, planning::PlannedTrajectory& out,
-                           std::string* reason) {
+PayloadError decodePayload(const std::uint8_t* data, std::size_t size, PlanMessage& out, std::string* reason) {
   constexpr std::size_t kSampleBytes = 11 * 8;
   Decoder d(data, size);
   planning::PlannedTrajectory m;
   std::uint16_t uav = 0, count = 0;
   if (d.u16(uav, "planned_trajectory.uav_index") && !validUavIndex(uav)) d.fail(PayloadError::kOutOfRange, "planned_trajectory.uav_index");
   d.u32(m.sequence, "planned_trajectory.sequence");
+  std::uint8_t flags = 0;
+  if (d.u8(flags, "planned_trajectory.flags") && (flags & ~1u) != 0) d.fail(PayloadError::kOutOfRange, "planned_trajectory.flags");
   d.time(m.t0_s, "planned_trajectory.t0_s");
   if (d.f64(m.dt_s, "planned_trajectory.dt_s") && !(m.dt_s > 0)) d.fail(PayloadError::kOutOfRange, "planned_trajectory.dt_s");
   if (d.u16(count, "planned_trajectory.count")) {
@@ -276,7 +280,7 @@ PayloadError decodePayload(const std::uint8_t* data, std::size_t size, planning:
       d.f64(s.pitch_rad, field + ".pitch_rad");
     }
   }
-  if (d.finish()) out = std::move(m);
+  if (d.finish()) out = PlanMessage{std::move(m), (flags & 1u) != 0};
   return d.report(reason);
 }
 

@@ -14,7 +14,9 @@ std::vector<comm::DiagnosticEntry> linkDiagnostics(comm::RejectionReport& report
                                                       {"publish_failed", t.publish_failed},
                                                       {"command_copies_dropped", inbox.commandCopiesDropped()},
                                                       {"observations_refused", inbox.observationsRefused()},
-                                                      {"plans_refused", inbox.plansRefused()}},
+                                                      {"plans_refused", inbox.plansRefused()},
+                                                      {"leadership_refused", inbox.leadershipRefused()},
+                                                      {"map_updates_refused", inbox.mapUpdatesRefused()}},
                                                      {"channel_mismatch", "undecodable_lcm"})};
   for (const auto& [sender, counters] : senders) out.push_back(report.sender(sender, counters));
   return out;

@@ -61,7 +61,7 @@ std::optional<std::string> SetpointRelay::accept(planning::PlannedTrajectory pla
     os << "plan t0 " << plan.t0_s << " s: more than " << kClockBackS << " s after now (" << t_now_s << " s)";
     return os.str();
   }
-  if (plan_ && !(plan_->t0_s > t_now_s + kClockBackS)) {
+  if (plan_ && !heldPlanAhead(t_now_s)) {
     const bool newer = plan.t0_s > plan_->t0_s || (plan.t0_s == plan_->t0_s && plan.sequence > plan_->sequence);
     if (!newer) {
       std::ostringstream os;

@@ -34,6 +34,7 @@ const char* toString(AbortAcceptance a) {
     case AbortAcceptance::kAccepted: return "accepted";
     case AbortAcceptance::kAlreadyAborting: return "already_aborting";
     case AbortAcceptance::kStale: return "stale";
+    case AbortAcceptance::kFromTheFuture: return "from_the_future";
   }
   return "unknown";
 }
@@ -255,6 +256,7 @@ formation::ReferenceTrajectory approachReference(const Eigen::Vector3d& p_from_w
 AbortAcceptance AbortPlanner::receive(const AbortCommand& command, double t_s) {
   if (command_) return AbortAcceptance::kAlreadyAborting;
   if (!(t_s - command.sent_s <= config_.max_command_age_s)) return AbortAcceptance::kStale;
+  if (!(command.sent_s - t_s <= config_.max_command_age_s)) return AbortAcceptance::kFromTheFuture;
   command_ = command;
   accepted_s_ = t_s;
   return AbortAcceptance::kAccepted;

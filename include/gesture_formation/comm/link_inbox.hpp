@@ -2,8 +2,8 @@
 /// \file
 /// \brief What a receiving node does with each authenticated envelope before it hands the content
 /// on (the LcmBridge's receive side, docs/security.md §2–3), ROS-free: the payload decoded
-/// (comm::PayloadDecoder: strict, every refusal counted), heartbeats kept per peer (a plan whose
-/// sequence a degraded heartbeat named just before is a fallback plan), plans refused unless their
+/// (comm::PayloadDecoder: strict, every refusal counted), heartbeats decoded (and counted) but not handed on, plans (their
+/// fallback flag on the wire with them, comm::PlanMessage) refused unless their
 /// UAV is the envelope's sender and their t0 is not after the envelope's stamp, formation commands through
 /// comm::CommandIntake (first copy of each id, name bound to the envelope sender), gesture
 /// observations refused when the observing UAV is not the envelope's sender or the frame time is
@@ -11,12 +11,13 @@
 /// UAV's ReplanStep acts on the first it accepts; docs/safety.md §2.8), command acknowledgements
 /// handed on once per command id (the leader repeats them like commands; docs/safety.md §2.9),
 /// leadership messages handed on at every copy when their `from` is the envelope's sender
-/// (formation::Leadership tolerates duplicates; docs/safety.md §1.2).
+/// (formation::Leadership tolerates duplicates; docs/safety.md §1.2), map updates handed on when
+/// their uav_index is the envelope's sender (the receiver's live map checks them against its grid:
+/// comm::checkMapUpdate; docs/mapping.md §8).
 /// Thread safety: none (the caller's lock).
 
 #include <cstdint>
 #include <deque>
-#include <map>
 #include <set>
 #include <string>
 #include <tuple>
@@ -24,21 +25,16 @@
 
 #include "gesture_formation/comm/command_intake.hpp"
 #include "gesture_formation/comm/envelope.hpp"
+#include "gesture_formation/comm/map_update.hpp"
 #include "gesture_formation/comm/payloads.hpp"
 
 namespace gesture_formation::comm {
 
-/// \brief A received plan with the fallback flag of its sender's last heartbeat.
-struct ReceivedPlanMessage {
-  planning::PlannedTrajectory plan;
-  bool fallback = false;  ///< the sender's heartbeat just before it was degraded and named this plan
-};
-
 /// \brief What one envelope yields to hand on (monostate: nothing — a heartbeat, a command's copy,
 /// a refusal).
-using InboxItem = std::variant<std::monostate, WorkerStateMessage, ReceivedPlanMessage, FormationParamsMessage,
+using InboxItem = std::variant<std::monostate, WorkerStateMessage, PlanMessage, FormationParamsMessage,
                                formation::FormationCommand, GestureObservationMessage, planning::AbortCommand,
-                               CommandAckMessage, AssistanceMessage, formation::LeadershipMessage>;
+                               CommandAckMessage, AssistanceMessage, formation::LeadershipMessage, MapUpdate>;
 
 class LinkInbox {
  public:
@@ -62,6 +58,8 @@ class LinkInbox {
   static constexpr double kPlanT0AllowanceS = 0.5;
   /// \brief Leadership messages whose `from` was not the envelope's sender.
   std::uint64_t leadershipRefused() const { return leadership_refused_; }
+  /// \brief Map updates whose uav_index was not the envelope's sender.
+  std::uint64_t mapUpdatesRefused() const { return map_updates_refused_; }
   const PayloadCounters& payloadCounters() const { return decoder_.counters(); }
 
  private:
@@ -69,7 +67,6 @@ class LinkInbox {
 
   PayloadDecoder decoder_;
   CommandIntake intake_;
-  std::map<std::uint16_t, Heartbeat> peers_;  ///< each sender's last heartbeat
   /// The last kAckMemory acknowledgements handed on, by (link sender, command id): later copies
   /// from the same sender are dropped; another sender's ack of the same id is its own (one UAV
   /// cannot silence another's acknowledgement by sending it first).
@@ -80,6 +77,7 @@ class LinkInbox {
   std::uint64_t observations_refused_ = 0;
   std::uint64_t plans_refused_ = 0;
   std::uint64_t leadership_refused_ = 0;
+  std::uint64_t map_updates_refused_ = 0;
   std::string last_refusal_;
   bool last_decode_failure_ = false;
 };

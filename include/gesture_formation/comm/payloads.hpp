@@ -53,6 +53,16 @@ struct FormationParamsMessage {
   std::uint64_t version = 0;
 };
 
+/// \brief One UAV's plan as it goes on the link: the trajectory and whether it is a fallback (the
+/// last verified plan re-flown or a brake plan, not this replanning's optimised one). Receivers with
+/// `avoid_all_plans: false` avoid a lower-priority UAV's plan only when it is a fallback
+/// (planning::buildPlanRequest), so the flag travels with the plan itself: a heartbeat naming it
+/// can be lost or arrive after it.
+struct PlanMessage {
+  planning::PlannedTrajectory plan;
+  bool fallback = false;
+};
+
 /// \brief Liveness of one UAV, sent periodically (e.g. 5 Hz).
 struct Heartbeat {
   enum class Status : std::uint8_t { kOk = 0, kDegraded = 1, kFailsafe = 2, kLanding = 3 };
@@ -165,7 +175,7 @@ const char* toString(PayloadError e);
 // ---- encoders: fail naming the field on what a decoder would refuse ----------------------
 common::Result<std::vector<std::uint8_t>> encodePayload(const Heartbeat& m);
 common::Result<std::vector<std::uint8_t>> encodePayload(const WorkerStateMessage& m);
-common::Result<std::vector<std::uint8_t>> encodePayload(const planning::PlannedTrajectory& m);
+common::Result<std::vector<std::uint8_t>> encodePayload(const PlanMessage& m);
 common::Result<std::vector<std::uint8_t>> encodePayload(const FormationParamsMessage& m);
 common::Result<std::vector<std::uint8_t>> encodePayload(const formation::FormationCommand& m);
 common::Result<std::vector<std::uint8_t>> encodePayload(const GestureObservationMessage& m);
@@ -179,7 +189,7 @@ common::Result<std::vector<std::uint8_t>> encodePayload(const formation::Leaders
 /// \brief The envelope type of each payload.
 inline MessageType messageTypeOf(const Heartbeat&) { return MessageType::kHeartbeat; }
 inline MessageType messageTypeOf(const WorkerStateMessage&) { return MessageType::kWorkerState; }
-inline MessageType messageTypeOf(const planning::PlannedTrajectory&) { return MessageType::kPlannedTrajectory; }
+inline MessageType messageTypeOf(const PlanMessage&) { return MessageType::kPlannedTrajectory; }
 inline MessageType messageTypeOf(const FormationParamsMessage&) { return MessageType::kFormationParams; }
 inline MessageType messageTypeOf(const formation::FormationCommand&) { return MessageType::kFormationCommand; }
 inline MessageType messageTypeOf(const GestureObservationMessage&) { return MessageType::kGestureObservation; }
@@ -192,7 +202,7 @@ inline MessageType messageTypeOf(const formation::LeadershipMessage&) { return M
 PayloadError decodePayload(const std::uint8_t* data, std::size_t size, Heartbeat& out, std::string* reason = nullptr);
 PayloadError decodePayload(const std::uint8_t* data, std::size_t size, WorkerStateMessage& out,
                            std::string* reason = nullptr);
-PayloadError decodePayload(const std::uint8_t* data, std::size_t size, planning::PlannedTrajectory& out,
+PayloadError decodePayload(const std::uint8_t* data, std::size_t size, PlanMessage& out,
                            std::string* reason = nullptr);
 PayloadError decodePayload(const std::uint8_t* data, std::size_t size, FormationParamsMessage& out,
                            std::string* reason = nullptr);

@@ -74,6 +74,9 @@ class SetpointRelay {
   /// \brief The setpoint at `t_s`; nullopt without a plan.
   std::optional<Setpoint> sample(double t_s) const;
   bool hasPlan() const { return plan_.has_value(); }
+  /// \brief The held plan starts more than kClockBackS after `t_s`: ROS time went back (the next
+  /// usable plan replaces it, see accept). False without a plan or for a NaN `t_s`.
+  bool heldPlanAhead(double t_s) const { return plan_ && plan_->t0_s > t_s + kClockBackS; }
   /// \brief The held plan's t0_s (NaN without one).
   double planT0() const;
 

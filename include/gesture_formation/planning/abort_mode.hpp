@@ -115,6 +115,11 @@ enum class AbortAcceptance {
   kAccepted,         ///< this UAV aborts from now on
   kAlreadyAborting,  ///< a copy, a repeat or another abort: nothing changes
   kStale,            ///< older than max_command_age_s on arrival: refused (not aborting)
+  /// Sent more than max_command_age_s after the time it arrived: a copy from another timeline (ROS
+  /// time went back — the simulation restarted, a bag looped — while it was queued or repeated):
+  /// refused (not aborting). Within that window a clock ahead of ours is tolerated: refusing a
+  /// real abort costs more than honouring a copy a few seconds early.
+  kFromTheFuture,
 };
 const char* toString(AbortAcceptance a);
 

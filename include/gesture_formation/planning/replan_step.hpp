@@ -198,7 +198,8 @@ class ReplanStep {
   /// flown, an accepted abort (the sender repeats it) — and it listens again before it moves.
   void restart(std::unique_ptr<Planner> planner);
 
-  /// \brief An abort command arrived at t_s (AbortPlanner::receive): accepted, a copy, or stale.
+  /// \brief An abort command arrived at t_s (AbortPlanner::receive): accepted, a copy, stale, or
+  /// from the future (another timeline).
   AbortAcceptance receiveAbort(const AbortCommand& command, double t_s) { return abort_.receive(command, t_s); }
   /// \brief The abort's state (command, phase, goals).
   const AbortPlanner& abort() const { return abort_; }

@@ -25,35 +25,38 @@ Envelope envelopeOf(const T& message, std::uint16_t sender, double stamp_s = 10.
   return e;
 }
 
-planning::PlannedTrajectory plan(std::uint32_t sequence, int uav = 1) {
-  planning::PlannedTrajectory p;
-  p.uav_index = uav;
-  p.sequence = sequence;
-  p.t0_s = 10.0;
-  p.dt_s = 0.1;
-  p.samples.resize(3);
-  return p;
+PlanMessage plan(std::uint32_t sequence, int uav = 1, bool fallback = false) {
+  PlanMessage m;
+  m.plan.uav_index = uav;
+  m.plan.sequence = sequence;
+  m.plan.t0_s = 10.0;
+  m.plan.dt_s = 0.1;
+  m.plan.samples.resize(3);
+  m.fallback = fallback;
+  return m;
 }
 
 }  // namespace
 
-TEST(LinkInboxTest, APlanIsAFallbackOnlyWhenTheDegradedHeartbeatBeforeItNamedIt) {
+// The fallback flag travels with the plan: with avoid_all_plans false a receiver avoids a
+// lower-priority UAV's plan only when it is a fallback, so it must not depend on a heartbeat that
+// can be lost or reordered (before, the flag was read from the heartbeat sent just before).
+TEST(LinkInboxTest, APlansFallbackFlagIsItsOwnWhateverTheHeartbeats) {
   LinkInbox inbox;
-  auto item = inbox.take(envelopeOf(plan(5), 1));
-  ASSERT_TRUE(std::holds_alternative<ReceivedPlanMessage>(item));
-  EXPECT_FALSE(std::get<ReceivedPlanMessage>(item).fallback);  // no heartbeat yet
+  auto item = inbox.take(envelopeOf(plan(5, 1, true), 1));  // no heartbeat at all (lost)
+  ASSERT_TRUE(std::holds_alternative<PlanMessage>(item));
+  EXPECT_TRUE(std::get<PlanMessage>(item).fallback);
+  EXPECT_EQ(std::get<PlanMessage>(item).plan.sequence, 5u);
 
-  Heartbeat h;
+  Heartbeat h;  // a late heartbeat of the sender, degraded and naming the next plan
   h.uav_index = 1;
   h.status = Heartbeat::Status::kDegraded;
   h.last_plan_sequence = 6;
   EXPECT_TRUE(std::holds_alternative<std::monostate>(inbox.take(envelopeOf(h, 1))));
-  item = inbox.take(envelopeOf(plan(6), 1));
-  EXPECT_TRUE(std::get<ReceivedPlanMessage>(item).fallback);
-  item = inbox.take(envelopeOf(plan(7), 1));  // a later plan: not the one the heartbeat named
-  EXPECT_FALSE(std::get<ReceivedPlanMessage>(item).fallback);
-  item = inbox.take(envelopeOf(plan(6, 2), 2));  // another sender's heartbeat state is its own
-  EXPECT_FALSE(std::get<ReceivedPlanMessage>(item).fallback);
+  item = inbox.take(envelopeOf(plan(6, 1, false), 1));
+  EXPECT_FALSE(std::get<PlanMessage>(item).fallback);
+  item = inbox.take(envelopeOf(plan(7, 1, true), 1));
+  EXPECT_TRUE(std::get<PlanMessage>(item).fallback);
 }
 
 // A holder of UAV 2's key must not speak for the leader: a plan claiming UAV 0 from sender 2 would
@@ -62,18 +65,18 @@ TEST(LinkInboxTest, APlanIsAFallbackOnlyWhenTheDegradedHeartbeatBeforeItNamedIt)
 // hour ahead would outrank every real plan of that UAV.
 TEST(LinkInboxTest, APlanOfAnotherUavOrStartingAfterItsEnvelopeIsRefused) {
   LinkInbox inbox;
-  EXPECT_TRUE(std::holds_alternative<ReceivedPlanMessage>(inbox.take(envelopeOf(plan(1, 2), 2, 10.0))));
+  EXPECT_TRUE(std::holds_alternative<PlanMessage>(inbox.take(envelopeOf(plan(1, 2), 2, 10.0))));
   EXPECT_TRUE(std::holds_alternative<std::monostate>(inbox.take(envelopeOf(plan(2, 0), 2, 10.0))));
   EXPECT_EQ(inbox.plansRefused(), 1u);
   EXPECT_NE(inbox.lastRefusal().find("plan refused (1 so far): sender 2, uav_index 0"), std::string::npos)
       << inbox.lastRefusal();
-  planning::PlannedTrajectory future = plan(3, 2);
-  future.t0_s = 10.0 + 3600.0;
+  PlanMessage future = plan(3, 2);
+  future.plan.t0_s = 10.0 + 3600.0;
   EXPECT_TRUE(std::holds_alternative<std::monostate>(inbox.take(envelopeOf(future, 2, 10.0))));
   EXPECT_EQ(inbox.plansRefused(), 2u);
   EXPECT_NE(inbox.lastRefusal().find("t0 3610 s, envelope stamp 10 s"), std::string::npos) << inbox.lastRefusal();
-  future.t0_s = 10.05;  // a clock tick ahead of the bridge's stamp (separate processes on /clock): accepted
-  EXPECT_TRUE(std::holds_alternative<ReceivedPlanMessage>(inbox.take(envelopeOf(future, 2, 10.0))));
+  future.plan.t0_s = 10.05;  // a clock tick ahead of the bridge's stamp (separate processes on /clock): accepted
+  EXPECT_TRUE(std::holds_alternative<PlanMessage>(inbox.take(envelopeOf(future, 2, 10.0))));
   EXPECT_EQ(inbox.plansRefused(), 2u);
 }
 
@@ -141,7 +144,7 @@ TEST(LinkInboxTest, TimesOutsideTheWireRangeAreDecodeFailuresNamingTheField) {
   const std::vector<Case> cases{
       {envelopeOf(w, 0), 0, "worker_state.t_s"},
       {envelopeOf(w, 0), 8, "worker_state.last_fused_t_s"},
-      {envelopeOf(plan(3), 1), 6, "planned_trajectory.t0_s"},
+      {envelopeOf(plan(3), 1), 7, "planned_trajectory.t0_s"},
       {envelopeOf(o, 2), 2, "gesture_observation.t_s"},
       {envelopeOf(a, 0), 1 + 6 + 8 + 1 + 1 + 8, "command_ack.command_stamp_s"},
       {envelopeOf(s, 0), 1, "assistance.requested_s"},
@@ -252,7 +255,7 @@ TEST(LinkInboxTest, AnUndecodablePayloadIsADecodeFailureNamingTheField) {
   EXPECT_NE(inbox.lastRefusal().find("decode_failure"), std::string::npos) << inbox.lastRefusal();
   EXPECT_EQ(inbox.payloadCounters().rejected(), 1u);
   // The next good envelope clears it.
-  EXPECT_TRUE(std::holds_alternative<ReceivedPlanMessage>(inbox.take(envelopeOf(plan(2), 1))));
+  EXPECT_TRUE(std::holds_alternative<PlanMessage>(inbox.take(envelopeOf(plan(2), 1))));
   EXPECT_FALSE(inbox.lastWasDecodeFailure());
   EXPECT_TRUE(inbox.lastRefusal().empty());
 }
@@ -282,4 +285,34 @@ TEST(OutgoingRepeatsTest, ALateCallGetsEveryOverdueEventOnceAndKeepsTheirPeriods
   EXPECT_EQ(d[1].payload[0], 2);
   EXPECT_EQ(r.pending(), 1u);  // the second had one copy to repeat
   EXPECT_EQ(r.due(0.25).size(), 1u);  // the first's next copy was due at 0.2
+}
+
+// Map updates come through the inbox like every payload (before, the LcmBridge nodelet decoded them
+// itself): handed on when the UAV speaks for its own map, refused and counted when it speaks for
+// another's, a decode failure naming the field when the payload is broken.
+TEST(LinkInboxTest, AMapUpdateIsHandedOnOnlyFromItsOwnUav) {
+  MapUpdate u;
+  u.uav_index = 2;
+  u.sequence = 4;
+  u.delta.stamp_s = 9.5;
+  u.delta.resolution_m = 0.2;
+  u.delta.occupied = {{32768, 32769, 32770}};
+  LinkInbox inbox;
+  auto item = inbox.take(envelopeOf(u, 2));
+  ASSERT_TRUE(std::holds_alternative<MapUpdate>(item)) << inbox.lastRefusal();
+  EXPECT_EQ(std::get<MapUpdate>(item).sequence, 4u);
+  EXPECT_EQ(std::get<MapUpdate>(item).delta.occupied, u.delta.occupied);
+  EXPECT_EQ(inbox.mapUpdatesRefused(), 0u);
+
+  EXPECT_TRUE(std::holds_alternative<std::monostate>(inbox.take(envelopeOf(u, 1))));  // sender 1 for UAV 2's map
+  EXPECT_EQ(inbox.mapUpdatesRefused(), 1u);
+  EXPECT_FALSE(inbox.lastWasDecodeFailure());
+  EXPECT_EQ(inbox.lastRefusal(), "map update refused (1 so far): sender 1, uav_index 2");
+
+  Envelope broken = envelopeOf(u, 2);
+  broken.payload.pop_back();
+  EXPECT_TRUE(std::holds_alternative<std::monostate>(inbox.take(broken)));
+  EXPECT_TRUE(inbox.lastWasDecodeFailure());
+  EXPECT_NE(inbox.lastRefusal().find("map_update"), std::string::npos) << inbox.lastRefusal();
+  EXPECT_EQ(inbox.mapUpdatesRefused(), 1u);
 }

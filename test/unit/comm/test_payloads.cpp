@@ -18,10 +18,12 @@ namespace {
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 const double kInf = std::numeric_limits<double>::infinity();
 
-planning::PlannedTrajectory trajectory(std::size_t n, std::uint64_t seed = 3) {
+PlanMessage trajectory(std::size_t n, std::uint64_t seed = 3, bool fallback = false) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(-50.0, 50.0);
-  planning::PlannedTrajectory t;
+  PlanMessage msg;
+  msg.fallback = fallback;
+  planning::PlannedTrajectory& t = msg.plan;
   t.uav_index = 2;
   t.sequence = 77;
   t.t0_s = 12.25;
@@ -35,7 +37,7 @@ planning::PlannedTrajectory trajectory(std::size_t n, std::uint64_t seed = 3) {
     s.pitch_rad = u(rng);
     t.samples.push_back(s);
   }
-  return t;
+  return msg;
 }
 
 formation::FormationCommand command() {
@@ -148,50 +150,60 @@ TEST(CommPayloadsTest, WorkerStateRoundTripAndNonFinite) {
 }
 
 TEST(CommPayloadsTest, PlannedTrajectoryRoundTripIsBitExact) {
-  for (std::size_t n : {0u, 1u, 40u, static_cast<unsigned>(kMaxTrajectorySamples)}) {
-    const auto t = trajectory(n);
-    const auto b = encoded(t);
-    ASSERT_EQ(b.size(), 24 + 88 * n);
-    ASSERT_LE(b.size(), kMaxPayloadBytes);
-    planning::PlannedTrajectory d;
-    ASSERT_EQ(decode(b, d), PayloadError::kNone);
-    EXPECT_EQ(d.uav_index, t.uav_index);
-    EXPECT_EQ(d.sequence, t.sequence);
-    EXPECT_EQ(d.t0_s, t.t0_s);
-    EXPECT_EQ(d.dt_s, t.dt_s);
-    ASSERT_EQ(d.samples.size(), n);
-    for (std::size_t k = 0; k < n; ++k) {
-      EXPECT_EQ(d.samples[k].p_world, t.samples[k].p_world);
-      EXPECT_EQ(d.samples[k].v_world, t.samples[k].v_world);
-      EXPECT_EQ(d.samples[k].a_world, t.samples[k].a_world);
-      EXPECT_EQ(d.samples[k].heading_rad, t.samples[k].heading_rad);
-      EXPECT_EQ(d.samples[k].pitch_rad, t.samples[k].pitch_rad);
+  for (bool fallback : {false, true}) {
+    for (std::size_t n : {0u, 1u, 40u, static_cast<unsigned>(kMaxTrajectorySamples)}) {
+      const auto msg = trajectory(n, 3, fallback);
+      const planning::PlannedTrajectory& t = msg.plan;
+      const auto b = encoded(msg);
+      ASSERT_EQ(b.size(), 25 + 88 * n);
+      ASSERT_LE(b.size(), kMaxPayloadBytes);
+      PlanMessage got;
+      got.fallback = !fallback;
+      ASSERT_EQ(decode(b, got), PayloadError::kNone);
+      EXPECT_EQ(got.fallback, fallback);  // the flag travels with the plan (a heartbeat naming it may be lost)
+      const planning::PlannedTrajectory& d = got.plan;
+      EXPECT_EQ(d.uav_index, t.uav_index);
+      EXPECT_EQ(d.sequence, t.sequence);
+      EXPECT_EQ(d.t0_s, t.t0_s);
+      EXPECT_EQ(d.dt_s, t.dt_s);
+      ASSERT_EQ(d.samples.size(), n);
+      for (std::size_t k = 0; k < n; ++k) {
+        EXPECT_EQ(d.samples[k].p_world, t.samples[k].p_world);
+        EXPECT_EQ(d.samples[k].v_world, t.samples[k].v_world);
+        EXPECT_EQ(d.samples[k].a_world, t.samples[k].a_world);
+        EXPECT_EQ(d.samples[k].heading_rad, t.samples[k].heading_rad);
+        EXPECT_EQ(d.samples[k].pitch_rad, t.samples[k].pitch_rad);
+      }
+      EXPECT_EQ(encoded(got), b);
     }
-    EXPECT_EQ(encoded(d), b);
   }
 }
 
 TEST(CommPayloadsTest, PlannedTrajectoryRefusals) {
   const auto b = encoded(trajectory(3));
-  planning::PlannedTrajectory d;
+  PlanMessage d;
   std::string reason;
   // Count above the maximum, whatever the bytes: refused before any allocation.
   auto bad = b;
-  bad[22] = 0xFF;
   bad[23] = 0xFF;
+  bad[24] = 0xFF;
   EXPECT_EQ(decode(bad, d, &reason), PayloadError::kOversizeArray);
   EXPECT_EQ(reason, "oversize_array: planned_trajectory.count 65535");
   bad = b;
-  bad[23] = 4;  // claims 4 samples, holds 3
+  bad[24] = 4;  // claims 4 samples, holds 3
   EXPECT_EQ(decode(bad, d), PayloadError::kTruncated);
   bad = b;
-  bad[23] = 2;  // claims 2, holds 3
+  bad[24] = 2;  // claims 2, holds 3
   EXPECT_EQ(decode(bad, d), PayloadError::kTrailingBytes);
   bad = b;
-  putDouble(bad, 14, 0.0);  // dt
+  bad[6] = 2;  // a flag bit that means nothing
+  EXPECT_EQ(decode(bad, d, &reason), PayloadError::kOutOfRange);
+  EXPECT_EQ(reason, "out_of_range: planned_trajectory.flags");
+  bad = b;
+  putDouble(bad, 15, 0.0);  // dt
   EXPECT_EQ(decode(bad, d), PayloadError::kOutOfRange);
   bad = b;
-  putDouble(bad, 24 + 88 + 9 * 8, kNaN);  // samples[1].heading
+  putDouble(bad, 25 + 88 + 9 * 8, kNaN);  // samples[1].heading
   EXPECT_EQ(decode(bad, d, &reason), PayloadError::kNonFinite);
   EXPECT_EQ(reason, "non_finite: planned_trajectory.samples[1].heading_rad");
   for (std::size_t cut = 0; cut < b.size(); ++cut) {
@@ -201,10 +213,10 @@ TEST(CommPayloadsTest, PlannedTrajectoryRefusals) {
   auto t = trajectory(kMaxTrajectorySamples + 1);
   EXPECT_FALSE(encodePayload(t));
   t = trajectory(2);
-  t.uav_index = -1;
+  t.plan.uav_index = -1;
   EXPECT_FALSE(encodePayload(t));
   t = trajectory(2);
-  t.samples[1].a_world.z() = kInf;
+  t.plan.samples[1].a_world.z() = kInf;
   EXPECT_FALSE(encodePayload(t));
 }
 

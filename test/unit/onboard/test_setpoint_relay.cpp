@@ -161,7 +161,10 @@ TEST(SetpointRelayTest, AfterRosTimeWentBackANewPlanReplacesTheHeldOne) {
   ASSERT_FALSE(relay.accept(straightPlan(100.0), 100.05));
   EXPECT_TRUE(relay.accept(straightPlan(99.0, 6, 2), 100.1));  // older, the clock did not go back
   EXPECT_TRUE(relay.accept(straightPlan(99.5, 6, 2), 99.6));   // 0.4 s back: within kClockBackS, a late plan
+  EXPECT_FALSE(relay.heldPlanAhead(99.6));
+  EXPECT_TRUE(relay.heldPlanAhead(5.05));                       // what the nodelet warns about
   EXPECT_FALSE(relay.accept(straightPlan(5.0, 6, 2), 5.05));   // 95 s back
+  EXPECT_FALSE(relay.heldPlanAhead(5.05));
   EXPECT_DOUBLE_EQ(relay.planT0(), 5.0);
   EXPECT_TRUE(relay.accept(straightPlan(4.8, 6, 3), 5.1));     // and from then on the usual order
   // A plan of the old timeline still queued does not swap back in.

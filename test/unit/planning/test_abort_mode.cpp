@@ -231,6 +231,18 @@ TEST(AbortPlannerTest, AcceptsOnceRefusesStaleCommandsAndCopiesChangeNothing) {
   pl::AbortPlanner a(0, 3, c, world().space());
   EXPECT_EQ(a.receive(command(0.0), 10.5), pl::AbortAcceptance::kStale);
   EXPECT_FALSE(a.aborting());
+  // A copy of the old timeline after ROS time went back (the simulation restarted at 0 s): refused;
+  // a sender clock a few seconds ahead is not (a real abort must not be lost to clock skew).
+  EXPECT_EQ(a.receive(command(300.0), 10.5), pl::AbortAcceptance::kFromTheFuture);
+  EXPECT_EQ(a.receive(command(std::numeric_limits<double>::quiet_NaN()), 10.5), pl::AbortAcceptance::kStale);
+  EXPECT_FALSE(a.aborting());
+  {
+    pl::AbortPlanner ahead(0, 3, c, world().space());
+    EXPECT_EQ(ahead.receive(command(20.5 + 1e-6), 10.5), pl::AbortAcceptance::kFromTheFuture);
+    EXPECT_EQ(ahead.receive(command(20.5), 10.5), pl::AbortAcceptance::kAccepted);  // exactly max_command_age_s ahead
+    pl::AbortPlanner skewed(0, 3, c, world().space());
+    EXPECT_EQ(skewed.receive(command(13.0), 10.5), pl::AbortAcceptance::kAccepted);  // a sender clock 2.5 s ahead
+  }
   EXPECT_EQ(a.receive(command(5.0), 10.5), pl::AbortAcceptance::kAccepted);
   EXPECT_TRUE(a.aborting());
   EXPECT_DOUBLE_EQ(a.acceptedAt(), 10.5);

@@ -89,12 +89,12 @@ TEST(CommLcmTransportTest, SecureLinkCarriesAPlannedTrajectoryOverMemq) {
   std::vector<comm::Envelope> received;
   link.setHandler([&](const comm::Envelope& e) { received.push_back(e); });
 
-  planning::PlannedTrajectory plan;
-  plan.uav_index = 1;
-  plan.sequence = 5;
-  plan.t0_s = 10.0;
-  plan.samples.resize(40);
-  plan.samples[7].p_world = {1, 2, 3};
+  comm::PlanMessage plan;
+  plan.plan.uav_index = 1;
+  plan.plan.sequence = 5;
+  plan.plan.t0_s = 10.0;
+  plan.plan.samples.resize(40);
+  plan.plan.samples[7].p_world = {1, 2, 3};
   auto seq = link.publish(plan);
   ASSERT_TRUE(seq) << seq.reason();
   EXPECT_EQ(seq.value(), 1u);
@@ -102,10 +102,10 @@ TEST(CommLcmTransportTest, SecureLinkCarriesAPlannedTrajectoryOverMemq) {
   ASSERT_EQ(received.size(), 1u);
   EXPECT_EQ(received[0].type, comm::MessageType::kPlannedTrajectory);
   comm::PayloadDecoder decoder;
-  planning::PlannedTrajectory got;
+  comm::PlanMessage got;
   ASSERT_TRUE(decoder.decode(received[0], got)) << decoder.lastReason();
-  EXPECT_EQ(got.samples.size(), 40u);
-  EXPECT_EQ(got.samples[7].p_world, plan.samples[7].p_world);
+  EXPECT_EQ(got.plan.samples.size(), 40u);
+  EXPECT_EQ(got.plan.samples[7].p_world, plan.plan.samples[7].p_world);
 
   comm::Heartbeat hb;
   ASSERT_TRUE(link.publish(hb));
