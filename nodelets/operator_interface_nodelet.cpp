@@ -40,6 +40,7 @@
 #include "gesture_formation/AcknowledgeAssistance.h"
 #include "gesture_formation/SendAbort.h"
 #include "gesture_formation/SendCommand.h"
+#include "gesture_formation/comm/outgoing_repeats.hpp"
 #include "gesture_formation/formation/uav_list.hpp"
 #include "command_sequence.hpp"
 #include "param_loader.hpp"
@@ -169,8 +170,8 @@ class OperatorInterfaceNodelet : public nodelet::Nodelet {
     abort_.sender = sender_;
     abort_.sequence = ++sequence_;
     abort_.link_sender = -1;
-    abort_copies_left_ = abort_repeats_;
-    abort_resend_at_ = ros::Time(0);
+    abort_schedule_ = comm::AbortCopySchedule(abort_repeats_, abort_resend_period_s_);
+    abort_schedule_.start();
     sendAbortCopy();
     res.accepted = true;
     res.sequence = abort_.sequence;
@@ -181,22 +182,13 @@ class OperatorInterfaceNodelet : public nodelet::Nodelet {
                                                      << abort_resend_period_s_ << " s while this node runs)");
     return true;
   }
-  // Mutex held. One copy, stamped now (its age at each UAV is this copy's): the burst's, then one
-  // every abort_resend_period_s for as long as this node runs — a UAV out of reach for the whole
-  // burst (a link outage, a reboot) still gets it when it is back (docs/safety.md §2.8). The timer
-  // ticks every abort_repeat_period_s: a resend falls on the first tick at or after its time.
+  // Mutex held. One copy when comm::AbortCopySchedule says so, stamped now (its age at each UAV is
+  // this copy's): the burst's, then one every abort_resend_period_s for as long as this node runs
+  // (docs/safety.md §2.8). The timer ticks every abort_repeat_period_s.
   void sendAbortCopy() {
     if (abort_.sequence == 0) return;  // no abort sent
     const ros::Time now = ros::Time::now();
-    if (abort_copies_left_ > 0) {
-      --abort_copies_left_;
-      if (abort_copies_left_ == 0) abort_resend_at_ = now + ros::Duration(abort_resend_period_s_);
-    } else if (now < abort_resend_at_) {
-      return;
-    } else {  // on schedule, not from this tick (no drift); after a stall, from now
-      abort_resend_at_ += ros::Duration(abort_resend_period_s_);
-      if (abort_resend_at_ <= now) abort_resend_at_ = now + ros::Duration(abort_resend_period_s_);
-    }
+    if (!abort_schedule_.due(now.toSec())) return;
     abort_.stamp = now;
     abort_pub_.publish(abort_);
   }
@@ -264,8 +256,7 @@ class OperatorInterfaceNodelet : public nodelet::Nodelet {
   int abort_repeats_ = 1;
   double abort_period_s_ = 0.2;
   double abort_resend_period_s_ = 1.0;
-  ros::Time abort_resend_at_;  ///< after the burst: when the next copy falls due
-  int abort_copies_left_ = 0;  ///< copies of abort_ still to send
+  comm::AbortCopySchedule abort_schedule_{1, 1.0};  ///< when the next copy of abort_ falls due
   gesture_formation::AbortCommand abort_;
   static constexpr double kAckTimeoutS = 5.0;  ///< a command of ours unacknowledged this long is reported
   std::map<std::uint64_t, ros::Time> unacked_;  ///< our commands sent and not yet acknowledged

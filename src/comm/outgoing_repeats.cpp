@@ -23,4 +23,17 @@ std::vector<OutgoingPayload> OutgoingRepeats::due(double now_s) {
   return out;
 }
 
+bool AbortCopySchedule::due(double now_s) {
+  if (!started_) return false;
+  if (copies_left_ > 0) {
+    if (--copies_left_ == 0) resend_at_s_ = now_s + resend_period_s_;
+    return true;
+  }
+  const bool clock_went_back = resend_at_s_ > now_s + resend_period_s_;
+  if (now_s < resend_at_s_ && !clock_went_back) return false;
+  resend_at_s_ += resend_period_s_;  // on schedule, not from this tick
+  if (resend_at_s_ <= now_s || clock_went_back) resend_at_s_ = now_s + resend_period_s_;  // after a stall or a jump back
+  return true;
+}
+
 }  // namespace gesture_formation::comm

@@ -1,5 +1,6 @@
 // comm::LinkInbox (the receive side of a node's link) and comm::OutgoingRepeats (the sender's
-// copies of single events): what each envelope yields, and when each copy falls due.
+// copies of single events), comm::AbortCopySchedule (the ground station's abort copies): what each
+// envelope yields, and when each copy falls due.
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -315,4 +316,34 @@ TEST(LinkInboxTest, AMapUpdateIsHandedOnOnlyFromItsOwnUav) {
   EXPECT_TRUE(inbox.lastWasDecodeFailure());
   EXPECT_NE(inbox.lastRefusal().find("map_update"), std::string::npos) << inbox.lastRefusal();
   EXPECT_EQ(inbox.mapUpdatesRefused(), 1u);
+}
+
+// The ground station's abort copies (OperatorInterface): the burst one per tick, then a resend per
+// resend period on schedule, from now after a stall — and at once after ROS time went back (before,
+// the resends paused until the clock caught up with the old schedule: 95 s after a restart at 5 s).
+TEST(AbortCopyScheduleTest, BurstThenResendsOnScheduleAndAtOnceAfterTheClockWentBack) {
+  AbortCopySchedule s(3, 1.0);
+  EXPECT_FALSE(s.due(99.0));  // no abort yet
+  s.start();
+  EXPECT_TRUE(s.due(100.0));  // the burst: one copy per tick
+  EXPECT_TRUE(s.due(100.2));
+  EXPECT_TRUE(s.due(100.4));
+  EXPECT_DOUBLE_EQ(s.nextResendS(), 101.4);
+  EXPECT_FALSE(s.due(100.6));
+  EXPECT_FALSE(s.due(101.2));
+  EXPECT_TRUE(s.due(101.4));   // on schedule
+  EXPECT_FALSE(s.due(101.6));
+  EXPECT_TRUE(s.due(102.5));   // the first tick after 102.4; the next stays on schedule
+  EXPECT_DOUBLE_EQ(s.nextResendS(), 103.4);
+  EXPECT_TRUE(s.due(110.0));   // after a stall: from now
+  EXPECT_DOUBLE_EQ(s.nextResendS(), 111.0);
+  EXPECT_TRUE(s.due(5.0));     // ROS time went back to 5 s: a copy at once, the schedule from now
+  EXPECT_DOUBLE_EQ(s.nextResendS(), 6.0);
+  EXPECT_FALSE(s.due(5.2));
+  EXPECT_TRUE(s.due(6.0));
+  s.start();                   // another abort: a new burst
+  EXPECT_TRUE(s.due(6.2));
+  EXPECT_TRUE(s.due(6.4));
+  EXPECT_TRUE(s.due(6.6));
+  EXPECT_FALSE(s.due(6.8));
 }
