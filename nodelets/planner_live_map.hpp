@@ -1,9 +1,11 @@
 #pragma once
 // The FormationPlanner's live map (docs/mapping.md "Through ROS"): with ~mapping_config (a YAML of
 // mapping::MappingConfig's keys, config/mapping.yaml) the planner plans on a mapping::LiveMap fed by
-// this UAV's aligned depth images (depth_in: sensor_msgs/Image 32FC1 metres or 16UC1 millimetres,
-// REP 118; depth_info_in: its CameraInfo — the pinhole of the rectified image; the optical frame's
-// pose from tf at the image's stamp), fused with the scenario's map as the prior (~mapping_prior,
+// this UAV's aligned depth images (depth_in: sensor_msgs/Image 32FC1 metres or 16UC1 in
+// ~mapping_depth_scale_m units, default 0.001 (millimetres), REP 118; depth_info_in: its CameraInfo
+// in the same frame_id — the pinhole of the rectified image, P where set, else K; the optical
+// frame's pose from tf at the image's stamp, which must be set; when ROS time goes back the live
+// map's stamps restart, mapping::LiveMap::restartClock), fused with the scenario's map as the prior (~mapping_prior,
 // default true). Frames are integrated at most ~mapping_rate_hz on the depth callback's thread
 // (ROS serialises one subscription's callbacks: never two integrate() at once); the planner holds
 // readLock() for a whole replanning. Without ~mapping_config nothing is subscribed and the planner
@@ -58,6 +60,10 @@ class PlannerLiveMap {
     params.load("mapping_rate_hz", rate_hz_, 0.1, 30.0);
     params.loadOptional("mapping_prior", prior_, true);
     pnh.param("mapping_tf_timeout_s", tf_timeout_s_, 0.1);
+    pnh.param("mapping_depth_scale_m", depth_scale_m_, 0.001);
+    if (!(depth_scale_m_ > 0.0 && depth_scale_m_ <= 0.01)) {
+      params.addError("mapping_depth_scale_m: must be in (0, 0.01] m per 16UC1 unit, got " + std::to_string(depth_scale_m_));
+    }
     pnh.param("mapping_markers_range_m", markers_range_m_, 20.0);
     if (!(markers_range_m_ >= 0.0 && markers_range_m_ <= 200.0)) {
       params.addError("mapping_markers_range_m: must be in [0, 200] m, got " + std::to_string(markers_range_m_));
@@ -146,6 +152,17 @@ class PlannerLiveMap {
 
   void onDepth(const sensor_msgs::Image::ConstPtr& m) {
     const double t = m->header.stamp.toSec();
+    // No stamp: the camera's pose cannot be looked up at it (tf would answer its latest, maybe stale).
+    if (!(t > 0.0)) return refuse("depth_in header.stamp is 0: the camera pose at the frame's time is unknown");
+    // ROS time went back (a simulation restarted, a bag looped): the rate limit and the live map's
+    // stamps restart from this frame — else every frame is dropped until the clock caught up.
+    if (next_frame_s_ > t + 2.0 / rate_hz_ + 1.0) {
+      ROS_WARN_STREAM("FormationPlanner live map: depth frame stamped " << t << " s, " << next_frame_s_ - t
+                                                                        << " s before the previous one: ROS time went back, the map's stamps restart");
+      std::lock_guard<std::mutex> serial(update_mutex_);
+      live_->restartClock(t);
+      next_frame_s_ = -1.0;
+    }
     // At most mapping_rate_hz; 1 ms of slack, or a camera at exactly that rate loses frames to
     // rounding (0.4 + 0.2 > 0.6 in binary: every third frame at 5 Hz).
     if (t + 1e-3 < next_frame_s_) return;
@@ -158,10 +175,20 @@ class PlannerLiveMap {
       info = info_;
     }
     if (!info) return refuse("no CameraInfo on depth_info_in yet");
+    // The depth must be the camera the CameraInfo describes (an unaligned depth stream of the same
+    // size would be placed with the colour camera's intrinsics).
+    if (info->header.frame_id != m->header.frame_id) {
+      return refuse("depth_in frame_id '" + m->header.frame_id + "' is not its CameraInfo's '" + info->header.frame_id +
+                    "' (depth aligned to that camera expected)");
+    }
     // The image's own pinhole: the calibration with the binning and region applied (REP 104); the
-    // aligned depth is taken as rectified, whatever distortion model the driver names.
+    // aligned depth is taken as rectified, whatever distortion model the driver names: the
+    // projection P where the driver sets it (the rectified image's), else K.
     sensor_msgs::CameraInfo pinhole = *info;
     pinhole.D.clear();
+    if (pinhole.P[0] > 0.0 && pinhole.P[5] > 0.0) {
+      pinhole.K = {pinhole.P[0], pinhole.P[1], pinhole.P[2], pinhole.P[4], pinhole.P[5], pinhole.P[6], 0.0, 0.0, 1.0};
+    }
     const auto k = toIntrinsics(pinhole);
     if (!k) return refuse("depth_info_in: " + k.reason());
     if (static_cast<std::uint32_t>(k->width_px) != m->width || static_cast<std::uint32_t>(k->height_px) != m->height) {
@@ -170,8 +197,8 @@ class PlannerLiveMap {
     frame.intrinsics = {k->fx, k->fy, k->cx, k->cy};
     auto depth = toDepth(*m);
     if (!depth) return refuse("depth_in: " + depth.reason());
-    if (depth->type() == CV_16UC1) {  // millimetres; 0: no return (REP 118) -> NaN
-      depth->convertTo(frame.depth_m, CV_32FC1, 1e-3);
+    if (depth->type() == CV_16UC1) {  // depth_scale_m units (millimetres by default); 0: no return (REP 118) -> NaN
+      depth->convertTo(frame.depth_m, CV_32FC1, depth_scale_m_);
       frame.depth_m.setTo(std::nanf(""), *depth == 0);
     } else {
       frame.depth_m = *depth;
@@ -282,6 +309,7 @@ class PlannerLiveMap {
   std::mutex update_mutex_;     ///< one of integrate(), merge(), takeChanges() at a time
   std::optional<Eigen::Vector3d> camera_world_;  ///< the camera at the last integrated frame (under update_mutex_)
   double rate_hz_ = 5.0, tf_timeout_s_ = 0.1, next_frame_s_ = -1e18, markers_range_m_ = 20.0;
+  double depth_scale_m_ = 0.001;  ///< 16UC1 depth units [m] (~mapping_depth_scale_m)
   std::shared_ptr<const planning::OccupancyMap> prior_map_;  ///< the scenario's map (null: no prior)
   double ground_z_m_ = -1e9;  ///< the scenario's ground (its voxels are not drawn)
   bool prior_ = true;

@@ -218,18 +218,23 @@ void LiveMap::notePending(std::size_t index, const planning::VoxelIndex& voxel, 
 
 std::vector<std::size_t> LiveMap::stampOwnCells(double stamp_s) {
   std::vector<std::size_t> recheck;
-  auto stamp = [&](const std::vector<std::pair<octomap::OcTreeKey, std::ptrdiff_t>>& cells) {
+  auto stamp = [&](const std::vector<std::pair<octomap::OcTreeKey, std::ptrdiff_t>>& cells, bool hit) {
     for (const auto& cell : cells) {
       const auto index = static_cast<std::size_t>(cell.second);
       own_s_[index] = std::max(own_s_[index], stamp_s);
-      if (received_[index] != kReceivedNone && received_s_[index] <= stamp_s) {  // own word is newer
+      // The own word is newer — or a return here contradicts a received "free", whatever its stamp:
+      // an update's stamp is the sender's newest frame, not when it saw this voxel (a free voxel
+      // may wait in its queue for seconds), so a received free never outweighs an own return.
+      const bool newer = received_s_[index] <= stamp_s;
+      const bool contradicted = hit && received_[index] == kReceivedFree;
+      if (received_[index] != kReceivedNone && (newer || contradicted)) {
         received_[index] = kReceivedNone;
         recheck.push_back(index);
       }
     }
   };
-  stamp(free_cells_);
-  stamp(occupied_cells_);
+  stamp(free_cells_, false);
+  stamp(occupied_cells_, true);
   return recheck;
 }
 
@@ -329,6 +334,13 @@ common::Result<MergeResult> LiveMap::merge(const MapDelta& delta) {
         ++out.superseded;  // seen here since, a newer received class, or listed twice
         continue;
       }
+      // A received "free" never clears what this UAV's own camera holds occupied: the update's stamp
+      // is the sender's newest frame, not when it saw this voxel (docs/mapping.md §8), so it cannot
+      // tell which word is newer; the own camera clears it when it sees the place free.
+      if (!occupied && ownOccupied(index)) {
+        ++out.superseded;
+        continue;
+      }
       received_[index] = occupied ? kReceivedOccupied : kReceivedFree;
       received_s_[index] = delta.stamp_s;
       mark_[index] = 1;
@@ -388,6 +400,7 @@ MapDelta LiveMap::takeChanges(const Eigen::Vector3d& p_sender_world, double now_
       continue;
     }
     pending_mark_[c.index] = 0;
+    mark_[c.index] = 4;  // sent in this update: not resent below (a key listed twice refuses the update)
     auto& a = announced_[c.index];
     a = static_cast<std::uint8_t>((a & kInRefreshList) | (c.occupied ? kAnnouncedOccupied : 0));
     if (c.occupied && (a & kInRefreshList) == 0) newly_occupied.push_back(c.index);
@@ -407,11 +420,15 @@ MapDelta LiveMap::takeChanges(const Eigen::Vector3d& p_sender_world, double now_
       refresh_.pop_back();
       continue;
     }
+    ++refresh_cursor_;
+    if (mark_[index] == 4) continue;  // a change sent in this very update (announced again above)
     const octomap::OcTreeKey k = keyOfIndex(index);
     delta.occupied.push_back(VoxelKey{{k[0], k[1], k[2]}});
     ++s.refreshed;
     --want;
-    ++refresh_cursor_;
+  }
+  for (const auto& keys : {&delta.occupied, &delta.free}) {
+    for (const VoxelKey& k : *keys) mark_[static_cast<std::size_t>(gridIndex(octomap::OcTreeKey(k[0], k[1], k[2])))] = 0;
   }
   for (const std::size_t index : newly_occupied) {
     announced_[index] = static_cast<std::uint8_t>(announced_[index] | kInRefreshList);
@@ -420,6 +437,14 @@ MapDelta LiveMap::takeChanges(const Eigen::Vector3d& p_sender_world, double now_
   s.sent = static_cast<int>(delta.size());
   if (stats != nullptr) *stats = s;
   return delta;
+}
+
+void LiveMap::restartClock(double now_s) {
+  const double none = -std::numeric_limits<double>::infinity();
+  std::fill(own_s_.begin(), own_s_.end(), none);
+  std::fill(received_s_.begin(), received_s_.end(), none);
+  for (const std::size_t index : pending_) pending_s_[index] = now_s;
+  map_stamp_s_ = 0.0;  // as created: no frame yet on this timeline
 }
 
 Observed LiveMap::observed(const Eigen::Vector3d& p_world) const {

@@ -111,7 +111,8 @@ class LiveMap {
   /// \brief Merges another UAV's map changes (docs/mapping.md §8). Per voxel, the newer word wins:
   /// a received class is ignored where this UAV's own rays crossed or ended in the voxel at or after
   /// `delta.stamp_s` (or a newer received class is held), and a later own frame through the voxel
-  /// replaces it. Received occupied voxels enter the map and the field like observed ones; prior
+  /// replaces it; a received "free" never clears a voxel this UAV's own camera holds occupied, and
+  /// an own return replaces a received "free" whatever the stamps. Received occupied voxels enter the map and the field like observed ones; prior
   /// voxels stay occupied. Received voxels do NOT count as seen for the seen-space rule (§8 why).
   /// Fails, changing nothing, on a delta that does not fit keyGrid() (naming the field).
   /// Same thread rules as integrate() (never concurrently with it or itself).
@@ -123,6 +124,13 @@ class LiveMap {
   /// newest integrated frame's time. Not concurrently with integrate().
   MapDelta takeChanges(const Eigen::Vector3d& p_sender_world, double now_s, std::size_t max_voxels, double max_age_s,
                        OutgoingStats* stats = nullptr);
+  /// \brief The clock went back (ROS time: a simulation restarted, a bag looped) to `now_s`: the
+  /// map, the field and the seen space are kept (what was seen stays — the safe side), the times
+  /// of the old timeline are forgotten — every voxel's own and received stamps (a new word of
+  /// either wins), the newest frame's stamp (0 again, as created) — and the changes waiting to be
+  /// sent are dated now_s.
+  /// Not concurrently with integrate(), merge() or takeChanges().
+  void restartClock(double now_s);
   /// \brief Own changes waiting to be sent.
   std::size_t pendingChanges() const { return pending_.size(); }
   /// \brief The keys this map holds (resolution and grid), what merge() accepts.
@@ -178,7 +186,7 @@ class LiveMap {
   std::vector<std::size_t> touched_;                                                          ///< castRays' scratch
   planning::VoxelIndex key_origin_ = planning::VoxelIndex::Zero();  ///< OctoMap key of the grid's first voxel
   planning::VoxelIndex grid_size_ = planning::VoxelIndex::Zero();
-  std::vector<std::uint8_t> mark_;       ///< per grid voxel, this frame: 1 free cell, 2 occupied cell
+  std::vector<std::uint8_t> mark_;       ///< per grid voxel, scratch: 1 free / 2 occupied cell of this frame; 3 changed; 4 sent in this update
   std::vector<std::uint8_t> saturated_;  ///< per grid voxel: kSaturatedFree / kSaturatedOccupied / 0
   // Sharing (docs/mapping.md §8), per grid voxel:
   std::vector<double> own_s_;             ///< the last own frame whose ray crossed or ended in it (−inf: none)

@@ -14,6 +14,7 @@
 
 #include <octomap/OcTree.h>
 
+#include "gesture_formation/comm/map_update.hpp"
 #include "gesture_formation/mapping/depth_points.hpp"
 #include "gesture_formation/mapping/live_map.hpp"
 #include "gesture_formation/mapping/mapping_config.hpp"
@@ -635,4 +636,91 @@ TEST(MappingConfigTest, ShareKeysAndTheBudgetRuleAreChecked) {
   EXPECT_EQ(mapping::shareVoxelBudget(c.share), 0u);
   c.share.max_bytes_per_s = 1e7;  // capped by the payload limit
   EXPECT_EQ(mapping::shareVoxelBudget(c.share), mapping::kMaxMapUpdateVoxels);
+}
+
+// An update's stamp is the sender's newest frame, not when it saw each voxel: a "free" voxel may
+// wait in its queue for seconds. UAV A sees the box, then the place empty at 2 s, then looks at
+// nothing at 6 s: its update lists the face free, stamped 6 s. UAV B saw the box itself at 4 s: the
+// received "free" must not clear it (before, the later stamp won and the obstacle left B's map and
+// field). Nor, the other way round, may a received "free" outweigh B's own later return.
+TEST(MapShareTest, AReceivedFreeNeverClearsWhatTheOwnCameraHoldsOccupied) {
+  auto a = makeLiveMap(), b = makeLiveMap(), c = makeLiveMap();
+  ASSERT_TRUE(a && b && c);
+  const std::set<Key> face = faceVoxels(4.7, -0.9, 0.9, 0.9, 2.1);
+  ASSERT_TRUE(a->integrate(boxFrame(kBoxALo, kBoxAHi, 1.0)));
+  ASSERT_EQ(a->takeChanges(kCamera, 1.0, 10000, 5.0).size(), face.size());
+  for (int i = 0; i < 4; ++i) ASSERT_TRUE(a->integrate(emptyFrame(2.0 + 0.1 * i)));
+  ASSERT_TRUE(occupiedVoxels(*a->map()).empty());
+  DepthFrame blind = cameraAt(kCamera);  // no valid pixel: a frame that observes nothing here
+  blind.depth_m.setTo(std::numeric_limits<float>::quiet_NaN());
+  blind.stamp_s = 6.0;
+  ASSERT_TRUE(a->integrate(blind));
+  const mapping::MapDelta freed = a->takeChanges(kCamera, 6.0, 10000, 5.0);
+  ASSERT_EQ(keysToVoxels(freed.free), face);
+  ASSERT_DOUBLE_EQ(freed.stamp_s, 6.0);
+
+  ASSERT_TRUE(b->integrate(boxFrame(kBoxALo, kBoxAHi, 4.0)));
+  ASSERT_EQ(occupiedVoxels(*b->map()), face);
+  const auto merged = b->merge(freed);
+  ASSERT_TRUE(merged) << merged.reason();
+  EXPECT_EQ(merged->superseded, static_cast<int>(face.size()));
+  EXPECT_EQ(occupiedVoxels(*b->map()), face);
+  expectFieldIsFullRebuild(*b);
+
+  ASSERT_TRUE(c->merge(freed));  // C never saw the place: it takes the word
+  ASSERT_TRUE(c->integrate(boxFrame(kBoxALo, kBoxAHi, 5.0)));  // then its camera sees the box, stamp < 6 s
+  EXPECT_EQ(occupiedVoxels(*c->map()), face);
+  expectFieldIsFullRebuild(*c);
+}
+
+// A voxel on the resend list that went free and occupied again is sent as a change; the resend pass
+// of the same update must not list it a second time (a key listed twice refuses the whole update at
+// the encoder and at every receiver).
+TEST(MapShareRefreshTest, AChangeIsNotResentInTheSameUpdate) {
+  auto a = makeLiveMap(nullptr, 0.5);
+  ASSERT_TRUE(a);
+  const std::set<Key> face = faceVoxels(4.7, -0.9, 0.9, 0.9, 2.1);
+  ASSERT_TRUE(a->integrate(boxFrame(kBoxALo, kBoxAHi, 1.0)));
+  ASSERT_EQ(a->takeChanges(kCamera, 1.0, 100, 5.0).occupied.size(), face.size());  // now on the resend list
+  for (int i = 0; i < 4; ++i) ASSERT_TRUE(a->integrate(emptyFrame(2.0 + 0.1 * i)));
+  // Sent free in an update with no room left for resends: they stay on the resend list meanwhile.
+  ASSERT_EQ(a->takeChanges(kCamera, 2.5, face.size(), 5.0).free.size(), face.size());
+  ASSERT_TRUE(a->integrate(boxFrame(kBoxALo, kBoxAHi, 3.0)));
+  ASSERT_EQ(occupiedVoxels(*a->map()), face);
+  mapping::OutgoingStats stats;
+  const mapping::MapDelta d = a->takeChanges(kCamera, 3.0, 100, 5.0, &stats);  // 70 changes, room for 30 resends
+  EXPECT_EQ(keysToVoxels(d.occupied), face);
+  EXPECT_EQ(d.occupied.size(), face.size());  // each key once
+  EXPECT_EQ(stats.refreshed, 0);
+  comm::MapUpdate u;
+  u.delta = d;
+  const auto bytes = comm::encodePayload(u);
+  EXPECT_TRUE(bytes) << bytes.reason();
+}
+
+// ROS time went back (a simulation restarted at 0 s after 100 s): the map is kept, the old
+// timeline's stamps are not — else every own frame and received word of the new timeline would
+// lose to voxels stamped ~100 s until the clock caught up (the receiver ignoring the others'
+// obstacles meanwhile).
+TEST(MapShareTest, AfterTheClockWentBackTheMapStaysAndNewWordsWin) {
+  auto a = makeLiveMap(), b = makeLiveMap();
+  ASSERT_TRUE(a && b);
+  const std::set<Key> face = faceVoxels(4.7, -0.9, 0.9, 0.9, 2.1);
+  ASSERT_TRUE(b->integrate(emptyFrame(100.0)));  // B saw the place empty at 100 s
+  ASSERT_TRUE(a->integrate(boxFrame(kBoxALo, kBoxAHi, 100.0)));
+  a->restartClock(5.0);
+  b->restartClock(5.0);
+  EXPECT_EQ(occupiedVoxels(*a->map()), face);  // kept
+  ASSERT_EQ(a->pendingChanges(), face.size());
+  // A's waiting changes go out stamped with its first frame of the new timeline; B takes them (its
+  // own word was of the old timeline: without the restart it would outweigh them until 100 s).
+  ASSERT_TRUE(a->integrate(boxFrame(kBoxALo, kBoxAHi, 6.0)));
+  const mapping::MapDelta d = a->takeChanges(kCamera, 6.0, 10000, 5.0);
+  EXPECT_EQ(keysToVoxels(d.occupied), face);
+  EXPECT_DOUBLE_EQ(d.stamp_s, 6.0);
+  const auto merged = b->merge(d);
+  ASSERT_TRUE(merged) << merged.reason();
+  EXPECT_EQ(merged->superseded, 0);
+  EXPECT_EQ(occupiedVoxels(*b->map()), face);
+  expectFieldIsFullRebuild(*b);
 }
