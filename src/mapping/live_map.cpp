@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <sstream>
 #include <mutex>
 
 #include <octomap/OcTree.h>
@@ -38,6 +39,16 @@ common::Result<std::unique_ptr<LiveMap>> LiveMap::create(const MappingConfig& co
   if (!problems.empty()) return R::fail(joinLines(problems));
   auto map = std::make_shared<planning::OccupancyMap>(
       planning::OccupancyMap::fromPrimitives(grid, planning::PrimitiveSet{}, planning::GroundSpec{}));
+  // OctoMap's keys (tree depth 16) hold voxel indices −32768 .. 32767 around the world origin: a grid
+  // beyond them would map nothing (and its keys would wrap on the wire).
+  const planning::VoxelIndex lo = map->gridOrigin(), hi = map->gridOrigin() + map->gridSize() - planning::VoxelIndex::Ones();
+  if ((lo.array() < -kKeyOrigin).any() || (hi.array() >= kKeyOrigin).any()) {
+    std::ostringstream os;
+    os << "map.bounds: voxel indices " << lo.transpose() << " .. " << hi.transpose() << " at map.resolution_m "
+       << grid.resolution_m << " leave OctoMap's key range (-" << kKeyOrigin << " .. " << kKeyOrigin - 1
+       << " per axis): bounds nearer the origin or a coarser resolution";
+    return R::fail(os.str());
+  }
   if (prior) {
     if (prior->resolution() != map->resolution() || prior->gridOrigin() != map->gridOrigin() ||
         prior->gridSize() != map->gridSize()) {

@@ -278,6 +278,18 @@ TEST(LiveMapTest, RayCastingEqualsOctomapInsertPointCloud) {
   EXPECT_TRUE(pruned) << ::testing::PrintToString(nodes);
 }
 
+// OctoMap's keys hold voxel indices -32768 .. 32767 per axis: a grid beyond them is refused, named.
+TEST(LiveMapTest, AGridBeyondOctomapsKeysIsRefused) {
+  planning::MapConfig far = grid();
+  far.resolution_m = 0.05;
+  far.bounds = planning::Aabb{Eigen::Vector3d(1640.0, -0.5, 0.0), Eigen::Vector3d(1642.0, 0.5, 1.0)};  // x index 32800 .. 32839
+  const auto live = LiveMap::create(MappingConfig{}, far);
+  ASSERT_FALSE(live);
+  EXPECT_NE(live.reason().find("leave OctoMap's key range"), std::string::npos) << live.reason();
+  far.bounds = planning::Aabb{Eigen::Vector3d(1630.0, -0.5, 0.0), Eigen::Vector3d(1632.0, 0.5, 1.0)};  // 32600 .. 32639: fits
+  EXPECT_TRUE(LiveMap::create(MappingConfig{}, far)) << "a grid inside the keys";
+}
+
 TEST(LiveMapTest, PriorOnAnotherGridIsRefused) {
   planning::MapConfig other = grid();
   other.resolution_m = 0.25;
