@@ -21,7 +21,9 @@ import time
 from campaign_store import BASE_CONFIG_HASH, UNKNOWN_BINARY, Store
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-THRESHOLDS = {"min_mutual_distance_m": 2.5, "min_obstacle_distance_m": 0.5}
+# Gamma_dis between UAVs and to the worker (UAV centre to his mid-body; issue 36: "0 violations of
+# Gamma_dis to the worker or between UAVs"), the planner's verification clearance to obstacles.
+THRESHOLDS = {"min_mutual_distance_m": 2.5, "min_obstacle_distance_m": 0.5, "min_human_distance_m": 2.5}
 
 # ---- report -------------------------------------------------------------------------------
 COLS = [("min_mutual_distance_m", "min mutual [m]", "{:.2f}"), ("min_obstacle_distance_m", "min obstacle [m]", "{:.2f}"),
@@ -40,8 +42,7 @@ def cell(vals, fmt):
 
 
 def is_violation(m):
-    return (m["min_mutual_distance_m"] < THRESHOLDS["min_mutual_distance_m"]
-            or m["min_obstacle_distance_m"] < THRESHOLDS["min_obstacle_distance_m"] or m["collisions"] != 0)
+    return (any(m[k] < t for k, t in THRESHOLDS.items() if m.get(k) is not None) or m["collisions"] != 0)
 
 
 def commit_time(commit):
@@ -145,7 +146,8 @@ def render_report(all_rows, every, fails, commits, scenario, profiles, out, plot
             if is_violation(m):
                 violations.append(f"{p} seed {m['seed']:.0f}: mutual {m['min_mutual_distance_m']:.2f} m, obstacle "
                                   f"{m['min_obstacle_distance_m']:.2f} m (UAV {m['min_obstacle_uav']:.0f} at "
-                                  f"{m['min_obstacle_t_s']:.1f} s), collisions {m['collisions']:.0f}")
+                                  f"{m['min_obstacle_t_s']:.1f} s), human {m.get('min_human_distance_m') or float('nan'):.2f} m, "
+                                  f"collisions {m['collisions']:.0f}")
         runs[p] = len(ms)
         get = lambda k: [float(m[k]) for m in ms if m.get(k) is not None]  # noqa: E731
         rows.append(f"| `{p}` | {len(ms)} | " + " | ".join(cell(get(k), fmt) for k, _, fmt in COLS) + " |")
@@ -168,7 +170,8 @@ def render_report(all_rows, every, fails, commits, scenario, profiles, out, plot
              + ", ".join(f"`{c[:10]}` / `{h}` ({sum(1 for r in all_rows if r['source_commit'] == c and r['model_sha256'][:16] == h)})"
                          for c, h in pairs) + ".\n\n")
     w.append("Each cell: **min / median / max over seeds**. Safety thresholds: mutual ≥ Γ_dis 2.5 m, obstacle ≥ the "
-             "planner's verification clearance 0.5 m (exact distance to the scenario's solids), 0 collisions. "
+             "planner's verification clearance 0.5 m (exact distance to the scenario's solids), human (UAV centre to the "
+             "worker's mid-body, in the diagnostics below) ≥ Γ_dis 2.5 m, 0 collisions. "
              "Requests applied counts operator + gesture commands applied (25 performed; 26 when a work motion fires one "
              "false adaptation); estimate error is the RMS of worker estimate − truth over camera frames.\n\n")
     w.append("| faults | seeds | " + " | ".join(h for _, h, _ in COLS) + " |\n")
@@ -211,7 +214,7 @@ def render_report(all_rows, every, fails, commits, scenario, profiles, out, plot
                  "e.g. §4.4, §4.11).\n")
     else:
         w.append(f"**No safety violation in the {total} missions** (no min mutual < 2.5 m, no obstacle distance < 0.5 m, "
-                 "no collision).\n")
+                 "no UAV within 2.5 m of the worker, no collision).\n")
     false_total = sum(int(r["false_adaptations"] or 0) for r in all_rows)
     false_missions = [f"`{r['profile']}` seed {r['seed']:.0f}" for r in sorted(all_rows, key=lambda r: (
         profiles.index(r["profile"]), r["seed"])) if (r["false_adaptations"] or 0) > 0]
@@ -235,14 +238,15 @@ def other_commits_text(every, commits, safety):
     for c, rs in sorted(by.items(), key=lambda kv: (-(commit_time(kv[0]) or 0), kv[0])):
         worst_m = min(r["min_mutual_distance_m"] for r in rs)
         worst_o = min(r["min_obstacle_distance_m"] for r in rs)
+        worst_h = min((r["min_human_distance_m"] for r in rs if r.get("min_human_distance_m") is not None), default=None)
         coll = sum(int(r["collisions"]) for r in rs)
         t = commit_time(c)
         newer = t is not None and t > newest
-        verdict = ("no safety violation" if worst_m >= 2.5 and worst_o >= 0.5 and coll == 0 else
+        verdict = ("no safety violation" if not any(is_violation(r) for r in rs) else
                    f"**a safety violation: see [safety.md]({safety}) §4**")
         lines.append(f"- `{c[:10]}`{' (newer: in progress)' if newer else ''}: {len(rs)} missions (seeds up to "
-                     f"{max(r['seed'] for r in rs)}): min mutual {worst_m:.2f} m, min obstacle {worst_o:.3f} m, {coll} "
-                     f"collisions — {verdict}")
+                     f"{max(r['seed'] for r in rs)}): min mutual {worst_m:.2f} m, min obstacle {worst_o:.3f} m, "
+                     f"min human {'–' if worst_h is None else format(worst_h, '.2f')} m, {coll} collisions — {verdict}")
     return ("Other commits of this matrix in the store (not in the tables; `tools/campaign.py compare A B` puts two "
             "side by side):\n\n" + "\n".join(lines) + "\n\n")
 

@@ -487,6 +487,17 @@ common::Result<MissionConfig> parseMissionConfig(const std::string& yaml, const 
   readLeadership(r, m, c.formation.params.uavCount(), c.leadership);
 
   for (const auto& e : c.worker.validate(m + "worker.")) r.addError(m + "worker", e);
+  // The verifier's clearance is the plan's last line against obstacles: a UAV whose frame and props
+  // reach farther than it may be planned into contact (docs/planning.md §7).
+  for (std::size_t i = 0; i < c.uavs.size(); ++i) {
+    const double radius = c.uavs[i].plant.body_radius_m;
+    if (radius > c.planner.verify_clearance_m) {
+      std::ostringstream os;
+      os << radius << " m exceeds the planner's verify.clearance_m " << c.planner.verify_clearance_m
+         << " m: the verified clearance would let the frame or props touch (raise verify.clearance_m)";
+      r.addError(m + "uavs[" + std::to_string(i) + "].plant.body_radius_m", os.str());
+    }
+  }
   c.duration_s = c.worker.routeDuration();
   r.readDouble(m + "duration_s", c.duration_s, Range::positive());
   for (const auto& u : r.unusedKeys()) {

@@ -138,3 +138,14 @@ TEST(MissionConfigRangesTest, RulesBetweenFieldsNameTheirKey) {
   EXPECT_NE(all.find("faults.follower_dropouts[0] needs from_s < to_s, got from_s 5, to_s 2"), std::string::npos) << all;
   EXPECT_NE(all.find("faults.range_outliers.max_error_m must be >= min_error_m, got 2"), std::string::npos) << all;
 }
+
+// A UAV reaching farther than the verifier's clearance could be planned into contact.
+TEST(MissionConfigRangesTest, ABodyWiderThanTheVerifiedClearanceIsRefused) {
+  const std::string dir = std::string(GF_SOURCE_DIR) + "/config/scenarios";
+  auto m = gf::sim::parseMissionConfig(scenarioWith("uavs[1].plant.body_radius_m", 0.52), "t.yaml", dir);
+  ASSERT_FALSE(m);
+  EXPECT_NE(m.reason().find("mission.uavs[1].plant.body_radius_m"), std::string::npos) << m.reason();
+  EXPECT_NE(m.reason().find("0.52 m exceeds the planner's verify.clearance_m 0.5 m"), std::string::npos) << m.reason();
+  m = gf::sim::parseMissionConfig(scenarioWith("uavs[1].plant.body_radius_m", 0.5), "t.yaml", dir);
+  EXPECT_TRUE(m) << m.reason();
+}
