@@ -17,6 +17,7 @@
 //   a gimbal's driver publishes it; `fixed`: ~camera_mount_rpy_rad [roll, pitch, yaw] of the camera
 //   in the body, REP 103, pitch positive down), ~camera_optical_axis (`x`: an FLU camera frame such
 //   as a RealSense camera_link; `z`: an optical frame), ~tf_timeout_s (tf only).
+#include <cmath>
 #include <memory>
 #include <mutex>
 
@@ -76,6 +77,14 @@ class OdometryAdapterNodelet : public nodelet::Nodelet {
       params.addError(pnh.resolveName("camera_mount_rpy_rad") + ": missing or not [roll, pitch, yaw] (3 numbers, rad)");
       return;
     }
+    for (std::size_t i = 0; i < 3; ++i) {
+      // Radians: degrees given by mistake (20 for 20°) would be read as a turn of 20 rad.
+      if (!(std::abs(rpy[i]) <= M_PI)) {
+        params.addError(pnh.resolveName("camera_mount_rpy_rad") + "[" + std::to_string(i) + "]: " + std::to_string(rpy[i]) +
+                        " rad is outside [-pi, pi] (radians, not degrees)");
+      }
+    }
+    if (!params.ok()) return;
     const auto axis = mount_.optical_axis;
     mount_ = onboard::CameraMount::fromRpy(rpy[0], rpy[1], rpy[2]);
     mount_.optical_axis = axis;

@@ -24,6 +24,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <tuple>
 
 #include <diagnostic_msgs/DiagnosticStatus.h>
 #include <visualization_msgs/Marker.h>
@@ -37,6 +38,7 @@
 #include "conversions.hpp"
 #include "map_update_conversions.hpp"
 #include "gesture_formation/common/config_reader.hpp"
+#include "gesture_formation/common/format_number.hpp"
 #include "gesture_formation/mapping/live_map.hpp"
 #include "param_loader.hpp"
 
@@ -52,17 +54,25 @@ class PlannerLiveMap {
     if (const auto why = start(nh, world, world_frame); !why.empty()) params.addError(why);
   }
 
-  /// Reads ~mapping_config (optional), ~mapping_rate_hz, ~mapping_prior, ~tf_timeout_s; every
+  /// Reads ~mapping_config (optional), ~mapping_rate_hz, ~mapping_prior, ~mapping_tf_timeout_s,
+  /// ~mapping_depth_scale_m; every
   /// problem into `params`. True when a live map is configured.
   bool load(ros::NodeHandle& pnh, ParamLoader& params) {
     params.loadOptional("mapping_config", file_, "");
     if (file_.empty()) return false;
     params.load("mapping_rate_hz", rate_hz_, 0.1, 30.0);
     params.loadOptional("mapping_prior", prior_, true);
-    pnh.param("mapping_tf_timeout_s", tf_timeout_s_, 0.1);
-    pnh.param("mapping_depth_scale_m", depth_scale_m_, 0.001);
-    if (!(depth_scale_m_ > 0.0 && depth_scale_m_ <= 0.01)) {
-      params.addError("mapping_depth_scale_m: must be in (0, 0.01] m per 16UC1 unit, got " + std::to_string(depth_scale_m_));
+    // Optional, with their defaults; present, a number in range (a mistyped value — e.g. the string
+    // PyYAML makes of 1e-4 — is refused, never replaced by the default in silence).
+    for (auto [name, value, lo, hi, unit] :
+         {std::make_tuple("mapping_tf_timeout_s", &tf_timeout_s_, 0.0, 1.0, "s"),
+          std::make_tuple("mapping_depth_scale_m", &depth_scale_m_, 0.0, 0.01, "m per 16UC1 unit")}) {
+      if (pnh.hasParam(name) && !pnh.getParam(name, *value)) {
+        params.addError(pnh.resolveName(name) + ": not a number");
+      } else if (!(*value > lo && *value <= hi)) {
+        params.addError(pnh.resolveName(name) + ": must be in (" + common::formatNumber(lo) + ", " + common::formatNumber(hi) +
+                        "] " + unit + ", got " + std::to_string(*value));
+      }
     }
     pnh.param("mapping_markers_range_m", markers_range_m_, 20.0);
     if (!(markers_range_m_ >= 0.0 && markers_range_m_ <= 200.0)) {

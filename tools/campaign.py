@@ -466,8 +466,9 @@ def _run(args, c, store, todo, total, already):
                 progress.done += 1
                 results.append(r)
                 mm = r["metrics"]
-                what = (f"{short_key(m['key'])}: mutual {mm.get('min_mutual_distance_m') or float('nan'):.2f} "
-                        f"obstacle {mm.get('min_obstacle_distance_m') or float('nan'):.2f} collisions "
+                num = lambda k: float("nan") if mm.get(k) is None else mm[k]  # noqa: E731 (0.00 is a distance)
+                what = (f"{short_key(m['key'])}: mutual {num('min_mutual_distance_m'):.2f} "
+                        f"obstacle {num('min_obstacle_distance_m'):.2f} collisions "
                         f"{mm.get('collisions')} ({r['mission_s']:.1f} s on {r['worker']})"
                         + ("" if new else " [already stored by another run: kept the first]"))
             else:
