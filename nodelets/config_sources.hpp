@@ -70,7 +70,9 @@ inline bool loadOnboard(const std::string& mission_file, ParamLoader& params, on
 }
 
 inline bool loadFormation(const std::string& path, ParamLoader& params, formation::FormationConfig& out) {
-  auto c = formation::loadFormationConfig(path, common::ConfigReader::MissingKeys::kError);
+  std::vector<std::string> unknown;
+  auto c = formation::loadFormationConfig(path, common::ConfigReader::MissingKeys::kError, &unknown);
+  refuseUnknown("formation_config", unknown, params);
   if (!c) {
     params.addError("formation_config: " + c.reason());
     return false;
@@ -80,7 +82,9 @@ inline bool loadFormation(const std::string& path, ParamLoader& params, formatio
 }
 
 inline bool loadPlanner(const std::string& path, ParamLoader& params, planning::PlannerConfig& out) {
-  auto c = planning::loadPlannerConfig(path, common::ConfigReader::MissingKeys::kError);
+  std::vector<std::string> unknown;
+  auto c = planning::loadPlannerConfig(path, common::ConfigReader::MissingKeys::kError, &unknown);
+  refuseUnknown("planner_config", unknown, params);
   if (!c) {
     params.addError("planner_config: " + c.reason());
     return false;
@@ -99,6 +103,7 @@ inline bool loadGestures(const std::string& path, int follower_count, ParamLoade
   mapping = gesture::GestureMapping::paperDefault();
   gesture::readGestureMapping(reader, filter.max_gesture_id, follower_count, mapping);
   fusion = gesture::readViewFusionConfig(reader);
+  for (const auto& k : reader.unusedKeys()) params.addError("gesture_config: " + path + ": unknown key '" + k + "'");
   if (!reader.ok()) {
     for (const auto& e : reader.errors()) params.addError("gesture_config: " + e);
     return false;

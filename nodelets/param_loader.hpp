@@ -131,4 +131,14 @@ class ParamLoader {
   std::ostringstream loaded_;
 };
 
+// A key the reader does not know is refused too, like the missions' (a misplaced or misspelled
+// optional key would otherwise be ignored in silence; a misspelled required one reads as missing).
+inline void refuseUnknown(const char* what, const std::vector<std::string>& unknown, ParamLoader& params) {
+  for (std::string w : unknown) {
+    const std::string suffix = " ignored";  // the loaders' warning wording; here it refuses the start
+    if (w.size() > suffix.size() && w.compare(w.size() - suffix.size(), suffix.size(), suffix) == 0) w.resize(w.size() - suffix.size());
+    params.addError(std::string(what) + ": " + w);
+  }
+}
+
 }  // namespace gesture_formation::nodelets

@@ -57,7 +57,9 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
     const auto source = estimation::parseIntrinsicsSource(source_name);
     if (!source) params.addError("intrinsics_source: " + source.reason());
     if (!config_file.empty()) {
-      const auto cfg = estimation::loadEstimatorConfig(config_file, common::ConfigReader::MissingKeys::kError);
+      std::vector<std::string> unknown;
+      const auto cfg = estimation::loadEstimatorConfig(config_file, common::ConfigReader::MissingKeys::kError, &unknown);
+      refuseUnknown("estimator_config", unknown, params);
       if (cfg) {
         config_ = *cfg;
       } else {
