@@ -61,7 +61,7 @@ class FormationPlannerNodelet : public nodelet::Nodelet {
     double params_rate_hz = 0.0;
     params.load("params_rate_hz", params_rate_hz, 0.1, 50.0);
     params.load("max_odometry_age_s", max_odometry_age_s_, 0.01, 10.0);
-    getPrivateNodeHandle().param("leadership", leadership_, false);  // optional: see the file comment
+    params.loadOptional("leadership", leadership_, false);  // optional (see the file comment); not a bool: refused
     PlannerSettings settings;  // from ~mission_file (simulation) or the parameters (config_sources.hpp)
     loadPlannerSettings(getPrivateNodeHandle(), params, mission_file, settings);
     const formation::FormationConfig& fcfg = settings.formation;

@@ -90,12 +90,12 @@ class GestureCommanderNodelet : public nodelet::Nodelet {
       params.addError("frame_wait_s: value " + std::to_string(frame_wait_s_) +
                       " must be below view_fusion.max_age_s " + std::to_string(vcfg.max_age_s));
     }
+    params.loadOptional("leadership", leadership_, false);  // optional (see the file comment); not a bool: refused
     if (params.ok()) sequence_ = commandSequenceStart(params, getPrivateNodeHandle().getNamespace());
     if (!params.ok()) {
       NODELET_ERROR_STREAM("GestureCommander refuses to start; fix these parameters:\n" << params.report());
       return;
     }
-    getPrivateNodeHandle().param("leadership", leadership_, false);  // optional: see the file comment
     make_frames_ = [=] { frames_.emplace(fcfg, vcfg, mapping, uav_count, frame_wait_s_, frame_merge_s_); };
     make_frames_();
     last_seen_s_.assign(static_cast<std::size_t>(frames_->views()), -1e9);

@@ -51,7 +51,7 @@ class WorkerEstimatorNodelet : public nodelet::Nodelet {
     params.load("tf_timeout_s", tf_timeout_s_, 0.0, 1.0);
     double rate_hz = 0.0;
     params.load("publish_rate_hz", rate_hz, 0.1, 200.0);
-    pnh.param("leadership", leadership_, false);  // optional: see the file comment
+    params.loadOptional("leadership", leadership_, false);  // optional (see the file comment); not a bool: refused
     std::string source_name;
     params.loadOptional("intrinsics_source", source_name, "camera_info");
     const auto source = estimation::parseIntrinsicsSource(source_name);
