@@ -103,7 +103,7 @@ inline bool loadGestures(const std::string& path, int follower_count, ParamLoade
   mapping = gesture::GestureMapping::paperDefault();
   gesture::readGestureMapping(reader, filter.max_gesture_id, follower_count, mapping);
   fusion = gesture::readViewFusionConfig(reader);
-  for (const auto& k : reader.unusedKeys()) params.addError("gesture_config: " + path + ": unknown key '" + k + "'");
+  for (const auto& k : reader.unusedKeysOfWholeDocument()) params.addError("gesture_config: " + path + ": unknown key '" + k + "'");
   if (!reader.ok()) {
     for (const auto& e : reader.errors()) params.addError("gesture_config: " + e);
     return false;

@@ -64,14 +64,14 @@ class PlannerLiveMap {
     params.loadOptional("mapping_prior", prior_, true);
     // Optional, with their defaults; present, a number in range (a mistyped value — e.g. the string
     // PyYAML makes of 1e-4 — is refused, never replaced by the default in silence).
-    for (auto [name, value, lo, hi, unit] :
-         {std::make_tuple("mapping_tf_timeout_s", &tf_timeout_s_, 0.0, 1.0, "s"),
-          std::make_tuple("mapping_depth_scale_m", &depth_scale_m_, 0.0, 0.01, "m per 16UC1 unit")}) {
+    for (auto [name, value, lo, hi, unit, lo_in] :
+         {std::make_tuple("mapping_tf_timeout_s", &tf_timeout_s_, 0.0, 1.0, "s", true),
+          std::make_tuple("mapping_depth_scale_m", &depth_scale_m_, 0.0, 0.01, "m per 16UC1 unit", false)}) {
       if (pnh.hasParam(name) && !pnh.getParam(name, *value)) {
         params.addError(pnh.resolveName(name) + ": not a number");
-      } else if (!(*value > lo && *value <= hi)) {
-        params.addError(pnh.resolveName(name) + ": must be in (" + common::formatNumber(lo) + ", " + common::formatNumber(hi) +
-                        "] " + unit + ", got " + std::to_string(*value));
+      } else if (!((lo_in ? *value >= lo : *value > lo) && *value <= hi)) {
+        params.addError(pnh.resolveName(name) + ": must be in " + (lo_in ? "[" : "(") + common::formatNumber(lo) + ", " +
+                        common::formatNumber(hi) + "] " + unit + ", got " + std::to_string(*value));
       }
     }
     pnh.param("mapping_markers_range_m", markers_range_m_, 20.0);

@@ -21,9 +21,11 @@ import time
 from campaign_store import BASE_CONFIG_HASH, UNKNOWN_BINARY, Store
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-# Gamma_dis between UAVs and to the worker (UAV centre to his mid-body; issue 36: "0 violations of
-# Gamma_dis to the worker or between UAVs"), the planner's verification clearance to obstacles.
-THRESHOLDS = {"min_mutual_distance_m": 2.5, "min_obstacle_distance_m": 0.5, "min_human_distance_m": 2.5}
+# Gamma_dis between UAVs, the planner's verification clearance to obstacles, and to the worker (UAV
+# centre to his mid-body) the planner's worker safety distance 3.0 m (> Gamma_dis 2.5 m; issue 36:
+# "0 violations of Gamma_dis to the worker"; docs/simulation.md's acceptance table, plot_fault_matrix.py).
+# Rows of older stores without a figure are not judged on it.
+THRESHOLDS = {"min_mutual_distance_m": 2.5, "min_obstacle_distance_m": 0.5, "min_human_distance_m": 3.0}
 
 # ---- report -------------------------------------------------------------------------------
 COLS = [("min_mutual_distance_m", "min mutual [m]", "{:.2f}"), ("min_obstacle_distance_m", "min obstacle [m]", "{:.2f}"),
@@ -146,7 +148,7 @@ def render_report(all_rows, every, fails, commits, scenario, profiles, out, plot
             if is_violation(m):
                 violations.append(f"{p} seed {m['seed']:.0f}: mutual {m['min_mutual_distance_m']:.2f} m, obstacle "
                                   f"{m['min_obstacle_distance_m']:.2f} m (UAV {m['min_obstacle_uav']:.0f} at "
-                                  f"{m['min_obstacle_t_s']:.1f} s), human {m.get('min_human_distance_m') or float('nan'):.2f} m, "
+                                  f"{m['min_obstacle_t_s']:.1f} s), human {float('nan') if m.get('min_human_distance_m') is None else m['min_human_distance_m']:.2f} m, "
                                   f"collisions {m['collisions']:.0f}")
         runs[p] = len(ms)
         get = lambda k: [float(m[k]) for m in ms if m.get(k) is not None]  # noqa: E731
@@ -171,7 +173,7 @@ def render_report(all_rows, every, fails, commits, scenario, profiles, out, plot
                          for c, h in pairs) + ".\n\n")
     w.append("Each cell: **min / median / max over seeds**. Safety thresholds: mutual ≥ Γ_dis 2.5 m, obstacle ≥ the "
              "planner's verification clearance 0.5 m (exact distance to the scenario's solids), human (UAV centre to the "
-             "worker's mid-body, in the diagnostics below) ≥ Γ_dis 2.5 m, 0 collisions. "
+             "worker's mid-body, in the diagnostics below) ≥ the planner's worker safety distance 3.0 m, 0 collisions. "
              "Requests applied counts operator + gesture commands applied (25 performed; 26 when a work motion fires one "
              "false adaptation); estimate error is the RMS of worker estimate − truth over camera frames.\n\n")
     w.append("| faults | seeds | " + " | ".join(h for _, h, _ in COLS) + " |\n")
@@ -214,7 +216,7 @@ def render_report(all_rows, every, fails, commits, scenario, profiles, out, plot
                  "e.g. §4.4, §4.11).\n")
     else:
         w.append(f"**No safety violation in the {total} missions** (no min mutual < 2.5 m, no obstacle distance < 0.5 m, "
-                 "no UAV within 2.5 m of the worker, no collision).\n")
+                 "no UAV within 3.0 m of the worker, no collision).\n")
     false_total = sum(int(r["false_adaptations"] or 0) for r in all_rows)
     false_missions = [f"`{r['profile']}` seed {r['seed']:.0f}" for r in sorted(all_rows, key=lambda r: (
         profiles.index(r["profile"]), r["seed"])) if (r["false_adaptations"] or 0) > 0]

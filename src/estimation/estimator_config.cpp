@@ -119,7 +119,7 @@ common::Result<EstimatorConfig> loadEstimatorConfig(const std::string& path, Con
   ConfigReader r = ConfigReader::fromFile(path, mode);
   const EstimatorConfig c = readEstimatorConfig(r);
   if (warnings) {
-    for (const auto& k : r.unusedKeys()) warnings->push_back(path + ": unknown key '" + k + "' ignored");
+    for (const auto& k : r.unusedKeysOfWholeDocument()) warnings->push_back(path + ": unknown key '" + k + "' ignored");
   }
   if (!r.ok()) return common::Result<EstimatorConfig>::fail(r.errorReport());
   return common::Result<EstimatorConfig>::ok(c);

@@ -75,7 +75,7 @@ common::Result<FormationConfig> loadFormationConfig(const std::string& path, Con
   ConfigReader r = ConfigReader::fromFile(path, mode);
   const FormationConfig c = readFormationConfig(r);
   if (warnings) {
-    for (const auto& k : r.unusedKeys()) warnings->push_back(path + ": unknown key '" + k + "' ignored");
+    for (const auto& k : r.unusedKeysOfWholeDocument()) warnings->push_back(path + ": unknown key '" + k + "' ignored");
   }
   if (!r.ok()) return common::Result<FormationConfig>::fail(r.errorReport());
   return common::Result<FormationConfig>::ok(c);

@@ -455,7 +455,7 @@ void LiveMap::restartClock(double now_s) {
   std::fill(own_s_.begin(), own_s_.end(), none);
   std::fill(received_s_.begin(), received_s_.end(), none);
   for (const std::size_t index : pending_) pending_s_[index] = now_s;
-  map_stamp_s_ = 0.0;  // as created: no frame yet on this timeline
+  map_stamp_s_ = now_s;  // the changes carried over go out dated now (0 would lose them to every receiver's own word)
 }
 
 Observed LiveMap::observed(const Eigen::Vector3d& p_world) const {

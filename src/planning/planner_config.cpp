@@ -124,7 +124,7 @@ common::Result<PlannerConfig> loadPlannerConfig(const std::string& path, ConfigR
   ConfigReader r = ConfigReader::fromFile(path, mode);
   const PlannerConfig c = readPlannerConfig(r);
   if (warnings) {
-    for (const auto& k : r.unusedKeys()) warnings->push_back(path + ": unknown key '" + k + "' ignored");
+    for (const auto& k : r.unusedKeysOfWholeDocument()) warnings->push_back(path + ": unknown key '" + k + "' ignored");
   }
   if (!r.ok()) return common::Result<PlannerConfig>::fail(r.errorReport());
   return common::Result<PlannerConfig>::ok(c);

@@ -13,6 +13,7 @@ source "$(dirname "$0")/common.bash"
 start_master
 CFG=$SRC/config
 sed -e '/distance_max_m/d' -e 's/^limits:$/limits:\n  distance_maximum_m: 30.0/' "$CFG/formation.yaml" > "$T/formation_broken.yaml"
+echo "safety_distance_m: 4.0  # misplaced: belongs under limits" >> "$T/formation_broken.yaml"
 grep -q "distance_maximum_m" "$T/formation_broken.yaml" || fail "could not add an unknown key to a copy of formation.yaml"
 sed 's/^ratio_threshold: .*/ratio_threshold: 1.7/' "$CFG/gestures.yaml" > "$T/gestures_broken.yaml"
 sed -e 's/^\( *min_agreeing_views:\) .*/\1 0/' -e '/^ *elevation_max_deg:/d' "$CFG/gestures.yaml" > "$T/gestures_vf_broken.yaml"
@@ -69,6 +70,7 @@ check fp_bad "fp_bad/max_wind_estimate_age_s: missing" "missing max_wind_estimat
 check fp_bad "fp_bad/avoid_all_plans: missing" "missing avoid_all_plans (the avoidance rule without a mission)"
 check fp_bad "limits.distance_max_m" "the missing YAML key limits.distance_max_m"
 check fp_bad "formation_config: .*unknown key 'limits.distance_maximum_m'" "the unknown YAML key limits.distance_maximum_m"
+check fp_bad "formation_config: .*unknown key 'safety_distance_m'" "the misplaced top-level YAML key safety_distance_m"
 check gc_bad "ratio_threshold" "the out-of-range YAML key ratio_threshold"
 check gc_vf "view_fusion.min_agreeing_views" "the out-of-range YAML key view_fusion.min_agreeing_views"
 check gc_vf "view_fusion.elevation_max_deg" "the missing YAML key view_fusion.elevation_max_deg"

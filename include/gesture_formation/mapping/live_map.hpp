@@ -127,8 +127,7 @@ class LiveMap {
   /// \brief The clock went back (ROS time: a simulation restarted, a bag looped) to `now_s`: the
   /// map, the field and the seen space are kept (what was seen stays — the safe side), the times
   /// of the old timeline are forgotten — every voxel's own and received stamps (a new word of
-  /// either wins), the newest frame's stamp (0 again, as created) — and the changes waiting to be
-  /// sent are dated now_s.
+  /// either wins) — and the newest frame's stamp and the changes waiting to be sent are dated now_s.
   /// Not concurrently with integrate(), merge() or takeChanges().
   void restartClock(double now_s);
   /// \brief Own changes waiting to be sent.

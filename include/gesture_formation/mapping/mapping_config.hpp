@@ -57,7 +57,7 @@ struct MappingConfig {
   /// (`octomap.prob_hit`, in (0.5, 1)) and of a voxel a ray passes being occupied
   /// (`octomap.prob_miss`, in (0, 0.5)); log-odds clamped to [clamping_min, clamping_max]
   /// (`octomap.clamping_min` in (0, 0.5), `octomap.clamping_max` in (0.5, 1)). With the defaults
-  /// one return makes a voxel occupied, and a voxel seen occupied for long is free again after
+  /// one return makes a never-seen voxel occupied (one clamped free needs three), and a voxel seen occupied for long is free again after
   /// ten rays through it (|log-odds(0.97)| / |log-odds(0.4)| ≈ 8.6).
   double prob_hit = 0.7;
   double prob_miss = 0.4;
