@@ -158,10 +158,21 @@ void WorkerTracker::setWorkerHint(const cv::Rect2f& box_px) {
 
 common::Result<cv::Rect2f> WorkerTracker::selectWorker(const cv::Point2f& point_px) {
   int best = -1;
+  std::vector<int> containing;
   for (std::size_t i = 0; i < last_detections_.size(); ++i) {
     const cv::Rect2f& b = last_detections_[i].box_px;
     if (!b.contains(point_px)) continue;
-    if (best < 0 || b.area() < last_detections_[static_cast<std::size_t>(best)].box_px.area()) best = static_cast<int>(i);
+    containing.push_back(static_cast<int>(i));
+    best = static_cast<int>(i);
+  }
+  // A point in two people's boxes (one standing behind the other) does not say whom: refused, the
+  // operator picks by candidate index (the smallest box, the old rule, is often the farther person).
+  if (containing.size() > 1) {
+    std::string list;
+    for (const int i : containing) list += (list.empty() ? "" : ", ") + std::to_string(i);
+    return common::Result<cv::Rect2f>::fail("select worker: the point (" + std::to_string(point_px.x) + ", " +
+                                            std::to_string(point_px.y) + ") px lies in the boxes of candidates " + list +
+                                            ": choose one by its candidate index");
   }
   if (best < 0) {
     return common::Result<cv::Rect2f>::fail("select worker: no person of the last detection round contains the point (" +
@@ -353,7 +364,21 @@ common::Result<TrackStep> WorkerTracker::step(const cv::Mat& frame) {
   const std::string bad = checkBgrImage(frame, "frame");
   if (!bad.empty()) return R::fail("worker tracker: " + bad);
   if (frame_size_ != frame.size()) {
-    if (frame_size_.area() > 0) reset();  // a new stream: boxes of the old one are meaningless
+    if (frame_size_.area() > 0) {  // a new stream: boxes of the old one are meaningless
+      // The operator's choice outlives it (else the next round took the best-scoring person):
+      // the locked worker is kept with his colours, lost, found again by appearance or not at all.
+      const bool locked = locked_ && id_ >= 0;
+      const int id = id_;
+      AppearanceModel appearance = appearance_;
+      reset();
+      if (locked) {
+        locked_ = true;
+        id_ = id;
+        appearance_ = std::move(appearance);
+        box_ = cv::Rect2f();
+        frames_since_lost_ = config_.reacquire_frames + 1;  // past the memory of where he stood
+      }
+    }
     frame_size_ = frame.size();
   }
   ++counters_.frames;

@@ -149,10 +149,10 @@ class WorkerTracker {
   void setWorkerHint(const cv::Rect2f& box_px);
 
   /// \brief The operator's choice: the person of the last detection round whose box contains
-  /// `point_px` (the smallest such box) becomes the worker with a new id — its track starts at once
-  /// on that round's frame — and the tracker is locked to that person (it never picks another one
-  /// by itself; `unlock()` ends that). Fails, changing nothing, when no detection of the last round
-  /// contains the point.
+  /// `point_px` becomes the worker with a new id — its track starts at once on that round's frame —
+  /// and the tracker is locked to that person (it does not start another identity by itself;
+  /// `unlock()` ends that). Fails, changing nothing, when no detection of the last round contains
+  /// the point, or more than one does (people overlapping: choose by candidate index).
   common::Result<cv::Rect2f> selectWorker(const cv::Point2f& point_px);
   /// \brief The operator's choice by candidate index (into `lastDetections()`); fails, changing
   /// nothing, when out of range.

@@ -407,5 +407,64 @@ TEST(WorkerTrackerTest, TheOperatorsChoiceIsKeptAndNoStrangerIsTaken) {
   EXPECT_TRUE(back->reidentified);
 }
 
+// A new image size (the driver restarted at another resolution) resets the track, but not the
+// operator's choice: the next round must not take the best-scoring stranger (before, the reset
+// dropped the lock and the colours). Session-40 review finding.
+// A point inside two people's boxes (one behind the other) does not say whom: refused, naming both.
+TEST(WorkerTrackerTest, APointInTwoPeoplesBoxesIsRefused) {
+  WorkerTrackerConfig cfg;
+  cfg.detect_every_k = 1;
+  cfg.roi_detection = false;
+  auto t = WorkerTracker::create(cfg, std::make_unique<ScriptedDetector>(std::vector<std::vector<Detection>>{
+                                          {det(100, 60, 40, 120, 0.9f), det(120, 80, 20, 60, 0.5f)}}));
+  ASSERT_TRUE(t);
+  ASSERT_TRUE((*t)->step(scene(100, 200)));
+  const auto both = (*t)->selectWorker({125.0f, 100.0f});
+  ASSERT_FALSE(both);
+  EXPECT_NE(both.reason().find("lies in the boxes of candidates 0, 1"), std::string::npos) << both.reason();
+  EXPECT_FALSE((*t)->locked());
+  EXPECT_TRUE((*t)->selectWorker({105.0f, 65.0f})) << "a point in one box only";
+}
+
+TEST(WorkerTrackerTest, TheOperatorsChoiceOutlivesAChangeOfImageSize) {
+  cv::setRNGSeed(7);
+  WorkerTrackerConfig cfg;
+  cfg.detect_every_k = 1;
+  cfg.roi_detection = false;
+  cfg.reacquire_frames = 2;
+  std::vector<std::vector<Detection>> script;
+  for (int i = 0; i < 6; ++i) script.push_back({det(100, 60, 20, 60, 0.9f), det(200, 60, 20, 60, 0.5f)});
+  for (int i = 0; i < 4; ++i) script.push_back({det(100, 60, 20, 60, 0.9f)});   // the new size: only A
+  script.push_back({det(100, 60, 20, 60, 0.9f), det(300, 60, 20, 60, 0.5f)});  // B back
+  auto t = WorkerTracker::create(cfg, std::make_unique<ScriptedDetector>(script));
+  ASSERT_TRUE(t);
+  ASSERT_TRUE((*t)->step(scene(100, 200)));
+  ASSERT_TRUE((*t)->selectWorker({210.0f, 90.0f}));
+  int id_b = -1;
+  for (int i = 1; i < 6; ++i) {
+    auto r = (*t)->step(scene(100, 200));
+    ASSERT_TRUE(r && r->found) << i;
+    id_b = r->id;
+  }
+  ASSERT_TRUE((*t)->appearance().established()) << "the test needs B's colours learnt";
+  const auto bigger = [](int x_a, int x_b) {
+    cv::Mat img(300, 400, CV_8UC3);
+    cv::randu(img, cv::Scalar::all(90), cv::Scalar::all(160));
+    cv::rectangle(img, cv::Rect(x_a, 60, 20, 60), cv::Scalar(20, 20, 20), -1);
+    if (x_b >= 0) cv::rectangle(img, cv::Rect(x_b, 60, 20, 60), cv::Scalar(30, 30, 200), -1);
+    return img;
+  };
+  for (int i = 0; i < 4; ++i) {
+    auto r = (*t)->step(bigger(100, -1));
+    ASSERT_TRUE(r);
+    EXPECT_FALSE(r->found) << "took the stranger after the size change, step " << i;
+  }
+  EXPECT_TRUE((*t)->locked());
+  auto back = (*t)->step(bigger(100, 300));
+  ASSERT_TRUE(back && back->found);
+  EXPECT_NEAR(back->box_px.x, 300.0f, 0.5f);
+  EXPECT_EQ(back->id, id_b);
+}
+
 }  // namespace
 }  // namespace gesture_formation::perception
