@@ -194,9 +194,11 @@ class PerceptionNodelet : public nodelet::Nodelet {
         .value("found_per_s", found_since_report_ / since_s)
         .value("gestures_per_s", gestures_since_report_ / since_s)
         .value("refused", refused_since_report_)
+        .warn(depth_refused_since_report_ > 0, std::to_string(depth_refused_since_report_) + " depth image(s) not aligned to the colour image")
+        .value("depth_refused", depth_refused_since_report_)
         .value("last_image_age_s", last_image_.isZero() ? -1.0 : (ros::Time::now() - last_image_).toSec())
         .value("image_transport", image_transport_ + (decode_compressed_ ? " (decoded here)" : ""));
-    images_since_report_ = found_since_report_ = gestures_since_report_ = refused_since_report_ = 0;
+    images_since_report_ = found_since_report_ = gestures_since_report_ = refused_since_report_ = depth_refused_since_report_ = 0;
     return {h.status()};
   }
 
@@ -227,7 +229,19 @@ class PerceptionNodelet : public nodelet::Nodelet {
       if (t.identity_changed) last_score_ = 0.0f;
       if (t.worker_detection >= 0) last_score_ = t.detections[static_cast<std::size_t>(t.worker_detection)].score;
       d.confidence = last_score_;
-      const sensor_msgs::Image::ConstPtr depth_msg = depths_.nearest(header.stamp);
+      sensor_msgs::Image::ConstPtr depth_msg = depths_.nearest(header.stamp);
+      // The depth must be aligned to this colour image: its size and frame (an unaligned or wrongly
+      // remapped depth topic gave a range from the wrong pixels, clipped in silence).
+      if (depth_msg && (depth_msg->width != static_cast<std::uint32_t>(bgr.cols) ||
+                        depth_msg->height != static_cast<std::uint32_t>(bgr.rows) ||
+                        depth_msg->header.frame_id != header.frame_id)) {
+        ++depth_refused_since_report_;
+        NODELET_WARN_STREAM_THROTTLE(5.0, "Perception: depth image not used: " << depth_msg->width << "x" << depth_msg->height
+                                              << " in '" << depth_msg->header.frame_id << "', the colour image "
+                                              << bgr.cols << "x" << bgr.rows << " in '" << header.frame_id
+                                              << "' (depth aligned to the colour image expected)");
+        depth_msg.reset();
+      }
       if (depth_msg && camera_) {
         auto depth = toDepth(*depth_msg);
         const estimation::Box box{d.u, d.v, d.w, d.h};
@@ -278,6 +292,7 @@ class PerceptionNodelet : public nodelet::Nodelet {
   std::string image_transport_, depth_transport_;
   bool decode_compressed_ = false;  ///< image_transport compressed without its plugin: decoded here
   int images_since_report_ = 0, found_since_report_ = 0, gestures_since_report_ = 0, refused_since_report_ = 0;
+  int depth_refused_since_report_ = 0;  ///< depth images of another size or frame than the colour image
   ros::Time last_image_;
   DiagnosticsPublisher diagnostics_;
   std::optional<image_transport::ImageTransport> image_it_, depth_it_;

@@ -143,13 +143,13 @@ def main():
     info_pub.publish(info)
     depth = np.full((h, w), DEPTH_M, dtype=np.float32)
     wall0 = time.time()
-    def send():  # one depth image and its colour image
+    def send(depth_frame="cam_optical"):  # one depth image and its colour image
         stamp = rospy.Time.now()
         m = CompressedImage(format="png", data=png_bytes) if compressed \
             else Image(height=h, width=w, encoding="bgr8", step=3 * w, data=bgr.tobytes())
         m.header.stamp, m.header.frame_id = stamp, "cam_optical"
         d = Image(height=h, width=w, encoding="32FC1", step=4 * w, data=depth.tobytes())
-        d.header.stamp, d.header.frame_id = stamp, "cam_optical"
+        d.header.stamp, d.header.frame_id = stamp, depth_frame
         depth_pub.publish(d)
         time.sleep(0.03)  # depth first (a RealSense driver publishes both at once; order is not guaranteed)
         img_pub.publish(m)
@@ -205,6 +205,19 @@ def main():
     print("%s: /diagnostics Perception: %d reports, %d with images and finds per second, transport %s (%s expected)" % (
         "PASS" if ok else "FAIL", len(values), len(busy), sorted({v.get("image_transport") for v in values}), want))
     fails += 0 if ok else 1
+    if not compressed:  # a depth image in another frame (not aligned to the colour image): no range, counted
+        mark = len(detections)
+        for _ in range(12):
+            send("other_depth_frame")
+            time.sleep(0.1)
+        time.sleep(1.2)
+        late = [y for y in detections[mark:] if y.detected]
+        refused = [float({kv.key: kv.value for kv in x.values}.get("depth_refused", 0)) for x in health]
+        ok = len(late) >= 5 and not any(math.isfinite(y.stereo_distance_m) for y in late) and max(refused) > 0
+        print("%s: depth in another frame than the colour image: %d detections, %d with a range (0 expected), "
+              "depth_refused %s on /diagnostics" % ("PASS" if ok else "FAIL", len(late),
+                                                     sum(math.isfinite(y.stereo_distance_m) for y in late), max(refused)))
+        fails += 0 if ok else 1
     return fails
 
 
