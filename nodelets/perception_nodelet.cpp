@@ -13,8 +13,10 @@
 //   delivered, for the formation's 3-D confirmation).
 //   candidates_out (WorkerCandidates, each detection round: the people the operator can choose from).
 // Service ~select_worker (SelectWorker): the operator chooses the worker by an image point or a
-//   candidate index; the tracker then keeps that person (appearance + geometry) and never takes
-//   another one by itself until ~select_worker unlock (docs/perception.md "Choosing the worker").
+//   candidate index (a point inside two people's boxes is refused); the tracker then keeps that
+//   person (appearance + geometry) and does not start another identity by itself until
+//   ~select_worker unlock — re-acquisition after a loss is by position or colour alone
+//   (docs/perception.md "Choosing the worker", Known limits).
 // Parameters (required): ~models_root (third_party_models), ~gesture_model (the LSTM's .onnx),
 //   ~detector (movenet_multipose | blazepose), ~skeleton (movenet_lightning | blazepose_landmark),
 //   ~detect_every_k, ~appearance (true: identity kept by the worker's colours too), ~min_depth_m, ~max_depth_m, ~depth_scale_m, ~max_depth_dt_s
@@ -30,7 +32,8 @@
 //   compressed_image_transport plugin is not installed (Debian ships the raw transport only).
 //   ~depth_transport (raw): the same for depth_in, through image_transport only (a transport whose
 //   plugin is not installed is refused at start, naming the ones that are).
-// /diagnostics: `Perception`: images per second, found, gestures, images refused, the last image's age.
+// /diagnostics: `Perception`: images per second, found, gestures, images refused, colour frames whose
+//   depth image was not aligned to them (another size or frame_id: no stereo range), the last image's age.
 #include <algorithm>
 #include <cmath>
 #include <mutex>
@@ -194,7 +197,8 @@ class PerceptionNodelet : public nodelet::Nodelet {
         .value("found_per_s", found_since_report_ / since_s)
         .value("gestures_per_s", gestures_since_report_ / since_s)
         .value("refused", refused_since_report_)
-        .warn(depth_refused_since_report_ > 0, std::to_string(depth_refused_since_report_) + " depth image(s) not aligned to the colour image")
+        .warn(depth_refused_since_report_ > 0, std::to_string(depth_refused_since_report_) +
+                                                   " frame(s) whose depth image was not aligned to the colour image (no stereo range)")
         .value("depth_refused", depth_refused_since_report_)
         .value("last_image_age_s", last_image_.isZero() ? -1.0 : (ros::Time::now() - last_image_).toSec())
         .value("image_transport", image_transport_ + (decode_compressed_ ? " (decoded here)" : ""));
@@ -232,9 +236,12 @@ class PerceptionNodelet : public nodelet::Nodelet {
       sensor_msgs::Image::ConstPtr depth_msg = depths_.nearest(header.stamp);
       // The depth must be aligned to this colour image: its size and frame (an unaligned or wrongly
       // remapped depth topic gave a range from the wrong pixels, clipped in silence).
+      // Frames compared without a leading '/' (tf1 style), and only when both name one.
+      const auto frameOf = [](const std::string& f) { return f.empty() || f[0] != '/' ? f : f.substr(1); };
       if (depth_msg && (depth_msg->width != static_cast<std::uint32_t>(bgr.cols) ||
                         depth_msg->height != static_cast<std::uint32_t>(bgr.rows) ||
-                        depth_msg->header.frame_id != header.frame_id)) {
+                        (!depth_msg->header.frame_id.empty() && !header.frame_id.empty() &&
+                         frameOf(depth_msg->header.frame_id) != frameOf(header.frame_id)))) {
         ++depth_refused_since_report_;
         NODELET_WARN_STREAM_THROTTLE(5.0, "Perception: depth image not used: " << depth_msg->width << "x" << depth_msg->height
                                               << " in '" << depth_msg->header.frame_id << "', the colour image "

@@ -4,13 +4,15 @@ worker"): the ground station's view of the Perception nodelet's candidates and i
 
   tools/gf_worker.py list [--ns /uav0/perception]         the people of the next detection round
   tools/gf_worker.py pick U V [--ns ...]                   the person whose box contains image point (U, V) [px]
+                                                           (refused when two boxes do: pick by candidate)
   tools/gf_worker.py pick --candidate N [--ns ...]         candidate N of the next detection round
   tools/gf_worker.py unlock [--ns ...]                     end the choice (after a loss the tracker may
                                                            take the best-scoring person again)
 --ns is the Perception nodelet's namespace: its candidates are on NS/candidates (onboard.launch and
 sim_uav.launch remap them so) and its service is NS/select_worker. After a choice the tracker is
-locked to that person: it keeps it through crossings by its colours and never takes anyone else
-by itself. Exit 0 when done, 1 when the nodelet refused (the reason is printed), 2 when it is
+locked to that person: it keeps it through crossings by its colours and does not start another
+identity by itself (after a loss it re-acquires by position or colour alone: a look-alike can be
+taken; docs/perception.md, Known limits). Exit 0 when done, 1 when the nodelet refused (the reason is printed), 2 when it is
 unreachable or no candidates arrived within --timeout."""
 import argparse
 import sys

@@ -98,7 +98,7 @@ common::Result<PerceptionFrame> PerceptionPipeline::step(const cv::Mat& frame_bg
   if (!track) return R::fail(track.reason());
   PerceptionFrame out;
   out.track = std::move(track.value());
-  if (!out.track.found || out.track.identity_changed) fifo_.clear();
+  if (!out.track.found || out.track.identity_changed || out.track.stream_reset) fifo_.clear();
   if (out.track.found) {
     const int64_t t1 = cv::getTickCount();
     auto skel = skeleton_->extract(frame_bgr, out.track.box_px);

@@ -172,7 +172,8 @@ common::Result<cv::Rect2f> WorkerTracker::selectWorker(const cv::Point2f& point_
     for (const int i : containing) list += (list.empty() ? "" : ", ") + std::to_string(i);
     return common::Result<cv::Rect2f>::fail("select worker: the point (" + std::to_string(point_px.x) + ", " +
                                             std::to_string(point_px.y) + ") px lies in the boxes of candidates " + list +
-                                            ": choose one by its candidate index");
+                                            " of the last detection round: choose one by its candidate index in the newest "
+                                            "WorkerCandidates");
   }
   if (best < 0) {
     return common::Result<cv::Rect2f>::fail("select worker: no person of the last detection round contains the point (" +
@@ -363,20 +364,28 @@ common::Result<TrackStep> WorkerTracker::step(const cv::Mat& frame) {
   using R = common::Result<TrackStep>;
   const std::string bad = checkBgrImage(frame, "frame");
   if (!bad.empty()) return R::fail("worker tracker: " + bad);
+  bool stream_reset = false;
   if (frame_size_ != frame.size()) {
-    if (frame_size_.area() > 0) {  // a new stream: boxes of the old one are meaningless
-      // The operator's choice outlives it (else the next round took the best-scoring person):
-      // the locked worker is kept with his colours, lost, found again by appearance or not at all.
+    if (frame_size_.area() > 0) {  // a new stream: the track restarts
+      // The operator's choice outlives it (else the next round took the best-scoring person): the
+      // locked worker is kept with his colours and his last box scaled to the new size, lost, and
+      // found again as after any loss (near that box, or by his colours) — or nobody.
+      stream_reset = true;
       const bool locked = locked_ && id_ >= 0;
       const int id = id_;
+      const bool announce = announce_new_id_;  // an operator's choice not yet reported
       AppearanceModel appearance = appearance_;
+      const float sx = static_cast<float>(frame.cols) / static_cast<float>(frame_size_.width);
+      const float sy = static_cast<float>(frame.rows) / static_cast<float>(frame_size_.height);
+      const cv::Rect2f scaled(box_.x * sx, box_.y * sy, box_.width * sx, box_.height * sy);
       reset();
       if (locked) {
         locked_ = true;
         id_ = id;
+        announce_new_id_ = announce;
         appearance_ = std::move(appearance);
-        box_ = cv::Rect2f();
-        frames_since_lost_ = config_.reacquire_frames + 1;  // past the memory of where he stood
+        box_ = scaled;
+        frames_since_lost_ = 0;
       }
     }
     frame_size_ = frame.size();
@@ -385,6 +394,7 @@ common::Result<TrackStep> WorkerTracker::step(const cv::Mat& frame) {
   const cv::Rect2f image_rect(0.0f, 0.0f, static_cast<float>(frame.cols), static_cast<float>(frame.rows));
   TrackStep out;
   out.identity_changed = announce_new_id_;  // the operator chose a person since the last frame
+  out.stream_reset = stream_reset;
   announce_new_id_ = false;
 
   // 1. visual tracker prediction; a box that stopped looking like the worker is a failure

@@ -55,7 +55,7 @@ check "false adaptations counted and named" 'False adaptations: 1 in the 3 missi
 check "missing seed listed" '`loss50` seed 2' "$R"
 check "the summary line" '3 missions, 1 with a safety violation' "$T/out.txt"
 check "the tables' commit" '`abc1234567` / `0123456789abcdef` (3)' "$R"
-check "the other commit by its safety figures" '`def7654321`: 2 missions (seeds up to 1): min mutual 3.20 m, min obstacle 0.880 m, 0 collisions — no safety violation' "$R"
+check "the other commit by its safety figures" '`def7654321`: 2 missions (seeds up to 1): min mutual 3.20 m, min obstacle 0.880 m, min human 6.10 m, 0 collisions — no safety violation' "$R"
 $C report "$T/matrix.yaml" --commit def7 --out "$T/r2.md" > /dev/null 2>&1
 check "--commit selects the tables" '| `nominal` | 1 | 5.90 / 5.90 / 5.90 |' "$T/r2.md"
 $C report "$T/matrix.yaml" --seeds 1..1 --commit abc --out "$T/r3.md" > "$T/out3.txt" 2>&1

@@ -31,8 +31,9 @@
 /// or behind stands on another image row, and a box merging the worker with them reaches down to
 /// the nearer one's feet. After a loss the worker is found
 /// again by appearance anywhere in the frame (same id). When the operator chose the worker
-/// (`selectWorker`), the tracker never starts a new identity by itself: without the chosen person
-/// it reports nobody, so a stranger's arms never reach the gesture classifier.
+/// (`selectWorker`), the tracker does not start a new identity by itself: without the chosen person
+/// it reports nobody — but re-acquisition after a loss is by position or colour alone, so a
+/// look-alike can be taken under the lock (docs/perception.md, Known limits).
 
 #include <memory>
 #include <string>
@@ -112,6 +113,7 @@ struct TrackStep {
   bool tracker_failed = false;   ///< the visual tracker reported failure this frame
   bool drift = false;            ///< re-initialised because the tracker drifted from the detection
   bool identity_changed = false; ///< a new id was started this frame
+  bool stream_reset = false;     ///< the image size changed: the track restarted (a gesture window must not span it)
   std::vector<Detection> detections;  ///< all detections of this frame (empty if none ran)
   int worker_detection = -1;     ///< index in `detections` of the worker, −1 none
   double similarity = -1.0;      ///< appearance similarity of the worker's box, −1 not computed
