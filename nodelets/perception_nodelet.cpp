@@ -54,6 +54,7 @@
 #include "gesture_formation/perception/perception_pipeline.hpp"
 #include "gesture_formation/perception/worker_tracker.hpp"
 #include "depth_buffer.hpp"
+#include "gesture_formation/onboard/frame_check.hpp"
 #include "param_loader.hpp"
 #include "worker_choice.hpp"
 
@@ -236,18 +237,13 @@ class PerceptionNodelet : public nodelet::Nodelet {
       sensor_msgs::Image::ConstPtr depth_msg = depths_.nearest(header.stamp);
       // The depth must be aligned to this colour image: its size and frame (an unaligned or wrongly
       // remapped depth topic gave a range from the wrong pixels, clipped in silence).
-      // Frames compared without a leading '/' (tf1 style), and only when both name one.
-      const auto frameOf = [](const std::string& f) { return f.empty() || f[0] != '/' ? f : f.substr(1); };
-      if (depth_msg && (depth_msg->width != static_cast<std::uint32_t>(bgr.cols) ||
-                        depth_msg->height != static_cast<std::uint32_t>(bgr.rows) ||
-                        (!depth_msg->header.frame_id.empty() && !header.frame_id.empty() &&
-                         frameOf(depth_msg->header.frame_id) != frameOf(header.frame_id)))) {
-        ++depth_refused_since_report_;
-        NODELET_WARN_STREAM_THROTTLE(5.0, "Perception: depth image not used: " << depth_msg->width << "x" << depth_msg->height
-                                              << " in '" << depth_msg->header.frame_id << "', the colour image "
-                                              << bgr.cols << "x" << bgr.rows << " in '" << header.frame_id
-                                              << "' (depth aligned to the colour image expected)");
-        depth_msg.reset();
+      if (depth_msg) {
+        if (const auto why = onboard::depthAlignmentProblem(static_cast<int>(depth_msg->width), static_cast<int>(depth_msg->height),
+                                                           depth_msg->header.frame_id, bgr.cols, bgr.rows, header.frame_id)) {
+          ++depth_refused_since_report_;
+          NODELET_WARN_STREAM_THROTTLE(5.0, "Perception: depth image not used: " << *why);
+          depth_msg.reset();
+        }
       }
       if (depth_msg && camera_) {
         auto depth = toDepth(*depth_msg);

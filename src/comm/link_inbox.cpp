@@ -5,6 +5,17 @@
 
 namespace gesture_formation::comm {
 
+namespace {
+
+// A payload that speaks for another UAV than its envelope's sender: counted, and why.
+std::string speaksForAnother(const char* what, std::uint64_t& refused, std::uint16_t sender, const char* field, long claimed) {
+  ++refused;
+  return std::string(what) + " refused (" + std::to_string(refused) + " so far): sender " + std::to_string(sender) + ", " +
+         field + " " + std::to_string(claimed);
+}
+
+}  // namespace
+
 InboxItem LinkInbox::take(const Envelope& e) {
   last_refusal_.clear();
   last_decode_failure_ = false;
@@ -98,9 +109,7 @@ InboxItem LinkInbox::decodeOne(const Envelope& e) {
       if (!decoder_.decode(e, m)) return {};
       // A UAV speaks for itself only: a captured key cannot vote or beat for another member.
       if (m.from != e.sender_id) {
-        ++leadership_refused_;
-        last_refusal_ = "leadership message refused (" + std::to_string(leadership_refused_) + " so far): sender " +
-                        std::to_string(e.sender_id) + ", from " + std::to_string(m.from);
+        last_refusal_ = speaksForAnother("leadership message", leadership_refused_, e.sender_id, "from", m.from);
         return {};
       }
       return m;
@@ -110,9 +119,7 @@ InboxItem LinkInbox::decodeOne(const Envelope& e) {
       if (!decoder_.decode(e, m)) return {};
       // A UAV shares its own map changes only (a captured key cannot speak for another UAV's map).
       if (m.uav_index != e.sender_id) {
-        ++map_updates_refused_;
-        last_refusal_ = "map update refused (" + std::to_string(map_updates_refused_) + " so far): sender " +
-                        std::to_string(e.sender_id) + ", uav_index " + std::to_string(m.uav_index);
+        last_refusal_ = speaksForAnother("map update", map_updates_refused_, e.sender_id, "uav_index", m.uav_index);
         return {};
       }
       return m;

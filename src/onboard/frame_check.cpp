@@ -15,4 +15,14 @@ std::optional<std::string> checkOdometryFrames(const std::string& what, const Od
 
 OdometryFrames plannerOdometryFrames(const std::string& world_frame) { return OdometryFrames{world_frame, world_frame}; }
 
+std::optional<std::string> depthAlignmentProblem(int depth_width, int depth_height, const std::string& depth_frame,
+                                                 int colour_width, int colour_height, const std::string& colour_frame) {
+  const auto bare = [](const std::string& f) { return f.empty() || f[0] != '/' ? f : f.substr(1); };
+  const bool same_frame = depth_frame.empty() || colour_frame.empty() || bare(depth_frame) == bare(colour_frame);
+  if (depth_width == colour_width && depth_height == colour_height && same_frame) return std::nullopt;
+  return "depth image " + std::to_string(depth_width) + "x" + std::to_string(depth_height) + " in '" + depth_frame +
+         "', the colour image " + std::to_string(colour_width) + "x" + std::to_string(colour_height) + " in '" +
+         colour_frame + "' (depth aligned to the colour image expected)";
+}
+
 }  // namespace gesture_formation::onboard

@@ -31,4 +31,10 @@ std::optional<std::string> checkOdometryFrames(const std::string& what, const Od
 /// odometry convention): pose and twist in the world frame, `child_frame_id` = the world frame.
 OdometryFrames plannerOdometryFrames(const std::string& world_frame);
 
+/// \brief A depth image belongs to its colour image (aligned depth, docs/perception.md): the same
+/// size and, where both name one, the same frame (compared without a leading '/'). nullopt when
+/// aligned; else the reason naming both sizes and frames.
+std::optional<std::string> depthAlignmentProblem(int depth_width, int depth_height, const std::string& depth_frame,
+                                                 int colour_width, int colour_height, const std::string& colour_frame);
+
 }  // namespace gesture_formation::onboard

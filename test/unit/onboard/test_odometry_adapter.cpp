@@ -213,3 +213,13 @@ TEST(OdometryAdapterTest, TheStateIsCarriedToTheReplanningTime) {
   EXPECT_EQ(ahead.p_world, odom.p_world);
   EXPECT_DOUBLE_EQ(ahead.t_s, 10.0);
 }
+
+// Depth aligned to the colour image: same size, same frame where both name one (a leading '/' aside).
+TEST(FrameCheckTest, DepthMustBeAlignedToTheColourImage) {
+  EXPECT_FALSE(gesture_formation::onboard::depthAlignmentProblem(640, 480, "cam", 640, 480, "/cam"));
+  EXPECT_FALSE(gesture_formation::onboard::depthAlignmentProblem(640, 480, "", 640, 480, "cam"));
+  const auto frame = gesture_formation::onboard::depthAlignmentProblem(640, 480, "depth", 640, 480, "cam");
+  ASSERT_TRUE(frame);
+  EXPECT_EQ(*frame, "depth image 640x480 in 'depth', the colour image 640x480 in 'cam' (depth aligned to the colour image expected)");
+  EXPECT_TRUE(gesture_formation::onboard::depthAlignmentProblem(848, 480, "cam", 640, 480, "cam"));
+}
